@@ -1,0 +1,210 @@
+//! Behavior Trees (SPEC §1; the paper's sec. II-A). Nodes live in an arena so that
+//! trees of any depth are walked without recursion.
+
+use super::{SkillCall, Span};
+
+/// Index of a node in [`Bt::nodes`].
+pub type NodeIdx = usize;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bt {
+    pub nodes: Vec<BtNode>,
+    pub root: NodeIdx,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct BtNode {
+    /// Unique identity of the node in the tree (the TOML key; nodes of included
+    /// subtrees are prefixed with the including node's id and `/`).
+    pub id: String,
+    /// Display name ("Move-To cube2!", "Fallback").
+    pub label: String,
+    pub kind: BtNodeKind,
+    pub children: Vec<NodeIdx>,
+    /// Skill binding of a leaf.
+    pub skill: Option<SkillCall>,
+    pub span: Option<Span>,
+}
+
+/// Every node type the tool knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BtNodeKind {
+    /// Reactive sequence (ticked from the first child every tick).
+    Sequence,
+    /// Reactive fallback (selector).
+    Fallback,
+    /// Sequence with memory (the paper's Sequence*).
+    SequenceMemory,
+    /// Fallback with memory.
+    FallbackMemory,
+    /// Succeeds when `success` children succeed.
+    Parallel { success: usize },
+    Inverter,
+    ForceSuccess,
+    ForceFailure,
+    /// Repeats the child on success; `None` repeats forever.
+    Repeat { times: Option<u32> },
+    /// Retries the child on failure up to `times` times.
+    Retry { times: u32 },
+    /// Fails the child after `ms` milliseconds of simulated time.
+    Timeout { ms: u64 },
+    Action,
+    Condition,
+}
+
+/// How many children a node type takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Arity {
+    Leaf,
+    One,
+    AtLeastOne,
+}
+
+impl BtNodeKind {
+    /// The TOML key of this node type.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            BtNodeKind::Sequence => "sequence",
+            BtNodeKind::Fallback => "fallback",
+            BtNodeKind::SequenceMemory => "sequence_memory",
+            BtNodeKind::FallbackMemory => "fallback_memory",
+            BtNodeKind::Parallel { .. } => "parallel",
+            BtNodeKind::Inverter => "inverter",
+            BtNodeKind::ForceSuccess => "force_success",
+            BtNodeKind::ForceFailure => "force_failure",
+            BtNodeKind::Repeat { .. } => "repeat",
+            BtNodeKind::Retry { .. } => "retry",
+            BtNodeKind::Timeout { .. } => "timeout",
+            BtNodeKind::Action => "action",
+            BtNodeKind::Condition => "condition",
+        }
+    }
+
+    pub fn arity(self) -> Arity {
+        match self {
+            BtNodeKind::Action | BtNodeKind::Condition => Arity::Leaf,
+            BtNodeKind::Inverter
+            | BtNodeKind::ForceSuccess
+            | BtNodeKind::ForceFailure
+            | BtNodeKind::Repeat { .. }
+            | BtNodeKind::Retry { .. }
+            | BtNodeKind::Timeout { .. } => Arity::One,
+            _ => Arity::AtLeastOne,
+        }
+    }
+
+    pub fn is_control(self) -> bool {
+        self.arity() == Arity::AtLeastOne
+    }
+
+    pub fn is_decorator(self) -> bool {
+        self.arity() == Arity::One
+    }
+
+    /// Default display name of a node of this type.
+    pub fn default_label(self) -> &'static str {
+        match self {
+            BtNodeKind::Sequence => "Sequence",
+            BtNodeKind::Fallback => "Fallback",
+            BtNodeKind::SequenceMemory => "Sequence*",
+            BtNodeKind::FallbackMemory => "Fallback*",
+            BtNodeKind::Parallel { .. } => "Parallel",
+            BtNodeKind::Inverter => "Inverter",
+            BtNodeKind::ForceSuccess => "ForceSuccess",
+            BtNodeKind::ForceFailure => "ForceFailure",
+            BtNodeKind::Repeat { .. } => "Repeat",
+            BtNodeKind::Retry { .. } => "Retry",
+            BtNodeKind::Timeout { .. } => "Timeout",
+            BtNodeKind::Action => "Action",
+            BtNodeKind::Condition => "Condition",
+        }
+    }
+}
+
+/// All node-type keywords, for "expected one of" hints.
+pub const NODE_KEYWORDS: &[&str] = &[
+    "sequence",
+    "fallback",
+    "sequence_memory",
+    "fallback_memory",
+    "parallel",
+    "inverter",
+    "force_success",
+    "force_failure",
+    "repeat",
+    "retry",
+    "timeout",
+    "action",
+    "condition",
+    "subtree",
+];
+
+impl Bt {
+    /// Node indices in pre-order (parent before children, children in order),
+    /// computed without recursion.
+    pub fn preorder(&self) -> Vec<NodeIdx> {
+        let mut out = Vec::with_capacity(self.nodes.len());
+        let mut stack = vec![self.root];
+        while let Some(n) = stack.pop() {
+            out.push(n);
+            stack.extend(self.nodes[n].children.iter().rev().copied());
+        }
+        out
+    }
+
+    /// Parent of every node (`None` for the root).
+    pub fn parents(&self) -> Vec<Option<NodeIdx>> {
+        let mut parent = vec![None; self.nodes.len()];
+        for (i, n) in self.nodes.iter().enumerate() {
+            for &c in &n.children {
+                parent[c] = Some(i);
+            }
+        }
+        parent
+    }
+
+    /// Number of action leaves (the paper's M).
+    pub fn action_count(&self) -> usize {
+        self.nodes
+            .iter()
+            .filter(|n| n.kind == BtNodeKind::Action)
+            .count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn leaf(id: &str) -> BtNode {
+        BtNode {
+            id: id.into(),
+            label: id.into(),
+            kind: BtNodeKind::Action,
+            children: vec![],
+            skill: None,
+            span: None,
+        }
+    }
+
+    #[test]
+    fn preorder_visits_parent_before_children_in_order() {
+        let mut root = leaf("r");
+        root.kind = BtNodeKind::Sequence;
+        root.children = vec![1, 2];
+        let bt = Bt {
+            nodes: vec![root, leaf("a"), leaf("b")],
+            root: 0,
+        };
+        assert_eq!(bt.preorder(), vec![0, 1, 2]);
+        assert_eq!(bt.parents(), vec![None, Some(0), Some(0)]);
+        assert_eq!(bt.action_count(), 2);
+    }
+
+    #[test]
+    fn arities() {
+        assert_eq!(BtNodeKind::Inverter.arity(), Arity::One);
+        assert_eq!(BtNodeKind::Condition.arity(), Arity::Leaf);
+        assert!(BtNodeKind::Parallel { success: 1 }.is_control());
+    }
+}
