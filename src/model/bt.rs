@@ -38,16 +38,24 @@ pub enum BtNodeKind {
     /// Fallback with memory.
     FallbackMemory,
     /// Succeeds when `success` children succeed.
-    Parallel { success: usize },
+    Parallel {
+        success: usize,
+    },
     Inverter,
     ForceSuccess,
     ForceFailure,
     /// Repeats the child on success; `None` repeats forever.
-    Repeat { times: Option<u32> },
+    Repeat {
+        times: Option<u32>,
+    },
     /// Retries the child on failure up to `times` times.
-    Retry { times: u32 },
+    Retry {
+        times: u32,
+    },
     /// Fails the child after `ms` milliseconds of simulated time.
-    Timeout { ms: u64 },
+    Timeout {
+        ms: u64,
+    },
     Action,
     Condition,
 }

@@ -8,7 +8,7 @@ pub mod skill;
 
 pub use bt::{Bt, BtNode, BtNodeKind};
 pub use fsm::{Region, State, StateBody, StateMachine, Target, Transition, Trigger};
-pub use skill::{ArgValue, Guard, SkillCall, SkillKind};
+pub use skill::{ArgValue, Guard, GuardTerm, SkillCall, SkillKind};
 
 use std::ops::Range;
 

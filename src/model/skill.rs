@@ -17,7 +17,11 @@ pub const SKILLS: &[(&str, SkillKind, &[(&str, bool)])] = &[
     ("Move-To", SkillKind::Action, &[("target", true)]),
     ("Safe-Move-To", SkillKind::Action, &[("target", true)]),
     ("Pick", SkillKind::Action, &[("object", true)]),
-    ("Place", SkillKind::Action, &[("object", true), ("at", true)]),
+    (
+        "Place",
+        SkillKind::Action,
+        &[("object", true), ("at", true)],
+    ),
     ("Recharge", SkillKind::Action, &[]),
     ("Dock", SkillKind::Action, &[]),
     ("Tuck-Arm", SkillKind::Action, &[]),
@@ -25,7 +29,11 @@ pub const SKILLS: &[(&str, SkillKind, &[(&str, bool)])] = &[
     ("Shut-Down", SkillKind::Action, &[]),
     ("Robot-At", SkillKind::Condition, &[("target", true)]),
     ("In-Hand", SkillKind::Condition, &[("object", true)]),
-    ("Object-At", SkillKind::Condition, &[("object", true), ("at", true)]),
+    (
+        "Object-At",
+        SkillKind::Condition,
+        &[("object", true), ("at", true)],
+    ),
     ("Battery-Level", SkillKind::Condition, &[("min", true)]),
     ("Arm-Tucked", SkillKind::Condition, &[]),
     ("Found", SkillKind::Condition, &[]),
@@ -42,7 +50,10 @@ pub fn skill_kind(name: &str) -> Option<SkillKind> {
 
 /// The argument schema of a skill, `None` when the skill is unknown.
 pub fn skill_params(name: &str) -> Option<&'static [(&'static str, bool)]> {
-    SKILLS.iter().find(|(n, _, _)| *n == name).map(|(_, _, p)| *p)
+    SKILLS
+        .iter()
+        .find(|(n, _, _)| *n == name)
+        .map(|(_, _, p)| *p)
 }
 
 /// Names of all skills of one kind, for "expected one of" hints.
@@ -95,16 +106,30 @@ impl std::fmt::Display for SkillCall {
     }
 }
 
-/// A guard condition on an FSM transition (the paper's Algorithm 3: checked
-/// before the state's skill runs).
+/// A guard on an FSM transition (the paper's Algorithm 3: checked before the
+/// state's skill runs). It holds when every term holds.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Guard {
-    /// The condition skill that is checked.
-    pub condition: SkillCall,
-    /// `true` for `unless`: the transition fires when the condition is false.
-    pub negate: bool,
-    /// Human text, e.g. "battery below 20%"; defaults to the condition.
+    pub all: Vec<GuardTerm>,
+    /// Human text, e.g. "battery below 20%"; defaults to the terms.
     pub label: String,
+}
+
+/// One condition of a guard, possibly negated (`unless`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GuardTerm {
+    pub condition: SkillCall,
+    /// `true` for `unless`: the term holds when the condition is false.
+    pub negate: bool,
+}
+
+impl std::fmt::Display for GuardTerm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.negate {
+            write!(f, "not ")?;
+        }
+        write!(f, "{}", self.condition)
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,1810 @@
+//! The TOML policy format (SPEC §1; documented with an example per kind in the
+//! README). Reads a file into the model and validates it, collecting every problem
+//! at once, each with file, line, column and a hint.
+//!
+//! BT nodes are a flat table keyed by node id (`[nodes]`), children referenced by
+//! id, so that trees of any depth parse without recursion and every node has an
+//! explicit identity (used by `named` GED). Subtrees are included from other files
+//! with `{ subtree = "file.toml", with = { param = "value" } }`.
+
+use super::{Limits, Loaded};
+use crate::diagnostic::{Diagnostic, SourceFile, suggest};
+use crate::model::bt::{Arity, BtNode, BtNodeKind, NODE_KEYWORDS};
+use crate::model::skill::{self, ArgValue, Guard, GuardTerm, SkillCall, SkillKind};
+use crate::model::{
+    Bt, Policy, PolicyBody, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
+};
+use std::collections::{BTreeMap, HashMap};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
+
+type Val<'i> = Spanned<DeValue<'i>>;
+
+/// The outcomes a task state can return.
+pub const TASK_OUTCOMES: &[&str] = &["SUCCESS", "FAILURE", "RUNNING"];
+
+/// Reads and validates a TOML policy file.
+pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    let file = read_source(path, &shown, limits)?;
+    let mut loader = Loader {
+        limits: limits.clone(),
+        stack: vec![canonical(path)],
+        diags: Vec::new(),
+        node_budget: limits.max_nodes,
+    };
+    let policy = loader.policy(&file, path.parent().unwrap_or(Path::new("")));
+    let (errors, warnings): (Vec<_>, Vec<_>) =
+        loader.diags.into_iter().partition(Diagnostic::is_error);
+    match policy {
+        Some(policy) if errors.is_empty() => Ok(Loaded {
+            path: shown,
+            policy,
+            warnings,
+        }),
+        _ => {
+            let mut all = errors;
+            all.extend(warnings);
+            if !all.iter().any(Diagnostic::is_error) {
+                all.push(Diagnostic::error("invalid policy").in_file(&file));
+            }
+            Err(all)
+        }
+    }
+}
+
+/// Parses a policy from text (tests, stdin); includes resolve against `base`.
+pub fn parse_str(
+    name: &str,
+    text: &str,
+    base: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let file = SourceFile::new(name, text);
+    let mut loader = Loader {
+        limits: limits.clone(),
+        stack: vec![PathBuf::from(name)],
+        diags: Vec::new(),
+        node_budget: limits.max_nodes,
+    };
+    let policy = loader.policy(&file, base);
+    let (errors, warnings): (Vec<_>, Vec<_>) =
+        loader.diags.into_iter().partition(Diagnostic::is_error);
+    match policy {
+        Some(policy) if errors.is_empty() => Ok(Loaded {
+            path: name.to_string(),
+            policy,
+            warnings,
+        }),
+        _ => Err(errors),
+    }
+}
+
+fn canonical(p: &Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+fn read_source(
+    path: &Path,
+    shown: &str,
+    limits: &Limits,
+) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
+    let meta = std::fs::metadata(path).map_err(|e| {
+        vec![Diagnostic::error(format!(
+            "cannot read `{shown}`: {}",
+            io_msg(&e)
+        ))]
+    })?;
+    if meta.is_dir() {
+        return Err(vec![Diagnostic::error(format!(
+            "cannot read `{shown}`: it is a directory"
+        ))]);
+    }
+    if meta.len() > limits.max_file_bytes {
+        return Err(vec![
+            Diagnostic::error(format!(
+                "`{shown}` is {} bytes, more than the limit of {} bytes",
+                meta.len(),
+                limits.max_file_bytes
+            ))
+            .hint("raise the limit with --max-file-bytes"),
+        ]);
+    }
+    let bytes = std::fs::read(path).map_err(|e| {
+        vec![Diagnostic::error(format!(
+            "cannot read `{shown}`: {}",
+            io_msg(&e)
+        ))]
+    })?;
+    match String::from_utf8(bytes) {
+        Ok(text) => Ok(SourceFile::new(shown, text)),
+        Err(e) => {
+            let off = e.utf8_error().valid_up_to();
+            let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+            let f = SourceFile::new(shown, text);
+            Err(vec![
+                Diagnostic::error("file is not valid UTF-8")
+                    .at(&f, off..off + 1)
+                    .hint("policy files are UTF-8 text"),
+            ])
+        }
+    }
+}
+
+fn io_msg(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        _ => e.to_string().to_lowercase(),
+    }
+}
+
+struct Loader {
+    limits: Limits,
+    /// Canonical paths of the files being read (for include cycles).
+    stack: Vec<PathBuf>,
+    diags: Vec<Diagnostic>,
+    /// Nodes that may still be created before the node limit is hit.
+    node_budget: usize,
+}
+
+/// Per-file reading context.
+struct Ctx<'a> {
+    file: &'a Arc<SourceFile>,
+    base: &'a Path,
+    /// Subtree parameters substituted into strings as `{name}`.
+    params: BTreeMap<String, String>,
+}
+
+impl Ctx<'_> {
+    fn subst(&self, s: &str) -> String {
+        if self.params.is_empty() || !s.contains('{') {
+            return s.to_string();
+        }
+        let mut out = s.to_string();
+        for (k, v) in &self.params {
+            out = out.replace(&format!("{{{k}}}"), v);
+        }
+        out
+    }
+}
+
+fn type_name(v: &DeValue<'_>) -> &'static str {
+    match v {
+        DeValue::String(_) => "a string",
+        DeValue::Integer(_) => "an integer",
+        DeValue::Float(_) => "a float",
+        DeValue::Boolean(_) => "a boolean",
+        DeValue::Datetime(_) => "a datetime",
+        DeValue::Array(_) => "an array",
+        DeValue::Table(_) => "a table",
+    }
+}
+
+fn int_of(v: &DeValue<'_>) -> Option<i64> {
+    match v {
+        DeValue::Integer(i) => {
+            let s: String = i.as_str().chars().filter(|&c| c != '_').collect();
+            let (neg, s) = match s.strip_prefix('-') {
+                Some(r) => (true, r.to_string()),
+                None => (false, s.trim_start_matches('+').to_string()),
+            };
+            let digits = s
+                .strip_prefix("0x")
+                .or_else(|| s.strip_prefix("0o"))
+                .or_else(|| s.strip_prefix("0b"))
+                .unwrap_or(&s);
+            let n = i64::from_str_radix(digits, i.radix()).ok()?;
+            Some(if neg { -n } else { n })
+        }
+        _ => None,
+    }
+}
+
+fn float_of(v: &DeValue<'_>) -> Option<f64> {
+    match v {
+        DeValue::Float(f) => f.as_str().replace('_', "").parse().ok(),
+        _ => int_of(v).map(|i| i as f64),
+    }
+}
+
+impl Loader {
+    fn err(&mut self, cx: &Ctx<'_>, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
+        self.diags.push(Diagnostic::error(msg).at(cx.file, span));
+        self.diags.last_mut().expect("just pushed")
+    }
+
+    fn warn(&mut self, cx: &Ctx<'_>, span: Range<usize>, msg: impl Into<String>) {
+        self.diags.push(Diagnostic::warning(msg).at(cx.file, span));
+    }
+
+    fn hint_last(&mut self, hint: impl Into<String>) {
+        if let Some(d) = self.diags.last_mut() {
+            d.hint = Some(hint.into());
+        }
+    }
+
+    /// Parses the TOML syntax of a file, reporting every syntax error.
+    fn parse_doc<'i>(&mut self, file: &'i Arc<SourceFile>) -> Option<Spanned<DeTable<'i>>> {
+        let (doc, errors) = DeTable::parse_recoverable(&file.text);
+        if errors.is_empty() {
+            return Some(doc);
+        }
+        for e in errors.iter().take(20) {
+            let span = e.span().unwrap_or(0..0);
+            let msg = e.message().trim().trim_end_matches('.').to_string();
+            let msg = format!("invalid TOML: {}", lower_first(&msg));
+            self.diags.push(
+                Diagnostic::error(msg)
+                    .at(file, span)
+                    .hint("see the TOML format in the README (`btfsm --help` for commands)"),
+            );
+        }
+        None
+    }
+
+    fn policy(&mut self, file: &Arc<SourceFile>, base: &Path) -> Option<Policy> {
+        let doc = self.parse_doc(file)?;
+        let cx = Ctx {
+            file,
+            base,
+            params: BTreeMap::new(),
+        };
+        let table = doc.get_ref();
+        let kind = self.kind(&cx, table, doc.span())?;
+        let allowed: &[&str] = match kind {
+            "bt" => &["kind", "name", "description", "root", "nodes", "params"],
+            "fsm" => &[
+                "kind",
+                "name",
+                "description",
+                "initial",
+                "outcomes",
+                "states",
+            ],
+            _ => &[
+                "kind",
+                "name",
+                "description",
+                "initial",
+                "outcomes",
+                "states",
+            ],
+        };
+        self.check_keys(&cx, table, allowed, "top-level key");
+        let name = self
+            .opt_str(&cx, table, "name")
+            .unwrap_or_else(|| file_stem(&file.path));
+        let description = self.opt_str(&cx, table, "description");
+        let body = match kind {
+            "bt" => PolicyBody::Bt(self.bt(&cx, table, doc.span(), None)?),
+            k => PolicyBody::Machine(self.machine(&cx, table, doc.span(), k == "hfsm")?),
+        };
+        Some(Policy {
+            name,
+            description,
+            body,
+        })
+    }
+
+    fn kind(&mut self, cx: &Ctx<'_>, t: &DeTable<'_>, whole: Range<usize>) -> Option<&'static str> {
+        let Some((_, v)) = t.get_key_value("kind") else {
+            self.err(cx, whole.start..whole.start, "missing `kind`")
+                .hint = Some("start the file with `kind = \"bt\"`, `\"fsm\"` or `\"hfsm\"`".into());
+            return None;
+        };
+        match v.get_ref().as_str() {
+            Some("bt") => Some("bt"),
+            Some("fsm") => Some("fsm"),
+            Some("hfsm") => Some("hfsm"),
+            Some(other) => {
+                let h = suggest(other, ["bt", "fsm", "hfsm"]);
+                self.err(cx, v.span(), format!("unknown policy kind `{other}`"))
+                    .hint = Some(h);
+                None
+            }
+            None => {
+                self.err(
+                    cx,
+                    v.span(),
+                    format!("`kind` must be a string, found {}", type_name(v.get_ref())),
+                )
+                .hint = Some("expected `\"bt\"`, `\"fsm\"` or `\"hfsm\"`".into());
+                None
+            }
+        }
+    }
+
+    fn check_keys(&mut self, cx: &Ctx<'_>, t: &DeTable<'_>, allowed: &[&str], what: &str) {
+        for (k, _) in t.iter() {
+            if !allowed.contains(&k.get_ref().as_ref()) {
+                let h = suggest(k.get_ref(), allowed.iter().copied());
+                self.err(cx, k.span(), format!("unknown {what} `{}`", k.get_ref()))
+                    .hint = Some(h);
+            }
+        }
+    }
+
+    fn opt_str(&mut self, cx: &Ctx<'_>, t: &DeTable<'_>, key: &str) -> Option<String> {
+        let v = t.get(key)?;
+        match v.get_ref().as_str() {
+            Some(s) => Some(cx.subst(s)),
+            None => {
+                self.err(
+                    cx,
+                    v.span(),
+                    format!("`{key}` must be a string, found {}", type_name(v.get_ref())),
+                );
+                None
+            }
+        }
+    }
+
+    fn opt_uint(&mut self, cx: &Ctx<'_>, t: &DeTable<'_>, key: &str, owner: &str) -> Option<u64> {
+        let v = t.get(key)?;
+        match int_of(v.get_ref()) {
+            Some(i) if i >= 0 => Some(i as u64),
+            _ => {
+                self.err(
+                    cx,
+                    v.span(),
+                    format!(
+                        "`{key}` of `{owner}` must be a non-negative integer, found {}",
+                        type_name(v.get_ref())
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    // ---------------------------------------------------------------- skills
+
+    /// Reads `skill = "..."` and `args = {...}` of a leaf or state.
+    fn skill_call(
+        &mut self,
+        cx: &Ctx<'_>,
+        t: &DeTable<'_>,
+        owner: &str,
+        want: Option<SkillKind>,
+    ) -> Option<SkillCall> {
+        let (_, sv) = t.get_key_value("skill")?;
+        let Some(name) = sv.get_ref().as_str() else {
+            self.err(
+                cx,
+                sv.span(),
+                format!(
+                    "`skill` of `{owner}` must be a string, found {}",
+                    type_name(sv.get_ref())
+                ),
+            );
+            return None;
+        };
+        let name = cx.subst(name);
+        let args = match t.get("args") {
+            None => BTreeMap::new(),
+            Some(a) => self.args(cx, a, owner)?,
+        };
+        match skill::skill_kind(&name) {
+            None => {
+                let cands: Vec<&str> = match want {
+                    Some(k) => skill::skill_names(k),
+                    None => skill::SKILLS.iter().map(|s| s.0).collect(),
+                };
+                let h = suggest(&name, cands.iter().copied());
+                self.err(
+                    cx,
+                    sv.span(),
+                    format!("unknown skill `{name}` in `{owner}`"),
+                )
+                .hint = Some(h);
+                return None;
+            }
+            Some(k) if want.is_some_and(|w| w != k) => {
+                let w = want.expect("checked");
+                let h = format!(
+                    "{} skills are {}",
+                    kind_word(w),
+                    skill::skill_names(w)
+                        .iter()
+                        .map(|s| format!("`{s}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+                self.err(
+                    cx,
+                    sv.span(),
+                    format!(
+                        "`{owner}` is {} but `{name}` is {} skill",
+                        article_kind(w),
+                        article_kind(k)
+                    ),
+                )
+                .hint = Some(h);
+                return None;
+            }
+            Some(_) => {}
+        }
+        let params = skill::skill_params(&name).unwrap_or(&[]);
+        let mut ok = true;
+        for (p, required) in params {
+            if *required && !args.contains_key(*p) {
+                let span = t.get("args").map_or(sv.span(), |a| a.span());
+                self.err(
+                    cx,
+                    span,
+                    format!("skill `{name}` of `{owner}` needs argument `{p}`"),
+                )
+                .hint = Some(format!(
+                    "write `args = {{ {} }}`",
+                    params
+                        .iter()
+                        .map(|(p, _)| format!("{p} = ..."))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+                ok = false;
+            }
+        }
+        if let Some(DeValue::Table(at)) = t.get("args").map(|a| a.get_ref()) {
+            for (k, _) in at.iter() {
+                if !params.iter().any(|(p, _)| *p == k.get_ref().as_ref()) {
+                    let h = if params.is_empty() {
+                        format!("`{name}` takes no arguments")
+                    } else {
+                        suggest(k.get_ref(), params.iter().map(|p| p.0))
+                    };
+                    self.err(
+                        cx,
+                        k.span(),
+                        format!("skill `{name}` has no argument `{}`", k.get_ref()),
+                    )
+                    .hint = Some(h);
+                    ok = false;
+                }
+            }
+        }
+        ok.then_some(SkillCall { skill: name, args })
+    }
+
+    fn args(
+        &mut self,
+        cx: &Ctx<'_>,
+        a: &Val<'_>,
+        owner: &str,
+    ) -> Option<BTreeMap<String, ArgValue>> {
+        let DeValue::Table(t) = a.get_ref() else {
+            self.err(
+                cx,
+                a.span(),
+                format!(
+                    "`args` of `{owner}` must be a table, found {}",
+                    type_name(a.get_ref())
+                ),
+            )
+            .hint = Some("write `args = { target = \"cube2\" }`".into());
+            return None;
+        };
+        let mut out = BTreeMap::new();
+        for (k, v) in t.iter() {
+            let val = match v.get_ref() {
+                DeValue::String(s) => ArgValue::Str(cx.subst(s)),
+                DeValue::Boolean(b) => ArgValue::Bool(*b),
+                DeValue::Integer(_) => match int_of(v.get_ref()) {
+                    Some(i) => ArgValue::Int(i),
+                    None => {
+                        self.err(cx, v.span(), "integer out of range");
+                        return None;
+                    }
+                },
+                DeValue::Float(_) => ArgValue::Float(float_of(v.get_ref()).unwrap_or(f64::NAN)),
+                other => {
+                    self.err(
+                        cx,
+                        v.span(),
+                        format!(
+                            "argument `{}` of `{owner}` must be a string, number or boolean, found {}",
+                            k.get_ref(),
+                            type_name(other)
+                        ),
+                    );
+                    return None;
+                }
+            };
+            out.insert(k.get_ref().to_string(), val);
+        }
+        Some(out)
+    }
+
+    // ---------------------------------------------------------------- BT
+
+    /// Reads a BT document. `prefix` is set for included subtrees: node ids become
+    /// `prefix/id` and the root takes the id `prefix`.
+    fn bt(
+        &mut self,
+        cx: &Ctx<'_>,
+        doc: &DeTable<'_>,
+        whole: Range<usize>,
+        prefix: Option<&str>,
+    ) -> Option<Bt> {
+        let Some(nodes_v) = doc.get("nodes") else {
+            self.err(cx, whole.start..whole.start, "a BT needs a `[nodes]` table")
+                .hint = Some(
+                "add `[nodes]` with one line per node, e.g. `root = { sequence = [\"a\", \"b\"] }`"
+                    .into(),
+            );
+            return None;
+        };
+        let DeValue::Table(nodes) = nodes_v.get_ref() else {
+            self.err(
+                cx,
+                nodes_v.span(),
+                format!(
+                    "`nodes` must be a table, found {}",
+                    type_name(nodes_v.get_ref())
+                ),
+            );
+            return None;
+        };
+        if nodes.is_empty() {
+            self.err(cx, nodes_v.span(), "`[nodes]` is empty").hint =
+                Some("a BT needs at least one node".into());
+            return None;
+        }
+        let ids: Vec<(&str, Range<usize>)> = nodes
+            .iter()
+            .map(|(k, _)| (k.get_ref().as_ref(), k.span()))
+            .collect();
+        let index: HashMap<&str, usize> =
+            ids.iter().enumerate().map(|(i, (k, _))| (*k, i)).collect();
+
+        // Root: explicit `root = "id"` or the first node.
+        let root = match doc.get("root") {
+            Some(r) => match r.get_ref().as_str() {
+                Some(s) => match index.get(s) {
+                    Some(&i) => i,
+                    None => {
+                        let h = suggest(s, ids.iter().map(|(k, _)| *k));
+                        self.err(cx, r.span(), format!("unknown node `{s}` given as `root`"))
+                            .hint = Some(h);
+                        return None;
+                    }
+                },
+                None => {
+                    self.err(cx, r.span(), "`root` must be a string naming a node");
+                    return None;
+                }
+            },
+            None => 0,
+        };
+
+        // First pass: each node's type, label, children ids, skill.
+        struct Raw {
+            kind: Option<BtNodeKind>,
+            label: String,
+            children: Vec<(String, Range<usize>)>,
+            skill: Option<SkillCall>,
+            include: Option<Bt>,
+        }
+        let mut raws: Vec<Raw> = Vec::with_capacity(ids.len());
+        for (key, v) in nodes.iter() {
+            let id = key.get_ref().as_ref();
+            if self.node_budget == 0 {
+                self.err(
+                    cx,
+                    key.span(),
+                    format!("more than {} nodes", self.limits.max_nodes),
+                )
+                .hint = Some("raise the limit with --max-nodes".into());
+                return None;
+            }
+            self.node_budget -= 1;
+            raws.push(match self.bt_node(cx, id, key.span(), v) {
+                Some((kind, label, children, skill, include)) => Raw {
+                    kind,
+                    label,
+                    children,
+                    skill,
+                    include,
+                },
+                None => Raw {
+                    kind: None,
+                    label: id.to_string(),
+                    children: vec![],
+                    skill: None,
+                    include: None,
+                },
+            });
+        }
+
+        // Second pass: resolve children, check arity and tree shape.
+        let mut parent: Vec<Option<usize>> = vec![None; ids.len()];
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); ids.len()];
+        for (i, raw) in raws.iter().enumerate() {
+            for (c, span) in &raw.children {
+                match index.get(c.as_str()) {
+                    None => {
+                        let h = suggest(c, ids.iter().map(|(k, _)| *k));
+                        self.err(
+                            cx,
+                            span.clone(),
+                            format!("unknown node `{c}` in children of `{}`", ids[i].0),
+                        )
+                        .hint = Some(h);
+                    }
+                    Some(&ci) if ci == root => {
+                        self.err(
+                            cx,
+                            span.clone(),
+                            format!(
+                                "the root `{}` cannot be a child of `{}`",
+                                ids[ci].0, ids[i].0
+                            ),
+                        )
+                        .hint = Some("a BT is a tree: the root has no parent".into());
+                    }
+                    Some(&ci) => match parent[ci] {
+                        Some(p) => {
+                            self.err(
+                                cx,
+                                span.clone(),
+                                format!(
+                                    "node `{c}` is a child of both `{}` and `{}`",
+                                    ids[p].0, ids[i].0
+                                ),
+                            )
+                            .hint = Some(
+                                "a BT is a tree: give the second use its own node (or include a subtree file twice)"
+                                    .into(),
+                            );
+                        }
+                        None => {
+                            parent[ci] = Some(i);
+                            children[i].push(ci);
+                        }
+                    },
+                }
+            }
+        }
+        // Cycles among non-root nodes: walk up from every node (iteratively).
+        let mut state = vec![0u8; ids.len()]; // 0 unknown, 1 on path, 2 reaches root
+        state[root] = 2;
+        for start in 0..ids.len() {
+            let mut path = Vec::new();
+            let mut cur = start;
+            loop {
+                match state[cur] {
+                    2 => break,
+                    1 => {
+                        self.err(
+                            cx,
+                            ids[cur].1.clone(),
+                            format!("node `{}` is its own ancestor", ids[cur].0),
+                        )
+                        .hint = Some("a BT is a tree: children lists must not form a cycle".into());
+                        break;
+                    }
+                    _ => {}
+                }
+                state[cur] = 1;
+                path.push(cur);
+                match parent[cur] {
+                    Some(p) => cur = p,
+                    None => break,
+                }
+            }
+            for p in path {
+                state[p] = 2;
+            }
+        }
+        // Unreachable nodes (no parent and not the root).
+        for (i, (id, span)) in ids.iter().enumerate() {
+            if i != root && parent[i].is_none() {
+                self.warn(
+                    cx,
+                    span.clone(),
+                    format!(
+                        "node `{id}` is not reachable from the root `{}`",
+                        ids[root].0
+                    ),
+                );
+                self.hint_last("list it in the children of a control node, or remove it");
+            }
+        }
+        // Arity.
+        for (i, raw) in raws.iter().enumerate() {
+            let Some(kind) = raw.kind else { continue };
+            let n = raw.children.len();
+            let span = ids[i].1.clone();
+            match kind.arity() {
+                Arity::One if n != 1 => {
+                    self.err(
+                        cx,
+                        span,
+                        format!(
+                            "decorator `{}` (`{}`) takes exactly one child, found {n}",
+                            ids[i].0,
+                            kind.keyword()
+                        ),
+                    )
+                    .hint = Some(format!(
+                        "write `{} = \"child\"`; wrap several children in a sequence or fallback",
+                        kind.keyword()
+                    ));
+                }
+                Arity::AtLeastOne if n == 0 => {
+                    self.err(
+                        cx,
+                        span,
+                        format!(
+                            "control node `{}` (`{}`) has no children",
+                            ids[i].0,
+                            kind.keyword()
+                        ),
+                    )
+                    .hint = Some(format!(
+                        "write `{} = [\"child1\", \"child2\"]`",
+                        kind.keyword()
+                    ));
+                }
+                _ => {}
+            }
+            if let BtNodeKind::Parallel { success } = kind
+                && n > 0
+                && (success == 0 || success > n)
+            {
+                self.err(
+                    cx,
+                    ids[i].1.clone(),
+                    format!(
+                        "parallel node `{}` needs `success` between 1 and its {n} children, found {success}",
+                        ids[i].0
+                    ),
+                );
+            }
+        }
+        if self.diags.iter().any(Diagnostic::is_error)
+            || raws.iter().any(|r| r.kind.is_none() && r.include.is_none())
+        {
+            return None;
+        }
+
+        // Build the arena in pre-order from the root, splicing included subtrees.
+        let full_id = |id: &str| match prefix {
+            Some(p) if id.is_empty() => p.to_string(),
+            Some(p) => format!("{p}/{id}"),
+            None => id.to_string(),
+        };
+        let mut out: Vec<BtNode> = Vec::new();
+        let mut new_index = vec![usize::MAX; ids.len()];
+        let mut order = vec![root];
+        let mut k = 0;
+        while k < order.len() {
+            let i = order[k];
+            k += 1;
+            order.extend(children[i].iter().copied());
+        }
+        for &i in &order {
+            new_index[i] = out.len();
+            let raw = &mut raws[i];
+            let id = if i == root && prefix.is_some() {
+                full_id("")
+            } else {
+                full_id(ids[i].0)
+            };
+            match raw.include.take() {
+                Some(sub) => {
+                    // The included tree's root takes this node's place and id.
+                    let offset = out.len();
+                    for (j, mut n) in sub.nodes.into_iter().enumerate() {
+                        n.id = if j == sub.root {
+                            id.clone()
+                        } else {
+                            format!("{id}/{}", n.id)
+                        };
+                        for c in &mut n.children {
+                            *c += offset;
+                        }
+                        out.push(n);
+                    }
+                    new_index[i] = offset + sub.root;
+                }
+                None => out.push(BtNode {
+                    id,
+                    label: std::mem::take(&mut raw.label),
+                    kind: raw.kind.expect("checked above"),
+                    children: Vec::new(),
+                    skill: raw.skill.take(),
+                    span: Some(ids[i].1.clone()),
+                }),
+            }
+        }
+        for &i in &order {
+            let ni = new_index[i];
+            if !children[i].is_empty() {
+                out[ni].children = children[i].iter().map(|&c| new_index[c]).collect();
+            }
+        }
+        Some(Bt {
+            nodes: out,
+            root: new_index[root],
+        })
+    }
+
+    /// Reads one node table.
+    #[allow(clippy::type_complexity)]
+    fn bt_node(
+        &mut self,
+        cx: &Ctx<'_>,
+        id: &str,
+        key_span: Range<usize>,
+        v: &Val<'_>,
+    ) -> Option<(
+        Option<BtNodeKind>,
+        String,
+        Vec<(String, Range<usize>)>,
+        Option<SkillCall>,
+        Option<Bt>,
+    )> {
+        let DeValue::Table(t) = v.get_ref() else {
+            self.err(
+                cx,
+                v.span(),
+                format!(
+                    "node `{id}` must be a table, found {}",
+                    type_name(v.get_ref())
+                ),
+            )
+            .hint = Some(format!(
+                "write `{id} = {{ action = \"Move-To cube2!\", skill = \"Move-To\", args = {{ target = \"cube2\" }} }}`"
+            ));
+            return None;
+        };
+        const FIELDS: &[&str] = &["name", "skill", "args", "success", "times", "ms", "with"];
+        let type_keys: Vec<(&str, &Val<'_>, Range<usize>)> = t
+            .iter()
+            .filter(|(k, _)| NODE_KEYWORDS.contains(&k.get_ref().as_ref()))
+            .map(|(k, v)| (k.get_ref().as_ref(), v, k.span()))
+            .collect();
+        for (k, _) in t.iter() {
+            let k_str: &str = k.get_ref();
+            if !NODE_KEYWORDS.contains(&k_str) && !FIELDS.contains(&k_str) {
+                let h = suggest(k_str, NODE_KEYWORDS.iter().chain(FIELDS).copied());
+                self.err(
+                    cx,
+                    k.span(),
+                    format!("unknown node type or field `{k_str}` in node `{id}`"),
+                )
+                .hint = Some(h);
+            }
+        }
+        let (tkey, tval, tspan) = match type_keys.as_slice() {
+            [one] => one.clone(),
+            [] => {
+                self.err(cx, key_span, format!("node `{id}` has no type"))
+                    .hint = Some(format!(
+                    "add one of {}",
+                    NODE_KEYWORDS
+                        .iter()
+                        .map(|k| format!("`{k}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+                return None;
+            }
+            [_, second, ..] => {
+                self.err(
+                    cx,
+                    second.2.clone(),
+                    format!(
+                        "node `{id}` has two types, `{}` and `{}`",
+                        type_keys[0].0, second.0
+                    ),
+                )
+                .hint = Some("a node has exactly one type key".into());
+                return None;
+            }
+        };
+        let name = self.opt_str(cx, t, "name");
+        let uint = |s: &mut Self, key: &str| s.opt_uint(cx, t, key, id);
+        let kind = match tkey {
+            "sequence" => BtNodeKind::Sequence,
+            "fallback" => BtNodeKind::Fallback,
+            "sequence_memory" => BtNodeKind::SequenceMemory,
+            "fallback_memory" => BtNodeKind::FallbackMemory,
+            "parallel" => BtNodeKind::Parallel {
+                success: uint(self, "success")
+                    .map(|s| s as usize)
+                    .unwrap_or_else(|| match tval.get_ref() {
+                        DeValue::Array(a) => a.len(),
+                        _ => 1,
+                    }),
+            },
+            "inverter" => BtNodeKind::Inverter,
+            "force_success" => BtNodeKind::ForceSuccess,
+            "force_failure" => BtNodeKind::ForceFailure,
+            "repeat" => BtNodeKind::Repeat {
+                times: uint(self, "times").map(|t| t.min(u32::MAX as u64) as u32),
+            },
+            "retry" => BtNodeKind::Retry {
+                times: uint(self, "times").map_or(1, |t| t.min(u32::MAX as u64) as u32),
+            },
+            "timeout" => match uint(self, "ms") {
+                Some(ms) => BtNodeKind::Timeout { ms },
+                None => {
+                    self.err(cx, tspan, format!("timeout `{id}` needs `ms`"))
+                        .hint = Some("write `ms = 5000`".into());
+                    return None;
+                }
+            },
+            "action" => BtNodeKind::Action,
+            "condition" => BtNodeKind::Condition,
+            "subtree" => {
+                let sub = self.include(cx, id, t, tval)?;
+                return Some((None, String::new(), vec![], None, Some(sub)));
+            }
+            _ => unreachable!("filtered by NODE_KEYWORDS"),
+        };
+        // Fields that do not belong to this type.
+        for (k, _) in t.iter() {
+            let k_str: &str = k.get_ref();
+            let fits = match k_str {
+                "name" => true,
+                "skill" | "args" => matches!(kind, BtNodeKind::Action | BtNodeKind::Condition),
+                "success" => matches!(kind, BtNodeKind::Parallel { .. }),
+                "times" => matches!(kind, BtNodeKind::Repeat { .. } | BtNodeKind::Retry { .. }),
+                "ms" => matches!(kind, BtNodeKind::Timeout { .. }),
+                "with" => false,
+                _ => true,
+            };
+            if !fits {
+                self.err(
+                    cx,
+                    k.span(),
+                    format!("`{k_str}` does not apply to {} node `{id}`", tkey),
+                );
+            }
+        }
+        let mut children = Vec::new();
+        let mut label = name.unwrap_or_else(|| kind.default_label().to_string());
+        let mut skill = None;
+        match kind.arity() {
+            Arity::Leaf => match tval.get_ref().as_str() {
+                Some(s) => {
+                    label = cx.subst(s);
+                    let want = if kind == BtNodeKind::Action {
+                        SkillKind::Action
+                    } else {
+                        SkillKind::Condition
+                    };
+                    skill = self.skill_call(cx, t, id, Some(want));
+                    if t.contains_key("skill") && skill.is_none() {
+                        return None;
+                    }
+                }
+                None => {
+                    self.err(
+                        cx,
+                        tval.span(),
+                        format!(
+                            "`{tkey}` of node `{id}` must be its display name (a string), found {}",
+                            type_name(tval.get_ref())
+                        ),
+                    )
+                    .hint = Some(format!("write `{tkey} = \"Robot-At cube2?\"`"));
+                    return None;
+                }
+            },
+            _ => match tval.get_ref() {
+                DeValue::String(s) => children.push((s.to_string(), tval.span())),
+                DeValue::Array(a) => {
+                    for c in a.iter() {
+                        match c.get_ref().as_str() {
+                            Some(s) => children.push((s.to_string(), c.span())),
+                            None => {
+                                self.err(
+                                    cx,
+                                    c.span(),
+                                    format!(
+                                        "children of `{id}` must be node ids (strings), found {}",
+                                        type_name(c.get_ref())
+                                    ),
+                                );
+                            }
+                        }
+                    }
+                }
+                other => {
+                    self.err(
+                        cx,
+                        tval.span(),
+                        format!(
+                            "`{tkey}` of node `{id}` must list children ids, found {}",
+                            type_name(other)
+                        ),
+                    )
+                    .hint = Some(format!("write `{tkey} = [\"child1\", \"child2\"]`"));
+                    return None;
+                }
+            },
+        }
+        Some((Some(kind), label, children, skill, None))
+    }
+
+    /// Reads an included subtree file.
+    fn include(&mut self, cx: &Ctx<'_>, id: &str, t: &DeTable<'_>, tval: &Val<'_>) -> Option<Bt> {
+        let Some(rel) = tval.get_ref().as_str() else {
+            self.err(
+                cx,
+                tval.span(),
+                format!("`subtree` of node `{id}` must be a file path"),
+            );
+            return None;
+        };
+        let path = cx.base.join(rel);
+        let canon = canonical(&path);
+        if let Some(pos) = self.stack.iter().position(|p| *p == canon) {
+            let chain: Vec<String> = self.stack[pos..]
+                .iter()
+                .chain(std::iter::once(&canon))
+                .map(|p| {
+                    p.file_name()
+                        .map_or_else(|| p.display().to_string(), |f| f.to_string_lossy().into())
+                })
+                .collect();
+            self.err(
+                cx,
+                tval.span(),
+                format!("cyclic subtree include: {}", chain.join(" -> ")),
+            )
+            .hint = Some("a subtree must not include itself, directly or through others".into());
+            return None;
+        }
+        if self.stack.len() > self.limits.max_include_depth {
+            self.err(
+                cx,
+                tval.span(),
+                format!(
+                    "subtree includes nested deeper than {}",
+                    self.limits.max_include_depth
+                ),
+            );
+            return None;
+        }
+        let shown = path.display().to_string();
+        let file = match read_source(&path, &shown, &self.limits) {
+            Ok(f) => f,
+            Err(mut ds) => {
+                let msg = ds.remove(0).message;
+                self.err(cx, tval.span(), format!("subtree of node `{id}`: {msg}"));
+                return None;
+            }
+        };
+        let doc = self.parse_doc(&file)?;
+        let sub_table = doc.get_ref();
+        let sub_cx0 = Ctx {
+            file: &file,
+            base: path.parent().unwrap_or(Path::new("")),
+            params: BTreeMap::new(),
+        };
+        match self.kind(&sub_cx0, sub_table, doc.span()) {
+            Some("bt") => {}
+            Some(k) => {
+                self.err(
+                    cx,
+                    tval.span(),
+                    format!("subtree `{rel}` of node `{id}` is a `{k}`, not a `bt`"),
+                );
+                return None;
+            }
+            None => return None,
+        }
+        self.check_keys(
+            &sub_cx0,
+            sub_table,
+            &["kind", "name", "description", "root", "nodes", "params"],
+            "top-level key",
+        );
+        // Parameters: declared defaults in the subtree file, overridden by `with`.
+        let mut params = BTreeMap::new();
+        if let Some(pv) = sub_table.get("params") {
+            match pv.get_ref() {
+                DeValue::Table(pt) => {
+                    for (k, v) in pt.iter() {
+                        params.insert(k.get_ref().to_string(), scalar_text(v.get_ref()));
+                    }
+                }
+                other => {
+                    self.err(
+                        &sub_cx0,
+                        pv.span(),
+                        format!("`params` must be a table, found {}", type_name(other)),
+                    );
+                }
+            }
+        }
+        if let Some(wv) = t.get("with") {
+            match wv.get_ref() {
+                DeValue::Table(wt) => {
+                    for (k, v) in wt.iter() {
+                        if !params.contains_key(k.get_ref().as_ref()) {
+                            let declared: Vec<&str> = params.keys().map(String::as_str).collect();
+                            let h = if declared.is_empty() {
+                                format!("`{rel}` declares no `[params]`")
+                            } else {
+                                suggest(k.get_ref(), declared)
+                            };
+                            self.err(
+                                cx,
+                                k.span(),
+                                format!("subtree `{rel}` has no parameter `{}`", k.get_ref()),
+                            )
+                            .hint = Some(h);
+                            continue;
+                        }
+                        params.insert(k.get_ref().to_string(), cx.subst(&scalar_text(v.get_ref())));
+                    }
+                }
+                other => {
+                    self.err(
+                        cx,
+                        wv.span(),
+                        format!(
+                            "`with` of node `{id}` must be a table, found {}",
+                            type_name(other)
+                        ),
+                    );
+                }
+            }
+        }
+        let sub_cx = Ctx {
+            file: &file,
+            base: sub_cx0.base,
+            params,
+        };
+        self.stack.push(canon);
+        let bt = self.bt(&sub_cx, sub_table, doc.span(), Some(""));
+        self.stack.pop();
+        bt
+    }
+
+    // ---------------------------------------------------------------- FSM
+
+    fn machine(
+        &mut self,
+        cx: &Ctx<'_>,
+        doc: &DeTable<'_>,
+        whole: Range<usize>,
+        hierarchical: bool,
+    ) -> Option<StateMachine> {
+        let mut m = StateMachine {
+            hierarchical,
+            top: Region {
+                initial: 0,
+                outcomes: vec![],
+                states: vec![],
+            },
+            states: Vec::new(),
+        };
+        // Regions are read breadth-first with an explicit queue (no recursion).
+        struct Pending<'t, 'i> {
+            table: &'t DeTable<'i>,
+            span: Range<usize>,
+            container: Option<usize>,
+        }
+        let mut queue = vec![Pending {
+            table: doc,
+            span: whole,
+            container: None,
+        }];
+        let mut ok = true;
+        // (state, transitions to resolve)
+        type RawTr = (Trigger, String, Range<usize>);
+        let mut raw_trs: Vec<Vec<RawTr>> = Vec::new();
+        let mut qi = 0;
+        while qi < queue.len() {
+            let Pending {
+                table,
+                span,
+                container,
+            } = std::mem::replace(
+                &mut queue[qi],
+                Pending {
+                    table: doc,
+                    span: 0..0,
+                    container: None,
+                },
+            );
+            qi += 1;
+            let owner =
+                container.map_or_else(|| "the machine".to_string(), |c| format!("`{}`", m.path(c)));
+            let outcomes = self.outcomes(cx, table, &span, &owner);
+            let Some(states_v) = table.get("states") else {
+                self.err(
+                    cx,
+                    span.start..span.start,
+                    format!("{owner} has no `states`"),
+                )
+                .hint = Some("add `[states]` (or `[states.NAME]` tables)".into());
+                ok = false;
+                continue;
+            };
+            let DeValue::Table(states) = states_v.get_ref() else {
+                self.err(
+                    cx,
+                    states_v.span(),
+                    format!(
+                        "`states` must be a table, found {}",
+                        type_name(states_v.get_ref())
+                    ),
+                );
+                ok = false;
+                continue;
+            };
+            let mut region = Region {
+                initial: usize::MAX,
+                outcomes: outcomes.clone(),
+                states: vec![],
+            };
+            let mut local: Vec<(String, usize, Range<usize>)> = Vec::new();
+            for (k, v) in states.iter() {
+                let name = k.get_ref().to_string();
+                if outcomes.contains(&name) {
+                    self.err(
+                        cx,
+                        k.span(),
+                        format!("state `{name}` has the name of an outcome of {owner}"),
+                    )
+                    .hint = Some("rename the state or the outcome".into());
+                    ok = false;
+                }
+                if self.node_budget == 0 {
+                    self.err(
+                        cx,
+                        k.span(),
+                        format!("more than {} states", self.limits.max_nodes),
+                    );
+                    return None;
+                }
+                self.node_budget -= 1;
+                let idx = m.states.len();
+                let DeValue::Table(st) = v.get_ref() else {
+                    self.err(
+                        cx,
+                        v.span(),
+                        format!(
+                            "state `{name}` must be a table, found {}",
+                            type_name(v.get_ref())
+                        ),
+                    )
+                    .hint = Some(format!(
+                        "write `[states.\"{name}\"]` with `skill = ...` and `on = {{ SUCCESS = \"...\" }}`"
+                    ));
+                    ok = false;
+                    continue;
+                };
+                let is_container = st.contains_key("states");
+                let allowed: &[&str] = if is_container {
+                    &["label", "initial", "outcomes", "states", "on", "guards"]
+                } else {
+                    &["label", "skill", "args", "decision", "on", "guards"]
+                };
+                let before = self.diags.len();
+                self.check_keys(cx, st, allowed, &format!("field of state `{name}`"));
+                if self.diags.len() > before {
+                    ok = false;
+                }
+                let label = self
+                    .opt_str(cx, st, "label")
+                    .unwrap_or_else(|| name.clone());
+                let decision = match st.get("decision") {
+                    None => false,
+                    Some(d) => match d.get_ref().as_bool() {
+                        Some(b) => b,
+                        None => {
+                            self.err(cx, d.span(), "`decision` must be `true` or `false`");
+                            false
+                        }
+                    },
+                };
+                let body = if is_container {
+                    if !hierarchical {
+                        self.err(
+                            cx,
+                            k.span(),
+                            format!(
+                                "state `{name}` holds `states`, but only an `hfsm` has containers"
+                            ),
+                        )
+                        .hint = Some("write `kind = \"hfsm\"` at the top of the file".into());
+                        ok = false;
+                    }
+                    queue.push(Pending {
+                        table: st,
+                        span: v.span(),
+                        container: Some(idx),
+                    });
+                    StateBody::Container(Region {
+                        initial: usize::MAX,
+                        outcomes: vec![],
+                        states: vec![],
+                    })
+                } else if decision {
+                    if st.contains_key("skill") {
+                        self.err(
+                            cx,
+                            k.span(),
+                            format!("decision state `{name}` cannot run a skill"),
+                        )
+                        .hint = Some("remove `skill`, or `decision = true`".into());
+                        ok = false;
+                    }
+                    StateBody::Decision
+                } else {
+                    let call = self.skill_call(cx, st, &name, None);
+                    if st.contains_key("skill") && call.is_none() {
+                        ok = false;
+                    }
+                    StateBody::Task(call)
+                };
+                // Transitions: guards (in order), then outcome transitions.
+                let mut trs: Vec<RawTr> = Vec::new();
+                if let Some(gv) = st.get("guards") {
+                    match gv.get_ref() {
+                        DeValue::Array(a) => {
+                            for g in a.iter() {
+                                match self.guard(cx, g, &name) {
+                                    Some(t) => trs.push(t),
+                                    None => ok = false,
+                                }
+                            }
+                        }
+                        other => {
+                            self.err(
+                                cx,
+                                gv.span(),
+                                format!(
+                                    "`guards` of state `{name}` must be an array, found {}",
+                                    type_name(other)
+                                ),
+                            )
+                            .hint = Some(
+                                "write `guards = [{ unless = \"Battery-Level\", args = { min = 20 }, to = \"Recharge\" }]`"
+                                    .into(),
+                            );
+                            ok = false;
+                        }
+                    }
+                }
+                if let Some(ov) = st.get("on") {
+                    match ov.get_ref() {
+                        DeValue::Table(ot) => {
+                            for (ok_key, tv) in ot.iter() {
+                                match tv.get_ref().as_str() {
+                                    Some(target) => trs.push((
+                                        Trigger::Outcome(ok_key.get_ref().to_string()),
+                                        target.to_string(),
+                                        tv.span(),
+                                    )),
+                                    None => {
+                                        self.err(
+                                            cx,
+                                            tv.span(),
+                                            format!(
+                                                "target of `{}` in state `{name}` must be a state or outcome name, found {}",
+                                                ok_key.get_ref(),
+                                                type_name(tv.get_ref())
+                                            ),
+                                        );
+                                        ok = false;
+                                    }
+                                }
+                            }
+                        }
+                        other => {
+                            self.err(
+                                cx,
+                                ov.span(),
+                                format!(
+                                    "`on` of state `{name}` must be a table, found {}",
+                                    type_name(other)
+                                ),
+                            )
+                            .hint = Some(
+                                "write `on = { SUCCESS = \"Next\", FAILURE = \"SELECTOR\" }`"
+                                    .into(),
+                            );
+                            ok = false;
+                        }
+                    }
+                }
+                // Outcome keys valid for this kind of state (container outcomes
+                // are checked after the container's region is read).
+                m.states.push(State {
+                    name: name.clone(),
+                    label,
+                    parent: container,
+                    body,
+                    transitions: Vec::new(),
+                    span: Some(k.span()),
+                });
+                raw_trs.push(trs);
+                region.states.push(idx);
+                local.push((name, idx, k.span()));
+            }
+            if local.is_empty() {
+                self.err(cx, states_v.span(), format!("{owner} has no states"));
+                ok = false;
+            }
+            // Initial state.
+            match table.get("initial") {
+                None => {
+                    let h = local
+                        .first()
+                        .map(|(n, _, _)| format!("add `initial = \"{n}\"`"))
+                        .unwrap_or_else(|| "add `initial = \"STATE\"`".into());
+                    let at = match container {
+                        Some(c) => m.states[c].span.clone().unwrap_or(span.clone()),
+                        None => span.start..span.start,
+                    };
+                    self.err(cx, at, format!("missing initial state of {owner}"))
+                        .hint = Some(h);
+                    ok = false;
+                }
+                Some(iv) => match iv.get_ref().as_str() {
+                    Some(s) => match local.iter().find(|(n, _, _)| n == s) {
+                        Some((_, idx, _)) => region.initial = *idx,
+                        None => {
+                            let h = suggest(s, local.iter().map(|(n, _, _)| n.as_str()));
+                            self.err(
+                                cx,
+                                iv.span(),
+                                format!("unknown initial state `{s}` of {owner}"),
+                            )
+                            .hint = Some(h);
+                            ok = false;
+                        }
+                    },
+                    None => {
+                        self.err(cx, iv.span(), "`initial` must be a state name (a string)");
+                        ok = false;
+                    }
+                },
+            }
+            match container {
+                None => m.top = region,
+                Some(c) => m.states[c].body = StateBody::Container(region),
+            }
+        }
+        if !ok {
+            return None;
+        }
+        // Resolve transitions now that every region is known.
+        for (si, trs) in raw_trs.into_iter().enumerate() {
+            let region = m.region_of(si).clone();
+            let sname = m.states[si].name.clone();
+            let valid_outcomes: Vec<String> = match &m.states[si].body {
+                StateBody::Container(r) => r.outcomes.clone(),
+                StateBody::Decision => vec!["RUNNING".into()],
+                StateBody::Task(_) => TASK_OUTCOMES.iter().map(|s| s.to_string()).collect(),
+            };
+            for (trigger, target, span) in trs {
+                if let Trigger::Outcome(o) = &trigger
+                    && !valid_outcomes.contains(o)
+                {
+                    let what = match &m.states[si].body {
+                        StateBody::Container(_) => "container",
+                        StateBody::Decision => "decision state",
+                        StateBody::Task(_) => "state",
+                    };
+                    let h = suggest(o, valid_outcomes.iter().map(String::as_str));
+                    // Point at the key: the span we have is the value's; say so by message.
+                    self.err(
+                        cx,
+                        span.clone(),
+                        format!("{what} `{sname}` cannot return `{o}`"),
+                    )
+                    .hint = Some(h);
+                    ok = false;
+                    continue;
+                }
+                let resolved =
+                    if let Some(&t) = region.states.iter().find(|&&t| m.states[t].name == target) {
+                        Target::State(t)
+                    } else if region.outcomes.contains(&target) {
+                        Target::Outcome(target)
+                    } else {
+                        let cands: Vec<&str> = region
+                            .states
+                            .iter()
+                            .map(|&t| m.states[t].name.as_str())
+                            .chain(region.outcomes.iter().map(String::as_str))
+                            .collect();
+                        let h = suggest(&target, cands);
+                        self.err(
+                            cx,
+                            span,
+                            format!("unknown state `{target}` in transition of `{sname}`"),
+                        )
+                        .hint = Some(h);
+                        ok = false;
+                        continue;
+                    };
+                m.states[si].transitions.push(Transition {
+                    trigger,
+                    target: resolved,
+                    span: Some(span),
+                });
+            }
+        }
+        if !ok {
+            return None;
+        }
+        self.unreachable_states(cx, &m);
+        Some(m)
+    }
+
+    fn outcomes(
+        &mut self,
+        cx: &Ctx<'_>,
+        table: &DeTable<'_>,
+        span: &Range<usize>,
+        owner: &str,
+    ) -> Vec<String> {
+        let Some(ov) = table.get("outcomes") else {
+            self.err(
+                cx,
+                span.start..span.start,
+                format!("{owner} has no `outcomes`"),
+            )
+            .hint = Some("add `outcomes = [\"SUCCESS\", \"FAILURE\"]`".into());
+            return vec![];
+        };
+        let DeValue::Array(a) = ov.get_ref() else {
+            self.err(
+                cx,
+                ov.span(),
+                format!(
+                    "`outcomes` must be an array of names, found {}",
+                    type_name(ov.get_ref())
+                ),
+            );
+            return vec![];
+        };
+        let mut out: Vec<String> = Vec::new();
+        for o in a.iter() {
+            match o.get_ref().as_str() {
+                Some(s) if out.iter().any(|x| x == s) => {
+                    self.err(cx, o.span(), format!("duplicate outcome `{s}`"));
+                }
+                Some(s) => out.push(s.to_string()),
+                None => {
+                    self.err(cx, o.span(), "outcome names must be strings");
+                }
+            }
+        }
+        if out.is_empty() {
+            self.err(cx, ov.span(), format!("{owner} needs at least one outcome"));
+        }
+        out
+    }
+
+    fn guard(
+        &mut self,
+        cx: &Ctx<'_>,
+        g: &Val<'_>,
+        state: &str,
+    ) -> Option<(Trigger, String, Range<usize>)> {
+        let DeValue::Table(t) = g.get_ref() else {
+            self.err(
+                cx,
+                g.span(),
+                format!(
+                    "a guard of state `{state}` must be a table, found {}",
+                    type_name(g.get_ref())
+                ),
+            );
+            return None;
+        };
+        let before = self.diags.len();
+        self.check_keys(
+            cx,
+            t,
+            &["if", "unless", "args", "all", "to", "label"],
+            &format!("field of a guard of `{state}`"),
+        );
+        if self.diags.len() > before {
+            return None;
+        }
+        let owner = format!("guard of `{state}`");
+        let all = match t.get("all") {
+            Some(av) => {
+                if t.contains_key("if") || t.contains_key("unless") {
+                    self.err(
+                        cx,
+                        av.span(),
+                        format!("a {owner} has both `all` and `if`/`unless`"),
+                    )
+                    .hint = Some("put every condition inside `all`".into());
+                    return None;
+                }
+                let DeValue::Array(items) = av.get_ref() else {
+                    self.err(
+                        cx,
+                        av.span(),
+                        format!("`all` of a {owner} must be an array of conditions"),
+                    );
+                    return None;
+                };
+                let mut terms = Vec::new();
+                for item in items.iter() {
+                    let DeValue::Table(it) = item.get_ref() else {
+                        self.err(cx, item.span(), "a condition in `all` must be a table")
+                            .hint = Some(
+                            "write `{ if = \"In-Hand\", args = { object = \"cube2\" } }`".into(),
+                        );
+                        return None;
+                    };
+                    let before = self.diags.len();
+                    self.check_keys(
+                        cx,
+                        it,
+                        &["if", "unless", "args"],
+                        &format!("field of a condition of a {owner}"),
+                    );
+                    if self.diags.len() > before {
+                        return None;
+                    }
+                    terms.push(self.guard_term(cx, it, item.span(), &owner)?);
+                }
+                if terms.is_empty() {
+                    self.err(cx, av.span(), format!("`all` of a {owner} is empty"));
+                    return None;
+                }
+                terms
+            }
+            None => vec![self.guard_term(cx, t, g.span(), &owner)?],
+        };
+        let Some(to_v) = t.get("to") else {
+            self.err(
+                cx,
+                g.span(),
+                format!("a guard of state `{state}` needs `to`"),
+            )
+            .hint = Some("write `to = \"TARGET STATE\"`".into());
+            return None;
+        };
+        let Some(to) = to_v.get_ref().as_str() else {
+            self.err(cx, to_v.span(), "`to` must be a state or outcome name");
+            return None;
+        };
+        let label = self.opt_str(cx, t, "label").unwrap_or_else(|| {
+            all.iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(" and ")
+        });
+        Some((
+            Trigger::Guard(Guard { all, label }),
+            to.to_string(),
+            to_v.span(),
+        ))
+    }
+
+    /// Reads one `if`/`unless` condition with its `args`.
+    fn guard_term(
+        &mut self,
+        cx: &Ctx<'_>,
+        t: &DeTable<'_>,
+        span: Range<usize>,
+        owner: &str,
+    ) -> Option<GuardTerm> {
+        let (negate, cond_v) = match (t.get("if"), t.get("unless")) {
+            (Some(c), None) => (false, c),
+            (None, Some(c)) => (true, c),
+            _ => {
+                self.err(cx, span, format!("a {owner} needs exactly one of `if` or `unless`"))
+                    .hint = Some(
+                    "write `{ unless = \"Battery-Level\", args = { min = 20 }, to = \"Recharge\" }`".into(),
+                );
+                return None;
+            }
+        };
+        let Some(cond_name) = cond_v.get_ref().as_str() else {
+            self.err(
+                cx,
+                cond_v.span(),
+                "the guard's condition must be a skill name",
+            );
+            return None;
+        };
+        // Reuse the skill reader on a view where `skill` is the condition.
+        let mut view = DeTable::new();
+        view.insert(
+            Spanned::new(0..0, std::borrow::Cow::Borrowed("skill")),
+            Spanned::new(
+                cond_v.span(),
+                DeValue::String(std::borrow::Cow::Owned(cond_name.to_string())),
+            ),
+        );
+        if let Some((k, a)) = t.get_key_value("args") {
+            view.insert(k.clone(), a.clone());
+        }
+        let condition = self.skill_call(cx, &view, owner, Some(SkillKind::Condition))?;
+        Some(GuardTerm { condition, negate })
+    }
+
+    /// Warns about states that no transition can reach.
+    fn unreachable_states(&mut self, cx: &Ctx<'_>, m: &StateMachine) {
+        let mut seen = vec![false; m.states.len()];
+        let mut stack = vec![m.top.initial];
+        while let Some(s) = stack.pop() {
+            if s >= seen.len() || seen[s] {
+                continue;
+            }
+            seen[s] = true;
+            if let StateBody::Container(r) = &m.states[s].body {
+                stack.push(r.initial);
+            }
+            for t in &m.states[s].transitions {
+                if let Target::State(n) = t.target {
+                    stack.push(n);
+                }
+            }
+        }
+        for (i, s) in m.states.iter().enumerate() {
+            if !seen[i] {
+                self.warn(
+                    cx,
+                    s.span.clone().unwrap_or(0..0),
+                    format!(
+                        "state `{}` is unreachable from the initial state",
+                        m.path(i)
+                    ),
+                );
+                self.hint_last("add a transition to it, or remove it");
+            }
+        }
+    }
+}
+
+fn scalar_text(v: &DeValue<'_>) -> String {
+    match v {
+        DeValue::String(s) => s.to_string(),
+        DeValue::Integer(i) => i.as_str().to_string(),
+        DeValue::Float(f) => f.as_str().to_string(),
+        DeValue::Boolean(b) => b.to_string(),
+        other => type_name(other).to_string(),
+    }
+}
+
+fn kind_word(k: SkillKind) -> &'static str {
+    match k {
+        SkillKind::Action => "action",
+        SkillKind::Condition => "condition",
+    }
+}
+
+fn article_kind(k: SkillKind) -> &'static str {
+    match k {
+        SkillKind::Action => "an action",
+        SkillKind::Condition => "a condition",
+    }
+}
+
+fn lower_first(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_lowercase().chain(c).collect(),
+        None => String::new(),
+    }
+}
+
+fn file_stem(path: &str) -> String {
+    Path::new(path)
+        .file_stem()
+        .map_or_else(|| path.to_string(), |s| s.to_string_lossy().into_owned())
+}
