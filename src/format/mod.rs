@@ -2,6 +2,7 @@
 //! collecting every problem it finds as a positioned [`Diagnostic`].
 
 pub mod toml;
+pub mod toml_write;
 
 use crate::diagnostic::Diagnostic;
 use crate::model::Policy;

@@ -1,4 +1,6 @@
 //! The paper's metrics (sec. IV), one per file, all computed from the graphs of
 //! `crate::graph`.
 
+pub mod complexity;
+pub mod counts;
 pub mod ged;

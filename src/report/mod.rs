@@ -1,0 +1,186 @@
+//! Reports: what `analyze` prints per policy, in table, JSON (the stable contract
+//! of SPEC §7) or CSV form, and the safe writing of output files.
+
+pub mod table;
+
+use crate::format::Loaded;
+use crate::graph::policy_graph;
+use crate::metrics::complexity::{cyclomatic, essential};
+use crate::metrics::counts::{TableOne, counts, fully_connected_states, table_one};
+use crate::model::{PolicyBody, PolicyKind};
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+
+/// Output format for figures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutputFormat {
+    Table,
+    Json,
+    Csv,
+}
+
+/// One row of `btfsm analyze` (SPEC §7's JSON contract).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PolicyReport {
+    pub file: String,
+    pub name: String,
+    pub kind: PolicyKind,
+    pub vertices: usize,
+    pub edges: usize,
+    pub graphical_elements: usize,
+    pub active_elements: usize,
+    pub cc: i64,
+    pub essential_cc: i64,
+    pub counts: BTreeMap<&'static str, usize>,
+    pub table1: TableOne,
+}
+
+/// Computes every metric of one loaded policy.
+pub fn analyze(loaded: &Loaded) -> PolicyReport {
+    let p = &loaded.policy;
+    let g = policy_graph(p);
+    let kind = p.kind();
+    let c = counts(kind, &g);
+    let m_fc = match &p.body {
+        PolicyBody::Machine(m) => fully_connected_states(m).len(),
+        PolicyBody::Bt(_) => 0,
+    };
+    PolicyReport {
+        file: loaded.path.clone(),
+        name: p.name.clone(),
+        kind,
+        vertices: c.vertices,
+        edges: c.edges,
+        graphical_elements: c.graphical_elements,
+        active_elements: c.active_elements,
+        cc: cyclomatic(&g),
+        essential_cc: essential(p),
+        counts: c.by_type,
+        table1: table_one(kind, &g, m_fc),
+    }
+}
+
+/// Renders `analyze` results.
+pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String {
+    match format {
+        OutputFormat::Json => {
+            let v = serde_json::json!({ "policies": reports });
+            let mut s = serde_json::to_string_pretty(&v).expect("serializable");
+            s.push('\n');
+            s
+        }
+        OutputFormat::Csv => {
+            let mut s = String::from(
+                "file,name,kind,vertices,edges,graphical_elements,active_elements,cc,essential_cc,m,m_fc,graphical_estimate,active_estimate\n",
+            );
+            for r in reports {
+                s.push_str(&format!(
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                    csv_field(&r.file),
+                    csv_field(&r.name),
+                    r.kind,
+                    r.vertices,
+                    r.edges,
+                    r.graphical_elements,
+                    r.active_elements,
+                    r.cc,
+                    r.essential_cc,
+                    r.table1.m,
+                    r.table1.m_fc,
+                    r.table1.graphical_estimate,
+                    r.table1.active_estimate
+                ));
+            }
+            s
+        }
+        OutputFormat::Table => {
+            let mut t = table::Table::new(&[
+                "file", "kind", "V", "E", "graphical", "active", "cc", "ess.cc", "M", "M_fc",
+                "T.I graph.", "T.I active",
+            ]);
+            for r in reports {
+                t.row(vec![
+                    r.file.clone(),
+                    r.kind.to_string(),
+                    r.vertices.to_string(),
+                    r.edges.to_string(),
+                    r.graphical_elements.to_string(),
+                    r.active_elements.to_string(),
+                    r.cc.to_string(),
+                    r.essential_cc.to_string(),
+                    r.table1.m.to_string(),
+                    r.table1.m_fc.to_string(),
+                    fmt_num(r.table1.graphical_estimate),
+                    fmt_num(r.table1.active_estimate),
+                ]);
+            }
+            t.render()
+        }
+    }
+}
+
+fn fmt_num(x: f64) -> String {
+    if x.fract() == 0.0 {
+        format!("{x:.0}")
+    } else {
+        format!("{x:.1}")
+    }
+}
+
+/// Quotes a CSV field when needed (RFC 4180).
+pub fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// Writes `bytes` to `path` whole or not at all: a temporary file in the same
+/// directory, renamed over the target when complete.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.btfsm-{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_quoting() {
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+        assert_eq!(csv_field("plain"), "plain");
+    }
+
+    #[test]
+    fn atomic_write_replaces_whole_file() {
+        let dir = std::env::temp_dir().join(format!("btfsm-aw-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("x.txt");
+        write_atomically(&p, b"one").unwrap();
+        write_atomically(&p, b"two").unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "two");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

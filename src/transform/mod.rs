@@ -1,0 +1,3 @@
+//! Transformations between representations (the paper's constructions).
+
+pub mod bt_to_hfsm;
