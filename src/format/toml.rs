@@ -37,8 +37,7 @@ pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>
         node_budget: limits.max_nodes,
     };
     let policy = loader.policy(&file, path.parent().unwrap_or(Path::new("")));
-    let (errors, warnings): (Vec<_>, Vec<_>) =
-        loader.diags.into_iter().partition(Diagnostic::is_error);
+    let (errors, warnings) = sorted_partition(loader.diags);
     match policy {
         Some(policy) if errors.is_empty() => Ok(Loaded {
             path: shown,
@@ -71,8 +70,7 @@ pub fn parse_str(
         node_budget: limits.max_nodes,
     };
     let policy = loader.policy(&file, base);
-    let (errors, warnings): (Vec<_>, Vec<_>) =
-        loader.diags.into_iter().partition(Diagnostic::is_error);
+    let (errors, warnings) = sorted_partition(loader.diags);
     match policy {
         Some(policy) if errors.is_empty() => Ok(Loaded {
             path: name.to_string(),
@@ -81,6 +79,17 @@ pub fn parse_str(
         }),
         _ => Err(errors),
     }
+}
+
+/// Errors and warnings, each in file and source order.
+fn sorted_partition(mut diags: Vec<Diagnostic>) -> (Vec<Diagnostic>, Vec<Diagnostic>) {
+    diags.sort_by_key(|d| {
+        (
+            d.file.as_ref().map(|f| f.path.clone()),
+            d.span.as_ref().map_or(0, |s| s.start),
+        )
+    });
+    diags.into_iter().partition(Diagnostic::is_error)
 }
 
 fn canonical(p: &Path) -> PathBuf {
@@ -233,15 +242,31 @@ impl Loader {
         if errors.is_empty() {
             return Some(doc);
         }
+        let mut last_dup_line = None;
         for e in errors.iter().take(20) {
             let span = e.span().unwrap_or(0..0);
             let msg = e.message().trim().trim_end_matches('.').to_string();
-            let msg = format!("invalid TOML: {}", lower_first(&msg));
-            self.diags.push(
-                Diagnostic::error(msg)
-                    .at(file, span)
-                    .hint("see the TOML format in the README (`btfsm --help` for commands)"),
-            );
+            let (line, _) = file.line_col(span.start);
+            let (msg, hint) = if msg.starts_with("duplicate key") {
+                // The keys of a duplicated table repeat too: report the table once.
+                if last_dup_line.is_some_and(|l| line <= l + 1) {
+                    last_dup_line = Some(line);
+                    continue;
+                }
+                last_dup_line = Some(line);
+                let key = file.text.get(span.clone()).unwrap_or("").trim();
+                (
+                    format!("duplicate key `{key}`"),
+                    "every node, state and field name may appear only once in its table; rename or merge one of them",
+                )
+            } else {
+                (
+                    format!("invalid TOML: {}", lower_first(&msg)),
+                    "see the TOML format in the README",
+                )
+            };
+            self.diags
+                .push(Diagnostic::error(msg).at(file, span).hint(hint));
         }
         None
     }
@@ -377,7 +402,7 @@ impl Loader {
                 cx,
                 sv.span(),
                 format!(
-                    "`skill` of `{owner}` must be a string, found {}",
+                    "`skill` of {owner} must be a string, found {}",
                     type_name(sv.get_ref())
                 ),
             );
@@ -395,12 +420,8 @@ impl Loader {
                     None => skill::SKILLS.iter().map(|s| s.0).collect(),
                 };
                 let h = suggest(&name, cands.iter().copied());
-                self.err(
-                    cx,
-                    sv.span(),
-                    format!("unknown skill `{name}` in `{owner}`"),
-                )
-                .hint = Some(h);
+                self.err(cx, sv.span(), format!("unknown skill `{name}` in {owner}"))
+                    .hint = Some(h);
                 return None;
             }
             Some(k) if want.is_some_and(|w| w != k) => {
@@ -418,7 +439,7 @@ impl Loader {
                     cx,
                     sv.span(),
                     format!(
-                        "`{owner}` is {} but `{name}` is {} skill",
+                        "{owner} is {} but `{name}` is {} skill",
                         article_kind(w),
                         article_kind(k)
                     ),
@@ -436,7 +457,7 @@ impl Loader {
                 self.err(
                     cx,
                     span,
-                    format!("skill `{name}` of `{owner}` needs argument `{p}`"),
+                    format!("skill `{name}` of {owner} needs argument `{p}`"),
                 )
                 .hint = Some(format!(
                     "write `args = {{ {} }}`",
@@ -481,7 +502,7 @@ impl Loader {
                 cx,
                 a.span(),
                 format!(
-                    "`args` of `{owner}` must be a table, found {}",
+                    "`args` of {owner} must be a table, found {}",
                     type_name(a.get_ref())
                 ),
             )
@@ -506,7 +527,7 @@ impl Loader {
                         cx,
                         v.span(),
                         format!(
-                            "argument `{}` of `{owner}` must be a string, number or boolean, found {}",
+                            "argument `{}` of {owner} must be a string, number or boolean, found {}",
                             k.get_ref(),
                             type_name(other)
                         ),
@@ -700,9 +721,12 @@ impl Loader {
                 state[p] = 2;
             }
         }
-        // Unreachable nodes (no parent and not the root).
+        // Unreachable nodes (no parent and not the root), when the tree is
+        // otherwise sound (a broken node makes its children look unreachable).
+        let sound = !self.diags.iter().any(Diagnostic::is_error)
+            && raws.iter().all(|r| r.kind.is_some() || r.include.is_some());
         for (i, (id, span)) in ids.iter().enumerate() {
-            if i != root && parent[i].is_none() {
+            if sound && i != root && parent[i].is_none() {
                 self.warn(
                     cx,
                     span.clone(),
@@ -869,9 +893,11 @@ impl Loader {
             .filter(|(k, _)| NODE_KEYWORDS.contains(&k.get_ref().as_ref()))
             .map(|(k, v)| (k.get_ref().as_ref(), v, k.span()))
             .collect();
+        let mut unknown_keys = false;
         for (k, _) in t.iter() {
             let k_str: &str = k.get_ref();
             if !NODE_KEYWORDS.contains(&k_str) && !FIELDS.contains(&k_str) {
+                unknown_keys = true;
                 let h = suggest(k_str, NODE_KEYWORDS.iter().chain(FIELDS).copied());
                 self.err(
                     cx,
@@ -883,6 +909,7 @@ impl Loader {
         }
         let (tkey, tval, tspan) = match type_keys.as_slice() {
             [one] => one.clone(),
+            [] if unknown_keys => return None,
             [] => {
                 self.err(cx, key_span, format!("node `{id}` has no type"))
                     .hint = Some(format!(
@@ -980,7 +1007,7 @@ impl Loader {
                     } else {
                         SkillKind::Condition
                     };
-                    skill = self.skill_call(cx, t, id, Some(want));
+                    skill = self.skill_call(cx, t, &format!("node `{id}`"), Some(want));
                     if t.contains_key("skill") && skill.is_none() {
                         return None;
                     }
@@ -1344,7 +1371,7 @@ impl Loader {
                     }
                     StateBody::Decision
                 } else {
-                    let call = self.skill_call(cx, st, &name, None);
+                    let call = self.skill_call(cx, st, &format!("state `{name}`"), None);
                     if st.contains_key("skill") && call.is_none() {
                         ok = false;
                     }
@@ -1479,10 +1506,8 @@ impl Loader {
                 Some(c) => m.states[c].body = StateBody::Container(region),
             }
         }
-        if !ok {
-            return None;
-        }
-        // Resolve transitions now that every region is known.
+        // Resolve transitions now that every region is known (even when other
+        // problems were found, so that all of them are reported at once).
         for (si, trs) in raw_trs.into_iter().enumerate() {
             let region = m.region_of(si).clone();
             let sname = m.states[si].name.clone();
@@ -1543,7 +1568,9 @@ impl Loader {
         if !ok {
             return None;
         }
-        self.unreachable_states(cx, &m);
+        if m.top.initial != usize::MAX {
+            self.unreachable_states(cx, &m);
+        }
         Some(m)
     }
 

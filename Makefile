@@ -1,0 +1,33 @@
+# btfsm: `make run` analyzes the bundled policies, `make test` is what CI runs.
+CARGO ?= cargo
+BIN := target/release/btfsm
+POLICIES := $(wildcard policies/paper/*.toml)
+
+.PHONY: build run test bench clean
+
+build:
+	$(CARGO) build --release --locked
+
+run: build
+	@mkdir -p out
+	$(BIN) analyze $(POLICIES)
+	$(BIN) analyze $(POLICIES) --format json > out/analysis.json
+	@for f in $(POLICIES); do \
+	  b=$$(basename $$f .toml); \
+	  $(BIN) dot $$f -o out/$$b.dot || exit 2; \
+	  if command -v dot >/dev/null 2>&1; then $(BIN) dot $$f --render svg -o out/$$b.svg || exit 2; fi; \
+	done
+	@if command -v dot >/dev/null 2>&1; then echo "wrote out/analysis.json, out/*.dot and out/*.svg"; \
+	 else echo "wrote out/analysis.json and out/*.dot (install Graphviz for SVG)"; fi
+
+test:
+	$(CARGO) fmt --check
+	$(CARGO) clippy --all-targets --locked -- -D warnings
+	$(CARGO) test --locked
+
+bench: build
+	$(CARGO) bench --locked
+
+clean:
+	rm -rf out
+	$(CARGO) clean
