@@ -1508,8 +1508,16 @@ impl Loader {
         }
         // Resolve transitions now that every region is known (even when other
         // problems were found, so that all of them are reported at once).
+        let by_name: HashMap<(Option<usize>, &str), usize> = m
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, st)| ((st.parent, st.name.as_str()), i))
+            .collect();
+        let mut resolved_all: Vec<Vec<Transition>> = vec![Vec::new(); m.states.len()];
         for (si, trs) in raw_trs.into_iter().enumerate() {
-            let region = m.region_of(si).clone();
+            let region = m.region_of(si);
+            let parent = m.states[si].parent;
             let sname = m.states[si].name.clone();
             let valid_outcomes: Vec<String> = match &m.states[si].body {
                 StateBody::Container(r) => r.outcomes.clone(),
@@ -1537,7 +1545,7 @@ impl Loader {
                     continue;
                 }
                 let resolved =
-                    if let Some(&t) = region.states.iter().find(|&&t| m.states[t].name == target) {
+                    if let Some(&t) = by_name.get(&(parent, target.as_str())) {
                         Target::State(t)
                     } else if region.outcomes.contains(&target) {
                         Target::Outcome(target)
@@ -1558,12 +1566,16 @@ impl Loader {
                         ok = false;
                         continue;
                     };
-                m.states[si].transitions.push(Transition {
+                resolved_all[si].push(Transition {
                     trigger,
                     target: resolved,
                     span: Some(span),
                 });
             }
+        }
+        drop(by_name);
+        for (st, trs) in m.states.iter_mut().zip(resolved_all) {
+            st.transitions = trs;
         }
         if !ok {
             return None;

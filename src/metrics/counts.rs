@@ -95,20 +95,30 @@ pub fn fully_connected_states(m: &StateMachine) -> Vec<usize> {
     if actions.len() < 3 {
         return Vec::new();
     }
-    let mut has_arc = vec![vec![false; m.states.len()]; 0];
-    has_arc.resize(m.states.len(), vec![false; m.states.len()]);
-    for (i, s) in m.states.iter().enumerate() {
-        for t in &s.transitions {
-            if let Target::State(j) = t.target {
-                has_arc[i][j] = true;
+    // Distinct action-state predecessors of every state.
+    let is_action: Vec<bool> = (0..m.states.len()).map(|i| is_action_state(m, i)).collect();
+    let mut preds: Vec<Vec<usize>> = vec![Vec::new(); m.states.len()];
+    for &i in &actions {
+        for t in &m.states[i].transitions {
+            if let Target::State(j) = t.target
+                && j != i
+            {
+                preds[j].push(i);
             }
         }
     }
-    actions
-        .iter()
-        .copied()
-        .filter(|&c| actions.iter().all(|&o| o == c || has_arc[o][c]))
-        .collect()
+    let mut out = Vec::new();
+    for &c in &actions {
+        {
+            let p = &mut preds[c];
+            p.sort_unstable();
+            p.dedup();
+        }
+        if is_action[c] && preds[c].len() == actions.len() - 1 {
+            out.push(c);
+        }
+    }
+    out
 }
 
 fn is_action_state(m: &StateMachine, i: usize) -> bool {

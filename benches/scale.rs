@@ -1,0 +1,117 @@
+//! Scale benchmark (issue: large inputs): a BT with 100,000 nodes, a BT nested
+//! 100,000 levels deep and a fault-tolerant FSM with 10,000 states are parsed,
+//! validated and analyzed; prints the time of each phase. Target: under 1 s per
+//! input, end to end. Run with `cargo bench --bench scale`.
+
+use btfsm::format::{Limits, Loaded, toml::parse_str};
+use btfsm::graph::policy_graph;
+use btfsm::metrics::complexity::{cyclomatic, essential};
+use btfsm::report::analyze;
+use std::fmt::Write;
+use std::path::Path;
+use std::time::Instant;
+
+/// Root sequence over fallbacks of (condition, action): 1 + 3k nodes.
+pub fn wide_bt(nodes: usize) -> String {
+    let k = (nodes - 1) / 3;
+    let mut s = String::from("kind = \"bt\"\nname = \"wide\"\n[nodes]\nroot = { sequence = [");
+    for i in 0..k {
+        let _ = write!(s, "{}\"f{i}\"", if i > 0 { ", " } else { "" });
+    }
+    s.push_str("] }\n");
+    for i in 0..k {
+        let _ = writeln!(s, "f{i} = {{ fallback = [\"c{i}\", \"a{i}\"] }}");
+        let _ = writeln!(
+            s,
+            "c{i} = {{ condition = \"At p{i}?\", skill = \"Robot-At\", args = {{ target = \"p{i}\" }} }}"
+        );
+        let _ = writeln!(
+            s,
+            "a{i} = {{ action = \"Move-To p{i}!\", skill = \"Move-To\", args = {{ target = \"p{i}\" }} }}"
+        );
+    }
+    s
+}
+
+/// A chain of alternating sequences and fallbacks `depth` levels deep.
+pub fn deep_bt(depth: usize) -> String {
+    let mut s = String::from("kind = \"bt\"\nname = \"deep\"\n[nodes]\n");
+    for i in 0..depth - 1 {
+        let kind = if i % 2 == 0 { "sequence" } else { "fallback" };
+        let _ = writeln!(s, "n{i} = {{ {kind} = [\"n{}\"] }}", i + 1);
+    }
+    let _ = writeln!(s, "n{} = {{ action = \"Dock!\", skill = \"Dock\" }}", depth - 1);
+    s
+}
+
+/// A fault-tolerant FSM (SELECTOR design of the paper's Fig. 4) with `n` states.
+pub fn big_fsm(n: usize) -> String {
+    let mut s = String::from(
+        "kind = \"fsm\"\nname = \"big\"\ninitial = \"s0\"\noutcomes = [\"SUCCESS\"]\n",
+    );
+    for i in 0..n {
+        let next = if i + 1 < n {
+            format!("s{}", i + 1)
+        } else {
+            "SUCCESS".into()
+        };
+        let _ = writeln!(
+            s,
+            "[states.s{i}]\nskill = \"Dock\"\non = {{ SUCCESS = \"{next}\", FAILURE = \"SELECTOR\", RUNNING = \"s{i}\" }}"
+        );
+    }
+    s.push_str("[states.SELECTOR]\ndecision = true\non = { RUNNING = \"SELECTOR\" }\nguards = [\n");
+    for i in 0..n {
+        let _ = writeln!(s, "  {{ if = \"Found\", to = \"s{i}\" }},");
+    }
+    s.push_str("]\n");
+    s
+}
+
+fn run(name: &str, text: &str) {
+    let t = Instant::now();
+    let doc = toml::de::DeTable::parse(text).expect("valid TOML");
+    let t_toml = t.elapsed();
+    drop(doc);
+    println!("{name:<22} TOML syntax alone {:>7.1} ms", t_toml.as_secs_f64() * 1e3);
+    let t0 = Instant::now();
+    let loaded: Loaded = parse_str(name, text, Path::new("."), &Limits::default())
+        .unwrap_or_else(|e| panic!("{name}: {}", e[0]));
+    let t_parse = t0.elapsed();
+    let t1 = Instant::now();
+    let g = policy_graph(&loaded.policy);
+    let t_graph = t1.elapsed();
+    let t2 = Instant::now();
+    let cc = cyclomatic(&g);
+    let ess = essential(&loaded.policy);
+    let t_cc = t2.elapsed();
+    let t3 = Instant::now();
+    let report = analyze(&loaded);
+    let t_all = t3.elapsed();
+    let total = t_parse + t_all;
+    println!(
+        "{name:<22} {:>7} vertices {:>7} arcs  parse {:>7.1} ms  graph {:>6.1} ms  cc+essential {:>6.1} ms  analyze {:>7.1} ms  total {:>7.1} ms  {}",
+        report.vertices,
+        report.edges,
+        t_parse.as_secs_f64() * 1e3,
+        t_graph.as_secs_f64() * 1e3,
+        t_cc.as_secs_f64() * 1e3,
+        t_all.as_secs_f64() * 1e3,
+        total.as_secs_f64() * 1e3,
+        if total.as_secs_f64() < 1.0 { "ok (< 1 s)" } else { "SLOW (target < 1 s)" }
+    );
+    assert!(cc >= 1 && ess >= 1);
+}
+
+fn main() {
+    // `cargo test --benches` runs this too: keep it quick there.
+    let quick = std::env::args().any(|a| a == "--test");
+    let (n, d, m) = if quick {
+        (1_000, 1_000, 100)
+    } else {
+        (100_000, 100_000, 10_000)
+    };
+    run("bt 100k nodes", &wide_bt(n));
+    run("bt 100k levels deep", &deep_bt(d));
+    run("fsm 10k states", &big_fsm(m));
+}
