@@ -1847,3 +1847,137 @@ fn file_stem(path: &str) -> String {
         .file_stem()
         .map_or_else(|| path.to_string(), |s| s.to_string_lossy().into_owned())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn parse(text: &str) -> Result<Loaded, Vec<Diagnostic>> {
+        parse_str("t.toml", text, Path::new("policies/paper"), &Limits::default())
+    }
+
+    const SEEDS: &[&str] = &[
+        include_str!("../../policies/paper/fig01-bt.toml"),
+        include_str!("../../policies/paper/fig04-fsm.toml"),
+        include_str!("../../policies/paper/fig06-hfsm.toml"),
+        include_str!("../../policies/paper/fig08e-fsm.toml"),
+        include_str!("../../policies/paper/scal-bt.toml"),
+    ];
+
+    /// Everything downstream of a successful parse must work on it too.
+    fn exercise(l: &Loaded) {
+        let g = crate::graph::policy_graph(&l.policy);
+        let _ = crate::metrics::complexity::cyclomatic(&g);
+        let _ = crate::metrics::complexity::essential(&l.policy);
+        let _ = crate::report::analyze(l);
+        let text = crate::format::toml_write::write_policy(&l.policy);
+        if !text.contains("subtree") {
+            // Spans differ; the written form is a fixpoint.
+            let again = parse(&text).expect("written TOML reads back");
+            assert_eq!(crate::format::toml_write::write_policy(&again.policy), text);
+        }
+        if let Ok(h) = crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
+            let _ = crate::metrics::complexity::essential(&h);
+        }
+    }
+
+    #[test]
+    fn seeds_parse_and_round_trip() {
+        for s in SEEDS {
+            let l = parse(s).unwrap_or_else(|e| panic!("{}", e[0]));
+            exercise(&l);
+        }
+    }
+
+    #[derive(Debug, Clone)]
+    enum Mutation {
+        Delete(usize, usize),
+        Insert(usize, String),
+        DuplicateLine(usize),
+        SwapLines(usize, usize),
+    }
+
+    fn mutation() -> impl Strategy<Value = Mutation> {
+        prop_oneof![
+            (any::<usize>(), 1usize..12).prop_map(|(a, n)| Mutation::Delete(a, n)),
+            (any::<usize>(), "[\\[\\]{}=\",.a-z0-9 \n#'\\\\]{1,6}")
+                .prop_map(|(a, s)| Mutation::Insert(a, s)),
+            any::<usize>().prop_map(Mutation::DuplicateLine),
+            (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Mutation::SwapLines(a, b)),
+        ]
+    }
+
+    fn apply(text: &str, ms: &[Mutation]) -> String {
+        let mut t = text.to_string();
+        for m in ms {
+            match m {
+                Mutation::Delete(a, n) => {
+                    let mut a = a % (t.len() + 1);
+                    while !t.is_char_boundary(a) {
+                        a -= 1;
+                    }
+                    let mut b = (a + n).min(t.len());
+                    while !t.is_char_boundary(b) {
+                        b -= 1;
+                    }
+                    t.replace_range(a..b, "");
+                }
+                Mutation::Insert(a, s) => {
+                    let mut a = a % (t.len() + 1);
+                    while !t.is_char_boundary(a) {
+                        a -= 1;
+                    }
+                    t.insert_str(a, s);
+                }
+                Mutation::DuplicateLine(i) | Mutation::SwapLines(i, _) => {
+                    let mut lines: Vec<String> = t.lines().map(String::from).collect();
+                    if lines.is_empty() {
+                        continue;
+                    }
+                    let i = i % lines.len();
+                    if let Mutation::SwapLines(_, j) = m {
+                        let j = j % lines.len();
+                        lines.swap(i, j);
+                    } else {
+                        let l = lines[i].clone();
+                        lines.insert(i, l);
+                    }
+                    t = lines.join("\n");
+                }
+            }
+        }
+        t
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+        /// Mutated policy files never panic: they parse (and then analyze,
+        /// write and read back) or give positioned errors.
+        #[test]
+        fn mutated_files_never_panic(seed in 0..SEEDS.len(), ms in proptest::collection::vec(mutation(), 1..4)) {
+            let text = apply(SEEDS[seed], &ms);
+            match parse(&text) {
+                Ok(l) => exercise(&l),
+                Err(diags) => {
+                    prop_assert!(!diags.is_empty());
+                    for d in &diags {
+                        let _ = d.to_string();
+                    }
+                    prop_assert!(diags.iter().any(Diagnostic::is_error));
+                }
+            }
+        }
+
+        /// Arbitrary text never panics either.
+        #[test]
+        fn random_text_never_panics(text in "\\PC{0,200}") {
+            if let Err(diags) = parse(&text) {
+                for d in &diags {
+                    let _ = d.to_string();
+                }
+            }
+        }
+    }
+}
