@@ -12,6 +12,7 @@ pub mod format;
 pub mod graph;
 pub mod metrics;
 pub mod model;
+pub mod render;
 pub mod report;
 pub mod transform;
 

@@ -273,3 +273,24 @@ fn csv_and_table_formats() {
     assert_eq!(code, 0);
     assert!(stdout.contains("fig01-bt.toml"));
 }
+
+#[test]
+fn dot_draws_every_vertex_and_writes_files_whole() {
+    let (code, stdout, stderr) = btfsm(&["dot", "policies/paper/fig04-fsm.toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.starts_with("digraph"));
+    assert!(stdout.contains("SELECTOR[") && stdout.contains("shape=doublecircle"));
+    assert_eq!(stdout.matches(" -> ").count(), 18, "one DOT edge per arc");
+    let dir = std::env::temp_dir().join(format!("btfsm-dot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("tmp");
+    let out = dir.join("fig01.dot").display().to_string();
+    let (code, _, _) = btfsm(&["dot", "policies/paper/fig01-bt.toml", "-o", &out]);
+    assert_eq!(code, 0);
+    assert!(std::fs::read_to_string(&out).expect("written").contains("ordering=out"));
+    // A bad input leaves no output file behind.
+    let bad = dir.join("bad.dot").display().to_string();
+    let (code, _, _) = btfsm(&["dot", "tests/fixtures/invalid/malformed.toml", "-o", &bad]);
+    assert_eq!(code, 2);
+    assert!(!Path::new(&bad).exists());
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}

@@ -43,7 +43,7 @@ pub enum Command {
         output: Option<PathBuf>,
         /// Render with Graphviz's `dot` instead of printing DOT
         #[arg(long, value_enum)]
-        render: Option<RenderArg>,
+        render: Option<crate::render::dot::RenderFormat>,
         #[command(flatten)]
         limits: LimitArgs,
     },
@@ -59,12 +59,6 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum RenderArg {
-    Svg,
-    Png,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -26,22 +26,44 @@ pub fn execute(cli: Cli) -> u8 {
                 return EXIT_BAD_INPUT;
             };
             for l in &loaded {
-                let errs = 0;
                 eprintln!(
-                    "{}: ok ({} {}, {} warning{}){}",
+                    "{}: ok ({} `{}`, {} warning{})",
                     l.path,
                     l.policy.kind(),
                     l.policy.name,
                     l.warnings.len(),
                     if l.warnings.len() == 1 { "" } else { "s" },
-                    if errs > 0 { "" } else { "" }
                 );
             }
             EXIT_OK
         }
-        Command::Dot { .. } => {
-            eprintln!("error: `dot` is not available in this build yet");
-            EXIT_BAD_INPUT
+        Command::Dot {
+            file,
+            output,
+            render,
+            limits,
+        } => {
+            let Some(mut loaded) = load_all(std::slice::from_ref(&file), &limits.limits()) else {
+                return EXIT_BAD_INPUT;
+            };
+            let l = loaded.remove(0);
+            let dot = crate::render::dot::policy_dot(&l.policy, &Default::default());
+            match render {
+                None => emit(output.as_deref(), dot.as_bytes()),
+                Some(fmt) => match crate::render::dot::render(&dot, fmt) {
+                    Ok(bytes) => {
+                        if output.is_none() && fmt != crate::render::dot::RenderFormat::Svg {
+                            eprintln!("error: {fmt} output is binary; write it to a file with -o");
+                            return EXIT_BAD_INPUT;
+                        }
+                        emit(output.as_deref(), &bytes)
+                    }
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        EXIT_BAD_INPUT
+                    }
+                },
+            }
         }
         Command::Convert {
             file,
