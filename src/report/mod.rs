@@ -65,8 +65,12 @@ pub fn analyze(loaded: &Loaded) -> PolicyReport {
 pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String {
     match format {
         OutputFormat::Json => {
-            let v = serde_json::json!({ "policies": reports });
-            let mut s = serde_json::to_string_pretty(&v).expect("serializable");
+            #[derive(serde::Serialize)]
+            struct Out<'a> {
+                policies: &'a [PolicyReport],
+            }
+            let mut s =
+                serde_json::to_string_pretty(&Out { policies: reports }).expect("serializable");
             s.push('\n');
             s
         }
