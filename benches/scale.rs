@@ -40,7 +40,11 @@ pub fn deep_bt(depth: usize) -> String {
         let kind = if i % 2 == 0 { "sequence" } else { "fallback" };
         let _ = writeln!(s, "n{i} = {{ {kind} = [\"n{}\"] }}", i + 1);
     }
-    let _ = writeln!(s, "n{} = {{ action = \"Dock!\", skill = \"Dock\" }}", depth - 1);
+    let _ = writeln!(
+        s,
+        "n{} = {{ action = \"Dock!\", skill = \"Dock\" }}",
+        depth - 1
+    );
     s
 }
 
@@ -73,7 +77,10 @@ fn run(name: &str, text: &str) {
     let doc = toml::de::DeTable::parse(text).expect("valid TOML");
     let t_toml = t.elapsed();
     drop(doc);
-    println!("{name:<22} TOML syntax alone {:>7.1} ms", t_toml.as_secs_f64() * 1e3);
+    println!(
+        "{name:<22} TOML syntax alone {:>7.1} ms",
+        t_toml.as_secs_f64() * 1e3
+    );
     let t0 = Instant::now();
     let loaded: Loaded = parse_str(name, text, Path::new("."), &Limits::default())
         .unwrap_or_else(|e| panic!("{name}: {}", e[0]));
@@ -98,7 +105,11 @@ fn run(name: &str, text: &str) {
         t_cc.as_secs_f64() * 1e3,
         t_all.as_secs_f64() * 1e3,
         total.as_secs_f64() * 1e3,
-        if total.as_secs_f64() < 1.0 { "ok (< 1 s)" } else { "SLOW (target < 1 s)" }
+        if total.as_secs_f64() < 1.0 {
+            "ok (< 1 s)"
+        } else {
+            "SLOW (target < 1 s)"
+        }
     );
     assert!(cc >= 1 && ess >= 1);
 }

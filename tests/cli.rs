@@ -286,7 +286,11 @@ fn dot_draws_every_vertex_and_writes_files_whole() {
     let out = dir.join("fig01.dot").display().to_string();
     let (code, _, _) = btfsm(&["dot", "policies/paper/fig01-bt.toml", "-o", &out]);
     assert_eq!(code, 0);
-    assert!(std::fs::read_to_string(&out).expect("written").contains("ordering=out"));
+    assert!(
+        std::fs::read_to_string(&out)
+            .expect("written")
+            .contains("ordering=out")
+    );
     // A bad input leaves no output file behind.
     let bad = dir.join("bad.dot").display().to_string();
     let (code, _, _) = btfsm(&["dot", "tests/fixtures/invalid/malformed.toml", "-o", &bad]);

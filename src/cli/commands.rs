@@ -82,7 +82,9 @@ pub fn execute(cli: Cli) -> u8 {
                         Ok(p) => p,
                         Err(errs) => {
                             for e in errs {
-                                eprintln!("error: {e}\n  = hint: the construction covers sequence, fallback (with or without memory), inverter, force_success, force_failure and leaves");
+                                eprintln!(
+                                    "error: {e}\n  = hint: the construction covers sequence, fallback (with or without memory), inverter, force_success, force_failure and leaves"
+                                );
                             }
                             return EXIT_BAD_INPUT;
                         }

@@ -1544,28 +1544,27 @@ impl Loader {
                     ok = false;
                     continue;
                 }
-                let resolved =
-                    if let Some(&t) = by_name.get(&(parent, target.as_str())) {
-                        Target::State(t)
-                    } else if region.outcomes.contains(&target) {
-                        Target::Outcome(target)
-                    } else {
-                        let cands: Vec<&str> = region
-                            .states
-                            .iter()
-                            .map(|&t| m.states[t].name.as_str())
-                            .chain(region.outcomes.iter().map(String::as_str))
-                            .collect();
-                        let h = suggest(&target, cands);
-                        self.err(
-                            cx,
-                            span,
-                            format!("unknown state `{target}` in transition of `{sname}`"),
-                        )
-                        .hint = Some(h);
-                        ok = false;
-                        continue;
-                    };
+                let resolved = if let Some(&t) = by_name.get(&(parent, target.as_str())) {
+                    Target::State(t)
+                } else if region.outcomes.contains(&target) {
+                    Target::Outcome(target)
+                } else {
+                    let cands: Vec<&str> = region
+                        .states
+                        .iter()
+                        .map(|&t| m.states[t].name.as_str())
+                        .chain(region.outcomes.iter().map(String::as_str))
+                        .collect();
+                    let h = suggest(&target, cands);
+                    self.err(
+                        cx,
+                        span,
+                        format!("unknown state `{target}` in transition of `{sname}`"),
+                    )
+                    .hint = Some(h);
+                    ok = false;
+                    continue;
+                };
                 resolved_all[si].push(Transition {
                     trigger,
                     target: resolved,
@@ -1854,7 +1853,12 @@ mod tests {
     use proptest::prelude::*;
 
     fn parse(text: &str) -> Result<Loaded, Vec<Diagnostic>> {
-        parse_str("t.toml", text, Path::new("policies/paper"), &Limits::default())
+        parse_str(
+            "t.toml",
+            text,
+            Path::new("policies/paper"),
+            &Limits::default(),
+        )
     }
 
     const SEEDS: &[&str] = &[

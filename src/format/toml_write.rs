@@ -48,8 +48,7 @@ pub fn quote(s: &str) -> String {
 /// A TOML key: bare when possible, else quoted.
 pub fn key(s: &str) -> String {
     if !s.is_empty()
-        && s
-            .chars()
+        && s.chars()
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
     {
         s.to_string()
@@ -102,7 +101,8 @@ fn write_bt(out: &mut String, bt: &Bt) {
                 fields.push(format!("{kw} = {}", quote(&bt.nodes[n.children[0]].id)));
             }
             _ => {
-                let kids: Vec<String> = n.children.iter().map(|&c| quote(&bt.nodes[c].id)).collect();
+                let kids: Vec<String> =
+                    n.children.iter().map(|&c| quote(&bt.nodes[c].id)).collect();
                 fields.push(format!("{kw} = [{}]", kids.join(", ")));
             }
         }
@@ -141,13 +141,15 @@ fn guard_inline(g: &Guard, to: &str) -> String {
         let terms: Vec<String> = g.all.iter().map(|t| format!("{{ {} }}", term(t))).collect();
         format!("all = [{}]", terms.join(", "))
     };
-    format!("{{ {cond}, to = {}, label = {} }}", quote(to), quote(&g.label))
+    format!(
+        "{{ {cond}, to = {}, label = {} }}",
+        quote(to),
+        quote(&g.label)
+    )
 }
 
 fn write_machine(out: &mut String, m: &StateMachine) {
-    let outcomes = |o: &[String]| {
-        o.iter().map(|s| quote(s)).collect::<Vec<_>>().join(", ")
-    };
+    let outcomes = |o: &[String]| o.iter().map(|s| quote(s)).collect::<Vec<_>>().join(", ");
     let _ = writeln!(out, "initial = {}", quote(&m.states[m.top.initial].name));
     let _ = writeln!(out, "outcomes = [{}]", outcomes(&m.top.outcomes));
     // Pre-order over the state hierarchy, without recursion.

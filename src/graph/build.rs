@@ -91,7 +91,11 @@ pub fn machine_graph(m: &StateMachine) -> PolicyGraph {
     }
     for (i, s) in m.states.iter().enumerate() {
         if let StateBody::Container(r) = &s.body {
-            g.add_edge(NodeIndex::new(i), NodeIndex::new(r.initial), ArcKind::Initial);
+            g.add_edge(
+                NodeIndex::new(i),
+                NodeIndex::new(r.initial),
+                ArcKind::Initial,
+            );
         }
         for t in &s.transitions {
             let to = match &t.target {

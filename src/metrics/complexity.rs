@@ -16,9 +16,10 @@
 //!   3. a vertex with one predecessor and one successor is contracted into an
 //!      arc (a statement inside a branch or loop body); with rule 1 this
 //!      reduces if-then, if-then-else, case and while shapes.
-//!   Every BT reduces to one vertex (value 1, the paper's CC column for BTs);
-//!   a state entered from several places, as in the fault-tolerant SELECTOR
-//!   design, does not reduce, and its FSM keeps a value above 1.
+//!
+//! Every BT reduces to one vertex (value 1, the paper's CC column for BTs); a
+//! state entered from several places, as in the fault-tolerant SELECTOR design,
+//! does not reduce, and its FSM keeps a value above 1.
 
 use crate::graph::PolicyGraph;
 use crate::model::{Bt, BtNodeKind, Policy, PolicyBody, StateBody, StateMachine, Target};
@@ -304,7 +305,11 @@ mod tests {
 
     #[test]
     fn never_above_cyclomatic() {
-        let c = cf(&[(1, 2), (1, 3), (2, 3), (3, 2), (2, 0), (3, 0), (3, 3)], 4, 1);
+        let c = cf(
+            &[(1, 2), (1, 3), (2, 3), (3, 2), (2, 0), (3, 0), (3, 3)],
+            4,
+            1,
+        );
         let direct = c.succ.iter().map(Vec::len).sum::<usize>() as i64 + 1 - 4 + 1;
         assert!(reduce(&c).cyclomatic() <= direct);
     }

@@ -57,11 +57,10 @@ pub struct TableOne {
 }
 
 pub fn table_one(kind: PolicyKind, g: &PolicyGraph, m_fc: usize) -> TableOne {
-    let m = g
-        .g
-        .node_weights()
-        .filter(|v| matches!(v.vtype, VertexType::Action | VertexType::State))
-        .count();
+    let m =
+        g.g.node_weights()
+            .filter(|v| matches!(v.vtype, VertexType::Action | VertexType::State))
+            .count();
     let mf = m as f64;
     let t_fc = m_fc * m.saturating_sub(1);
     let (graphical_estimate, active_estimate) = match kind {

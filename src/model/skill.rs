@@ -11,9 +11,14 @@ pub enum SkillKind {
     Condition,
 }
 
-/// Every skill of the shared library: name, kind and the arguments it takes
-/// (`(name, required)`).
-pub const SKILLS: &[(&str, SkillKind, &[(&str, bool)])] = &[
+/// An argument a skill takes: `(name, required)`.
+pub type Param = (&'static str, bool);
+
+/// A skill of the library: name, kind and the arguments it takes.
+pub type SkillSpec = (&'static str, SkillKind, &'static [Param]);
+
+/// Every skill of the shared library.
+pub const SKILLS: &[SkillSpec] = &[
     ("Move-To", SkillKind::Action, &[("target", true)]),
     ("Safe-Move-To", SkillKind::Action, &[("target", true)]),
     ("Pick", SkillKind::Action, &[("object", true)]),

@@ -100,8 +100,18 @@ pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String
         }
         OutputFormat::Table => {
             let mut t = table::Table::new(&[
-                "file", "kind", "V", "E", "graphical", "active", "cc", "ess.cc", "M", "M_fc",
-                "T.I graph.", "T.I active",
+                "file",
+                "kind",
+                "V",
+                "E",
+                "graphical",
+                "active",
+                "cc",
+                "ess.cc",
+                "M",
+                "M_fc",
+                "T.I graph.",
+                "T.I active",
             ]);
             for r in reports {
                 t.row(vec![

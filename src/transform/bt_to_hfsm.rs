@@ -9,8 +9,8 @@
 //! top-level outcomes (SPEC §2).
 
 use crate::model::{
-    Bt, BtNodeKind, Policy, PolicyBody, Region, State, StateBody, StateMachine, Target,
-    Transition, Trigger,
+    Bt, BtNodeKind, Policy, PolicyBody, Region, State, StateBody, StateMachine, Target, Transition,
+    Trigger,
 };
 
 const S: &str = "SUCCESS";
@@ -93,7 +93,10 @@ pub fn bt_to_hfsm(bt: &Bt) -> Result<StateMachine, Vec<Unsupported>> {
             None => (None, None),
             Some(p) => {
                 let sib = &bt.nodes[p].children;
-                let pos = sib.iter().position(|&c| c == i).expect("child of its parent");
+                let pos = sib
+                    .iter()
+                    .position(|&c| c == i)
+                    .expect("child of its parent");
                 (Some(bt.nodes[p].kind), sib.get(pos + 1).copied())
             }
         };
