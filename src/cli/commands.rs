@@ -43,10 +43,9 @@ pub fn execute(cli: Cli) -> u8 {
             render,
             limits,
         } => {
-            let Some(mut loaded) = load_all(std::slice::from_ref(&file), &limits.limits()) else {
+            let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let l = loaded.remove(0);
             let dot = crate::render::dot::policy_dot(&l.policy, &Default::default());
             match render {
                 None => emit(output.as_deref(), dot.as_bytes()),
@@ -71,10 +70,9 @@ pub fn execute(cli: Cli) -> u8 {
             output,
             limits,
         } => {
-            let Some(mut loaded) = load_all(std::slice::from_ref(&file), &limits.limits()) else {
+            let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let l = loaded.remove(0);
             let policy = match to {
                 ConvertTarget::Toml => l.policy,
                 ConvertTarget::Hfsm => {
@@ -95,6 +93,11 @@ pub fn execute(cli: Cli) -> u8 {
             emit(output.as_deref(), text.as_bytes())
         }
     }
+}
+
+/// Loads one file (see [`load_all`]).
+fn load_one(file: &Path, limits: &Limits) -> Option<Loaded> {
+    load_all(&[file.to_path_buf()], limits).and_then(|mut v| v.pop())
 }
 
 /// Loads every file, printing all diagnostics (warnings too); `None` when any

@@ -30,29 +30,8 @@ pub const TASK_OUTCOMES: &[&str] = &["SUCCESS", "FAILURE", "RUNNING"];
 pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
     let file = read_source(path, &shown, limits)?;
-    let mut loader = Loader {
-        limits: limits.clone(),
-        stack: vec![canonical(path)],
-        diags: Vec::new(),
-        node_budget: limits.max_nodes,
-    };
-    let policy = loader.policy(&file, path.parent().unwrap_or(Path::new("")));
-    let (errors, warnings) = sorted_partition(loader.diags);
-    match policy {
-        Some(policy) if errors.is_empty() => Ok(Loaded {
-            path: shown,
-            policy,
-            warnings,
-        }),
-        _ => {
-            let mut all = errors;
-            all.extend(warnings);
-            if !all.iter().any(Diagnostic::is_error) {
-                all.push(Diagnostic::error("invalid policy").in_file(&file));
-            }
-            Err(all)
-        }
-    }
+    let base = path.parent().unwrap_or(Path::new(""));
+    load_source(&file, canonical(path), base, limits)
 }
 
 /// Parses a policy from text (tests, stdin); includes resolve against `base`.
@@ -63,21 +42,39 @@ pub fn parse_str(
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let file = SourceFile::new(name, text);
+    load_source(&file, PathBuf::from(name), base, limits)
+}
+
+/// Reads a policy from a source file; on failure returns every error, followed
+/// by the warnings.
+fn load_source(
+    file: &Arc<SourceFile>,
+    identity: PathBuf,
+    base: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
     let mut loader = Loader {
         limits: limits.clone(),
-        stack: vec![PathBuf::from(name)],
+        stack: vec![identity],
         diags: Vec::new(),
         node_budget: limits.max_nodes,
     };
-    let policy = loader.policy(&file, base);
+    let policy = loader.policy(file, base);
     let (errors, warnings) = sorted_partition(loader.diags);
     match policy {
         Some(policy) if errors.is_empty() => Ok(Loaded {
-            path: name.to_string(),
+            path: file.path.clone(),
             policy,
             warnings,
         }),
-        _ => Err(errors),
+        _ => {
+            let mut all = errors;
+            if all.is_empty() {
+                all.push(Diagnostic::error("invalid policy").in_file(file));
+            }
+            all.extend(warnings);
+            Err(all)
+        }
     }
 }
 
