@@ -24,6 +24,7 @@ mod lsap;
 mod problem;
 mod script;
 mod search;
+mod wl;
 
 #[cfg(test)]
 mod brute;
@@ -119,52 +120,159 @@ pub fn ged_graphs(a: &GedGraph, b: &GedGraph, mode: GedMode, opts: &GedOptions) 
         let c = s.cost();
         return finish(c, c, s);
     }
-    let (ua, ub);
-    let (ga, gb) = if mode == GedMode::Structural {
-        ua = a.unlabeled();
-        ub = b.unlabeled();
-        (&ua, &ub)
+    let deadline = start + opts.timeout;
+    let labeled = Oriented::new(a, b);
+    let (lower, map_ab) = if mode == GedMode::Labeled {
+        let lim = search::Limits {
+            deadline,
+            max_expansions: opts.max_expansions,
+        };
+        let out = search::solve(&labeled.p, &lim, None);
+        (out.lower, labeled.to_ab(&out.sigma))
     } else {
-        (a, b)
+        structural(a, b, &labeled, start, opts)
     };
-    let swap = orientation_key(gb) < orientation_key(ga);
-    let (g1, g2) = if swap { (gb, ga) } else { (ga, gb) };
-    let p = Problem::new(g1, g2);
-    let limits = search::Limits {
-        deadline: start + opts.timeout,
-        max_expansions: opts.max_expansions,
+    let s = script::build(a, b, &map_ab);
+    // The script scores the mapping found, in the original graphs.
+    let upper = s.cost();
+    finish(lower.min(upper), upper, s)
+}
+
+/// Structural GED. When the graphs carry more than one label, a labeled
+/// mapping is also a structural one, and on policy graphs usually a very
+/// good one, while the labeled search is far easier (its classes are
+/// small); so if a first structural search (a third of the budget) does not
+/// settle the value, a labeled search (another third) seeds a second
+/// structural search with its mapping. Both structural lower bounds are
+/// certified; the larger is kept.
+fn structural(
+    a: &GedGraph,
+    b: &GedGraph,
+    labeled: &Oriented,
+    start: Instant,
+    opts: &GedOptions,
+) -> (u64, Vec<Option<usize>>) {
+    let (ua, ub) = (a.unlabeled(), b.unlabeled());
+    let st = Oriented::new(&ua, &ub);
+    let multi_class = labeled.p.classes.len() > 1;
+    if !multi_class {
+        let lim = search::Limits {
+            deadline: start + opts.timeout,
+            max_expansions: opts.max_expansions,
+        };
+        let out = search::solve(&st.p, &lim, None);
+        return (out.lower, st.to_ab(&out.sigma));
+    }
+    let third = opts.timeout / 3;
+    let part = (opts.max_expansions / 3).max(1);
+    let lim = |deadline: Instant| search::Limits {
+        deadline,
+        max_expansions: part,
     };
-    let out = search::solve(&p, &limits);
-    // Padded bijection -> partial injection of original vertices g1 -> g2.
-    let mut map12: Vec<Option<usize>> = vec![None; g1.n()];
-    for (u, &v) in out.sigma.iter().enumerate() {
-        let (ou, ov) = (
-            p.s1.orig[u],
-            p.s2.orig.get(v as usize).copied().unwrap_or(NONE),
-        );
-        if ou != NONE && ov != NONE {
-            map12[ou as usize] = Some(ov as usize);
+    let first = search::solve(&st.p, &lim(start + third), None);
+    if first.lower >= first.upper {
+        return (first.lower, st.to_ab(&first.sigma));
+    }
+    let lab = search::solve(&labeled.p, &lim(start + 2 * third), None);
+    let hint = st.padded_from_ab(&labeled.to_ab(&lab.sigma));
+    let second = search::solve(&st.p, &lim(start + opts.timeout), Some(hint));
+    let lower = first.lower.max(second.lower);
+    let best = if second.upper <= first.upper {
+        second.sigma
+    } else {
+        first.sigma
+    };
+    (lower, st.to_ab(&best))
+}
+
+/// A padded instance in canonical orientation, with conversions between its
+/// padded bijections and partial injections of the original a → b.
+struct Oriented {
+    p: Problem,
+    swap: bool,
+    n_a: usize,
+    n_b: usize,
+}
+
+impl Oriented {
+    fn new(a: &GedGraph, b: &GedGraph) -> Oriented {
+        let swap = orientation_key(b) < orientation_key(a);
+        let p = if swap {
+            Problem::new(b, a)
+        } else {
+            Problem::new(a, b)
+        };
+        Oriented {
+            p,
+            swap,
+            n_a: a.n(),
+            n_b: b.n(),
         }
     }
-    let map_ab = if swap {
-        let mut m = vec![None; a.n()];
-        for (u2, v) in map12.iter().enumerate() {
-            if let Some(v) = *v
-                && let Some(slot) = m.get_mut(v)
-            {
-                *slot = Some(u2);
+
+    /// Padded bijection -> partial injection of the original a -> b.
+    fn to_ab(&self, sigma: &[u32]) -> Vec<Option<usize>> {
+        let mut m = vec![None; self.n_a];
+        for (u, &v) in sigma.iter().enumerate() {
+            let ou = self.p.s1.orig.get(u).copied().unwrap_or(NONE);
+            let ov = self.p.s2.orig.get(v as usize).copied().unwrap_or(NONE);
+            if ou == NONE || ov == NONE {
+                continue;
+            }
+            let (x, y) = if self.swap { (ov, ou) } else { (ou, ov) };
+            if let Some(slot) = m.get_mut(x as usize) {
+                *slot = Some(y as usize);
             }
         }
         m
-    } else {
-        map12
-    };
-    let s = script::build(a, b, &map_ab);
-    // The script scores the same mapping; keep the two in agreement even if
-    // the padded and original views ever diverged.
-    let upper = s.cost();
-    debug_assert_eq!(upper, out.upper, "script and padded cost agree");
-    finish(out.lower.min(upper), upper, s)
+    }
+
+    /// Partial injection a -> b -> padded bijection: pairs that respect the
+    /// classes are kept, the rest filled in index order within each class.
+    fn padded_from_ab(&self, map_ab: &[Option<usize>]) -> Vec<u32> {
+        let p = &self.p;
+        let n = p.n();
+        let (n1, n2) = if self.swap {
+            (self.n_b, self.n_a)
+        } else {
+            (self.n_a, self.n_b)
+        };
+        let mut pos1 = vec![NONE; n1];
+        let mut pos2 = vec![NONE; n2];
+        for u in 0..n {
+            if let Some(slot) = pos1.get_mut(p.s1.orig[u] as usize) {
+                *slot = u as u32;
+            }
+            if let Some(slot) = pos2.get_mut(p.s2.orig[u] as usize) {
+                *slot = u as u32;
+            }
+        }
+        let mut sigma = vec![NONE; n];
+        let mut used = vec![false; n];
+        for (x, y) in map_ab.iter().enumerate() {
+            let Some(y) = *y else { continue };
+            let (o1, o2) = if self.swap { (y, x) } else { (x, y) };
+            let (Some(&u), Some(&v)) = (pos1.get(o1), pos2.get(o2)) else {
+                continue;
+            };
+            if u == NONE || v == NONE || used[v as usize] {
+                continue;
+            }
+            if p.class_of[u as usize] == p.class_of[v as usize] {
+                sigma[u as usize] = v;
+                used[v as usize] = true;
+            }
+        }
+        for &(s, e) in &p.classes {
+            let mut free = (s..e).filter(|&v| !used[v]);
+            for slot in sigma[s..e].iter_mut() {
+                if *slot == NONE {
+                    *slot = free.next().map_or(NONE, |v| v as u32);
+                }
+            }
+        }
+        sigma
+    }
 }
 
 /// Vertex count, arc count, sorted (label, out, in, loops) per vertex.

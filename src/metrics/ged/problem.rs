@@ -58,6 +58,55 @@ impl Side {
         }
     }
 
+    /// Whether exchanging `u1` and `u2` is an automorphism (same class
+    /// assumed): equal loops, equal arcs to and from every third vertex,
+    /// and as many arcs u1 -> u2 as u2 -> u1.
+    pub fn twins(&self, u1: u32, u2: u32) -> bool {
+        let (a, b) = (u1 as usize, u2 as usize);
+        if self.loops[a] != self.loops[b]
+            || self.out[a].len() != self.out[b].len()
+            || self.inn[a].len() != self.inn[b].len()
+            || self.mult(u1, u2) != self.mult(u2, u1)
+        {
+            return false;
+        }
+        let others = |l: &[(u32, u32)]| -> Vec<(u32, u32)> {
+            l.iter()
+                .copied()
+                .filter(|&(w, _)| w != u1 && w != u2)
+                .collect()
+        };
+        others(&self.out[a]) == others(&self.out[b]) && others(&self.inn[a]) == others(&self.inn[b])
+    }
+
+    /// For each vertex, the nearest lower-index twin in its class (`NONE` if
+    /// none). Twin classes are equivalence classes (transpositions that are
+    /// automorphisms compose into automorphisms), so this chains each class
+    /// in index order.
+    pub fn twin_prev(&self, classes: &[(usize, usize)]) -> Vec<u32> {
+        let mut prev = vec![NONE; self.n];
+        let sig = |u: usize| {
+            (
+                self.loops[u],
+                self.out[u].len(),
+                self.inn[u].len(),
+                self.degree(u),
+            )
+        };
+        for &(s, e) in classes {
+            for (u2, slot) in prev.iter_mut().enumerate().take(e).skip(s) {
+                let s2 = sig(u2);
+                if let Some(u1) = (s..u2)
+                    .rev()
+                    .find(|&u1| sig(u1) == s2 && self.twins(u1 as u32, u2 as u32))
+                {
+                    *slot = u1 as u32;
+                }
+            }
+        }
+        prev
+    }
+
     /// Out-degree + in-degree + loops (with multiplicity).
     pub fn degree(&self, u: usize) -> u64 {
         let o: u64 = self.out[u].iter().map(|&(_, m)| u64::from(m)).sum();
@@ -250,5 +299,18 @@ mod tests {
         // a: 0->1(pos 2), 1->2 (2->3), loop at 3. b: 0->1 (pos 0 -> pos 1).
         // identity keeps nothing: cost = 2 + 3 + 1.
         assert_eq!(p.cost(&id), 6);
+    }
+
+    #[test]
+    fn finds_twins() {
+        // 0 -> {1, 2, 3}; 1 and 2 are leaves (twins), 3 has a loop; 4 and 5
+        // form a 2-cycle (twins of each other), 6 is isolated.
+        let a = g(
+            vec![0; 7],
+            &[(0, 1), (0, 2), (0, 3), (3, 3), (4, 5), (5, 4)],
+        );
+        let p = Problem::new(&a, &a);
+        let prev = p.s1.twin_prev(&p.classes);
+        assert_eq!(prev, vec![NONE, NONE, 1, NONE, NONE, 4, NONE]);
     }
 }

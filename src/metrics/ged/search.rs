@@ -1,45 +1,63 @@
 //! Exact GED by depth-first branch and bound over the padded instance of
 //! `problem.rs`, with an assignment lower bound at every node.
 //!
-//! The bound follows the branch-match bound of Chang, Feng, Lin, Qin, Zhang
-//! and Zhou ("Speeding Up GED Verification for Graph Similarity Search",
-//! ICDE 2020; "Accelerating Graph Similarity Search via Efficient GED
-//! Computation", TKDE 2022), adapted to directed multigraphs with self-loops.
-//! At a node with partial mapping f (cost g on the pairs it fixes), a
-//! completion σ costs g plus, for each unmapped u,
+//! **Lower bound.** It follows the branch-match bound of Chang, Feng, Lin,
+//! Qin, Zhang and Zhou ("Speeding Up GED Verification for Graph Similarity
+//! Search", ICDE 2020; "Accelerating Graph Similarity Search via Efficient
+//! GED Computation", TKDE 2022), adapted to directed multigraphs with
+//! self-loops. At a node with partial mapping f (cost g on the pairs it
+//! fixes), a completion σ costs g plus, for each unmapped u,
 //!   (a) Σ_{w mapped} |A(u,w) − B(σu, f w)| + |A(w,u) − B(f w, σu)|  — exact,
 //!   (b) |A(u,u) − B(σu,σu)|                                         — exact,
-//!   (c) half of Σ_{w unmapped} |A(u,w) − B(σu,σw)| + |A(w,u) − B(σw,σu)|,
-//! since each unmapped–unmapped pair is seen from both ends. For (c) the sum
-//! over w of |a_w − b_{σw}| is at least the sorted-matching distance of the
-//! two multisets of multiplicities, which for non-negative integers is
-//! Σ_t |#{a ≥ t} − #{b ≥ t}|; we keep the layers t = 1, 2, 3 and the mass
-//! above 3 (a valid relaxation) for out- and in-arcs separately. A linear
-//! assignment (`lsap.rs`) of these local costs, class by class, is the lower
-//! bound; its optimal assignment is also a complete mapping, hence an upper
-//! bound, polished by 2-swaps (`local.rs`). The assignment's duals bound each
-//! child (`total + reduced cost`) so that children are ordered and discarded
-//! without being solved. All bounds are rounded up to the parity every
-//! mapping's cost has (vertex cost + m1 + m2, mod 2).
+//!   plus R, the cost over unmapped pairs u ≠ w. R is at least Σ_u O(u) and
+//!   at least Σ_u I(u), where O(u) (I(u)) lower-bounds the cost of u's out-
+//!   (in-) pairs; so each u may be charged (c) = λ·O(u) + (1 − λ)·I(u) for
+//!   any fixed λ ∈ [0, 1]. λ ∈ {0, ½, 1} is chosen at the root for the
+//!   highest bound (½ is the classic "each pair seen from both ends"; 1 suits
+//!   trees, whose in-degrees say nothing). O(u) is the sorted-matching
+//!   distance between the multiplicities of u's and σu's out-arcs to unmapped
+//!   vertices, Σ_t |#{a ≥ t} − #{b ≥ t}| for non-negative integers; we keep
+//!   t = 1, 2, 3 and the mass above 3 (a relaxation, still valid).
+//! A linear assignment (`lsap.rs`) of these local costs, class by class, is
+//! the bound. Its duals bound each child (`total + reduced cost`), so
+//! children are ordered and discarded without being solved. Every mapping's
+//! cost has the parity of vertex cost + m1 + m2, so bounds are rounded up to
+//! it.
 //!
 //! (a) is maintained incrementally: with |x − y| = x + y − 2 min(x, y),
 //! (a) = row[u] + col[v] − 2 pair[u][v], where row/col count arcs to the
 //! mapped/used part and pair accumulates the minima, updated only along the
-//! arcs of the newly mapped pair.
+//! arcs of the newly mapped pair; the layer counts of O and I likewise.
 //!
-//! The branching vertex is the unmapped real G1 vertex with the fewest
-//! children surviving the bound (fail first), ties to the most arcs towards
-//! the mapped part. G2 dummies of a class are interchangeable, so only one is
-//! ever a child. When the time budget or the expansion budget runs out, the
-//! certified lower bound is the smallest bound among the subtrees still open
-//! on the stack.
+//! **Upper bounds.** Greedy dives from every image of the highest-degree
+//! vertex (connectivity-first, least local cost), each node's assignment
+//! completed into a full mapping, all polished by 2-swaps (`local.rs`).
+//! Ties between equal local costs — siblings of equal degree, say — are
+//! broken by Weisfeiler–Lehman colour similarity (`wl.rs`), which sees past
+//! degrees; inside the assignment this is done by scaling the costs and
+//! adding the tie term below one unit, so the bound is unchanged.
+//!
+//! **Branching.** Forced vertices (at most one surviving child) first, then
+//! the unmapped real G1 vertex with most arcs to the mapped part, then the
+//! fewest surviving children, then the highest degree; children by bound,
+//! then WL similarity. Symmetries are broken without losing optima: G2
+//! dummies of a class are interchangeable, so only the first unused one is
+//! a child; and G1 twins (vertices whose exchange is an automorphism, such as
+//! sibling leaves of one type) are branched in index order onto increasing
+//! images.
+//!
+//! **Budgets.** When the time or expansion budget runs out, the certified
+//! lower bound is the smallest bound among the subtrees still open on the
+//! stack; the upper bound is the best mapping found.
 
+use std::cmp::Reverse;
 use std::time::Instant;
 
 use super::embed::{self, Embedding};
 use super::local;
 use super::lsap::{Assignment, Lsap};
 use super::problem::{NONE, Problem};
+use super::wl::Colours;
 
 /// Above this padded size the exact search is not attempted (the pair table
 /// is n² words); the result is then the count bound and a local-search upper
@@ -62,6 +80,19 @@ pub(crate) struct Outcome {
     pub upper: u64,
     /// Padded G1 → padded G2 bijection of cost `upper`.
     pub sigma: Vec<u32>,
+    /// Search statistics (printed by the timing report in the tests).
+    #[allow(dead_code)]
+    pub stats: Stats,
+}
+
+/// What the search did (printed by the timing report in the tests).
+#[derive(Debug, Clone, Default)]
+#[allow(dead_code)] // only ever printed with {:?}
+pub(crate) struct Stats {
+    pub embedding: Option<bool>,
+    pub first_upper: u64,
+    pub root_lower: u64,
+    pub expansions: u64,
 }
 
 type Layers = [u32; 4];
@@ -106,11 +137,27 @@ enum Eval {
 }
 
 /// Per-class data of the assignment solved at a node.
+///
+/// The matrix holds `scale · local cost + tie`, where `tie` < 1/k of
+/// `scale` favours pairs of higher WL similarity: the optimum of the scaled
+/// problem is an optimum of the unscaled one (`min` = ⌊total / scale⌋),
+/// chosen to be the most similar, which makes its completion a better upper
+/// bound. A forced pair's bound is ⌊(total + reduced cost) / scale⌋.
 struct ClassLsap {
     rows: Vec<u32>,
     cols: Vec<u32>,
     cost: Vec<i64>,
     sol: Assignment,
+    min: i64,
+}
+
+impl ClassLsap {
+    /// Lower bound on this class's unscaled assignment cost when row `i`
+    /// is forced onto column `j`.
+    fn forced(&self, i: usize, j: usize, scale: i64) -> i64 {
+        let k = self.rows.len();
+        (self.sol.total + self.sol.reduced(&self.cost, k, i, j)).div_euclid(scale)
+    }
 }
 
 struct Bnb<'a> {
@@ -132,6 +179,16 @@ struct Bnb<'a> {
     lsap: Lsap,
     lim: Limits,
     expansions: u64,
+    root_lower: u64,
+    /// Nearest lower-index twin of each G1 vertex (see `Side::twin_prev`).
+    twin_prev: Vec<u32>,
+    /// Weights of the out- and in-arc layer distances (sum 2).
+    w_out: i64,
+    w_in: i64,
+    /// WL colours, for tie-breaking in the upper-bound heuristics.
+    wl: Colours,
+    /// Scale of local costs in the assignment matrices (see `ClassLsap`).
+    scale: i64,
 }
 
 impl<'a> Bnb<'a> {
@@ -149,6 +206,7 @@ impl<'a> Bnb<'a> {
                 })
                 .collect()
         };
+        let wl = Colours::new(p);
         Bnb {
             p,
             n,
@@ -168,6 +226,12 @@ impl<'a> Bnb<'a> {
             lsap: Lsap::default(),
             lim,
             expansions: 0,
+            root_lower: 0,
+            twin_prev: p.s1.twin_prev(&p.classes),
+            w_out: 1,
+            w_in: 1,
+            scale: n as i64 * i64::from(wl.max_similarity()) + 1,
+            wl,
         }
     }
 
@@ -249,6 +313,29 @@ impl<'a> Bnb<'a> {
         self.g -= dg;
     }
 
+    /// Whether `u` may be branched on now: its lower twin is already mapped.
+    fn eligible(&self, u: u32) -> bool {
+        let t = self.twin_prev[u as usize];
+        t == NONE || self.f[t as usize] != NONE
+    }
+
+    /// Whether `v` is a child of `u` under symmetry breaking: above the
+    /// image of `u`'s lower twin, and the first of the unused G2 dummies
+    /// (`dummy_seen` tracks that along one scan of a class's columns).
+    fn allowed(&self, u: u32, v: u32, dummy_seen: &mut bool) -> bool {
+        let t = self.twin_prev[u as usize];
+        if t != NONE && v <= self.f[t as usize] {
+            return false;
+        }
+        if self.p.s2.is_dummy(v) {
+            if *dummy_seen {
+                return false;
+            }
+            *dummy_seen = true;
+        }
+        true
+    }
+
     /// Doubled local cost of mapping unmapped `u` onto unused `v`.
     #[inline]
     fn local_cost(&self, u: usize, v: usize) -> i64 {
@@ -256,8 +343,8 @@ impl<'a> Bnb<'a> {
         let a = self.row[u] as i64 + self.col[v] as i64 - 2 * i64::from(self.pair[u * self.n + v]);
         let lp = i64::from(p.s1.loops[u].abs_diff(p.s2.loops[v]));
         2 * (a + lp)
-            + layer_dist(&self.out1[u], &self.out2[v])
-            + layer_dist(&self.in1[u], &self.in2[v])
+            + self.w_out * layer_dist(&self.out1[u], &self.out2[v])
+            + self.w_in * layer_dist(&self.in1[u], &self.in2[v])
     }
 
     /// Offers a complete mapping as an upper bound, polishing it when it wins.
@@ -270,8 +357,94 @@ impl<'a> Bnb<'a> {
         }
     }
 
-    /// Bounds the current node and, unless it can be discarded, lists its children.
-    fn eval(&mut self, parent_lb: u64) -> Eval {
+    /// A greedy dive from the empty mapping: map the unmapped real G1 vertex
+    /// with most arcs to the mapped part (then highest degree) onto the
+    /// candidate of least local cost, until only dummies are left; complete
+    /// arbitrarily. `start` forces the first pair. Leaves the state empty
+    /// and returns the complete mapping.
+    fn dive(&mut self, start: Option<(u32, u32)>) -> Vec<u32> {
+        let p = self.p;
+        let mut steps: Vec<(u32, u32, u64)> = Vec::new();
+        if let Some((u, v)) = start {
+            let dg = self.map(u, v);
+            steps.push((u, v, dg));
+        }
+        loop {
+            let mut pick: Option<(u64, u64, usize)> = None;
+            for u in 0..self.n {
+                if self.f[u] != NONE || p.s1.is_dummy(u as u32) {
+                    continue;
+                }
+                let key = (self.row[u], p.s1.degree(u), u);
+                let better = match pick {
+                    None => true,
+                    Some(k) => (key.0, key.1) > (k.0, k.1),
+                };
+                if better {
+                    pick = Some(key);
+                }
+            }
+            let Some((_, _, u)) = pick else { break };
+            let (s, e) = p.classes[p.class_of[u] as usize];
+            let mut bestv: Option<(i64, Reverse<u32>, Reverse<u64>, usize)> = None;
+            let mut dummy_seen = false;
+            for v in s..e {
+                if self.used[v] {
+                    continue;
+                }
+                if p.s2.is_dummy(v as u32) {
+                    if dummy_seen {
+                        continue;
+                    }
+                    dummy_seen = true;
+                }
+                let sim = self.wl.similarity(u, v);
+                let key = (self.local_cost(u, v), Reverse(sim), Reverse(self.col[v]), v);
+                if bestv.is_none_or(|b| key < b) {
+                    bestv = Some(key);
+                }
+            }
+            let Some((_, _, _, v)) = bestv else { break };
+            let dg = self.map(u as u32, v as u32);
+            steps.push((u as u32, v as u32, dg));
+        }
+        let mut sigma = self.f.clone();
+        for &(s, e) in &p.classes {
+            let mut free = (s..e).filter(|&v| !self.used[v]);
+            for slot in sigma[s..e].iter_mut() {
+                if *slot == NONE {
+                    *slot = free.next().map_or(NONE, |v| v as u32);
+                }
+            }
+        }
+        for &(u, v, dg) in steps.iter().rev() {
+            self.unmap(u, v, dg);
+        }
+        sigma
+    }
+
+    /// Upper bounds from greedy dives, one per image of the first vertex.
+    fn seed(&mut self) {
+        let p = self.p;
+        let first = (0..self.n)
+            .filter(|&u| !p.s1.is_dummy(u as u32))
+            .max_by_key(|&u| (p.s1.degree(u), Reverse(u)));
+        let Some(u) = first else { return };
+        let (s, e) = p.classes[p.class_of[u] as usize];
+        for v in s..e {
+            if Instant::now() > self.lim.deadline {
+                return;
+            }
+            let sigma = self.dive(Some((u as u32, v as u32)));
+            if sigma.iter().all(|&x| x != NONE) {
+                self.offer(sigma);
+            }
+        }
+    }
+
+    /// Solves the class-by-class assignment of local costs at the current
+    /// node; `None` on timeout.
+    fn assign(&mut self) -> Option<(Vec<ClassLsap>, i64)> {
         let p = self.p;
         let mut classes: Vec<ClassLsap> = Vec::new();
         let mut total = 0i64;
@@ -289,27 +462,62 @@ impl<'a> Bnb<'a> {
                 .collect();
             let k = rows.len();
             if cols.len() != k {
-                return Eval::Timeout; // cannot happen: classes are balanced
+                return None; // cannot happen: classes are balanced
             }
             let mut cost = Vec::with_capacity(k * k);
+            let top = i64::from(self.wl.max_similarity());
             for &u in &rows {
                 for &v in &cols {
-                    cost.push(self.local_cost(u as usize, v as usize));
+                    let (u, v) = (u as usize, v as usize);
+                    let tie = top - i64::from(self.wl.similarity(u, v));
+                    cost.push(self.local_cost(u, v) * self.scale + tie);
                 }
             }
-            let Some(sol) = self.lsap.solve(k, &cost, self.lim.deadline) else {
-                return Eval::Timeout;
-            };
-            total += sol.total;
+            let sol = self.lsap.solve(k, &cost, self.lim.deadline)?;
+            let min = sol.total.div_euclid(self.scale);
+            total += min;
             classes.push(ClassLsap {
                 rows,
                 cols,
                 cost,
                 sol,
+                min,
             });
         }
+        Some((classes, total))
+    }
+
+    /// Picks the split of the unmapped–unmapped term between out- and
+    /// in-arcs that gives the highest bound at the current node: any
+    /// λ·(out) + (1 − λ)·(in) is valid, as each of the two sums alone is at
+    /// most the cost among unmapped pairs. Trees, whose in-degrees are all
+    /// 1, want λ = 1.
+    fn choose_split(&mut self) {
+        let mut best = (i64::MIN, 1, 1);
+        for (wo, wi) in [(1, 1), (2, 0), (0, 2)] {
+            self.w_out = wo;
+            self.w_in = wi;
+            match self.assign() {
+                Some((_, total)) if total > best.0 => best = (total, wo, wi),
+                Some(_) => {}
+                None => break,
+            }
+        }
+        self.w_out = best.1;
+        self.w_in = best.2;
+    }
+
+    /// Bounds the current node and, unless it can be discarded, lists its children.
+    fn eval(&mut self, parent_lb: u64) -> Eval {
+        let p = self.p;
+        let Some((classes, total)) = self.assign() else {
+            return Eval::Timeout;
+        };
         let half = |t: i64| (t.max(0) as u64).div_ceil(2);
         let lb = self.round(parent_lb.max(self.g + half(total)));
+        if self.expansions == 0 {
+            self.root_lower = lb;
+        }
         if lb >= self.ub {
             return Eval::Prune;
         }
@@ -328,30 +536,28 @@ impl<'a> Bnb<'a> {
         let mut choice: Option<(usize, usize)> = None; // (class idx, row idx)
         let mut key = (usize::MAX, 0u64, 0u64);
         for (ci, c) in classes.iter().enumerate() {
-            let k = c.rows.len();
             for (i, &u) in c.rows.iter().enumerate() {
-                if p.s1.is_dummy(u) {
+                if p.s1.is_dummy(u) || !self.eligible(u) {
                     continue;
                 }
                 let mut viable = 0usize;
                 let mut dummy_seen = false;
                 for (j, &v) in c.cols.iter().enumerate() {
-                    if p.s2.is_dummy(v) {
-                        if dummy_seen {
-                            continue;
-                        }
-                        dummy_seen = true;
+                    if !self.allowed(u, v, &mut dummy_seen) {
+                        continue;
                     }
-                    let est = self.g + half(total + c.sol.reduced(&c.cost, k, i, j));
+                    let est = self.g + half(total - c.min + c.forced(i, j, self.scale));
                     if self.round(est) < self.ub {
                         viable += 1;
                     }
                 }
                 let uu = u as usize;
                 let cand = (viable, self.row[uu], p.s1.degree(uu));
-                let better = choice.is_none()
-                    || cand.0 < key.0
-                    || (cand.0 == key.0 && (cand.1, cand.2) > (key.1, key.2));
+                // Forced vertices (at most one viable child) first, then the
+                // most arcs to the mapped part, then fewest children, then
+                // highest degree.
+                let rank = |c: (usize, u64, u64)| (c.0 > 1, Reverse(c.1), c.0, Reverse(c.2));
+                let better = choice.is_none() || rank(cand) < rank(key);
                 if better {
                     choice = Some((ci, i));
                     key = cand;
@@ -366,24 +572,25 @@ impl<'a> Bnb<'a> {
             return Eval::Prune;
         }
         let c = &classes[ci];
-        let k = c.rows.len();
         let mut children = Vec::with_capacity(key.0);
         let mut dummy_seen = false;
+        let u = c.rows[i];
         for (j, &v) in c.cols.iter().enumerate() {
-            if p.s2.is_dummy(v) {
-                if dummy_seen {
-                    continue;
-                }
-                dummy_seen = true;
+            if !self.allowed(u, v, &mut dummy_seen) {
+                continue;
             }
-            let est = self.round(lb.max(self.g + half(total + c.sol.reduced(&c.cost, k, i, j))));
+            let bound = self.g + half(total - c.min + c.forced(i, j, self.scale));
+            let est = self.round(lb.max(bound));
             if est < self.ub {
                 children.push((est, v));
             }
         }
-        children.sort_unstable();
+        // Equal bounds: most WL-similar image first.
+        children.sort_unstable_by_key(|&(est, v)| {
+            (est, Reverse(self.wl.similarity(u as usize, v as usize)), v)
+        });
         Eval::Branch(Frame {
-            u: c.rows[i],
+            u,
             children,
             cur: 0,
             via: None,
@@ -393,6 +600,8 @@ impl<'a> Bnb<'a> {
     /// Runs the search from the root; returns the certified lower bound.
     fn run(&mut self, root_lb: u64) -> u64 {
         let mut stack: Vec<Frame> = Vec::new();
+        self.seed();
+        self.choose_split();
         match self.eval(root_lb) {
             Eval::Prune => return self.ub,
             Eval::Timeout => return root_lb.min(self.ub),
@@ -450,36 +659,159 @@ impl<'a> Bnb<'a> {
     }
 }
 
-/// Computes GED on a padded instance within the limits.
-pub(crate) fn solve(p: &Problem, lim: &Limits) -> Outcome {
+/// Computes GED on a padded instance within the limits, starting from the
+/// mapping `hint` if it is the cheapest known.
+pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcome {
     let count = p.count_bound();
     let mut best = p.greedy();
     let mut ub = p.cost(&best);
-    let done = |lower: u64, upper: u64, sigma: Vec<u32>| Outcome {
+    let hinted = hint.is_some();
+    if let Some(h) = hint
+        && h.len() == p.n()
+    {
+        let c = p.cost(&h);
+        if c < ub {
+            best = h;
+            ub = c;
+        }
+    }
+    let mut stats = Stats {
+        first_upper: ub,
+        ..Stats::default()
+    };
+    let done = |lower: u64, upper: u64, sigma: Vec<u32>, stats: Stats| Outcome {
         lower,
         upper,
         sigma,
+        stats,
     };
     if ub == count {
-        return done(ub, ub, best);
+        return done(ub, ub, best, stats);
     }
     let now = Instant::now();
     let embed_deadline = now + lim.deadline.saturating_duration_since(now) / 4;
     let mut lb = count;
-    match embed::find(p, embed_deadline, EMBED_BUDGET) {
-        Embedding::Found(sigma) => return done(count, count, sigma),
-        Embedding::Absent => lb = count + 2,
+    // A hinted call is a second attempt: the embedding search, being
+    // deterministic, would only repeat itself.
+    let embedding = if hinted {
+        Embedding::Unknown
+    } else {
+        embed::find(p, embed_deadline, EMBED_BUDGET)
+    };
+    match embedding {
+        Embedding::Found(sigma) => {
+            stats.embedding = Some(true);
+            return done(count, count, sigma, stats);
+        }
+        Embedding::Absent => {
+            stats.embedding = Some(false);
+            lb = count + 2;
+        }
         Embedding::Unknown => {}
     }
     local::two_swap(p, &mut best, lim.deadline);
     ub = p.cost(&best);
     if lb >= ub {
-        return done(ub, ub, best);
+        return done(ub, ub, best, stats);
     }
     if p.n() > MAX_SEARCH_N {
-        return done(lb, ub, best);
+        return done(lb, ub, best, stats);
     }
     let mut bnb = Bnb::new(p, ub, best, *lim);
     let lower = bnb.run(lb);
-    done(lower, bnb.ub, bnb.best)
+    stats.root_lower = bnb.root_lower;
+    stats.expansions = bnb.expansions;
+    done(lower, bnb.ub, bnb.best, stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::graph::GedGraph;
+    use super::*;
+    use std::time::Duration;
+
+    /// A random tree and a relabelled copy: the dives alone (no search)
+    /// must recover the isomorphism, which degree-based costs cannot do for
+    /// siblings of equal degree but WL tie-breaking can.
+    #[test]
+    fn dives_recover_an_isomorphic_tree() {
+        let mut x = 12345u64;
+        let mut next = |m: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % m
+        };
+        let n = 40;
+        let parent: Vec<usize> = (0..n)
+            .map(|i| if i == 0 { 0 } else { next(i as u64) as usize })
+            .collect();
+        let labels: Vec<u32> = (0..n).map(|_| next(3) as u32).collect();
+        let keys: Vec<String> = (0..n).map(|i| format!("v{i}")).collect();
+        let a = GedGraph::new(labels.clone(), keys.clone(), (1..n).map(|i| (parent[i], i)))
+            .expect("valid");
+        let rev = |i: usize| n - 1 - i;
+        let mut l2 = vec![0; n];
+        for u in 0..n {
+            l2[rev(u)] = labels[u];
+        }
+        let b = GedGraph::new(l2, keys, (1..n).map(|i| (rev(parent[i]), rev(i)))).expect("valid");
+        for (ga, gb) in [(a.clone(), b.clone()), (a.unlabeled(), b.unlabeled())] {
+            let p = Problem::new(&ga, &gb);
+            let lim = Limits {
+                deadline: Instant::now() + Duration::from_secs(60),
+                max_expansions: 0,
+            };
+            let greedy = p.greedy();
+            let mut bnb = Bnb::new(&p, p.cost(&greedy), greedy, lim);
+            bnb.seed();
+            assert_eq!(bnb.ub, 0);
+            assert_eq!(p.cost(&bnb.best), 0);
+        }
+    }
+
+    #[test]
+    fn map_and_unmap_are_inverse() {
+        let keys = |n: usize| (0..n).map(|i| format!("v{i}")).collect::<Vec<_>>();
+        let a = GedGraph::new(
+            vec![0; 4],
+            keys(4),
+            [(0, 1), (0, 1), (1, 2), (2, 0), (3, 3)],
+        )
+        .expect("valid");
+        let b = GedGraph::new(
+            vec![0; 4],
+            keys(4),
+            [(1, 0), (1, 2), (2, 2), (2, 3), (3, 1)],
+        )
+        .expect("valid");
+        let p = Problem::new(&a, &b);
+        let lim = Limits {
+            deadline: Instant::now() + Duration::from_secs(60),
+            max_expansions: 0,
+        };
+        let mut bnb = Bnb::new(&p, u64::MAX, p.greedy(), lim);
+        let snapshot = |b: &Bnb| {
+            (
+                b.g,
+                b.row.clone(),
+                b.col.clone(),
+                b.pair.clone(),
+                b.out1.clone(),
+                b.in2.clone(),
+            )
+        };
+        let before = snapshot(&bnb);
+        let d1 = bnb.map(0, 2);
+        let d2 = bnb.map(1, 0);
+        let d3 = bnb.map(2, 1);
+        let d4 = bnb.map(3, 3);
+        // With everything mapped, g is the cost of the mapping.
+        assert_eq!(bnb.g, p.cost(&[2, 0, 1, 3]) - p.vertex_cost);
+        bnb.unmap(3, 3, d4);
+        bnb.unmap(2, 1, d3);
+        bnb.unmap(1, 0, d2);
+        bnb.unmap(0, 2, d1);
+        assert!(before == snapshot(&bnb));
+    }
 }

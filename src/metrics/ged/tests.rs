@@ -741,6 +741,48 @@ fn hfsm_pairs_are_certified() {
 // ---------------------------------------------------------------- budgets
 
 #[test]
+fn two_phase_structural_search_stays_certified() {
+    // Tiny expansion budgets force the structural search through its
+    // labeled-seeded second attempt.
+    let mut rng = Rng(0xC0FFEE);
+    for i in 0..40 {
+        let a = random_graph(&mut rng, 5, 12, 3, "a");
+        let b = random_graph(&mut rng, 6, 12, 3, "b");
+        let o = GedOptions {
+            timeout: Duration::from_secs(30),
+            max_expansions: 3 + (i % 5) * 4,
+        };
+        let r = ged_graphs(&a, &b, GedMode::Structural, &o);
+        let truth = brute_ged(&a, &b, false);
+        assert!(
+            r.lower_bound <= truth && truth <= r.upper_bound,
+            "{r:?} vs {truth}"
+        );
+        assert_eq!(r.edit_script.cost(), r.upper_bound);
+        // The labeled optimum is a structural upper bound.
+        assert!(r.upper_bound <= brute_ged(&a, &b, true).max(truth));
+    }
+}
+
+#[test]
+fn orientation_round_trips_mappings() {
+    let mut rng = Rng(77);
+    for _ in 0..50 {
+        let n1 = rng.below(7) as usize;
+        let n2 = rng.below(7) as usize;
+        let a = random_graph(&mut rng, n1, 10, 2, "a");
+        let b = random_graph(&mut rng, n2, 10, 2, "b");
+        let o = Oriented::new(&a, &b);
+        let sigma = o.p.greedy();
+        let m = o.to_ab(&sigma);
+        let back = o.padded_from_ab(&m);
+        assert_eq!(o.to_ab(&back), m);
+        assert_eq!(o.p.cost(&back), o.p.cost(&sigma));
+        assert_eq!(script::build(&a, &b, &m).cost(), o.p.cost(&sigma));
+    }
+}
+
+#[test]
 fn large_random_graphs_return_a_certified_interval_in_budget() {
     let mut rng = Rng(0xB16_6EA9);
     let a = random_graph(&mut rng, 200, 800, 4, "a");
@@ -762,8 +804,8 @@ fn large_random_graphs_return_a_certified_interval_in_budget() {
 fn expansion_budget_gives_a_certified_interval() {
     let mut rng = Rng(42);
     for _ in 0..20 {
-        let a = random_graph(&mut rng, 7, 20, 1, "a");
-        let b = random_graph(&mut rng, 7, 20, 1, "b");
+        let a = random_graph(&mut rng, 6, 16, 1, "a");
+        let b = random_graph(&mut rng, 6, 16, 1, "b");
         let o = GedOptions {
             timeout: Duration::from_secs(30),
             max_expansions: 3,
@@ -784,34 +826,163 @@ fn expansion_budget_gives_a_certified_interval() {
 fn report() {
     let f4 = fig4().build();
     let f8d = fig8d_fsm().build();
-    let pairs: Vec<(&str, GedGraph, GedGraph)> = vec![
-        ("fsm 4-8a", f4.clone(), fig8a()),
-        ("fsm 4-8b", f4.clone(), fig8b()),
-        ("fsm 4-8c", f4.clone(), fig8c()),
-        ("fsm 4-8d", f4.clone(), f8d.clone()),
-        ("fsm 4-8e", f4.clone(), fig8e()),
-        ("fsm 4-9b", f4.clone(), fig9b()),
-        ("fsm 8d-15", f8d.clone(), fig15_fsm()),
-        ("fsm 2-4", fig2(), f4.clone()),
-        ("fsm 10-11", fig10(), f8d.clone()),
-        ("fsm scal-16b", scal_fsm().build(), fig16b()),
-        ("bt 1-7a", bt_graph(&fig1()), bt_graph(&fig7a())),
-        ("bt 1-7b", bt_graph(&fig1()), bt_graph(&fig7b())),
-        ("bt 1-7c", bt_graph(&fig1()), bt_graph(&fig7c())),
-        ("bt 1-7d", bt_graph(&fig1()), bt_graph(&fig7d())),
-        ("bt 7d-15", bt_graph(&fig7d()), bt_graph(&fig15_bt())),
-        ("bt scal-16a", bt_graph(&scal_bt()), bt_graph(&fig16a())),
-        ("hfsm 1-7a", hfsm_graph(&fig1()), hfsm_graph(&fig7a())),
-        ("hfsm 1-7b", hfsm_graph(&fig1()), hfsm_graph(&fig7b())),
-        ("hfsm 1-7c", hfsm_graph(&fig1()), hfsm_graph(&fig7c())),
-        ("hfsm 1-7d", hfsm_graph(&fig1()), hfsm_graph(&fig7d())),
-        ("hfsm 7d-15", hfsm_graph(&fig7d()), hfsm_graph(&fig15_bt())),
-        (
-            "hfsm scal-16a",
-            hfsm_graph(&scal_bt()),
-            hfsm_graph(&fig16a()),
-        ),
-    ];
+    let pairs: Vec<(&str, GedGraph, GedGraph)> = if std::env::var("GED_ONLY_STRESS").is_ok() {
+        vec![]
+    } else {
+        vec![
+            ("fsm 4-8a", f4.clone(), fig8a()),
+            ("fsm 4-8b", f4.clone(), fig8b()),
+            ("fsm 4-8c", f4.clone(), fig8c()),
+            ("fsm 4-8d", f4.clone(), f8d.clone()),
+            ("fsm 4-8e", f4.clone(), fig8e()),
+            ("fsm 4-9b", f4.clone(), fig9b()),
+            ("fsm 8d-15", f8d.clone(), fig15_fsm()),
+            ("fsm 2-4", fig2(), f4.clone()),
+            ("fsm 10-11", fig10(), f8d.clone()),
+            ("fsm scal-16b", scal_fsm().build(), fig16b()),
+            ("bt 1-7a", bt_graph(&fig1()), bt_graph(&fig7a())),
+            ("bt 1-7b", bt_graph(&fig1()), bt_graph(&fig7b())),
+            ("bt 1-7c", bt_graph(&fig1()), bt_graph(&fig7c())),
+            ("bt 1-7d", bt_graph(&fig1()), bt_graph(&fig7d())),
+            ("bt 7d-15", bt_graph(&fig7d()), bt_graph(&fig15_bt())),
+            ("bt scal-16a", bt_graph(&scal_bt()), bt_graph(&fig16a())),
+            ("hfsm 1-7a", hfsm_graph(&fig1()), hfsm_graph(&fig7a())),
+            ("hfsm 1-7b", hfsm_graph(&fig1()), hfsm_graph(&fig7b())),
+            ("hfsm 1-7c", hfsm_graph(&fig1()), hfsm_graph(&fig7c())),
+            ("hfsm 1-7d", hfsm_graph(&fig1()), hfsm_graph(&fig7d())),
+            ("hfsm 7d-15", hfsm_graph(&fig7d()), hfsm_graph(&fig15_bt())),
+            (
+                "hfsm scal-16a",
+                hfsm_graph(&scal_bt()),
+                hfsm_graph(&fig16a()),
+            ),
+        ]
+    };
+    let mut pairs = pairs;
+    // Stress: the paper's larger FSMs with a few arcs re-routed at random.
+    let mut rng = Rng(7);
+    for k in [2usize, 4, 8] {
+        for (name, base) in [("hfsm16a", hfsm_graph(&fig16a()))] {
+            let mut arcs: Vec<(usize, usize)> = Vec::new();
+            for &(t, h, m) in base.arcs() {
+                for _ in 0..m {
+                    arcs.push((t as usize, h as usize));
+                }
+            }
+            for _ in 0..k {
+                let i = rng.below(arcs.len() as u64) as usize;
+                arcs[i].1 = rng.below(base.n() as u64) as usize;
+            }
+            let g =
+                GedGraph::new(base.labels().to_vec(), base.keys().to_vec(), arcs).expect("valid");
+            let other = if name == "16b" {
+                scal_fsm().build()
+            } else {
+                hfsm_graph(&scal_bt())
+            };
+            pairs.push((
+                if name == "16b" {
+                    ["fsm16b~", "fsm16b~~", "fsm16b~~~"][k / 4]
+                } else {
+                    ["hfsm~", "hfsm~~", "hfsm~~~"][k / 4]
+                },
+                other,
+                g,
+            ));
+        }
+    }
+    if std::env::var("GED_RANDOM").is_ok() {
+        pairs.clear();
+        let mut rng = Rng(99);
+        for &(n, m, k) in &[
+            (8usize, 24usize, 0usize),
+            (10, 30, 0),
+            (12, 36, 0),
+            (15, 45, 0),
+            (25, 100, 6),
+            (25, 100, 12),
+            (25, 100, 20),
+            (40, 160, 10),
+        ] {
+            for _ in 0..3 {
+                let a = random_graph(&mut rng, n, m, 3, "a");
+                let b = if k == 0 {
+                    random_graph(&mut rng, n, m, 3, "b")
+                } else {
+                    let mut arcs: Vec<(usize, usize)> = Vec::new();
+                    for &(t, h, mm) in a.arcs() {
+                        for _ in 0..mm {
+                            arcs.push((t as usize, h as usize));
+                        }
+                    }
+                    for _ in 0..k {
+                        let i = rng.below(arcs.len() as u64) as usize;
+                        arcs[i].1 = rng.below(n as u64) as usize;
+                    }
+                    permuted(
+                        &GedGraph::new(a.labels().to_vec(), a.keys().to_vec(), arcs)
+                            .expect("valid"),
+                        &mut rng,
+                    )
+                };
+                pairs.push((["rand", "pert"][usize::from(k > 0)], a, b));
+            }
+        }
+    }
+    if std::env::var("GED_TREES").is_ok() {
+        pairs.clear();
+        let mut rng = Rng(1234);
+        for &(n, k) in &[
+            (20usize, 2usize),
+            (20, 4),
+            (40, 2),
+            (40, 4),
+            (40, 8),
+            (80, 4),
+            (80, 8),
+        ] {
+            for _ in 0..3 {
+                let mut parent: Vec<usize> = (0..n)
+                    .map(|i| {
+                        if i == 0 {
+                            0
+                        } else {
+                            rng.below(i as u64) as usize
+                        }
+                    })
+                    .collect();
+                let labels: Vec<u32> = (0..n).map(|_| rng.below(4) as u32).collect();
+                let tree = |parent: &[usize], labels: &[u32]| {
+                    GedGraph::new(
+                        labels.to_vec(),
+                        keys(parent.len(), "t"),
+                        (1..parent.len()).map(|i| (parent[i], i)),
+                    )
+                    .expect("valid")
+                };
+                let a = tree(&parent, &labels);
+                let mut labels2 = labels.clone();
+                for _ in 0..k {
+                    // Move a random subtree under a random vertex outside it
+                    // (vertex ids are topological: parents precede children).
+                    let v = 1 + rng.below(n as u64 - 1) as usize;
+                    let mut inside = vec![false; parent.len()];
+                    inside[v] = true;
+                    for i in v + 1..parent.len() {
+                        inside[i] = inside[parent[i]];
+                    }
+                    let outside: Vec<usize> = (0..v).filter(|&i| !inside[i]).collect();
+                    parent[v] = outside[rng.below(outside.len() as u64) as usize];
+                    // and add a leaf
+                    let at = rng.below(parent.len() as u64) as usize;
+                    parent.push(at);
+                    labels2.push(rng.below(4) as u32);
+                }
+                let b = permuted(&tree(&parent, &labels2), &mut rng);
+                pairs.push(("tree", a, b));
+            }
+        }
+    }
     let o = GedOptions::default();
     for (name, a, b) in &pairs {
         for mode in [GedMode::Structural, GedMode::Labeled, GedMode::Named] {
@@ -830,6 +1001,25 @@ fn report() {
                 r.upper_bound,
                 t.elapsed().as_secs_f64() * 1e3
             );
+            if mode != GedMode::Named {
+                let (ua, ub) = if mode == GedMode::Structural {
+                    (a.unlabeled(), b.unlabeled())
+                } else {
+                    (a.clone(), b.clone())
+                };
+                let swap = orientation_key(&ub) < orientation_key(&ua);
+                let p = if swap {
+                    problem::Problem::new(&ub, &ua)
+                } else {
+                    problem::Problem::new(&ua, &ub)
+                };
+                let lim = search::Limits {
+                    deadline: std::time::Instant::now() + o.timeout,
+                    max_expansions: o.max_expansions,
+                };
+                let out = search::solve(&p, &lim, None);
+                println!("      count {} {:?}", p.count_bound(), out.stats);
+            }
         }
     }
 }
