@@ -52,6 +52,22 @@ impl Lsap {
     /// Solves the `n × n` problem `cost` (row-major). Returns `None` if the
     /// deadline passes first (checked once per row when `n` is large).
     pub fn solve(&mut self, n: usize, cost: &[i64], deadline: Instant) -> Option<Assignment> {
+        self.solve_warm(n, cost, deadline, None)
+    }
+
+    /// As [`Lsap::solve`], warm-started from column potentials and a
+    /// tentative assignment (for instance those of a similar matrix solved
+    /// before): row potentials are set to the row minima of the reduced
+    /// costs, which makes the duals feasible; tentative pairs that are tight
+    /// under them are kept; only the remaining rows are augmented. The
+    /// result is optimal whatever the start.
+    pub fn solve_warm(
+        &mut self,
+        n: usize,
+        cost: &[i64],
+        deadline: Instant,
+        init: Option<(&[i64], &[usize])>,
+    ) -> Option<Assignment> {
         if cost.len() != n * n {
             return None;
         }
@@ -63,8 +79,32 @@ impl Lsap {
         };
         self.row_of_col.clear();
         self.row_of_col.resize(n, NIL);
+        if let Some((v0, cols0)) = init
+            && v0.len() == n
+            && cols0.len() == n
+        {
+            a.v.copy_from_slice(v0);
+            for i in 0..n {
+                let row = &cost[i * n..(i + 1) * n];
+                a.u[i] = row
+                    .iter()
+                    .zip(&a.v)
+                    .map(|(&c, &vj)| c - vj)
+                    .min()
+                    .unwrap_or(0);
+                let j = cols0[i];
+                if j < n && self.row_of_col[j] == NIL && row[j] - a.u[i] - a.v[j] == 0 {
+                    self.row_of_col[j] = i;
+                    a.col_of_row[i] = j;
+                }
+            }
+        }
+        let every = if n >= 256 { 1 } else { 8 };
         for cur in 0..n {
-            if n >= 48 && cur % 8 == 0 && Instant::now() > deadline {
+            if a.col_of_row[cur] != NIL {
+                continue;
+            }
+            if n >= 48 && cur % every == 0 && Instant::now() > deadline {
                 return None;
             }
             self.spc.clear();
@@ -192,6 +232,27 @@ mod tests {
                 }
             }
             assert_eq!(a.u.iter().sum::<i64>() + a.v.iter().sum::<i64>(), a.total);
+            // Warm starts from arbitrary potentials and assignments, and from
+            // the optimum of a perturbed matrix, reach the same optimum.
+            let v0: Vec<i64> = (0..n).map(|_| (next() % 9) as i64 - 4).collect();
+            let c0: Vec<usize> = (0..n).map(|_| (next() % (n as u64 + 1)) as usize).collect();
+            let mut perturbed = cost.clone();
+            for x in perturbed.iter_mut() {
+                if next() % 4 == 0 {
+                    *x += (next() % 3) as i64;
+                }
+            }
+            for (v, c) in [(v0, c0), (a.v.clone(), a.col_of_row.clone())] {
+                let w = lsap
+                    .solve_warm(n, &perturbed, deadline, Some((&v, &c)))
+                    .expect("no deadline");
+                assert_eq!(w.total, if n == 0 { 0 } else { brute(n, &perturbed) });
+                for i in 0..n {
+                    for j in 0..n {
+                        assert!(w.reduced(&perturbed, n, i, j) >= 0);
+                    }
+                }
+            }
         }
     }
 }

@@ -85,14 +85,17 @@ impl Side {
     /// in index order.
     pub fn twin_prev(&self, classes: &[(usize, usize)]) -> Vec<u32> {
         let mut prev = vec![NONE; self.n];
-        let sig = |u: usize| {
-            (
-                self.loops[u],
-                self.out[u].len(),
-                self.inn[u].len(),
-                self.degree(u),
-            )
-        };
+        let sigs: Vec<(u32, usize, usize, u64)> = (0..self.n)
+            .map(|u| {
+                (
+                    self.loops[u],
+                    self.out[u].len(),
+                    self.inn[u].len(),
+                    self.degree(u),
+                )
+            })
+            .collect();
+        let sig = |u: usize| sigs[u];
         for &(s, e) in classes {
             for (u2, slot) in prev.iter_mut().enumerate().take(e).skip(s) {
                 let s2 = sig(u2);

@@ -115,7 +115,10 @@ fn layer_sub(l: &mut Layers, m: u32) {
 
 #[inline]
 fn layer_dist(a: &Layers, b: &Layers) -> i64 {
-    (0..4).map(|t| i64::from(a[t].abs_diff(b[t]))).sum()
+    i64::from(a[0].abs_diff(b[0]))
+        + i64::from(a[1].abs_diff(b[1]))
+        + i64::from(a[2].abs_diff(b[2]))
+        + i64::from(a[3].abs_diff(b[3]))
 }
 
 /// One open node of the depth-first search.
@@ -126,8 +129,17 @@ struct Frame {
     children: Vec<(u64, u32)>,
     /// Child being explored (or next to explore).
     cur: usize,
+    /// Column potentials and assignment of this node's bound.
+    warm: Warm,
     /// The mapping step that led here, to undo on leaving: (w, x, Δg).
     via: Option<(u32, u32, u64)>,
+}
+
+/// Column potentials (by G2 vertex) and assigned column (by G1 vertex) of a
+/// node's assignment, in scaled units.
+struct Warm {
+    v: Vec<i64>,
+    col: Vec<u32>,
 }
 
 enum Eval {
@@ -185,8 +197,11 @@ struct Bnb<'a> {
     /// Weights of the out- and in-arc layer distances (sum 2).
     w_out: i64,
     w_in: i64,
-    /// WL colours, for tie-breaking in the upper-bound heuristics.
-    wl: Colours,
+    /// WL similarity of every pair (row-major), for tie-breaking in the
+    /// upper-bound heuristics.
+    sim: Vec<u8>,
+    /// Its maximum.
+    sim_top: u8,
     /// Scale of local costs in the assignment matrices (see `ClassLsap`).
     scale: i64,
 }
@@ -207,6 +222,13 @@ impl<'a> Bnb<'a> {
                 .collect()
         };
         let wl = Colours::new(p);
+        let sim_top = u8::try_from(wl.max_similarity()).unwrap_or(u8::MAX);
+        let mut sim = vec![0u8; n * n];
+        for u in 0..n {
+            for v in 0..n {
+                sim[u * n + v] = u8::try_from(wl.similarity(u, v)).unwrap_or(u8::MAX);
+            }
+        }
         Bnb {
             p,
             n,
@@ -230,8 +252,9 @@ impl<'a> Bnb<'a> {
             twin_prev: p.s1.twin_prev(&p.classes),
             w_out: 1,
             w_in: 1,
-            scale: n as i64 * i64::from(wl.max_similarity()) + 1,
-            wl,
+            scale: n as i64 * i64::from(sim_top) + 1,
+            sim,
+            sim_top,
         }
     }
 
@@ -347,6 +370,47 @@ impl<'a> Bnb<'a> {
             + self.w_in * layer_dist(&self.in1[u], &self.in2[v])
     }
 
+    /// The scaled assignment matrix of one class: `local_cost(u, v) · scale +
+    /// tie(u, v)`, written out for speed (it is the search's inner loop).
+    fn cost_matrix(&self, rows: &[u32], cols: &[u32]) -> Vec<i64> {
+        let (p, n) = (self.p, self.n);
+        let top = i64::from(self.sim_top);
+        let (wo, wi, scale) = (self.w_out, self.w_in, self.scale);
+        let coldata: Vec<(i64, u32, Layers, Layers)> = cols
+            .iter()
+            .map(|&v| {
+                let v = v as usize;
+                (
+                    2 * self.col[v] as i64,
+                    p.s2.loops[v],
+                    self.out2[v],
+                    self.in2[v],
+                )
+            })
+            .collect();
+        let mut cost = Vec::with_capacity(rows.len() * cols.len());
+        for &u in rows {
+            let u = u as usize;
+            let (ru, lu, ou, iu) = (
+                2 * self.row[u] as i64,
+                p.s1.loops[u],
+                self.out1[u],
+                self.in1[u],
+            );
+            let pair = &self.pair[u * n..(u + 1) * n];
+            let sim = &self.sim[u * n..(u + 1) * n];
+            for (&v, &(cv, lv, ov, iv)) in cols.iter().zip(&coldata) {
+                let v = v as usize;
+                let local = ru + cv - 4 * i64::from(pair[v])
+                    + 2 * i64::from(lu.abs_diff(lv))
+                    + wo * layer_dist(&ou, &ov)
+                    + wi * layer_dist(&iu, &iv);
+                cost.push(local * scale + top - i64::from(sim[v]));
+            }
+        }
+        cost
+    }
+
     /// Offers a complete mapping as an upper bound, polishing it when it wins.
     fn offer(&mut self, mut sigma: Vec<u32>) {
         let c = self.p.cost(&sigma);
@@ -386,7 +450,7 @@ impl<'a> Bnb<'a> {
             }
             let Some((_, _, u)) = pick else { break };
             let (s, e) = p.classes[p.class_of[u] as usize];
-            let mut bestv: Option<(i64, Reverse<u32>, Reverse<u64>, usize)> = None;
+            let mut bestv: Option<(i64, Reverse<u8>, Reverse<u64>, usize)> = None;
             let mut dummy_seen = false;
             for v in s..e {
                 if self.used[v] {
@@ -398,7 +462,7 @@ impl<'a> Bnb<'a> {
                     }
                     dummy_seen = true;
                 }
-                let sim = self.wl.similarity(u, v);
+                let sim = self.sim[u * self.n + v];
                 let key = (self.local_cost(u, v), Reverse(sim), Reverse(self.col[v]), v);
                 if bestv.is_none_or(|b| key < b) {
                     bestv = Some(key);
@@ -444,11 +508,15 @@ impl<'a> Bnb<'a> {
 
     /// Solves the class-by-class assignment of local costs at the current
     /// node; `None` on timeout.
-    fn assign(&mut self) -> Option<(Vec<ClassLsap>, i64)> {
+    fn assign(&mut self, warm: Option<&Warm>) -> Option<(Vec<ClassLsap>, i64)> {
         let p = self.p;
+        let mut local_col = vec![usize::MAX; if warm.is_some() { self.n } else { 0 }];
         let mut classes: Vec<ClassLsap> = Vec::new();
         let mut total = 0i64;
         for &(s, e) in &p.classes {
+            if e - s >= 64 && Instant::now() > self.lim.deadline {
+                return None;
+            }
             let rows: Vec<u32> = (s..e)
                 .filter(|&u| self.f[u] == NONE)
                 .map(|u| u as u32)
@@ -464,16 +532,29 @@ impl<'a> Bnb<'a> {
             if cols.len() != k {
                 return None; // cannot happen: classes are balanced
             }
-            let mut cost = Vec::with_capacity(k * k);
-            let top = i64::from(self.wl.max_similarity());
-            for &u in &rows {
-                for &v in &cols {
-                    let (u, v) = (u as usize, v as usize);
-                    let tie = top - i64::from(self.wl.similarity(u, v));
-                    cost.push(self.local_cost(u, v) * self.scale + tie);
+            let cost = self.cost_matrix(&rows, &cols);
+            let sol = match warm {
+                Some(w) => {
+                    for (j, &v) in cols.iter().enumerate() {
+                        local_col[v as usize] = j;
+                    }
+                    let v0: Vec<i64> = cols.iter().map(|&v| w.v[v as usize]).collect();
+                    let c0: Vec<usize> = rows
+                        .iter()
+                        .map(|&u| {
+                            let x = w.col[u as usize];
+                            if x == NONE {
+                                usize::MAX
+                            } else {
+                                local_col[x as usize]
+                            }
+                        })
+                        .collect();
+                    self.lsap
+                        .solve_warm(k, &cost, self.lim.deadline, Some((&v0, &c0)))?
                 }
-            }
-            let sol = self.lsap.solve(k, &cost, self.lim.deadline)?;
+                None => self.lsap.solve(k, &cost, self.lim.deadline)?,
+            };
             let min = sol.total.div_euclid(self.scale);
             total += min;
             classes.push(ClassLsap {
@@ -497,7 +578,7 @@ impl<'a> Bnb<'a> {
         for (wo, wi) in [(1, 1), (2, 0), (0, 2)] {
             self.w_out = wo;
             self.w_in = wi;
-            match self.assign() {
+            match self.assign(None) {
                 Some((_, total)) if total > best.0 => best = (total, wo, wi),
                 Some(_) => {}
                 None => break,
@@ -508,9 +589,9 @@ impl<'a> Bnb<'a> {
     }
 
     /// Bounds the current node and, unless it can be discarded, lists its children.
-    fn eval(&mut self, parent_lb: u64) -> Eval {
+    fn eval(&mut self, parent_lb: u64, warm: Option<&Warm>) -> Eval {
         let p = self.p;
-        let Some((classes, total)) = self.assign() else {
+        let Some((classes, total)) = self.assign(warm) else {
             return Eval::Timeout;
         };
         let half = |t: i64| (t.max(0) as u64).div_ceil(2);
@@ -532,10 +613,23 @@ impl<'a> Bnb<'a> {
         if lb >= self.ub {
             return Eval::Prune;
         }
+        // A child (i, j) survives iff round(g + ⌈(total − min + q) / 2⌉) < ub
+        // with q = ⌊(class total + reduced cost) / scale⌋; that is, iff its
+        // reduced cost is below a per-class limit. The largest surviving
+        // value of total − min + q is x_max.
+        let d = self.ub as i64 - self.g as i64;
+        let x_max = if (self.ub - 1) % 2 == self.parity {
+            2 * (d - 1)
+        } else {
+            2 * (d - 2)
+        };
+        let limit = |c: &ClassLsap| (x_max - (total - c.min) + 1) * self.scale - c.sol.total;
         // Fail-first choice of the branching vertex among real rows.
         let mut choice: Option<(usize, usize)> = None; // (class idx, row idx)
         let mut key = (usize::MAX, 0u64, 0u64);
         for (ci, c) in classes.iter().enumerate() {
+            let k = c.rows.len();
+            let lim = limit(c);
             for (i, &u) in c.rows.iter().enumerate() {
                 if p.s1.is_dummy(u) || !self.eligible(u) {
                     continue;
@@ -546,10 +640,13 @@ impl<'a> Bnb<'a> {
                     if !self.allowed(u, v, &mut dummy_seen) {
                         continue;
                     }
-                    let est = self.g + half(total - c.min + c.forced(i, j, self.scale));
-                    if self.round(est) < self.ub {
-                        viable += 1;
-                    }
+                    let ok = c.sol.reduced(&c.cost, k, i, j) < lim;
+                    debug_assert_eq!(
+                        ok,
+                        self.round(self.g + half(total - c.min + c.forced(i, j, self.scale)))
+                            < self.ub
+                    );
+                    viable += usize::from(ok);
                 }
                 let uu = u as usize;
                 let cand = (viable, self.row[uu], p.s1.degree(uu));
@@ -587,11 +684,25 @@ impl<'a> Bnb<'a> {
         }
         // Equal bounds: most WL-similar image first.
         children.sort_unstable_by_key(|&(est, v)| {
-            (est, Reverse(self.wl.similarity(u as usize, v as usize)), v)
+            (est, Reverse(self.sim[u as usize * self.n + v as usize]), v)
         });
+        // The node's duals and assignment warm-start its children's.
+        let mut w = Warm {
+            v: vec![0; self.n],
+            col: vec![NONE; self.n],
+        };
+        for c in &classes {
+            for (j, &v) in c.cols.iter().enumerate() {
+                w.v[v as usize] = c.sol.v[j];
+            }
+            for (i, &u) in c.rows.iter().enumerate() {
+                w.col[u as usize] = c.cols[c.sol.col_of_row[i]];
+            }
+        }
         Eval::Branch(Frame {
             u,
             children,
+            warm: w,
             cur: 0,
             via: None,
         })
@@ -599,10 +710,15 @@ impl<'a> Bnb<'a> {
 
     /// Runs the search from the root; returns the certified lower bound.
     fn run(&mut self, root_lb: u64) -> u64 {
-        let mut stack: Vec<Frame> = Vec::new();
         self.seed();
+        self.search(root_lb)
+    }
+
+    /// The depth-first search proper (after any seeding).
+    fn search(&mut self, root_lb: u64) -> u64 {
+        let mut stack: Vec<Frame> = Vec::new();
         self.choose_split();
-        match self.eval(root_lb) {
+        match self.eval(root_lb, None) {
             Eval::Prune => return self.ub,
             Eval::Timeout => return root_lb.min(self.ub),
             Eval::Branch(fr) => stack.push(fr),
@@ -629,7 +745,8 @@ impl<'a> Bnb<'a> {
                 break;
             }
             let dg = self.map(u, v);
-            match self.eval(est) {
+            let warm = stack.last().map(|fr| &fr.warm);
+            match self.eval(est, warm) {
                 Eval::Branch(mut fr) => {
                     fr.via = Some((u, v, dg));
                     stack.push(fr);
@@ -768,6 +885,51 @@ mod tests {
             assert_eq!(bnb.ub, 0);
             assert_eq!(p.cost(&bnb.best), 0);
         }
+    }
+
+    /// The bare search — no seeding dives, no embedding, a useless initial
+    /// upper bound — must still be exact: this drives the bounds, the child
+    /// pruning, warm starts and symmetry breaking through deep trees.
+    #[test]
+    fn bare_search_matches_brute_force() {
+        let mut x = 0xDEAD_BEEFu64;
+        let mut next = |m: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % m.max(1)
+        };
+        let mut expanded = 0;
+        for i in 0..150 {
+            let n1 = next(7) as usize + 1;
+            let n2 = next(7) as usize + 1;
+            let labels = if i % 2 == 0 { 1 } else { 3 };
+            let mut graph = |n: usize| {
+                let m = next(3 * n as u64 + 2) as usize;
+                let l: Vec<u32> = (0..n).map(|_| next(labels) as u32).collect();
+                let k: Vec<String> = (0..n).map(|i| format!("v{i}")).collect();
+                let arcs: Vec<(usize, usize)> = (0..m)
+                    .map(|_| (next(n as u64) as usize, next(n as u64) as usize))
+                    .collect();
+                GedGraph::new(l, k, arcs).expect("valid")
+            };
+            let (a, b) = (graph(n1), graph(n2));
+            let p = Problem::new(&a, &b);
+            let lim = Limits {
+                deadline: Instant::now() + Duration::from_secs(60),
+                max_expansions: u64::MAX,
+            };
+            let greedy = p.greedy();
+            let mut bnb = Bnb::new(&p, p.cost(&greedy) + 1, greedy, lim);
+            bnb.choose_split();
+            let lower = bnb.search(0);
+            assert_eq!(lower, bnb.ub);
+            let truth = super::super::brute::brute_ged(&a, &b, labels > 1);
+            assert_eq!(bnb.ub, truth, "pair {i}");
+            assert_eq!(p.cost(&bnb.best), truth);
+            expanded += bnb.expansions;
+        }
+        assert!(expanded > 500, "the search went deep: {expanded}");
     }
 
     #[test]

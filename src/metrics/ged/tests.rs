@@ -723,17 +723,25 @@ fn larger_fsm_pairs_are_exact() {
     }
 }
 
+/// Table II's HFSM column on the HFSM graphs built by `hfsm_graph` (the paper
+/// reports Eq. 3's 12 / 4 / 17 / 17 instead; SPEC §5 says why they differ).
 #[test]
-fn hfsm_pairs_are_certified() {
+fn hfsm_pairs_are_exact() {
     let f1 = hfsm_graph(&fig1());
-    for t in [fig7a(), fig7b(), fig7c(), fig7d()] {
+    let cases = [
+        (fig7a(), [14, 14, 14]),
+        (fig7b(), [6, 6, 6]),
+        (fig7c(), [19, 23, 23]),
+        (fig7d(), [21, 23, 23]),
+    ];
+    for (t, want) in cases {
         let g = hfsm_graph(&t);
-        for mode in [GedMode::Structural, GedMode::Labeled, GedMode::Named] {
-            let r = check(&f1, &g, mode);
-            let r2 = check(&g, &f1, mode);
-            if r.exact && r2.exact {
-                assert_eq!(r.ged, r2.ged);
-            }
+        for (mode, w) in [GedMode::Structural, GedMode::Labeled, GedMode::Named]
+            .into_iter()
+            .zip(want)
+        {
+            assert_eq!(exact(&f1, &g, mode), w, "{mode:?}");
+            assert_eq!(exact(&g, &f1, mode), w, "{mode:?} reversed");
         }
     }
 }
@@ -819,169 +827,183 @@ fn expansion_budget_gives_a_certified_interval() {
     }
 }
 
-/// Timing report for the paper's pairs: `cargo test --release --lib
-/// metrics::ged::tests::report -- --ignored --nocapture`.
+type Pair = (&'static str, GedGraph, GedGraph);
+
+/// The SPEC §5 pairs plus the HFSM versions of the BT pairs.
+fn paper_pairs() -> Vec<Pair> {
+    let f4 = fig4().build();
+    let f8d = fig8d_fsm().build();
+    let bt = |t: Bt| bt_graph(&t);
+    let hf = |t: Bt| hfsm_graph(&t);
+    vec![
+        ("fsm 4-8a", f4.clone(), fig8a()),
+        ("fsm 4-8b", f4.clone(), fig8b()),
+        ("fsm 4-8c", f4.clone(), fig8c()),
+        ("fsm 4-8d", f4.clone(), f8d.clone()),
+        ("fsm 4-8e", f4.clone(), fig8e()),
+        ("fsm 4-9b", f4.clone(), fig9b()),
+        ("fsm 8d-15", f8d.clone(), fig15_fsm()),
+        ("fsm 2-4", fig2(), f4.clone()),
+        ("fsm 10-11", fig10(), f8d.clone()),
+        ("fsm scal-16b", scal_fsm().build(), fig16b()),
+        ("bt 1-7a", bt(fig1()), bt(fig7a())),
+        ("bt 1-7b", bt(fig1()), bt(fig7b())),
+        ("bt 1-7c", bt(fig1()), bt(fig7c())),
+        ("bt 1-7d", bt(fig1()), bt(fig7d())),
+        ("bt 7d-15", bt(fig7d()), bt(fig15_bt())),
+        ("bt scal-16a", bt(scal_bt()), bt(fig16a())),
+        ("hfsm 1-7a", hf(fig1()), hf(fig7a())),
+        ("hfsm 1-7b", hf(fig1()), hf(fig7b())),
+        ("hfsm 1-7c", hf(fig1()), hf(fig7c())),
+        ("hfsm 1-7d", hf(fig1()), hf(fig7d())),
+        ("hfsm 7d-15", hf(fig7d()), hf(fig15_bt())),
+        ("hfsm scal-16a", hf(scal_bt()), hf(fig16a())),
+    ]
+}
+
+/// Arcs of `g` listed one per arc.
+fn arc_list(g: &GedGraph) -> Vec<(usize, usize)> {
+    let mut arcs = Vec::new();
+    for &(t, h, m) in g.arcs() {
+        for _ in 0..m {
+            arcs.push((t as usize, h as usize));
+        }
+    }
+    arcs
+}
+
+/// `g` with `k` arcs re-routed to random heads.
+fn rerouted(g: &GedGraph, k: usize, rng: &mut Rng) -> GedGraph {
+    let mut arcs = arc_list(g);
+    for _ in 0..k {
+        if arcs.is_empty() {
+            break;
+        }
+        let i = rng.below(arcs.len() as u64) as usize;
+        arcs[i].1 = rng.below(g.n() as u64) as usize;
+    }
+    GedGraph::new(g.labels().to_vec(), g.keys().to_vec(), arcs).expect("valid")
+}
+
+/// The larger paper FSM and HFSM with a few arcs re-routed.
+fn stress_pairs() -> Vec<Pair> {
+    let mut rng = Rng(7);
+    let mut v = Vec::new();
+    for k in [2usize, 4, 8] {
+        v.push((
+            "fsm 16b rerouted",
+            scal_fsm().build(),
+            rerouted(&fig16b(), k, &mut rng),
+        ));
+        let h = hfsm_graph(&fig16a());
+        v.push((
+            "hfsm 16a rerouted",
+            hfsm_graph(&scal_bt()),
+            rerouted(&h, k, &mut rng),
+        ));
+    }
+    v
+}
+
+/// Random multigraphs, and random graphs against perturbed relabelled copies.
+fn random_pairs() -> Vec<Pair> {
+    let mut rng = Rng(99);
+    let mut v = Vec::new();
+    let sizes = [
+        (8, 24, 0),
+        (10, 30, 0),
+        (12, 36, 0),
+        (15, 45, 0),
+        (25, 100, 6),
+        (25, 100, 12),
+        (25, 100, 20),
+        (40, 160, 10),
+    ];
+    for &(n, m, k) in &sizes {
+        for _ in 0..3 {
+            let a = random_graph(&mut rng, n, m, 3, "a");
+            if k == 0 {
+                let b = random_graph(&mut rng, n, m, 3, "b");
+                v.push(("random", a, b));
+            } else {
+                let b = rerouted(&a, k, &mut rng);
+                v.push(("perturbed copy", a, permuted(&b, &mut rng)));
+            }
+        }
+    }
+    v
+}
+
+/// Random trees against relabelled copies with k subtrees moved and k
+/// leaves added.
+fn tree_pairs() -> Vec<Pair> {
+    let mut rng = Rng(1234);
+    let mut v = Vec::new();
+    let tree = |parent: &[usize], labels: &[u32]| {
+        GedGraph::new(
+            labels.to_vec(),
+            keys(parent.len(), "t"),
+            (1..parent.len()).map(|i| (parent[i], i)),
+        )
+        .expect("valid")
+    };
+    for &(n, k) in &[
+        (20usize, 2usize),
+        (20, 4),
+        (40, 2),
+        (40, 4),
+        (40, 8),
+        (80, 4),
+        (80, 8),
+    ] {
+        for _ in 0..3 {
+            let mut parent: Vec<usize> = (0..n)
+                .map(|i| {
+                    if i == 0 {
+                        0
+                    } else {
+                        rng.below(i as u64) as usize
+                    }
+                })
+                .collect();
+            let mut labels: Vec<u32> = (0..n).map(|_| rng.below(4) as u32).collect();
+            let a = tree(&parent, &labels);
+            for _ in 0..k {
+                // Parents precede children, so the subtree of v is the
+                // vertices after v whose parent is in it.
+                let v = 1 + rng.below(n as u64 - 1) as usize;
+                let mut inside = vec![false; parent.len()];
+                inside[v] = true;
+                for i in v + 1..parent.len() {
+                    inside[i] = inside[parent[i]];
+                }
+                let outside: Vec<usize> = (0..v).filter(|&i| !inside[i]).collect();
+                parent[v] = outside[rng.below(outside.len() as u64) as usize];
+                parent.push(rng.below(parent.len() as u64) as usize);
+                labels.push(rng.below(4) as u32);
+            }
+            v.push(("tree", a, permuted(&tree(&parent, &labels), &mut rng)));
+        }
+    }
+    v
+}
+
+/// Timing report: `GED_REPORT=paper,stress,random,trees cargo test --release
+/// --lib metrics::ged::tests::report -- --ignored --nocapture` (default
+/// `paper,stress`).
 #[test]
 #[ignore]
 fn report() {
-    let f4 = fig4().build();
-    let f8d = fig8d_fsm().build();
-    let pairs: Vec<(&str, GedGraph, GedGraph)> = if std::env::var("GED_ONLY_STRESS").is_ok() {
-        vec![]
-    } else {
-        vec![
-            ("fsm 4-8a", f4.clone(), fig8a()),
-            ("fsm 4-8b", f4.clone(), fig8b()),
-            ("fsm 4-8c", f4.clone(), fig8c()),
-            ("fsm 4-8d", f4.clone(), f8d.clone()),
-            ("fsm 4-8e", f4.clone(), fig8e()),
-            ("fsm 4-9b", f4.clone(), fig9b()),
-            ("fsm 8d-15", f8d.clone(), fig15_fsm()),
-            ("fsm 2-4", fig2(), f4.clone()),
-            ("fsm 10-11", fig10(), f8d.clone()),
-            ("fsm scal-16b", scal_fsm().build(), fig16b()),
-            ("bt 1-7a", bt_graph(&fig1()), bt_graph(&fig7a())),
-            ("bt 1-7b", bt_graph(&fig1()), bt_graph(&fig7b())),
-            ("bt 1-7c", bt_graph(&fig1()), bt_graph(&fig7c())),
-            ("bt 1-7d", bt_graph(&fig1()), bt_graph(&fig7d())),
-            ("bt 7d-15", bt_graph(&fig7d()), bt_graph(&fig15_bt())),
-            ("bt scal-16a", bt_graph(&scal_bt()), bt_graph(&fig16a())),
-            ("hfsm 1-7a", hfsm_graph(&fig1()), hfsm_graph(&fig7a())),
-            ("hfsm 1-7b", hfsm_graph(&fig1()), hfsm_graph(&fig7b())),
-            ("hfsm 1-7c", hfsm_graph(&fig1()), hfsm_graph(&fig7c())),
-            ("hfsm 1-7d", hfsm_graph(&fig1()), hfsm_graph(&fig7d())),
-            ("hfsm 7d-15", hfsm_graph(&fig7d()), hfsm_graph(&fig15_bt())),
-            (
-                "hfsm scal-16a",
-                hfsm_graph(&scal_bt()),
-                hfsm_graph(&fig16a()),
-            ),
-        ]
-    };
-    let mut pairs = pairs;
-    // Stress: the paper's larger FSMs with a few arcs re-routed at random.
-    let mut rng = Rng(7);
-    for k in [2usize, 4, 8] {
-        for (name, base) in [("hfsm16a", hfsm_graph(&fig16a()))] {
-            let mut arcs: Vec<(usize, usize)> = Vec::new();
-            for &(t, h, m) in base.arcs() {
-                for _ in 0..m {
-                    arcs.push((t as usize, h as usize));
-                }
-            }
-            for _ in 0..k {
-                let i = rng.below(arcs.len() as u64) as usize;
-                arcs[i].1 = rng.below(base.n() as u64) as usize;
-            }
-            let g =
-                GedGraph::new(base.labels().to_vec(), base.keys().to_vec(), arcs).expect("valid");
-            let other = if name == "16b" {
-                scal_fsm().build()
-            } else {
-                hfsm_graph(&scal_bt())
-            };
-            pairs.push((
-                if name == "16b" {
-                    ["fsm16b~", "fsm16b~~", "fsm16b~~~"][k / 4]
-                } else {
-                    ["hfsm~", "hfsm~~", "hfsm~~~"][k / 4]
-                },
-                other,
-                g,
-            ));
-        }
-    }
-    if std::env::var("GED_RANDOM").is_ok() {
-        pairs.clear();
-        let mut rng = Rng(99);
-        for &(n, m, k) in &[
-            (8usize, 24usize, 0usize),
-            (10, 30, 0),
-            (12, 36, 0),
-            (15, 45, 0),
-            (25, 100, 6),
-            (25, 100, 12),
-            (25, 100, 20),
-            (40, 160, 10),
-        ] {
-            for _ in 0..3 {
-                let a = random_graph(&mut rng, n, m, 3, "a");
-                let b = if k == 0 {
-                    random_graph(&mut rng, n, m, 3, "b")
-                } else {
-                    let mut arcs: Vec<(usize, usize)> = Vec::new();
-                    for &(t, h, mm) in a.arcs() {
-                        for _ in 0..mm {
-                            arcs.push((t as usize, h as usize));
-                        }
-                    }
-                    for _ in 0..k {
-                        let i = rng.below(arcs.len() as u64) as usize;
-                        arcs[i].1 = rng.below(n as u64) as usize;
-                    }
-                    permuted(
-                        &GedGraph::new(a.labels().to_vec(), a.keys().to_vec(), arcs)
-                            .expect("valid"),
-                        &mut rng,
-                    )
-                };
-                pairs.push((["rand", "pert"][usize::from(k > 0)], a, b));
-            }
-        }
-    }
-    if std::env::var("GED_TREES").is_ok() {
-        pairs.clear();
-        let mut rng = Rng(1234);
-        for &(n, k) in &[
-            (20usize, 2usize),
-            (20, 4),
-            (40, 2),
-            (40, 4),
-            (40, 8),
-            (80, 4),
-            (80, 8),
-        ] {
-            for _ in 0..3 {
-                let mut parent: Vec<usize> = (0..n)
-                    .map(|i| {
-                        if i == 0 {
-                            0
-                        } else {
-                            rng.below(i as u64) as usize
-                        }
-                    })
-                    .collect();
-                let labels: Vec<u32> = (0..n).map(|_| rng.below(4) as u32).collect();
-                let tree = |parent: &[usize], labels: &[u32]| {
-                    GedGraph::new(
-                        labels.to_vec(),
-                        keys(parent.len(), "t"),
-                        (1..parent.len()).map(|i| (parent[i], i)),
-                    )
-                    .expect("valid")
-                };
-                let a = tree(&parent, &labels);
-                let mut labels2 = labels.clone();
-                for _ in 0..k {
-                    // Move a random subtree under a random vertex outside it
-                    // (vertex ids are topological: parents precede children).
-                    let v = 1 + rng.below(n as u64 - 1) as usize;
-                    let mut inside = vec![false; parent.len()];
-                    inside[v] = true;
-                    for i in v + 1..parent.len() {
-                        inside[i] = inside[parent[i]];
-                    }
-                    let outside: Vec<usize> = (0..v).filter(|&i| !inside[i]).collect();
-                    parent[v] = outside[rng.below(outside.len() as u64) as usize];
-                    // and add a leaf
-                    let at = rng.below(parent.len() as u64) as usize;
-                    parent.push(at);
-                    labels2.push(rng.below(4) as u32);
-                }
-                let b = permuted(&tree(&parent, &labels2), &mut rng);
-                pairs.push(("tree", a, b));
-            }
-        }
+    let which = std::env::var("GED_REPORT").unwrap_or_else(|_| "paper,stress".into());
+    let mut pairs = Vec::new();
+    for part in which.split(',') {
+        pairs.extend(match part.trim() {
+            "paper" => paper_pairs(),
+            "stress" => stress_pairs(),
+            "random" => random_pairs(),
+            "trees" => tree_pairs(),
+            _ => Vec::new(),
+        });
     }
     let o = GedOptions::default();
     for (name, a, b) in &pairs {
@@ -989,7 +1011,7 @@ fn report() {
             let t = std::time::Instant::now();
             let r = ged_graphs(a, b, mode, &o);
             println!(
-                "{name:14} {:10} {:>3}/{:<4} vs {:>3}/{:<4}: ged {:3} exact {:5} [{}, {}] {:8.2} ms",
+                "{name:18} {:10} {:>3}/{:<4} vs {:>3}/{:<4}: ged {:3} exact {:5} [{}, {}] {:8.2} ms",
                 mode.as_str(),
                 a.n(),
                 a.arc_count(),
@@ -1007,18 +1029,39 @@ fn report() {
                 } else {
                     (a.clone(), b.clone())
                 };
-                let swap = orientation_key(&ub) < orientation_key(&ua);
-                let p = if swap {
-                    problem::Problem::new(&ub, &ua)
-                } else {
-                    problem::Problem::new(&ua, &ub)
-                };
+                let o2 = Oriented::new(&ua, &ub);
                 let lim = search::Limits {
                     deadline: std::time::Instant::now() + o.timeout,
                     max_expansions: o.max_expansions,
                 };
-                let out = search::solve(&p, &lim, None);
-                println!("      count {} {:?}", p.count_bound(), out.stats);
+                let out = search::solve(&o2.p, &lim, None);
+                println!("    count bound {}, {:?}", o2.p.count_bound(), out.stats);
+            }
+        }
+    }
+}
+
+#[test]
+#[ignore]
+fn budget_overshoot_report() {
+    let mut rng = Rng(0xB16_6EA9);
+    for &(n, m) in &[(200usize, 800usize), (1000, 4000), (3000, 9000)] {
+        let a = random_graph(&mut rng, n, m, 4, "a");
+        let b = random_graph(&mut rng, n, m, 4, "b");
+        for ms in [0u64, 200] {
+            let o = GedOptions {
+                timeout: Duration::from_millis(ms),
+                max_expansions: u64::MAX,
+            };
+            for mode in [GedMode::Structural, GedMode::Labeled] {
+                let t = std::time::Instant::now();
+                let r = ged_graphs(&a, &b, mode, &o);
+                println!(
+                    "n {n} budget {ms} ms {mode:?}: [{}, {}] in {:.1} ms",
+                    r.lower_bound,
+                    r.upper_bound,
+                    t.elapsed().as_secs_f64() * 1e3
+                );
             }
         }
     }
