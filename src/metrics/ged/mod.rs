@@ -1,21 +1,36 @@
 //! Graph edit distance (paper sec. IV-A 2, Eq. 2; SPEC §3) between two policy
-//! graphs: directed multigraphs with self-loops, unit costs (vertex and arc
-//! insertion/deletion 1, substitution 0).
+//! graphs: directed multigraphs with self-loops and parallel arcs, unit costs
+//! (vertex and arc insertion/deletion 1, substitution 0). For a vertex
+//! mapping f, the cost is the vertices deleted and inserted, plus
+//! Σ |mult_a(u, w) − mult_b(f u, f w)| over ordered pairs of mapped vertices
+//! (self-loops are the pairs (u, u)), plus every arc at a deleted or inserted
+//! vertex.
 //!
 //! Three modes:
 //! - `Structural`: the minimum over all vertex mappings — what NetworkX's
 //!   `graph_edit_distance` computes by default, which the paper used, but with
-//!   self-loops and parallel arcs scored correctly (NetworkX issues #5400,
-//!   #8188). Exact by branch and bound (`search.rs`) after an embedding fast
-//!   path (`embed.rs`); under a time or expansion budget the result is a
-//!   certified interval `[lower_bound, upper_bound]` with `exact = false`.
-//! - `Labeled`: the same, but a vertex maps only to a vertex of the same type.
-//! - `Named`: vertices map by key; linear time, always exact.
+//!   self-loops scored correctly (NetworkX issues #5400, #8188). NP-hard:
+//!   exact by an embedding fast path (`embed.rs`) and a branch and bound
+//!   with assignment lower bounds (`search.rs`); when the time or expansion
+//!   budget runs out, a certified interval `[lower_bound, upper_bound]` with
+//!   `exact = false`, never a guess.
+//! - `Labeled`: the same, but a vertex maps only to a vertex of the same
+//!   type.
+//! - `Named`: vertices map by key; linear time (plus sorting the script),
+//!   always exact.
 //!
-//! Every mode returns the edit script of the mapping it found (`script.rs`).
-//! The value does not depend on argument order: the search always starts from
-//! the smaller graph (a canonical orientation), and the script is turned back
-//! to read a → b.
+//! Every mode returns the edit script of the mapping it found (`script.rs`),
+//! whose cost is `upper_bound`. The search always starts from a canonical
+//! orientation of the pair (fewer vertices first, then a total order on the
+//! graphs), so `ged(a, b)` and `ged(b, a)` run the same search; the script
+//! is turned back to read a → b.
+//!
+//! Files: `graph.rs` the compact graph; `problem.rs` the padded instance and
+//! its cost; `embed.rs` the count-bound fast path; `lsap.rs` linear
+//! assignment; `local.rs` 2-swap local search; `wl.rs` Weisfeiler–Lehman
+//! tie-breaking; `search.rs` the branch and bound; `script.rs` edit scripts
+//! and the named mapping; `brute.rs` and `tests.rs` the test oracle and
+//! tests.
 
 mod embed;
 mod graph;
@@ -61,13 +76,22 @@ impl GedMode {
     }
 }
 
-/// Budgets for the exact search (`Structural` and `Labeled`).
+/// Budgets for the exact search (`Structural` and `Labeled`; `Named` needs
+/// none).
+///
+/// Memory does not grow with either budget: with n the larger vertex count,
+/// the search holds two n × n tables (4 + 1 bytes per entry) and a stack of
+/// at most n frames of O(n) words. Above 2048 vertices no search is made
+/// (the count bound and a local-search mapping are returned).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GedOptions {
-    /// Wall-clock budget; the search stops at the first check past it.
+    /// Wall-clock budget, checked at every search node and inside long
+    /// loops; overshoot is a few milliseconds on graphs of a few hundred
+    /// vertices.
     pub timeout: Duration,
-    /// Bound on branch-and-bound nodes expanded (each holds O(n) memory on a
-    /// stack of depth at most n, on top of one n × n table).
+    /// Bound on branch-and-bound nodes expanded. Structural GED on labeled
+    /// graphs may run up to three searches (see `structural`), each with a
+    /// third of both budgets.
     pub max_expansions: u64,
 }
 
@@ -196,7 +220,10 @@ struct Oriented {
 
 impl Oriented {
     fn new(a: &GedGraph, b: &GedGraph) -> Oriented {
-        let swap = orientation_key(b) < orientation_key(a);
+        let (ka, kb) = (orientation_key(a), orientation_key(b));
+        // Equal keys: fall back on the raw data, so that (a, b) and (b, a)
+        // always run the same search.
+        let swap = kb < ka || (kb == ka && (b.labels(), b.arcs()) < (a.labels(), a.arcs()));
         let p = if swap {
             Problem::new(b, a)
         } else {
@@ -279,7 +306,8 @@ impl Oriented {
 type OrientationKey = (usize, u64, Vec<(u32, u64, u64, u32)>);
 
 /// Canonical orientation: the graph with fewer vertices (then fewer arcs, then
-/// the smaller degree/label signature) is searched from.
+/// the smaller degree/label signature, then the smaller raw data) is searched
+/// from.
 fn orientation_key(g: &GedGraph) -> OrientationKey {
     let n = g.n();
     let mut out = vec![0u64; n];

@@ -204,6 +204,8 @@ struct Bnb<'a> {
     sim_top: u8,
     /// Scale of local costs in the assignment matrices (see `ClassLsap`).
     scale: i64,
+    /// Degree of each G1 vertex.
+    deg1: Vec<u64>,
 }
 
 impl<'a> Bnb<'a> {
@@ -255,6 +257,7 @@ impl<'a> Bnb<'a> {
             scale: n as i64 * i64::from(sim_top) + 1,
             sim,
             sim_top,
+            deg1: (0..n).map(|u| p.s1.degree(u)).collect(),
         }
     }
 
@@ -439,7 +442,7 @@ impl<'a> Bnb<'a> {
                 if self.f[u] != NONE || p.s1.is_dummy(u as u32) {
                     continue;
                 }
-                let key = (self.row[u], p.s1.degree(u), u);
+                let key = (self.row[u], self.deg1[u], u);
                 let better = match pick {
                     None => true,
                     Some(k) => (key.0, key.1) > (k.0, k.1),
@@ -649,7 +652,7 @@ impl<'a> Bnb<'a> {
                     viable += usize::from(ok);
                 }
                 let uu = u as usize;
-                let cand = (viable, self.row[uu], p.s1.degree(uu));
+                let cand = (viable, self.row[uu], self.deg1[uu]);
                 // Forced vertices (at most one viable child) first, then the
                 // most arcs to the mapped part, then fewest children, then
                 // highest degree.
