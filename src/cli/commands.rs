@@ -75,6 +75,20 @@ pub fn execute(cli: Cli) -> u8 {
             };
             let policy = match to {
                 ConvertTarget::Toml => l.policy,
+                ConvertTarget::FaultTolerant => {
+                    match crate::transform::fault_tolerant::fault_tolerant_policy(&l.policy) {
+                        Ok(p) => p,
+                        Err(errs) => {
+                            for e in errs {
+                                eprintln!(
+                                    "error: {}: {e}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
+                                    l.path
+                                );
+                            }
+                            return EXIT_BAD_INPUT;
+                        }
+                    }
+                }
                 ConvertTarget::Hfsm => {
                     match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
                         Ok(p) => p,
@@ -92,17 +106,24 @@ pub fn execute(cli: Cli) -> u8 {
             let text = crate::format::toml_write::write_policy(&policy);
             emit(output.as_deref(), text.as_bytes())
         }
+        Command::Effort {
+            files,
+            format,
+            limits,
+        } => super::paper::effort(&files, format, &limits.limits()),
+        Command::Paper(args) => super::paper::paper(&args),
+        Command::Edit(args) => super::edit::edit(&args),
     }
 }
 
 /// Loads one file (see [`load_all`]).
-fn load_one(file: &Path, limits: &Limits) -> Option<Loaded> {
+pub(super) fn load_one(file: &Path, limits: &Limits) -> Option<Loaded> {
     load_all(&[file.to_path_buf()], limits).and_then(|mut v| v.pop())
 }
 
 /// Loads every file, printing all diagnostics (warnings too); `None` when any
 /// file has an error.
-fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>> {
+pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>> {
     let mut out = Vec::new();
     let mut failed = false;
     let stderr = std::io::stderr();
@@ -139,7 +160,7 @@ fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
 }
 
 /// Writes output to a file (atomically) or stdout.
-fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
+pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
     match path {
         Some(p) => match report::write_atomically(p, bytes) {
             Ok(()) => EXIT_OK,

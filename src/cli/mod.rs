@@ -4,6 +4,8 @@
 
 pub mod args;
 mod commands;
+mod edit;
+mod paper;
 
 use clap::Parser;
 use std::ffi::OsString;

@@ -1,3 +1,4 @@
 //! Transformations between representations (the paper's constructions).
 
 pub mod bt_to_hfsm;
+pub mod fault_tolerant;
