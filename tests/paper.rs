@@ -317,3 +317,110 @@ fn convert_to_fault_tolerant_writes_a_valid_reactive_fsm() {
     assert!(stderr.contains("flat FSMs"), "{stderr}");
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
+
+fn counts(file: &str) -> (u64, u64) {
+    let (code, stdout, stderr) = btfsm(&["analyze", file, "--format", "json"]);
+    assert_eq!(code, 0, "{stderr}");
+    let j: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    let p = &j["policies"][0];
+    (
+        p["vertices"].as_u64().expect("vertices"),
+        p["edges"].as_u64().expect("edges"),
+    )
+}
+
+#[test]
+fn edit_commands_rebuild_fig07c_and_fig08a() {
+    let dir = temp_dir("edit");
+    let wrapped = dir.join("wrapped.toml").display().to_string();
+    let fig07c = dir.join("fig07c.toml").display().to_string();
+    let (code, _, stderr) = btfsm(&[
+        "edit",
+        "policies/paper/fig01-bt.toml",
+        "wrap-root",
+        "--kind",
+        "sequence",
+        "--id",
+        "root",
+        "-o",
+        &wrapped,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("(2 unit edits)"), "{stderr}");
+    let (code, _, stderr) = btfsm(&[
+        "edit",
+        &wrapped,
+        "insert-subtree",
+        "--parent",
+        "root",
+        "--subtree",
+        "policies/paper/lib/dock.toml",
+        "-o",
+        &fig07c,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("(6 unit edits)"), "{stderr}");
+    assert_eq!(counts(&fig07c), (18, 17));
+
+    let fig08a = dir.join("fig08a.toml").display().to_string();
+    let (code, _, stderr) = btfsm(&[
+        "edit",
+        "policies/paper/fig04-fsm.toml",
+        "add-state",
+        "--kind",
+        "sequential",
+        "--name",
+        "Tuck arm",
+        "--after",
+        "Pick cube2",
+        "--skill",
+        "Tuck-Arm",
+        "--selector-guard",
+        "In-Hand(object=cube2) & not Arm-Tucked",
+        "-o",
+        &fig08a,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("+5 -1 (7 unit edits)"), "{stderr}");
+    assert_eq!(counts(&fig08a), (7, 22));
+    let (code, _, stderr) = btfsm(&["effort", &fig08a, "--format", "json"]);
+    assert_eq!(code, 0, "{stderr}");
+
+    // Wrong kind of policy, bad guard: exit 2, no file written.
+    let bad = dir.join("bad.toml");
+    let bad_s = bad.display().to_string();
+    let (code, _, stderr) = btfsm(&[
+        "edit",
+        "policies/paper/fig01-bt.toml",
+        "add-state",
+        "--kind",
+        "connected",
+        "--name",
+        "Recharge",
+        "--skill",
+        "Recharge",
+        "-o",
+        &bad_s,
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("add-state edits fsms"), "{stderr}");
+    let (code, _, stderr) = btfsm(&[
+        "edit",
+        "policies/paper/fig04-fsm.toml",
+        "add-state",
+        "--kind",
+        "connected",
+        "--name",
+        "Recharge",
+        "--skill",
+        "Recharge",
+        "--guard",
+        "not Battery-Lvl(min=20)",
+        "-o",
+        &bad_s,
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("unknown skill `Battery-Lvl`"), "{stderr}");
+    assert!(!bad.exists());
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
