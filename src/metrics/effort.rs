@@ -100,15 +100,8 @@ pub fn effort(p: &Policy, opts: &GedOptions) -> (Effort, Option<Policy>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::{Limits, load};
-    use std::path::Path;
 
-    fn paper(name: &str) -> Policy {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("policies/paper")
-            .join(format!("{name}.toml"));
-        load(&p, &Limits::default()).expect("paper policy").policy
-    }
+    use crate::transform::paper_policy as paper;
 
     #[test]
     fn formula_and_named_ged_agree_on_the_papers_examples() {

@@ -588,30 +588,13 @@ pub fn parse_value(v: &str) -> ArgValue {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::{Limits, load};
-    use crate::graph::policy_graph;
-    use crate::metrics::ged::{GedMode, GedOptions, ged};
+    use crate::format::Limits;
     use crate::model::{Policy, PolicyBody};
     use std::path::Path;
 
-    fn paper(name: &str) -> Policy {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("policies/paper")
-            .join(format!("{name}.toml"));
-        load(&p, &Limits::default())
-            .unwrap_or_else(|d| panic!("{name}: {d:?}"))
-            .policy
-    }
+    use crate::transform::paper_policy as paper;
 
-    fn named(a: &Policy, b: &Policy) -> u64 {
-        ged(
-            &policy_graph(a),
-            &policy_graph(b),
-            GedMode::Named,
-            &GedOptions::default(),
-        )
-        .ged
-    }
+    use crate::transform::named_ged as named;
 
     fn bt(p: &mut Policy) -> &mut Bt {
         match &mut p.body {

@@ -255,21 +255,21 @@ pub fn fault_tolerant(m: &StateMachine) -> Result<StateMachine, Vec<FaultToleran
         let st = &mut out.states[c];
         st.transitions
             .retain(|t| !matches!(t.target, Target::State(j) if det.sequential.contains(&j)));
-        if !has_outcome(st, RUNNING) {
-            st.transitions.push(outcome(RUNNING, Target::State(c)));
-        }
         if !has_outcome(st, SUCCESS) {
             st.transitions.push(outcome(SUCCESS, Target::State(sel)));
+        }
+        if !has_outcome(st, RUNNING) {
+            st.transitions.push(outcome(RUNNING, Target::State(c)));
         }
     }
     // Sequential states: RUNNING -> itself, FAILURE -> SELECTOR.
     for &s in &det.sequential {
         let st = &mut out.states[s];
-        if !has_outcome(st, RUNNING) {
-            st.transitions.push(outcome(RUNNING, Target::State(s)));
-        }
         if !has_outcome(st, FAILURE) {
             st.transitions.push(outcome(FAILURE, Target::State(sel)));
+        }
+        if !has_outcome(st, RUNNING) {
+            st.transitions.push(outcome(RUNNING, Target::State(s)));
         }
     }
 
@@ -382,17 +382,10 @@ pub fn fault_tolerant(m: &StateMachine) -> Result<StateMachine, Vec<FaultToleran
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::format::{Limits, load};
-    use crate::graph::policy_graph;
-    use crate::metrics::ged::{GedMode, GedOptions, ged};
+    use crate::format::Limits;
     use std::path::Path;
 
-    fn paper(name: &str) -> Policy {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("policies/paper")
-            .join(format!("{name}.toml"));
-        load(&p, &Limits::default()).expect("paper policy").policy
-    }
+    use crate::transform::paper_policy as paper;
 
     fn machine(p: &Policy) -> &StateMachine {
         match &p.body {
@@ -401,15 +394,7 @@ mod tests {
         }
     }
 
-    fn named(a: &Policy, b: &Policy) -> u64 {
-        ged(
-            &policy_graph(a),
-            &policy_graph(b),
-            GedMode::Named,
-            &GedOptions::default(),
-        )
-        .ged
-    }
+    use crate::transform::named_ged as named;
 
     #[test]
     fn eq4_and_eq5_agree() {
