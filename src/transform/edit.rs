@@ -405,6 +405,21 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
                     new.transitions.push(t.clone());
                 }
             }
+            if spec.kind == AddKind::Sequential
+                && let Some(s) = selector
+                && spec.selector_guard.is_none()
+            {
+                return Err(err(
+                    format!(
+                        "the SELECTOR `{}` needs a guard to resume the task at `{}`",
+                        m.states[s].name, spec.name
+                    ),
+                    Some(
+                        "give --selector-guard, e.g. 'In-Hand(object=cube2) & not Arm-Tucked'"
+                            .into(),
+                    ),
+                ));
+            }
             let fail = outcome_target(&pred, "FAILURE").cloned();
             let running = outcome_target(&pred, "RUNNING").cloned();
             if spec.kind == AddKind::Sequential {
@@ -438,20 +453,8 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
             touched.transitions_added += 1 + new.transitions.len();
             touched.transitions_removed += 1;
             if spec.kind == AddKind::Sequential
-                && let Some(s) = selector
+                && let (Some(s), Some(g)) = (selector, &spec.selector_guard)
             {
-                let Some(g) = &spec.selector_guard else {
-                    return Err(err(
-                        format!(
-                            "the SELECTOR `{}` needs a guard to resume the task at `{}`",
-                            m.states[s].name, spec.name
-                        ),
-                        Some(
-                            "give --selector-guard, e.g. 'In-Hand(object=cube2) & not Arm-Tucked'"
-                                .into(),
-                        ),
-                    ));
-                };
                 let k = spec.selector_guard_index.unwrap_or_else(|| {
                     m.states[s]
                         .transitions
@@ -766,6 +769,7 @@ mod tests {
         );
         let e = add_state(fsm(&mut f), &s).unwrap_err();
         assert!(e.message.contains("needs a guard"), "{e}");
+        assert_eq!(f, paper("fig04-fsm"), "a refused edit changes nothing");
         let s = spec(AddKind::Sequential, "X", Some("Pick cube2"), "Fly");
         assert!(
             add_state(fsm(&mut f), &s)
@@ -804,5 +808,68 @@ mod tests {
         );
         assert_eq!(parse_value("0.5"), ArgValue::Float(0.5));
         assert_eq!(parse_value("true"), ArgValue::Bool(true));
+    }
+
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+        /// Law: the unit edits an edit sequence reports are the named GED
+        /// it causes, and the result is a valid policy file.
+        #[test]
+        fn bt_edit_counts_are_the_named_ged(ops in proptest::collection::vec((0usize..64, 0usize..8, 0usize..4), 1..5)) {
+            let subs = ["tuck-arm", "safe-move-to", "dock", "recharge"].map(sub);
+            let orig = paper("fig01-bt");
+            let mut p = orig.clone();
+            let mut edits = 0;
+            for (k, (parent, index, which)) in ops.into_iter().enumerate() {
+                let b = bt(&mut p);
+                let controls: Vec<usize> = (0..b.nodes.len()).filter(|&i| b.nodes[i].kind.is_control()).collect();
+                let parent = controls[parent % controls.len()];
+                let id = b.nodes[parent].id.clone();
+                let index = index % (b.nodes[parent].children.len() + 1);
+                let before = p.clone();
+                let t = insert_subtree(bt(&mut p), &id, Some(index), &subs[which], Some(&format!("e{k}"))).unwrap();
+                prop_assert_eq!(t.edits() as u64, named(&before, &p));
+                edits += t.edits();
+            }
+            // Insertions never cancel out.
+            prop_assert_eq!(edits as u64, named(&orig, &p));
+            let text = crate::format::toml_write::write_policy(&p);
+            prop_assert!(crate::format::toml::parse_str("e.toml", &text, Path::new("."), &Limits::default()).is_ok());
+        }
+
+        #[test]
+        fn fsm_edit_counts_are_the_named_ged(ops in proptest::collection::vec((0usize..64, 0usize..3), 1..5)) {
+            let orig = paper("fig04-fsm");
+            let mut p = orig.clone();
+            let mut edits = 0;
+            for (k, (after, kind)) in ops.into_iter().enumerate() {
+                let m = fsm(&mut p);
+                let actions: Vec<String> = m.top.states.iter()
+                    .filter(|&&i| matches!(m.states[i].body, StateBody::Task(_)))
+                    .map(|&i| m.states[i].name.clone())
+                    .collect();
+                let kind = [AddKind::Sequential, AddKind::Alternative, AddKind::Connected][kind];
+                let mut s = spec(kind, &format!("S{k}"), Some(&actions[after % actions.len()]), "Dock");
+                s.guard = Some(parse_guard("not Battery-Level(min=20)", None).unwrap());
+                s.selector_guard = Some(parse_guard("Robot-At(target=inspection)", None).unwrap());
+                let before = p.clone();
+                match add_state(fsm(&mut p), &s) {
+                    // Each edit's count is the named GED of that step.
+                    Ok(t) => {
+                        prop_assert_eq!(t.edits() as u64, named(&before, &p));
+                        edits += t.edits();
+                    }
+                    // A refused edit changes nothing.
+                    Err(_) => prop_assert_eq!(&before, &p),
+                }
+            }
+            // Edits of a sequence may cancel out (an arc re-routed twice).
+            prop_assert!(edits as u64 >= named(&orig, &p));
+            let text = crate::format::toml_write::write_policy(&p);
+            prop_assert!(crate::format::toml::parse_str("e.toml", &text, Path::new("."), &Limits::default()).is_ok());
+        }
     }
 }
