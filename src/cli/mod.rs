@@ -4,6 +4,7 @@
 
 pub mod args;
 mod commands;
+mod compare;
 
 use clap::Parser;
 use std::ffi::OsString;
