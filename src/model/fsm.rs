@@ -118,27 +118,15 @@ impl StateMachine {
         for o in &self.top.outcomes {
             *uses.entry(o.as_str()).or_default() += 1;
         }
-        // Parents before children, without recursion.
         let mut key: Vec<Option<String>> = vec![None; n];
-        for i in 0..n {
-            let mut chain = Vec::new();
-            let mut cur = Some(i);
-            while let Some(c) = cur {
-                if key[c].is_some() {
-                    break;
+        for c in self.parents_first() {
+            let name = &self.states[c].name;
+            key[c] = Some(match self.states[c].parent {
+                Some(p) if uses[name.as_str()] > 1 => {
+                    format!("{}/{name}", key[p].as_deref().unwrap_or_default())
                 }
-                chain.push(c);
-                cur = self.states[c].parent;
-            }
-            for &c in chain.iter().rev() {
-                let name = &self.states[c].name;
-                key[c] = Some(match self.states[c].parent {
-                    Some(p) if uses[name.as_str()] > 1 => {
-                        format!("{}/{name}", key[p].as_deref().unwrap_or_default())
-                    }
-                    _ => name.clone(),
-                });
-            }
+                _ => name.clone(),
+            });
         }
         let mut key: Vec<String> = key.into_iter().map(Option::unwrap_or_default).collect();
         let mut seen: HashMap<&str, usize> = HashMap::with_capacity(n);
@@ -160,6 +148,20 @@ impl StateMachine {
             }
         }
         key
+    }
+
+    /// Every state once, each container before the states it holds (breadth
+    /// first from the top region; no recursion, whatever the nesting depth).
+    pub fn parents_first(&self) -> Vec<StateIdx> {
+        let mut order: Vec<StateIdx> = self.top.states.clone();
+        let mut i = 0;
+        while let Some(&s) = order.get(i) {
+            if let StateBody::Container(r) = &self.states[s].body {
+                order.extend_from_slice(&r.states);
+            }
+            i += 1;
+        }
+        order
     }
 
     /// Path of names from the top level, joined with `/` (unique in the machine).
@@ -234,6 +236,7 @@ mod tests {
             ["A", "A/Move", "Pick", "B", "B/Move", "C", "C/Move"]
         );
         assert_eq!(m.path(6), "B/C/Move");
+        assert_eq!(m.parents_first(), [0, 3, 1, 2, 4, 5, 6]);
     }
 
     #[test]

@@ -586,22 +586,10 @@ impl<'o> Builder<'o> {
     fn machine(&mut self, m: &StateMachine) {
         let n = m.states.len();
         // Nesting levels, parents before children, without recursion.
-        let mut level: Vec<Option<usize>> = vec![None; n];
-        for i in 0..n {
-            let mut chain = Vec::new();
-            let mut cur = Some(i);
-            while let Some(c) = cur {
-                if level[c].is_some() {
-                    break;
-                }
-                chain.push(c);
-                cur = m.states[c].parent;
-            }
-            for &c in chain.iter().rev() {
-                level[c] = Some(m.states[c].parent.map_or(0, |p| level[p].unwrap_or(0) + 1));
-            }
+        let mut level = vec![0usize; n];
+        for c in m.parents_first() {
+            level[c] = m.states[c].parent.map_or(0, |p| level[p] + 1);
         }
-        let level: Vec<usize> = level.into_iter().map(Option::unwrap_or_default).collect();
         // Vertices are identified by the graph's keys (SPEC §3 identity),
         // so that highlights and ghosts given by key find them.
         let key: Vec<String> = m.keys();

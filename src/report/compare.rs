@@ -532,6 +532,14 @@ mod tests {
     use crate::format::toml::parse_str;
     use std::path::Path;
 
+    fn pair<'a>(a: &'a Policy, b: &'a Policy) -> Pair<'a> {
+        let side = |policy| Side {
+            file: "test.toml",
+            policy,
+        };
+        Pair::new(side(a), side(b))
+    }
+
     fn policy(src: &str) -> Policy {
         parse_str("test.toml", src, Path::new(""), &Default::default())
             .expect("valid")
@@ -573,16 +581,7 @@ on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
     #[test]
     fn named_script_tells_arcs_apart_by_label() {
         let (pa, pb) = (policy(A), policy(B));
-        let pair = Pair::new(
-            Side {
-                file: "a.toml",
-                policy: &pa,
-            },
-            Side {
-                file: "b.toml",
-                policy: &pb,
-            },
-        );
+        let pair = pair(&pa, &pb);
         let m = pair.run(GedMode::Named, &GedOptions::default());
         let s = &m.edit_script;
         assert_eq!(m.ged, s.cost());
@@ -620,16 +619,7 @@ on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
             "FAILURE = \"Go\", RUNNING = \"Pick\"",
         );
         let (pa, pb) = (policy(A), policy(&b));
-        let pair = Pair::new(
-            Side {
-                file: "a",
-                policy: &pa,
-            },
-            Side {
-                file: "b",
-                policy: &pb,
-            },
-        );
+        let pair = pair(&pa, &pb);
         let m = pair.run(GedMode::Named, &GedOptions::default());
         // Go -> Go loses its RUNNING arc; Go -> Pick gains one (now 2 arcs).
         assert_eq!(m.ged, 2);
@@ -649,16 +639,7 @@ on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
         // Structurally, b's `Safe` may take a's place under another key; a
         // removed vertex whose key b also uses must be drawn apart.
         let (pa, pb) = (policy(B), policy(A));
-        let pair = Pair::new(
-            Side {
-                file: "a",
-                policy: &pa,
-            },
-            Side {
-                file: "b",
-                policy: &pb,
-            },
-        );
+        let pair = pair(&pa, &pb);
         for mode in [GedMode::Structural, GedMode::Named] {
             let m = pair.run(mode, &GedOptions::default());
             let o = pair.dot_options(&m.edit_script);
