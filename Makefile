@@ -3,7 +3,7 @@ CARGO ?= cargo
 BIN := target/release/btfsm
 POLICIES := $(wildcard policies/paper/*.toml)
 
-.PHONY: build run test bench clean paper-docs
+.PHONY: build run test bench bench-ged clean paper-docs
 
 build:
 	$(CARGO) build --release --locked
@@ -33,6 +33,10 @@ paper-docs:
 
 bench: build
 	$(CARGO) bench --locked
+
+# btfsm vs NetworkX on the same GED pairs, in one run (docs/performance.md).
+bench-ged:
+	python3 bench/ged_vs_networkx.py
 
 clean:
 	rm -rf out

@@ -47,6 +47,32 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
+    /// Graph edit distance between two policies, with the edit script
+    Compare {
+        /// The old policy
+        a: PathBuf,
+        /// The new policy
+        b: PathBuf,
+        /// Which GED: structural (any vertex to any vertex), labeled (same
+        /// vertex type only), named (by node id / state name), or all three
+        #[arg(long, value_enum, default_value_t = CompareMode::All)]
+        mode: CompareMode,
+        /// Time budget per mode for the exact search; when it runs out the
+        /// result is a certified interval with `exact: false`
+        #[arg(long, default_value_t = 2000, value_name = "MS")]
+        timeout_ms: u64,
+        #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
+        format: CompareFormat,
+        /// Also draw B with added elements red and A's removed ones dashed grey
+        /// (the edit script of --mode; named when all modes run)
+        #[arg(long, value_name = "OUT")]
+        dot: Option<PathBuf>,
+        /// With --dot: render through Graphviz instead of writing DOT
+        #[arg(long, value_enum, requires = "dot")]
+        render: Option<crate::render::dot::RenderFormat>,
+        #[command(flatten)]
+        limits: LimitArgs,
+    },
     /// Converts a policy into another representation
     Convert {
         file: PathBuf,
@@ -72,6 +98,33 @@ pub enum Command {
     Paper(PaperArgs),
     /// The paper's edit operations: insert a BT subtree, add an FSM state
     Edit(Box<EditArgs>),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompareMode {
+    Structural,
+    Labeled,
+    Named,
+    All,
+}
+
+impl CompareMode {
+    /// The single GED mode selected, or `None` for all three.
+    pub fn selection(self) -> Option<crate::metrics::ged::GedMode> {
+        use crate::metrics::ged::GedMode;
+        match self {
+            CompareMode::Structural => Some(GedMode::Structural),
+            CompareMode::Labeled => Some(GedMode::Labeled),
+            CompareMode::Named => Some(GedMode::Named),
+            CompareMode::All => None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompareFormat {
+    Table,
+    Json,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

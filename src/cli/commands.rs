@@ -46,24 +46,27 @@ pub fn execute(cli: Cli) -> u8 {
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let dot = crate::render::dot::policy_dot(&l.policy, &Default::default());
-            match render {
-                None => emit(output.as_deref(), dot.as_bytes()),
-                Some(fmt) => match crate::render::dot::render(&dot, fmt) {
-                    Ok(bytes) => {
-                        if output.is_none() && fmt != crate::render::dot::RenderFormat::Svg {
-                            eprintln!("error: {fmt} output is binary; write it to a file with -o");
-                            return EXIT_BAD_INPUT;
-                        }
-                        emit(output.as_deref(), &bytes)
-                    }
-                    Err(e) => {
-                        eprintln!("error: {e}");
-                        EXIT_BAD_INPUT
-                    }
-                },
-            }
+            draw(&l.policy, &Default::default(), output.as_deref(), render)
         }
+        Command::Compare {
+            a,
+            b,
+            mode,
+            timeout_ms,
+            format,
+            dot,
+            render,
+            limits,
+        } => super::compare::execute(super::compare::CompareArgs {
+            a,
+            b,
+            mode,
+            timeout_ms,
+            format,
+            dot,
+            render,
+            limits: limits.limits(),
+        }),
         Command::Convert {
             file,
             to,
@@ -113,6 +116,32 @@ pub fn execute(cli: Cli) -> u8 {
         } => super::paper::effort(&files, format, &limits.limits()),
         Command::Paper(args) => super::paper::paper(&args),
         Command::Edit(args) => super::edit::edit(&args),
+    }
+}
+
+/// Draws a policy as DOT, or renders it through Graphviz, to `output` or
+/// stdout.
+pub(super) fn draw(
+    policy: &crate::model::Policy,
+    opts: &crate::render::dot::DotOptions,
+    output: Option<&Path>,
+    render: Option<crate::render::dot::RenderFormat>,
+) -> u8 {
+    use crate::render::dot::{self, RenderFormat};
+    let text = dot::policy_dot(policy, opts);
+    let Some(fmt) = render else {
+        return emit(output, text.as_bytes());
+    };
+    if output.is_none() && fmt != RenderFormat::Svg {
+        eprintln!("error: {fmt} output is binary; write it to a file with -o");
+        return EXIT_BAD_INPUT;
+    }
+    match dot::render(&text, fmt) {
+        Ok(bytes) => emit(output, &bytes),
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
     }
 }
 

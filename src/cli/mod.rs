@@ -4,6 +4,7 @@
 
 pub mod args;
 mod commands;
+mod compare;
 mod edit;
 mod paper;
 

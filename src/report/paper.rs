@@ -289,24 +289,6 @@ fn graph(p: &Policy) -> PolicyGraph {
     policy_graph(p)
 }
 
-/// The graph of an HFSM converted from a BT, with every state keyed by its
-/// name (the BT node id, unique in the tree) instead of its path, so that
-/// `named` GED still matches a node after a new root is put above it (Figs.
-/// 7c, 7d): the path of every state changes, its identity does not.
-fn hfsm_graph_by_name(p: &Policy) -> PolicyGraph {
-    let mut g = graph(p);
-    if let PolicyBody::Machine(m) = &p.body {
-        for (i, s) in m.states.iter().enumerate() {
-            let v = &mut g.g[petgraph::graph::NodeIndex::new(i)];
-            // `machine_graph` adds one vertex per state first, in order.
-            if v.key == m.path(i) {
-                v.key = s.name.clone();
-            }
-        }
-    }
-    g
-}
-
 fn m_fc(p: &Policy) -> usize {
     match &p.body {
         PolicyBody::Machine(m) => fully_connected_states(m).len(),
@@ -523,12 +505,7 @@ pub fn build(
         }
         if let (Some(a), Some(b)) = (&base_h, inp.hfsm(bt)) {
             let s = g2(a, &b, GedMode::Structural);
-            let n = ged(
-                &hfsm_graph_by_name(a),
-                &hfsm_graph_by_name(&b),
-                GedMode::Named,
-                opts,
-            );
+            let n = g2(a, &b, GedMode::Named);
             rows.push(row(
                 "Table II",
                 name,
