@@ -82,6 +82,11 @@ fn paper_check_names_the_cell_a_policy_edit_changes() {
         "{stderr}"
     );
     assert!(stderr.contains("--record"), "{stderr}");
+    // A broken policy file is bad input (exit 2, positioned message).
+    std::fs::write(copy.join("fig04-fsm.toml"), "kind = \"fsm\"\nname = [\n").expect("write");
+    let (code, _, stderr) = btfsm(&["paper", "--check", "--policies", &copy_s]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("fig04-fsm.toml:"), "{stderr}");
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
 
