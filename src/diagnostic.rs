@@ -12,6 +12,9 @@ pub struct SourceFile {
     /// The path as the user gave it (or as an include resolved it).
     pub path: String,
     pub text: String,
+    /// Byte offset of each line's start, computed on first use, so that
+    /// positioning many messages in a large file stays linear.
+    line_starts: std::sync::OnceLock<Vec<usize>>,
 }
 
 impl SourceFile {
@@ -19,22 +22,37 @@ impl SourceFile {
         Arc::new(SourceFile {
             path: path.into(),
             text: text.into(),
+            line_starts: std::sync::OnceLock::new(),
+        })
+    }
+
+    fn line_starts(&self) -> &[usize] {
+        self.line_starts.get_or_init(|| {
+            std::iter::once(0)
+                .chain(self.text.match_indices('\n').map(|(i, _)| i + 1))
+                .collect()
         })
     }
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: usize) -> (usize, usize) {
-        let offset = offset.min(self.text.len());
-        let before = &self.text[..floor_char_boundary(&self.text, offset)];
-        let line = before.matches('\n').count() + 1;
-        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-        let col = before[line_start..].chars().count() + 1;
+        let offset = floor_char_boundary(&self.text, offset.min(self.text.len()));
+        let starts = self.line_starts();
+        let line = starts.partition_point(|&s| s <= offset);
+        let line_start = starts[line - 1];
+        let col = self.text[line_start..offset].chars().count() + 1;
         (line, col)
     }
 
     /// The text of a 1-based line, without its newline.
     pub fn line_text(&self, line: usize) -> &str {
-        self.text.lines().nth(line.saturating_sub(1)).unwrap_or("")
+        let starts = self.line_starts();
+        let Some(&start) = starts.get(line.saturating_sub(1)) else {
+            return "";
+        };
+        let end = starts.get(line).map_or(self.text.len(), |&e| e - 1);
+        let text = &self.text[start..end];
+        text.strip_suffix('\r').unwrap_or(text)
     }
 }
 
@@ -173,13 +191,34 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
+/// Candidates [`suggest`] compares at most.
+pub const SUGGEST_SCAN: usize = 5_000;
+/// Longest name (in characters) [`suggest`] computes an edit distance for.
+pub const SUGGEST_MAX_CHARS: usize = 128;
+
 /// A hint naming the closest candidate, or listing the valid ones.
+///
+/// Bounded work whatever the input: only the first [`SUGGEST_SCAN`]
+/// candidates are compared, and only names of at most [`SUGGEST_MAX_CHARS`]
+/// characters (longer ones are not typos of each other).
 pub fn suggest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -> String {
-    let cands: Vec<&str> = candidates.into_iter().collect();
-    let best = cands
-        .iter()
-        .map(|c| (edit_distance(&wrong.to_lowercase(), &c.to_lowercase()), *c))
-        .min();
+    let mut cands: Vec<&str> = candidates.into_iter().take(SUGGEST_SCAN + 1).collect();
+    let more_than_scanned = cands.len() > SUGGEST_SCAN;
+    cands.truncate(SUGGEST_SCAN);
+    let wrong_chars = wrong.chars().count();
+    let best = if wrong_chars <= SUGGEST_MAX_CHARS {
+        let lower = wrong.to_lowercase();
+        cands
+            .iter()
+            .filter(|c| {
+                c.len() <= 4 * SUGGEST_MAX_CHARS
+                    && c.chars().count().abs_diff(wrong_chars) <= (wrong_chars / 3).max(2)
+            })
+            .map(|c| (edit_distance(&lower, &c.to_lowercase()), *c))
+            .min()
+    } else {
+        None
+    };
     match best {
         Some((d, c)) if d <= (wrong.chars().count() / 3).max(2) => {
             format!("did you mean `{c}`?")
@@ -187,7 +226,9 @@ pub fn suggest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -
         _ if cands.is_empty() => "nothing is defined here".to_string(),
         _ => {
             let shown: Vec<String> = cands.iter().take(12).map(|c| format!("`{c}`")).collect();
-            let more = if cands.len() > 12 {
+            let more = if more_than_scanned {
+                " (and more)".to_string()
+            } else if cands.len() > 12 {
                 format!(" (and {} more)", cands.len() - 12)
             } else {
                 String::new()

@@ -9,6 +9,8 @@
 pub mod cli;
 pub mod diagnostic;
 pub mod format;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod graph;
 pub mod metrics;
 pub mod model;

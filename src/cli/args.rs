@@ -140,12 +140,18 @@ pub enum ConvertTarget {
 /// Input limits (documented defaults; see `format::Limits`).
 #[derive(Debug, Clone, Args)]
 pub struct LimitArgs {
-    /// Largest input file, in bytes
-    #[arg(long, default_value_t = 64 * 1024 * 1024, hide_short_help = true)]
+    /// Largest input file, in bytes (also the total read through subtree includes)
+    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_FILE_BYTES, hide_short_help = true)]
     pub max_file_bytes: u64,
     /// Most BT nodes or FSM states per policy, subtrees expanded
-    #[arg(long, default_value_t = 2_000_000, hide_short_help = true)]
+    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_NODES, hide_short_help = true)]
     pub max_nodes: usize,
+    /// Deepest BT or HFSM nesting (the root is at depth 0)
+    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_DEPTH, hide_short_help = true)]
+    pub max_depth: usize,
+    /// Longest node id, state name, display name or label, in bytes
+    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_NAME_BYTES, hide_short_help = true)]
+    pub max_name_bytes: usize,
 }
 
 impl LimitArgs {
@@ -153,6 +159,8 @@ impl LimitArgs {
         crate::format::Limits {
             max_file_bytes: self.max_file_bytes,
             max_nodes: self.max_nodes,
+            max_depth: self.max_depth,
+            max_name_bytes: self.max_name_bytes,
             ..Default::default()
         }
     }

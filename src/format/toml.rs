@@ -8,7 +8,7 @@
 //! with `{ subtree = "file.toml", with = { param = "value" } }`.
 
 use super::{Limits, Loaded};
-use crate::diagnostic::{Diagnostic, SourceFile, suggest};
+use crate::diagnostic::{Diagnostic, SourceFile};
 use crate::model::bt::{Arity, BtNode, BtNodeKind, NODE_KEYWORDS};
 use crate::model::skill::{self, ArgValue, Guard, GuardTerm, SkillCall, SkillKind};
 use crate::model::{
@@ -29,7 +29,7 @@ pub const TASK_OUTCOMES: &[&str] = &["SUCCESS", "FAILURE", "RUNNING"];
 /// Reads and validates a TOML policy file.
 pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
-    let file = read_source(path, &shown, limits)?;
+    let file = read_source(path, &shown, limits, false)?;
     let base = path.parent().unwrap_or(Path::new(""));
     load_source(&file, canonical(path), base, limits)
 }
@@ -58,9 +58,40 @@ fn load_source(
         stack: vec![identity],
         diags: Vec::new(),
         node_budget: limits.max_nodes,
+        include_bytes: limits.max_file_bytes,
+        includes: HashMap::new(),
+        dropped_errors: 0,
+        dropped_warnings: 0,
+        scratch: Diagnostic::error(""),
     };
-    let policy = loader.policy(file, base);
-    let (errors, warnings) = sorted_partition(loader.diags);
+    let mut policy = loader.policy(file, base);
+    if let Some(mut d) = policy.as_ref().and_then(|p| super::check_shape(p, limits)) {
+        d.file = Some(file.clone());
+        if d.span.is_none() {
+            d.span = Some(0..0);
+        }
+        loader.diags.push(d);
+        policy = None;
+    }
+    let (mut errors, mut warnings) = sorted_partition(loader.diags);
+    if loader.dropped_errors > 0 {
+        errors.push(
+            Diagnostic::error(format!(
+                "{} more errors not shown (the first {MAX_DIAGNOSTICS} messages are)",
+                loader.dropped_errors
+            ))
+            .in_file(file),
+        );
+    }
+    if loader.dropped_warnings > 0 {
+        warnings.push(
+            Diagnostic::warning(format!(
+                "{} more warnings not shown",
+                loader.dropped_warnings
+            ))
+            .in_file(file),
+        );
+    }
     match policy {
         Some(policy) if errors.is_empty() => Ok(Loaded {
             path: file.path.clone(),
@@ -97,34 +128,52 @@ fn read_source(
     path: &Path,
     shown: &str,
     limits: &Limits,
+    include: bool,
 ) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
-    let meta = std::fs::metadata(path).map_err(|e| {
+    use std::io::Read;
+    let cannot = |e: std::io::Error| {
         vec![Diagnostic::error(format!(
             "cannot read `{shown}`: {}",
             io_msg(&e)
         ))]
-    })?;
+    };
+    let meta = std::fs::metadata(path).map_err(cannot)?;
     if meta.is_dir() {
         return Err(vec![Diagnostic::error(format!(
             "cannot read `{shown}`: it is a directory"
         ))]);
     }
-    if meta.len() > limits.max_file_bytes {
+    // A subtree is a file; a device or pipe could block or never end.
+    if include && !meta.is_file() {
         return Err(vec![
+            Diagnostic::error(format!("cannot read `{shown}`: not a regular file"))
+                .hint("a subtree is a policy file"),
+        ]);
+    }
+    let too_big = |len: Option<u64>| {
+        let size = len.map_or_else(|| "larger than".into(), |n| format!("{n} bytes, more than"));
+        vec![
             Diagnostic::error(format!(
-                "`{shown}` is {} bytes, more than the limit of {} bytes",
-                meta.len(),
+                "`{shown}` is {size} the limit of {} bytes",
                 limits.max_file_bytes
             ))
             .hint("raise the limit with --max-file-bytes"),
-        ]);
+        ]
+    };
+    if meta.len() > limits.max_file_bytes {
+        return Err(too_big(Some(meta.len())));
     }
-    let bytes = std::fs::read(path).map_err(|e| {
-        vec![Diagnostic::error(format!(
-            "cannot read `{shown}`: {}",
-            io_msg(&e)
-        ))]
-    })?;
+    // Read at most one byte past the limit: pipes and devices report no size.
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| {
+            f.take(limits.max_file_bytes.saturating_add(1))
+                .read_to_end(&mut bytes)
+        })
+        .map_err(cannot)?;
+    if bytes.len() as u64 > limits.max_file_bytes {
+        return Err(too_big(None));
+    }
     match String::from_utf8(bytes) {
         Ok(text) => Ok(SourceFile::new(shown, text)),
         Err(e) => {
@@ -148,6 +197,9 @@ fn io_msg(e: &std::io::Error) -> String {
     }
 }
 
+/// An included file (canonical path) with its `with` values.
+type IncludeKey = (PathBuf, Vec<(String, String)>);
+
 struct Loader {
     limits: Limits,
     /// Canonical paths of the files being read (for include cycles).
@@ -155,7 +207,22 @@ struct Loader {
     diags: Vec<Diagnostic>,
     /// Nodes that may still be created before the node limit is hit.
     node_budget: usize,
+    /// Bytes that subtree includes may still read (each include counts, so
+    /// that a file included many times cannot multiply the work).
+    include_bytes: u64,
+    /// Subtrees already read, by file and `with` values: a file included
+    /// 2^k times through k levels is read k times, not 2^k.
+    includes: HashMap<IncludeKey, Option<Bt>>,
+    /// Messages past [`MAX_DIAGNOSTICS`], counted, not kept.
+    dropped_errors: usize,
+    dropped_warnings: usize,
+    scratch: Diagnostic,
 }
+
+/// Most messages kept per policy file (with its includes); the rest are
+/// counted in one last message, so that a file with a million bad lines is
+/// reported in bounded time.
+pub const MAX_DIAGNOSTICS: usize = 200;
 
 /// Per-file reading context.
 struct Ctx<'a> {
@@ -219,15 +286,51 @@ fn float_of(v: &DeValue<'_>) -> Option<f64> {
 
 impl Loader {
     fn err(&mut self, cx: &Ctx<'_>, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
-        self.diags.push(Diagnostic::error(msg).at(cx.file, span));
-        self.diags.last_mut().expect("just pushed")
+        self.push(Diagnostic::error(msg).at(cx.file, span))
     }
 
     fn warn(&mut self, cx: &Ctx<'_>, span: Range<usize>, msg: impl Into<String>) {
-        self.diags.push(Diagnostic::warning(msg).at(cx.file, span));
+        self.push(Diagnostic::warning(msg).at(cx.file, span));
+    }
+
+    /// Keeps a message, or past [`MAX_DIAGNOSTICS`] counts it (the returned
+    /// slot is then a scratch one).
+    fn push(&mut self, d: Diagnostic) -> &mut Diagnostic {
+        if self.diags.len() >= MAX_DIAGNOSTICS {
+            if d.is_error() {
+                self.dropped_errors += 1;
+            } else {
+                self.dropped_warnings += 1;
+            }
+            self.scratch = d;
+            return &mut self.scratch;
+        }
+        self.diags.push(d);
+        self.diags.last_mut().expect("just pushed")
+    }
+
+    /// A did-you-mean hint; once messages are only counted (past
+    /// [`MAX_DIAGNOSTICS`]) none is computed.
+    fn suggest<'a>(&self, wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -> String {
+        if self.diags.len() >= MAX_DIAGNOSTICS {
+            return String::new();
+        }
+        crate::diagnostic::suggest(wrong, candidates)
+    }
+
+    /// Messages so far, kept or not.
+    fn problems(&self) -> usize {
+        self.diags.len() + self.dropped_errors + self.dropped_warnings
+    }
+
+    fn any_error(&self) -> bool {
+        self.dropped_errors > 0 || self.diags.iter().any(Diagnostic::is_error)
     }
 
     fn hint_last(&mut self, hint: impl Into<String>) {
+        if self.dropped_errors + self.dropped_warnings > 0 {
+            return;
+        }
         if let Some(d) = self.diags.last_mut() {
             d.hint = Some(hint.into());
         }
@@ -237,14 +340,23 @@ impl Loader {
     fn parse_doc<'i>(&mut self, file: &'i Arc<SourceFile>) -> Option<Spanned<DeTable<'i>>> {
         let (doc, errors) = DeTable::parse_recoverable(&file.text);
         if errors.is_empty() {
-            return Some(doc);
+            return self.names_within_limit(file, &doc).then_some(doc);
         }
         let mut last_dup_line = None;
+        let mut seen = std::collections::HashSet::new();
         for e in errors.iter().take(20) {
             let span = e.span().unwrap_or(0..0);
             let msg = e.message().trim().trim_end_matches('.').to_string();
+            if !seen.insert((span.start, msg.clone())) {
+                continue;
+            }
             let (line, _) = file.line_col(span.start);
-            let (msg, hint) = if msg.starts_with("duplicate key") {
+            let (msg, hint) = if msg.contains("recursion") {
+                (
+                    "invalid TOML: tables, arrays or dotted keys nested too deeply".to_string(),
+                    "the TOML reader accepts at most 80 levels of nesting (an HFSM's `[states.a.states.b...]` headers about 39 containers)",
+                )
+            } else if msg.starts_with("duplicate key") {
                 // The keys of a duplicated table repeat too: report the table once.
                 if last_dup_line.is_some_and(|l| line <= l + 1) {
                     last_dup_line = Some(line);
@@ -266,6 +378,56 @@ impl Loader {
                 .push(Diagnostic::error(msg).at(file, span).hint(hint));
         }
         None
+    }
+
+    /// Checks the length of every key and string (but descriptions) against
+    /// `max_name_bytes`, walking the document with an explicit stack.
+    fn names_within_limit(&mut self, file: &Arc<SourceFile>, doc: &Spanned<DeTable<'_>>) -> bool {
+        let max = self.limits.max_name_bytes;
+        let mut found = 0;
+        let mut report = |diags: &mut Vec<Diagnostic>, what: &str, text: &str, span| {
+            found += 1;
+            if found <= 20 {
+                let mut shown: String = text.chars().take(24).collect();
+                if shown.len() < text.len() {
+                    shown.push('…');
+                }
+                diags.push(
+                    Diagnostic::error(format!(
+                        "{what} `{shown}` is {} bytes long, more than the limit of {max} bytes",
+                        text.len()
+                    ))
+                    .at(file, span)
+                    .hint("shorten it, or raise the limit with --max-name-bytes"),
+                );
+            }
+        };
+        let mut stack: Vec<&Val<'_>> = Vec::new();
+        let mut tables: Vec<&DeTable<'_>> = vec![doc.get_ref()];
+        loop {
+            if let Some(t) = tables.pop() {
+                for (k, v) in t.iter() {
+                    if k.get_ref().len() > max {
+                        report(&mut self.diags, "key", k.get_ref(), k.span());
+                    }
+                    if k.get_ref() != "description" {
+                        stack.push(v);
+                    }
+                }
+            } else if let Some(v) = stack.pop() {
+                match v.get_ref() {
+                    DeValue::String(text) if text.len() > max => {
+                        report(&mut self.diags, "string", text, v.span());
+                    }
+                    DeValue::Table(t) => tables.push(t),
+                    DeValue::Array(a) => stack.extend(a.iter()),
+                    _ => {}
+                }
+            } else {
+                break;
+            }
+        }
+        found == 0
     }
 
     fn policy(&mut self, file: &Arc<SourceFile>, base: &Path) -> Option<Policy> {
@@ -323,7 +485,7 @@ impl Loader {
             Some("fsm") => Some("fsm"),
             Some("hfsm") => Some("hfsm"),
             Some(other) => {
-                let h = suggest(other, ["bt", "fsm", "hfsm"]);
+                let h = self.suggest(other, ["bt", "fsm", "hfsm"]);
                 self.err(cx, v.span(), format!("unknown policy kind `{other}`"))
                     .hint = Some(h);
                 None
@@ -343,7 +505,7 @@ impl Loader {
     fn check_keys(&mut self, cx: &Ctx<'_>, t: &DeTable<'_>, allowed: &[&str], what: &str) {
         for (k, _) in t.iter() {
             if !allowed.contains(&k.get_ref().as_ref()) {
-                let h = suggest(k.get_ref(), allowed.iter().copied());
+                let h = self.suggest(k.get_ref(), allowed.iter().copied());
                 self.err(cx, k.span(), format!("unknown {what} `{}`", k.get_ref()))
                     .hint = Some(h);
             }
@@ -416,7 +578,7 @@ impl Loader {
                     Some(k) => skill::skill_names(k),
                     None => skill::SKILLS.iter().map(|s| s.0).collect(),
                 };
-                let h = suggest(&name, cands.iter().copied());
+                let h = self.suggest(&name, cands.iter().copied());
                 self.err(cx, sv.span(), format!("unknown skill `{name}` in {owner}"))
                     .hint = Some(h);
                 return None;
@@ -473,7 +635,7 @@ impl Loader {
                     let h = if params.is_empty() {
                         format!("`{name}` takes no arguments")
                     } else {
-                        suggest(k.get_ref(), params.iter().map(|p| p.0))
+                        self.suggest(k.get_ref(), params.iter().map(|p| p.0))
                     };
                     self.err(
                         cx,
@@ -585,7 +747,7 @@ impl Loader {
                 Some(s) => match index.get(s) {
                     Some(&i) => i,
                     None => {
-                        let h = suggest(s, ids.iter().map(|(k, _)| *k));
+                        let h = self.suggest(s, ids.iter().map(|(k, _)| *k));
                         self.err(cx, r.span(), format!("unknown node `{s}` given as `root`"))
                             .hint = Some(h);
                         return None;
@@ -645,7 +807,7 @@ impl Loader {
             for (c, span) in &raw.children {
                 match index.get(c.as_str()) {
                     None => {
-                        let h = suggest(c, ids.iter().map(|(k, _)| *k));
+                        let h = self.suggest(c, ids.iter().map(|(k, _)| *k));
                         self.err(
                             cx,
                             span.clone(),
@@ -720,8 +882,8 @@ impl Loader {
         }
         // Unreachable nodes (no parent and not the root), when the tree is
         // otherwise sound (a broken node makes its children look unreachable).
-        let sound = !self.diags.iter().any(Diagnostic::is_error)
-            && raws.iter().all(|r| r.kind.is_some() || r.include.is_some());
+        let sound =
+            !self.any_error() && raws.iter().all(|r| r.kind.is_some() || r.include.is_some());
         for (i, (id, span)) in ids.iter().enumerate() {
             if sound && i != root && parent[i].is_none() {
                 self.warn(
@@ -787,9 +949,7 @@ impl Loader {
                 );
             }
         }
-        if self.diags.iter().any(Diagnostic::is_error)
-            || raws.iter().any(|r| r.kind.is_none() && r.include.is_none())
-        {
+        if self.any_error() || raws.iter().any(|r| r.kind.is_none() && r.include.is_none()) {
             return None;
         }
 
@@ -829,6 +989,8 @@ impl Loader {
                         for c in &mut n.children {
                             *c += offset;
                         }
+                        // Spans are positions in this file.
+                        n.span = None;
                         out.push(n);
                     }
                     new_index[i] = offset + sub.root;
@@ -895,7 +1057,7 @@ impl Loader {
             let k_str: &str = k.get_ref();
             if !NODE_KEYWORDS.contains(&k_str) && !FIELDS.contains(&k_str) {
                 unknown_keys = true;
-                let h = suggest(k_str, NODE_KEYWORDS.iter().chain(FIELDS).copied());
+                let h = self.suggest(k_str, NODE_KEYWORDS.iter().chain(FIELDS).copied());
                 self.err(
                     cx,
                     k.span(),
@@ -1098,8 +1260,51 @@ impl Loader {
             );
             return None;
         }
+        let with: Vec<(String, String)> = match t.get("with").map(|w| w.get_ref()) {
+            Some(DeValue::Table(wt)) => wt
+                .iter()
+                .map(|(k, v)| (k.get_ref().to_string(), cx.subst(&scalar_text(v.get_ref()))))
+                .collect(),
+            Some(other) => vec![(String::new(), type_name(other).to_string())],
+            None => Vec::new(),
+        };
+        let key = (canon.clone(), with);
+        if let Some(done) = self.includes.get(&key) {
+            // Read before: its problems are reported already.
+            let size = done.as_ref()?.nodes.len();
+            if size > self.node_budget {
+                self.err(
+                    cx,
+                    tval.span(),
+                    format!(
+                        "more than {} nodes with the subtrees expanded",
+                        self.limits.max_nodes
+                    ),
+                )
+                .hint = Some("raise the limit with --max-nodes".into());
+                return None;
+            }
+            self.node_budget -= size;
+            return done.clone();
+        }
+        let bt = self.read_include(cx, id, t, rel, &path, canon);
+        self.includes.insert(key, bt.clone());
+        bt
+    }
+
+    /// Reads an included subtree file the first time (see [`Self::include`]).
+    fn read_include(
+        &mut self,
+        cx: &Ctx<'_>,
+        id: &str,
+        t: &DeTable<'_>,
+        rel: &str,
+        path: &Path,
+        canon: PathBuf,
+    ) -> Option<Bt> {
+        let tval = t.get("subtree").expect("a subtree node");
         let shown = path.display().to_string();
-        let file = match read_source(&path, &shown, &self.limits) {
+        let file = match read_source(path, &shown, &self.limits, true) {
             Ok(f) => f,
             Err(mut ds) => {
                 let msg = ds.remove(0).message;
@@ -1107,6 +1312,20 @@ impl Loader {
                 return None;
             }
         };
+        let len = file.text.len() as u64;
+        if len > self.include_bytes {
+            self.err(
+                cx,
+                tval.span(),
+                format!(
+                    "subtree includes read more than {} bytes in total",
+                    self.limits.max_file_bytes
+                ),
+            )
+            .hint = Some("raise the limit with --max-file-bytes".into());
+            return None;
+        }
+        self.include_bytes -= len;
         let doc = self.parse_doc(&file)?;
         let sub_table = doc.get_ref();
         let sub_cx0 = Ctx {
@@ -1159,7 +1378,7 @@ impl Loader {
                             let h = if declared.is_empty() {
                                 format!("`{rel}` declares no `[params]`")
                             } else {
-                                suggest(k.get_ref(), declared)
+                                self.suggest(k.get_ref(), declared)
                             };
                             self.err(
                                 cx,
@@ -1316,9 +1535,9 @@ impl Loader {
                 } else {
                     &["label", "skill", "args", "decision", "on", "guards"]
                 };
-                let before = self.diags.len();
+                let before = self.problems();
                 self.check_keys(cx, st, allowed, &format!("field of state `{name}`"));
-                if self.diags.len() > before {
+                if self.problems() > before {
                     ok = false;
                 }
                 let label = self
@@ -1482,7 +1701,7 @@ impl Loader {
                     Some(s) => match local.iter().find(|(n, _, _)| n == s) {
                         Some((_, idx, _)) => region.initial = *idx,
                         None => {
-                            let h = suggest(s, local.iter().map(|(n, _, _)| n.as_str()));
+                            let h = self.suggest(s, local.iter().map(|(n, _, _)| n.as_str()));
                             self.err(
                                 cx,
                                 iv.span(),
@@ -1530,7 +1749,7 @@ impl Loader {
                         StateBody::Decision => "decision state",
                         StateBody::Task(_) => "state",
                     };
-                    let h = suggest(o, valid_outcomes.iter().map(String::as_str));
+                    let h = self.suggest(o, valid_outcomes.iter().map(String::as_str));
                     // Point at the key: the span we have is the value's; say so by message.
                     self.err(
                         cx,
@@ -1552,7 +1771,7 @@ impl Loader {
                         .map(|&t| m.states[t].name.as_str())
                         .chain(region.outcomes.iter().map(String::as_str))
                         .collect();
-                    let h = suggest(&target, cands);
+                    let h = self.suggest(&target, cands);
                     self.err(
                         cx,
                         span,
@@ -1644,14 +1863,14 @@ impl Loader {
             );
             return None;
         };
-        let before = self.diags.len();
+        let before = self.problems();
         self.check_keys(
             cx,
             t,
             &["if", "unless", "args", "all", "to", "label"],
             &format!("field of a guard of `{state}`"),
         );
-        if self.diags.len() > before {
+        if self.problems() > before {
             return None;
         }
         let owner = format!("guard of `{state}`");
@@ -1683,14 +1902,14 @@ impl Loader {
                         );
                         return None;
                     };
-                    let before = self.diags.len();
+                    let before = self.problems();
                     self.check_keys(
                         cx,
                         it,
                         &["if", "unless", "args"],
                         &format!("field of a condition of a {owner}"),
                     );
-                    if self.diags.len() > before {
+                    if self.problems() > before {
                         return None;
                     }
                     terms.push(self.guard_term(cx, it, item.span(), &owner)?);
@@ -1866,21 +2085,11 @@ mod tests {
         include_str!("../../policies/paper/scal-bt.toml"),
     ];
 
-    /// Everything downstream of a successful parse must work on it too.
+    /// Everything downstream of a successful parse must work on it too (the
+    /// fuzz targets' harness: graph, metrics, DOT, write-back fixpoint,
+    /// transforms, effort).
     fn exercise(l: &Loaded) {
-        let g = crate::graph::policy_graph(&l.policy);
-        let _ = crate::metrics::complexity::cyclomatic(&g);
-        let _ = crate::metrics::complexity::essential(&l.policy);
-        let _ = crate::report::analyze(l);
-        let text = crate::format::toml_write::write_policy(&l.policy);
-        if !text.contains("subtree") {
-            // Spans differ; the written form is a fixpoint.
-            let again = parse(&text).expect("written TOML reads back");
-            assert_eq!(crate::format::toml_write::write_policy(&again.policy), text);
-        }
-        if let Ok(h) = crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
-            let _ = crate::metrics::complexity::essential(&h);
-        }
+        crate::fuzzing::exercise(l);
     }
 
     #[test]
@@ -1979,6 +2188,29 @@ mod tests {
                     let _ = d.to_string();
                 }
             }
+        }
+
+        /// Arbitrary bytes through the fuzz target's body.
+        #[test]
+        fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..300)) {
+            crate::fuzzing::toml_policy(&bytes);
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 40, ..ProptestConfig::default() })]
+
+        /// Two mutated policies compared in every mode with a tiny budget: the
+        /// `compare` fuzz target's body (certified interval, script cost).
+        #[test]
+        fn mutated_pairs_compare_within_their_certificates(
+            a in 0..SEEDS.len(),
+            b in 0..SEEDS.len(),
+            ma in proptest::collection::vec(mutation(), 0..3),
+            mb in proptest::collection::vec(mutation(), 0..3),
+        ) {
+            let pair = format!("{}\n%%\n{}", apply(SEEDS[a], &ma), apply(SEEDS[b], &mb));
+            crate::fuzzing::compare(pair.as_bytes());
         }
     }
 }

@@ -166,6 +166,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".into());
     let tmp = dir.join(format!(".{name}.btfsm-{}.tmp", std::process::id()));
+    remove_stale_temporaries(&dir, &name);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -178,9 +179,56 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// Removes `.NAME.btfsm-PID.tmp` files beside the target left by runs that
+/// were killed between writing and renaming (the target itself is never
+/// half-written: the rename is atomic). Only temporaries of processes that
+/// no longer run are removed; where that cannot be told (no `/proc`), none.
+fn remove_stale_temporaries(dir: &Path, name: &str) {
+    let proc = Path::new("/proc/self");
+    if !proc.exists() {
+        return;
+    }
+    let prefix = format!(".{name}.btfsm-");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(pid) = file
+            .to_str()
+            .and_then(|f| f.strip_prefix(&prefix))
+            .and_then(|r| r.strip_suffix(".tmp"))
+            .filter(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
+        else {
+            continue;
+        };
+        if !Path::new("/proc").join(pid).exists() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn stale_temporaries_of_dead_runs_are_removed() {
+        let dir = std::env::temp_dir().join(format!("btfsm-stale-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // No process has pid 4294967295 (above Linux's pid_max).
+        let dead = dir.join(".x.txt.btfsm-4294967295.tmp");
+        let mine = dir.join(format!(".y.txt.btfsm-{}.tmp", std::process::id()));
+        for f in [&dead, &mine] {
+            std::fs::write(f, b"partial").unwrap();
+        }
+        write_atomically(&dir.join("x.txt"), b"whole").unwrap();
+        if Path::new("/proc/self").exists() {
+            assert!(!dead.exists());
+        }
+        assert!(mine.exists(), "another target's temporary is kept");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn csv_quoting() {

@@ -1,0 +1,49 @@
+#!/bin/sh
+# Runs each fuzz target for FUZZ_SECONDS (default 600) with a per-input
+# timeout, seeding its corpus from the policies in the repository; the last
+# libFuzzer stats line of each run goes to fuzz/logs/TARGET.log. Crashes land
+# in fuzz/artifacts/TARGET/ (keep each as a regression test:
+# tests/fixtures/fuzz-regressions/, see docs/robustness.md).
+# Usage: fuzz/run.sh [TARGET...]   (default: every target in fuzz/Cargo.toml)
+set -eu
+cd "$(dirname "$0")"
+SECONDS_EACH=${FUZZ_SECONDS:-600}
+TIMEOUT=${FUZZ_TIMEOUT:-10}
+RSS=${FUZZ_RSS_MB:-2048}
+TARGETS=${*:-$(cargo +nightly fuzz list)}
+mkdir -p logs
+for t in $TARGETS; do
+  mkdir -p "corpus/$t"
+  case $t in
+    compare)
+      # Pairs of policies: each paper policy against the next one.
+      prev=""
+      for f in ../policies/paper/*.toml; do
+        [ -n "$prev" ] && { cat "$prev"; printf '\n%%%%\n'; cat "$f"; } > "corpus/$t/seed-$(basename "$f")"
+        prev=$f
+      done ;;
+    toml_policy)
+      for f in ../policies/paper/*.toml ../policies/paper/lib/*.toml ../tests/fixtures/valid/*.toml ../tests/fixtures/invalid/*.toml ../tests/fixtures/fuzz-regressions/*; do
+        [ -f "$f" ] && cp "$f" "corpus/$t/seed-$(basename "$f")"
+      done ;;
+    # Importers (add their seeds here): ../../shared/corpus/bt-xml, ../../shared/corpus/scxml
+    *)
+      for f in ../tests/fixtures/fuzz-regressions/*; do
+        [ -f "$f" ] && cp "$f" "corpus/$t/"
+      done ;;
+  esac
+  dict=""
+  [ -f "$t.dict" ] && dict="-dict=$t.dict"
+  case $t in toml_policy|compare) dict="-dict=toml.dict" ;; esac
+  echo "== fuzzing $t for ${SECONDS_EACH}s"
+  nice cargo +nightly fuzz run "$t" "corpus/$t" -- \
+    -max_total_time="$SECONDS_EACH" -timeout="$TIMEOUT" -rss_limit_mb="$RSS" \
+    -print_final_stats=1 $dict 2>&1 | tee "logs/$t.full.log" | grep -E '^#[0-9]+.*(DONE|pulse)|ERROR|crash|timeout' || true
+  grep -E '^#[0-9]+' "logs/$t.full.log" | tail -1 > "logs/$t.log"
+  grep -E '^(stat::|Done)' "logs/$t.full.log" >> "logs/$t.log" || true
+  cat "logs/$t.log"
+  if ls "artifacts/$t"/crash-* "artifacts/$t"/timeout-* "artifacts/$t"/oom-* >/dev/null 2>&1; then
+    echo "fuzz: $t found failing inputs in fuzz/artifacts/$t/" >&2
+    exit 1
+  fi
+done

@@ -1,0 +1,240 @@
+//! The no-panic harness (issue 7; SPEC §1 "bad input never panics"): drives
+//! arbitrary bytes through every stage of the pipeline — parse and validate,
+//! graph, metrics, analyze report, DOT, TOML write-back, the paper's
+//! transforms, effort and GED — and checks the laws that must hold on any
+//! input (a written policy reads back to itself; a GED result is a certified
+//! interval whose edit script costs its upper bound).
+//!
+//! It is the body of the coverage-guided fuzz targets in `fuzz/` (one line
+//! each) and of the no-panic property tests of the normal suite, so that what
+//! fuzzing finds is guarded by `cargo test`. A new input format gets one
+//! function here (bytes → `Loaded` → [`exercise`]) and a fuzz target calling
+//! it; see docs/robustness.md.
+
+use crate::diagnostic::Diagnostic;
+use crate::format::{Limits, Loaded};
+use crate::metrics::ged::{GedMode, GedOptions, GedResult};
+use crate::model::Policy;
+use crate::report::compare::{self, Pair, Side};
+use std::path::Path;
+use std::time::Duration;
+
+/// Small limits, so that every input runs in milliseconds.
+pub fn limits() -> Limits {
+    Limits {
+        max_file_bytes: 1 << 20,
+        max_nodes: 2_000,
+        max_include_depth: 8,
+        max_depth: 200,
+        max_name_bytes: 4096,
+    }
+}
+
+/// A tiny GED budget: the certificate must hold however early the search stops.
+pub fn ged_options() -> GedOptions {
+    GedOptions {
+        timeout: Duration::from_millis(20),
+        max_expansions: 2_000,
+    }
+}
+
+/// Where subtree includes of fuzzed policies resolve: the paper's policies,
+/// so that `subtree = "lib/dock.toml"` finds a file.
+fn include_base() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper"))
+}
+
+/// Parses bytes as a TOML policy; `None` when the bytes are not a policy (the
+/// diagnostics are checked and rendered).
+pub fn parse_toml(data: &[u8]) -> Option<Loaded> {
+    let text = std::str::from_utf8(data).ok()?;
+    let limits = limits();
+    match crate::format::toml::parse_str("fuzz.toml", text, include_base(), &limits) {
+        Ok(l) => Some(l),
+        Err(diags) => {
+            check_diagnostics(&diags);
+            None
+        }
+    }
+}
+
+/// Fuzz target `toml_policy`: any bytes through the TOML reader and, when
+/// they are a policy, through everything downstream.
+pub fn toml_policy(data: &[u8]) {
+    if let Some(l) = parse_toml(data) {
+        exercise(&l);
+    }
+}
+
+/// Splits one input into two at the first `\n%%\n`.
+pub fn split_pair(data: &[u8]) -> (&[u8], &[u8]) {
+    const SEP: &[u8] = b"\n%%\n";
+    match data.windows(SEP.len()).position(|w| w == SEP) {
+        Some(i) => (&data[..i], &data[i + SEP.len()..]),
+        None => (data, &[]),
+    }
+}
+
+/// Fuzz target `compare`: two policies split from one input (`A\n%%\nB`),
+/// compared in every mode with a tiny budget.
+pub fn compare(data: &[u8]) {
+    let (a, b) = split_pair(data);
+    let (Some(la), Some(lb)) = (parse_toml(a), parse_toml(b)) else {
+        return;
+    };
+    compare_policies(&la.policy, &lb.policy, &ged_options());
+}
+
+/// Every GED mode between two policies, with the report, the table, the JSON
+/// and the diff drawing; checks each certificate.
+pub fn compare_policies(a: &Policy, b: &Policy, opts: &GedOptions) {
+    let pair = Pair::new(
+        Side {
+            file: "a.toml",
+            policy: a,
+        },
+        Side {
+            file: "b.toml",
+            policy: b,
+        },
+    );
+    let mut reports = Vec::new();
+    for mode in compare::modes_of(None) {
+        let raw = crate::metrics::ged::ged(&pair_graph(a), &pair_graph(b), mode, opts);
+        check_ged(&raw, mode);
+        let r = pair.run(mode, opts);
+        assert!(r.lower_bound <= r.upper_bound, "{mode:?}: lower > upper");
+        assert_eq!(r.ged, r.upper_bound, "{mode:?}: ged is not the upper bound");
+        assert_eq!(
+            r.edit_script.cost(),
+            r.upper_bound,
+            "{mode:?}: the labelled script does not cost the upper bound"
+        );
+        reports.push(r);
+    }
+    let report = pair.report(reports);
+    let _ = compare::render_json(&report);
+    let _ = compare::render_table(&report);
+    if let Some(primary) = report.primary() {
+        let dot = pair.dot_options(&primary.edit_script);
+        let _ = crate::render::dot::policy_dot(b, &dot);
+    }
+}
+
+fn pair_graph(p: &Policy) -> crate::graph::PolicyGraph {
+    crate::graph::policy_graph(p)
+}
+
+/// The laws of a GED result: a certified interval, the script costs the
+/// upper bound, `exact` exactly when the interval is closed, named is exact.
+pub fn check_ged(r: &GedResult, mode: GedMode) {
+    assert!(
+        r.lower_bound <= r.upper_bound,
+        "{mode:?}: lower {} > upper {}",
+        r.lower_bound,
+        r.upper_bound
+    );
+    assert_eq!(r.ged, r.upper_bound, "{mode:?}: ged is not the upper bound");
+    assert_eq!(
+        r.edit_script.cost(),
+        r.upper_bound,
+        "{mode:?}: the edit script does not cost the upper bound"
+    );
+    assert_eq!(
+        r.exact,
+        r.lower_bound == r.upper_bound,
+        "{mode:?}: exact flag"
+    );
+    if mode == GedMode::Named {
+        assert!(r.exact, "named GED is always exact");
+    }
+}
+
+/// Every diagnostic renders, and a failed read has at least one error.
+pub fn check_diagnostics(diags: &[Diagnostic]) {
+    assert!(
+        diags.iter().any(Diagnostic::is_error),
+        "a rejected input has no error"
+    );
+    for d in diags {
+        let _ = d.to_string();
+    }
+}
+
+/// Everything downstream of a successful parse: graph, metrics, analyze
+/// (table, JSON, CSV), DOT, the TOML write-back (a fixpoint), the BT → HFSM
+/// and fault-tolerant transforms and effort.
+pub fn exercise(l: &Loaded) {
+    use crate::report::OutputFormat;
+    let g = crate::graph::policy_graph(&l.policy);
+    let _ = crate::metrics::complexity::cyclomatic(&g);
+    let _ = crate::metrics::complexity::essential(&l.policy);
+    let row = crate::report::analyze(l);
+    for f in [OutputFormat::Table, OutputFormat::Json, OutputFormat::Csv] {
+        let _ = crate::report::render_analysis(std::slice::from_ref(&row), f);
+    }
+    let _ = crate::render::dot::policy_dot(&l.policy, &Default::default());
+    let text = crate::format::toml_write::write_policy(&l.policy);
+    let again = crate::format::toml::parse_str("written.toml", &text, include_base(), &limits())
+        .unwrap_or_else(|e| panic!("written TOML does not read back: {}\n{text}", e[0]));
+    assert_eq!(
+        crate::format::toml_write::write_policy(&again.policy),
+        text,
+        "the written form is not a fixpoint"
+    );
+    if let Ok(h) = crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
+        let _ = crate::metrics::complexity::essential(&h);
+        let _ = crate::render::dot::policy_dot(&h, &Default::default());
+    }
+    let (effort, _) = crate::metrics::effort::effort(&l.policy, &ged_options());
+    for r in effort.named.iter() {
+        check_ged(r, GedMode::Named);
+    }
+    for r in effort.structural.iter() {
+        check_ged(r, GedMode::Structural);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every input a fuzz run once failed on (tests/fixtures/fuzz-regressions/,
+    /// named after its target) goes through that target's body again.
+    #[test]
+    fn fuzz_regressions_stay_fixed() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fuzz-regressions");
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return;
+        };
+        let mut files: Vec<_> = entries.flatten().map(|e| e.path()).collect();
+        files.sort();
+        for f in files {
+            let name = f.file_name().map(|n| n.to_string_lossy().into_owned());
+            let data = std::fs::read(&f).expect("readable");
+            match name.as_deref().and_then(|n| n.split('-').next()) {
+                Some("toml_policy") => toml_policy(&data),
+                Some("compare") => compare(&data),
+                other => panic!("{}: no fuzz target `{other:?}`", f.display()),
+            }
+        }
+    }
+
+    #[test]
+    fn pairs_split_at_the_separator() {
+        assert_eq!(split_pair(b"a\n%%\nb"), (&b"a"[..], &b"b"[..]));
+        assert_eq!(split_pair(b"ab"), (&b"ab"[..], &b""[..]));
+    }
+
+    #[test]
+    fn paper_pairs_compare_with_a_tiny_budget() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper");
+        let a = std::fs::read(dir.join("fig01-bt.toml")).expect("fig01");
+        let b = std::fs::read(dir.join("fig07c-bt.toml")).expect("fig07c");
+        let mut pair = a.clone();
+        pair.extend_from_slice(b"\n%%\n");
+        pair.extend_from_slice(&b);
+        compare(&pair);
+        toml_policy(&a);
+    }
+}
