@@ -807,3 +807,70 @@ fn hostile_million_problems_are_reported_in_bounded_time() {
         &stderr[stderr.len().saturating_sub(2000)..]
     );
 }
+
+/// Ctrl-C at any moment leaves either no output file or the whole one,
+/// never a prefix; a temporary left by the interrupted run is removed by
+/// the next run writing the same file.
+#[cfg(unix)]
+#[test]
+fn interrupted_runs_leave_no_partial_output() {
+    use std::process::{Command, Stdio};
+    use std::time::Duration;
+    let dir = Scratch::new("sigint");
+    let mut s = String::from("kind = \"bt\"\nroot = \"n0\"\n[nodes]\nn0 = { sequence = [");
+    let n = 30_000;
+    s.push_str(
+        &(1..n)
+            .map(|i| format!("\"n{i}\""))
+            .collect::<Vec<_>>()
+            .join(", "),
+    );
+    s.push_str("] }\n");
+    for i in 1..n {
+        s.push_str(&format!(
+            "n{i} = {{ action = \"Act {i}!\", skill = \"Dock\" }}\n"
+        ));
+    }
+    let input = dir.write("big.toml", s);
+    let reference = dir.0.join("reference.toml").display().to_string();
+    let (code, _, stderr) = btfsm(&["convert", &input, "--to", "toml", "-o", &reference]);
+    assert_eq!(code, 0, "{stderr}");
+    let whole = std::fs::read(&reference).expect("reference");
+    let out = dir.0.join("out.toml");
+    for delay_ms in [5u64, 20, 60, 150, 300, 600, 1200] {
+        let _ = std::fs::remove_file(&out);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_btfsm"))
+            .args(["convert", &input, "--to", "toml", "-o"])
+            .arg(&out)
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn");
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        let _ = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+        let _ = child.wait();
+        if let Ok(got) = std::fs::read(&out) {
+            assert!(
+                got == whole,
+                "interrupted after {delay_ms} ms: partial output"
+            );
+        }
+    }
+    let (code, _, stderr) = btfsm(&[
+        "convert",
+        &input,
+        "--to",
+        "toml",
+        "-o",
+        &out.display().to_string(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let stray: Vec<_> = std::fs::read_dir(&dir.0)
+        .expect("dir")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|f| f.ends_with(".tmp"))
+        .collect();
+    assert!(stray.is_empty(), "temporaries left: {stray:?}");
+}

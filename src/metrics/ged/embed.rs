@@ -62,31 +62,28 @@ impl Degrees {
 /// The connected, depth-first-leaning matching order of the vertices of `sub`
 /// that have arcs: next is the vertex with most arcs to the ordered set, ties
 /// to the neighbour of the most recently ordered vertex, then higher degree.
+///
+/// The next vertex comes from a max-heap keyed `(arcs to the ordered set,
+/// stamp, degree, lowest index)` with stale entries skipped, so the order
+/// costs O(m log m), not O(n²) (a 100k-vertex BT is ordered in milliseconds).
 fn order(sub: &Side) -> Vec<u32> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
     let n = sub.n;
     let deg: Vec<u64> = (0..n).map(|u| sub.degree(u)).collect();
     let mut placed = vec![false; n];
     let mut conn = vec![0u64; n];
     let mut stamp = vec![0usize; n];
     let mut out = Vec::new();
-    let want = (0..n).filter(|&u| deg[u] > 0).count();
-    while out.len() < want {
-        let mut pick = NONE;
-        let mut key = (0u64, 0usize, 0u64);
-        for u in 0..n {
-            if placed[u] || deg[u] == 0 {
-                continue;
-            }
-            let k = (conn[u], stamp[u], deg[u]);
-            if pick == NONE || k > key {
-                pick = u as u32;
-                key = k;
-            }
-        }
-        if pick == NONE {
-            break;
-        }
+    let mut heap: BinaryHeap<(u64, usize, u64, Reverse<u32>)> = (0..n)
+        .filter(|&u| deg[u] > 0)
+        .map(|u| (0, 0, deg[u], Reverse(u as u32)))
+        .collect();
+    while let Some((c, st, _, Reverse(pick))) = heap.pop() {
         let pu = pick as usize;
+        if placed[pu] || c != conn[pu] || st != stamp[pu] {
+            continue;
+        }
         placed[pu] = true;
         out.push(pick);
         let t = out.len();
@@ -95,6 +92,7 @@ fn order(sub: &Side) -> Vec<u32> {
             if !placed[w] {
                 conn[w] += u64::from(m);
                 stamp[w] = t;
+                heap.push((conn[w], t, deg[w], Reverse(w as u32)));
             }
         }
     }
@@ -219,7 +217,9 @@ fn search(p: &Problem, sub: &Side, sup: &Side, deadline: Instant, budget: u64) -
         }
         next[top] = i + 1;
         tries += 1;
-        if tries > budget || (tries.is_multiple_of(1024) && Instant::now() > deadline) {
+        // The clock is read at every try: one try builds a candidate list,
+        // which on a large class costs far more than reading it.
+        if tries > budget || Instant::now() > deadline {
             return Embedding::Unknown;
         }
         let v = cands[top][i];

@@ -809,6 +809,9 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
         return done(ub, ub, best, stats);
     }
     let now = Instant::now();
+    if now >= lim.deadline {
+        return done(count, ub, best, stats);
+    }
     let embed_deadline = now + lim.deadline.saturating_duration_since(now) / 4;
     let mut lb = count;
     // A hinted call is a second attempt: the embedding search, being
@@ -834,7 +837,9 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     if lb >= ub {
         return done(ub, ub, best, stats);
     }
-    if p.n() > MAX_SEARCH_N {
+    // Setting the search up costs O(n²) (its tables): not when the budget
+    // is already spent.
+    if p.n() > MAX_SEARCH_N || Instant::now() >= lim.deadline {
         return done(lb, ub, best, stats);
     }
     let mut bnb = Bnb::new(p, ub, best, *lim);
