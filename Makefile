@@ -3,7 +3,7 @@ CARGO ?= cargo
 BIN := target/release/btfsm
 POLICIES := $(wildcard policies/paper/*.toml)
 
-.PHONY: build run test bench bench-ged clean paper-docs
+.PHONY: build run test bench bench-ged clean paper-docs fuzz
 
 build:
 	$(CARGO) build --release --locked
@@ -37,6 +37,12 @@ bench: build
 # btfsm vs NetworkX on the same GED pairs, in one run (docs/performance.md).
 bench-ged:
 	python3 bench/ged_vs_networkx.py
+
+# Each fuzz target for FUZZ_SECONDS (default 600) with cargo-fuzz on nightly
+# (docs/robustness.md); FUZZ_TARGETS="toml_policy" runs only some.
+FUZZ_SECONDS ?= 600
+fuzz:
+	FUZZ_SECONDS=$(FUZZ_SECONDS) ./fuzz/run.sh $(FUZZ_TARGETS)
 
 clean:
 	rm -rf out
