@@ -59,6 +59,8 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
+    /// Runs policies in the planar robot simulator and compares their behavior
+    Sim(super::sim::SimArgs),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -92,6 +92,7 @@ pub fn execute(cli: Cli) -> u8 {
             let text = crate::format::toml_write::write_policy(&policy);
             emit(output.as_deref(), text.as_bytes())
         }
+        Command::Sim(args) => super::sim::execute(args),
     }
 }
 
@@ -124,7 +125,7 @@ fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>> {
     (!failed).then_some(out)
 }
 
-fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
+pub(super) fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
     let n = diags.iter().filter(|d| d.is_error()).count();
     for d in diags {
         let _ = write!(w, "{d}");
@@ -139,7 +140,7 @@ fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
 }
 
 /// Writes output to a file (atomically) or stdout.
-fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
+pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
     match path {
         Some(p) => match report::write_atomically(p, bytes) {
             Ok(()) => EXIT_OK,

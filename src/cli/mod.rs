@@ -4,6 +4,7 @@
 
 pub mod args;
 mod commands;
+pub mod sim;
 
 use clap::Parser;
 use std::ffi::OsString;
