@@ -64,6 +64,22 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
             esc(&ob.name)
         );
     }
+    // Obstacles that disturbances add (blocked paths), hatched in red.
+    for d in &s.disturbances {
+        if let super::scenario::Effect::Block(ob) = &d.effect {
+            let _ = writeln!(
+                o,
+                r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#f4b6b6" stroke="#b00" stroke-dasharray="4,3"/><text x="{:.1}" y="{:.1}" font-size="10" text-anchor="middle" fill="#900">{}</text>"##,
+                px(ob.x0),
+                py(ob.y1),
+                (ob.x1 - ob.x0) * SCALE,
+                (ob.y1 - ob.y0) * SCALE,
+                px((ob.x0 + ob.x1) / 2.0),
+                py((ob.y0 + ob.y1) / 2.0) + 3.0,
+                esc(&format!("{} (blocked later)", ob.name))
+            );
+        }
+    }
     // Stations and waypoints.
     for (n, p) in &l.stations {
         let _ = writeln!(
