@@ -469,3 +469,80 @@ fn sim_rejects_bad_scenarios_with_positioned_messages() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+#[test]
+fn dot_colours_nodes_by_their_status_at_a_trace_step() {
+    let dir = std::env::temp_dir().join(format!("btfsm-dot-trace-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let trace = dir.join("exp2.json");
+    let plot = dir.join("exp2.svg");
+    let (code, _, stderr) = btfsm(&[
+        "sim",
+        "policies/scenarios/exp2-recharge.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(
+        svg.starts_with("<svg")
+            && svg.contains("central table")
+            && svg.contains("Fig. 8d FSM recharge")
+    );
+    // Step 45 (t = 4.5 s): the battery is low and the robot drives to the charger.
+    let (code, dot, stderr) = btfsm(&[
+        "dot",
+        "policies/paper/fig07d-bt.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--step",
+        "45",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let line = |id: &str| {
+        dot.lines()
+            .find(|l| l.trim_start().starts_with(id))
+            .unwrap_or("")
+            .to_string()
+    };
+    assert!(line("recharge[").contains("fillcolor=gold"), "{dot}");
+    assert!(
+        line("\"battery-ok\"[").contains("fillcolor=tomato"),
+        "{dot}"
+    );
+    assert!(line("root[").contains("fillcolor=gold"), "{dot}");
+    assert!(!line("pick[").contains("gold"), "{dot}");
+    let (code, dot, _) = btfsm(&[
+        "dot",
+        "policies/paper/fig08d-fsm.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--step",
+        "45",
+    ]);
+    assert_eq!(code, 0);
+    assert!(
+        line_of(&dot, "Recharge[").contains("fillcolor=gold"),
+        "{dot}"
+    );
+    let (code, _, stderr) = btfsm(&[
+        "dot",
+        "policies/paper/fig07d-bt.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--step",
+        "999999",
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("past the end of the trace"), "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn line_of(dot: &str, id: &str) -> String {
+    dot.lines()
+        .find(|l| l.trim_start().starts_with(id))
+        .unwrap_or("")
+        .to_string()
+}

@@ -44,6 +44,9 @@ pub enum Command {
         /// Render with Graphviz's `dot` instead of printing DOT
         #[arg(long, value_enum)]
         render: Option<crate::render::dot::RenderFormat>,
+        /// Colour nodes by their status at --step in a `sim --trace` file
+        #[command(flatten)]
+        trace: super::sim::DotTraceArgs,
         #[command(flatten)]
         limits: LimitArgs,
     },

@@ -41,12 +41,16 @@ pub fn execute(cli: Cli) -> u8 {
             file,
             output,
             render,
+            trace,
             limits,
         } => {
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let dot = crate::render::dot::policy_dot(&l.policy, &Default::default());
+            let Some((policy, opts)) = super::sim::dot_trace(&trace, &file, l.policy) else {
+                return EXIT_BAD_INPUT;
+            };
+            let dot = crate::render::dot::policy_dot(&policy, &opts);
             match render {
                 None => emit(output.as_deref(), dot.as_bytes()),
                 Some(fmt) => match crate::render::dot::render(&dot, fmt) {

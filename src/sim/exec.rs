@@ -63,14 +63,24 @@ impl CompiledBt {
 #[derive(Debug)]
 pub struct BtExec {
     pub bt: Arc<CompiledBt>,
-    mem: Vec<u32>,
-    t0: Vec<f64>,
-    last: Vec<u64>,
+    node: Vec<NodeState>,
     step: u64,
     /// When `Some`, every node ticked in the last step with its status.
     pub statuses: Option<Vec<(usize, Status)>>,
+    /// The explicit stack, kept between ticks to avoid allocating.
+    stack: Vec<Frame>,
 }
 
+/// Per-node memory: the running child of a memory composite or a decorator's
+/// counter, the start of a Timeout, the step the node was last ticked.
+#[derive(Debug, Clone, Copy, Default)]
+struct NodeState {
+    mem: u32,
+    last: u64,
+    t0: f64,
+}
+
+#[derive(Debug)]
 struct Frame {
     node: usize,
     i: usize,
@@ -83,22 +93,22 @@ impl BtExec {
         let n = bt.kind.len();
         BtExec {
             bt,
-            mem: vec![0; n],
-            t0: vec![0.0; n],
-            last: vec![0; n],
+            node: vec![NodeState::default(); n],
             step: 0,
             statuses: record.then(Vec::new),
+            stack: Vec::new(),
         }
     }
 
-    fn enter(&mut self, n: usize, now: f64) -> Frame {
-        if self.last[n] + 1 != self.step {
-            self.mem[n] = 0;
-            self.t0[n] = now;
+    fn enter(st: &mut [NodeState], kind: &[BtNodeKind], step: u64, n: usize, now: f64) -> Frame {
+        let ns = &mut st[n];
+        if ns.last + 1 != step {
+            ns.mem = 0;
+            ns.t0 = now;
         }
-        self.last[n] = self.step;
-        let i = match self.bt.kind[n] {
-            BtNodeKind::SequenceMemory | BtNodeKind::FallbackMemory => self.mem[n] as usize,
+        ns.last = step;
+        let i = match kind[n] {
+            BtNodeKind::SequenceMemory | BtNodeKind::FallbackMemory => ns.mem as usize,
             _ => 0,
         };
         Frame {
@@ -117,9 +127,14 @@ impl BtExec {
         if let Some(v) = &mut self.statuses {
             v.clear();
         }
-        let bt = self.bt.clone();
+        let bt: &CompiledBt = &self.bt;
+        let st = &mut self.node;
+        let step = self.step;
         let now = leaves.now();
-        let mut stack = vec![self.enter(bt.root, now)];
+        let mut stack = std::mem::take(&mut self.stack);
+        stack.clear();
+        let root = Self::enter(st, &bt.kind, step, bt.root, now);
+        stack.push(root);
         let mut ret: Option<Status> = None;
         loop {
             let top = stack.len() - 1;
@@ -139,29 +154,51 @@ impl BtExec {
                     let seq = matches!(k, K::Sequence | K::SequenceMemory);
                     let (go_on, stop) = if seq { (S, F) } else { (F, S) };
                     let f = &mut stack[top];
-                    match ret.take() {
-                        None if f.i < kids.len() => {
-                            push = Some(kids[f.i]);
-                            R
-                        }
-                        None => go_on,
-                        Some(r) if r == go_on => {
-                            f.i += 1;
-                            if f.i < kids.len() {
-                                push = Some(kids[f.i]);
-                                R
-                            } else {
-                                self.mem[n] = 0;
-                                go_on
+                    // Runs through leaf children in place; stops at a
+                    // composite child (pushed) or at the node's result.
+                    let mut r = ret.take();
+                    loop {
+                        match r {
+                            None if f.i < kids.len() => {
+                                let c = kids[f.i];
+                                let leaf = match (bt.kind[c], &bt.call[c]) {
+                                    (K::Action, Some(call)) => leaves.action(c, call),
+                                    (K::Condition, Some(call)) => {
+                                        if leaves.condition(call) {
+                                            S
+                                        } else {
+                                            F
+                                        }
+                                    }
+                                    (K::Action | K::Condition, None) => F,
+                                    _ => {
+                                        push = Some(c);
+                                        break R;
+                                    }
+                                };
+                                if let Some(v) = &mut self.statuses {
+                                    v.push((c, leaf));
+                                }
+                                r = Some(leaf);
                             }
-                        }
-                        Some(r) if r == stop => {
-                            self.mem[n] = 0;
-                            stop
-                        }
-                        Some(_) => {
-                            self.mem[n] = f.i as u32;
-                            R
+                            None => break go_on,
+                            Some(x) if x == go_on => {
+                                f.i += 1;
+                                if f.i < kids.len() {
+                                    r = None;
+                                } else {
+                                    st[n].mem = 0;
+                                    break go_on;
+                                }
+                            }
+                            Some(x) if x == stop => {
+                                st[n].mem = 0;
+                                break stop;
+                            }
+                            Some(_) => {
+                                st[n].mem = f.i as u32;
+                                break R;
+                            }
                         }
                     }
                 }
@@ -187,8 +224,8 @@ impl BtExec {
                         R
                     }
                 }
-                K::Timeout { ms } if ret.is_none() && (now - self.t0[n]) * 1000.0 >= ms as f64 => {
-                    self.last[n] = 0;
+                K::Timeout { ms } if ret.is_none() && (now - st[n].t0) * 1000.0 >= ms as f64 => {
+                    st[n].last = 0;
                     F
                 }
                 kind => match ret.take() {
@@ -202,30 +239,30 @@ impl BtExec {
                         (K::ForceSuccess, S | F) => S,
                         (K::ForceFailure, S | F) => F,
                         (K::Repeat { times }, S) => {
-                            self.mem[n] += 1;
-                            if times.is_some_and(|t| self.mem[n] >= t) {
-                                self.mem[n] = 0;
+                            st[n].mem += 1;
+                            if times.is_some_and(|t| st[n].mem >= t) {
+                                st[n].mem = 0;
                                 S
                             } else {
                                 R
                             }
                         }
                         (K::Retry { times }, F) => {
-                            self.mem[n] += 1;
-                            if self.mem[n] > times {
-                                self.mem[n] = 0;
+                            st[n].mem += 1;
+                            if st[n].mem > times {
+                                st[n].mem = 0;
                                 F
                             } else {
                                 R
                             }
                         }
                         (K::Repeat { .. } | K::Retry { .. }, r) => {
-                            self.mem[n] = 0;
+                            st[n].mem = 0;
                             r
                         }
                         (K::Timeout { .. }, r) => {
                             if r != R {
-                                self.last[n] = 0;
+                                st[n].last = 0;
                             }
                             r
                         }
@@ -234,8 +271,25 @@ impl BtExec {
                 },
             };
             if let Some(c) = push {
-                let fr = self.enter(c, now);
-                stack.push(fr);
+                // Leaves are evaluated in place (no frame): the hot path.
+                let leaf = match (bt.kind[c], &bt.call[c]) {
+                    (K::Action, Some(call)) => Some(leaves.action(c, call)),
+                    (K::Condition, Some(call)) => Some(if leaves.condition(call) { S } else { F }),
+                    (K::Action | K::Condition, None) => Some(F),
+                    _ => None,
+                };
+                match leaf {
+                    Some(r) => {
+                        if let Some(v) = &mut self.statuses {
+                            v.push((c, r));
+                        }
+                        ret = Some(r);
+                    }
+                    None => {
+                        let fr = Self::enter(st, &bt.kind, step, c, now);
+                        stack.push(fr);
+                    }
+                }
                 continue;
             }
             if let Some(v) = &mut self.statuses {
@@ -243,6 +297,7 @@ impl BtExec {
             }
             stack.pop();
             if stack.is_empty() {
+                self.stack = stack;
                 return out;
             }
             ret = Some(out);

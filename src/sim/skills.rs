@@ -222,13 +222,16 @@ fn goal_of(t: Target, w: &World) -> Option<P2> {
 }
 
 /// Evaluates a condition (actions evaluate to `false`).
+#[inline]
 pub fn condition(c: &Call, w: &World) -> bool {
     let tol = w.params.at_tolerance;
+    // Squared distances: no square root on the hot path.
+    let near = |a: P2, b: P2, r: f64| (a.0 - b.0).powi(2) + (a.1 - b.1).powi(2) <= r * r;
     match *c {
-        Call::RobotAt(t) => goal_of(t, w).is_some_and(|g| dist(g, w.robot) <= tol),
+        Call::RobotAt(t) => goal_of(t, w).is_some_and(|g| near(g, w.robot, tol)),
         Call::InHand(o) => w.objects[o].place == Place::Held,
         Call::ObjectAt { object, at } => match w.objects[object].place {
-            Place::At(p) => dist(p, w.layout.stations[at].1) <= w.params.station_radius,
+            Place::At(p) => near(p, w.layout.stations[at].1, w.params.station_radius),
             Place::Held => false,
         },
         Call::BatteryLevel(min) => !w.charging && w.battery > min,
