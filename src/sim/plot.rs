@@ -240,3 +240,40 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
     o.push_str("</svg>\n");
     o
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostic::SourceFile;
+    use crate::format::Limits;
+    use std::path::Path;
+
+    #[test]
+    fn plot_has_room_obstacles_trajectories_and_markers() {
+        let f = SourceFile::new(
+            "t.toml",
+            r#"
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[disturbances]]
+at = 1.0
+block = { name = "crate", rect = [-1.0, -2.9, -0.9, -2.5] }
+"#,
+        );
+        let s =
+            super::super::scenario::parse(&f, Path::new("policies/scenarios"), &Limits::default())
+                .unwrap();
+        let runs = super::super::run::run_scenario(&s, false);
+        let svg = svg(&s, &runs);
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert!(svg.contains(">central table<") && svg.contains("crate (blocked later)"));
+        assert!(svg.contains(r#"<path d="M"#), "a trajectory");
+        assert!(
+            svg.contains("Pick(object=cube2) -&gt; success"),
+            "a pick marker"
+        );
+        assert_eq!(svg.matches("<svg").count(), 1);
+    }
+}

@@ -632,3 +632,92 @@ pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<Mc
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostic::SourceFile;
+    use crate::format::Limits;
+    use std::path::Path;
+
+    fn scenario(text: &str) -> Scenario {
+        let f = SourceFile::new("t.toml", text);
+        super::super::scenario::parse(&f, Path::new("policies/scenarios"), &Limits::default())
+            .expect("valid scenario")
+    }
+
+    const FLAKY: &str = r#"
+seed = 11
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[rates]
+Pick = 0.5
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+[monte_carlo]
+battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
+"#;
+
+    #[test]
+    fn runs_are_deterministic_given_the_seed() {
+        let s = scenario(FLAKY);
+        let a = run_scenario(&s, false);
+        let b = run_scenario(&s, false);
+        assert_eq!(a[0].skills, b[0].skills);
+        assert_eq!(a[0].trajectory, b[0].trajectory);
+        // With a 50% grasp failure rate some seed makes a Pick fail.
+        let failed = (0..10u64).any(|seed| {
+            let mut s = s.clone();
+            s.seed = seed;
+            run_scenario(&s, false)[0]
+                .skills
+                .iter()
+                .any(|r| r.skill == "Pick" && r.outcome == "failure")
+        });
+        assert!(failed);
+    }
+
+    #[test]
+    fn monte_carlo_does_not_depend_on_the_number_of_threads() {
+        let s = scenario(FLAKY);
+        let one = monte_carlo(&s, 6, 3, 1);
+        let two = monte_carlo(&s, 6, 3, 2);
+        assert_eq!(one, two);
+        assert_eq!(one.len(), 2);
+        assert_eq!(one[0].runs, 6);
+        // Every episode drops the battery, so every policy recharges.
+        assert!(
+            one.iter()
+                .all(|p| p.recharges == 0 || p.mean_recharge_latency_s.is_some())
+        );
+        assert!(one.iter().all(|p| p.success_rate > 0.0));
+    }
+
+    #[test]
+    fn a_sequential_policy_without_a_failure_arc_fails() {
+        let s = scenario(
+            r#"
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+[[disturbances]]
+at = 0.0
+fail = "Move-To"
+"#,
+        );
+        let r = &run_scenario(&s, true)[0];
+        assert_eq!(r.outcome, Outcome::Failure);
+        assert_eq!(r.skills.len(), 1);
+        assert!(!r.trace.is_empty());
+        assert!(
+            r.trace[0]
+                .statuses
+                .iter()
+                .any(|(k, st)| k == "Move-To cube2" && st == "RUNNING")
+        );
+    }
+}

@@ -747,7 +747,7 @@ impl Reader {
             .unwrap_or(0.1);
         let max_steps = t
             .get("max_steps")
-            .and_then(|v| self.number(v, "`max_steps`", 1.0, 1e8))
+            .and_then(|v| self.number(v, "`max_steps`", 1.0, 1e6))
             .unwrap_or(20_000.0) as u64;
         let chatter_switches = t
             .get("chatter_switches")
