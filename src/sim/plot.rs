@@ -50,35 +50,42 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
         (r.x1 - r.x0) * SCALE,
         (r.y1 - r.y0) * SCALE
     );
-    // Obstacles.
-    for ob in &l.obstacles {
+    // Obstacles; those that disturbances add (blocked paths) dashed in red.
+    let blocked = s.disturbances.iter().filter_map(|d| match &d.effect {
+        super::scenario::Effect::Block(ob) => Some(ob),
+        _ => None,
+    });
+    let styled = l
+        .obstacles
+        .iter()
+        .map(|ob| {
+            (
+                ob,
+                r##"fill="#c8b89a" stroke="#6b5a3a""##,
+                "#4a3d27",
+                ob.name.clone(),
+            )
+        })
+        .chain(blocked.map(|ob| {
+            (
+                ob,
+                r##"fill="#f4b6b6" stroke="#b00" stroke-dasharray="4,3""##,
+                "#900",
+                format!("{} (blocked later)", ob.name),
+            )
+        }));
+    for (ob, style, ink, label) in styled {
         let _ = writeln!(
             o,
-            r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#c8b89a" stroke="#6b5a3a"/><text x="{:.1}" y="{:.1}" font-size="10" text-anchor="middle" fill="#4a3d27">{}</text>"##,
+            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {style}/><text x="{:.1}" y="{:.1}" font-size="10" text-anchor="middle" fill="{ink}">{}</text>"#,
             px(ob.x0),
             py(ob.y1),
             (ob.x1 - ob.x0) * SCALE,
             (ob.y1 - ob.y0) * SCALE,
             px((ob.x0 + ob.x1) / 2.0),
             py((ob.y0 + ob.y1) / 2.0) + 3.0,
-            esc(&ob.name)
+            esc(&label)
         );
-    }
-    // Obstacles that disturbances add (blocked paths), hatched in red.
-    for d in &s.disturbances {
-        if let super::scenario::Effect::Block(ob) = &d.effect {
-            let _ = writeln!(
-                o,
-                r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#f4b6b6" stroke="#b00" stroke-dasharray="4,3"/><text x="{:.1}" y="{:.1}" font-size="10" text-anchor="middle" fill="#900">{}</text>"##,
-                px(ob.x0),
-                py(ob.y1),
-                (ob.x1 - ob.x0) * SCALE,
-                (ob.y1 - ob.y0) * SCALE,
-                px((ob.x0 + ob.x1) / 2.0),
-                py((ob.y0 + ob.y1) / 2.0) + 3.0,
-                esc(&format!("{} (blocked later)", ob.name))
-            );
-        }
     }
     // Stations and waypoints.
     for (n, p) in &l.stations {

@@ -307,11 +307,24 @@ impl Running {
         Some(self.path_i >= self.path.len() || dist(w.robot, goal) <= tol)
     }
 
+    /// One step of a timed manipulation: `Some(RUNNING)` until `secs` have
+    /// passed, then `Some(FAILURE)` for an injected fault, or `None` when the
+    /// action may take effect.
+    fn work(&mut self, secs: f64, dt: f64) -> Option<Status> {
+        self.steps += 1;
+        if (self.steps as f64) * dt < secs - 1e-9 {
+            Some(Status::Running)
+        } else if self.doomed {
+            Some(Status::Failure)
+        } else {
+            None
+        }
+    }
+
     /// Performs one step of the action.
     pub fn tick(&mut self, w: &mut World, dt: f64) -> Status {
         let speed = w.params.max_speed;
         let tol = w.params.at_tolerance;
-        let timed = |steps: u32, secs: f64| (steps as f64) * dt >= secs - 1e-9;
         match self.call {
             Call::MoveTo { target, safe } => {
                 let Some(goal) = goal_of(target, w) else {
@@ -363,12 +376,8 @@ impl Running {
                 if !reachable {
                     return Status::Failure;
                 }
-                self.steps += 1;
-                if !timed(self.steps, w.params.manipulation_s) {
-                    return Status::Running;
-                }
-                if self.doomed {
-                    return Status::Failure;
+                if let Some(st) = self.work(w.params.manipulation_s, dt) {
+                    return st;
                 }
                 w.objects[object].place = Place::Held;
                 w.arm_tucked = false;
@@ -380,24 +389,16 @@ impl Running {
                 if w.objects[object].place != Place::Held || dist(spot, w.robot) > tol {
                     return Status::Failure;
                 }
-                self.steps += 1;
-                if !timed(self.steps, w.params.manipulation_s) {
-                    return Status::Running;
-                }
-                if self.doomed {
-                    return Status::Failure;
+                if let Some(st) = self.work(w.params.manipulation_s, dt) {
+                    return st;
                 }
                 w.objects[object].place = Place::At(spot);
                 w.progress += 1;
                 Status::Success
             }
             Call::TuckArm | Call::ShutDown => {
-                self.steps += 1;
-                if !timed(self.steps, w.params.arm_s) {
-                    return Status::Running;
-                }
-                if self.doomed {
-                    return Status::Failure;
+                if let Some(st) = self.work(w.params.arm_s, dt) {
+                    return st;
                 }
                 if self.call == Call::TuckArm {
                     w.arm_tucked = true;
