@@ -204,16 +204,15 @@ impl BtExec {
                 }
                 K::Parallel { success } => {
                     let f = &mut stack[top];
-                    match ret.take() {
-                        Some(S) => f.ok += 1,
-                        Some(F) => f.bad += 1,
-                        _ => {}
-                    }
-                    let started = f.i > 0 || f.ok + f.bad > 0;
-                    if started {
+                    if let Some(r) = ret.take() {
+                        match r {
+                            S => f.ok += 1,
+                            F => f.bad += 1,
+                            R => {}
+                        }
                         f.i += 1;
                     }
-                    if f.i < kids.len() && !(started && f.i == 0) {
+                    if f.i < kids.len() {
                         push = Some(kids[f.i]);
                         R
                     } else if f.ok >= success {
@@ -621,6 +620,82 @@ b = { action = "Dock!", skill = "Dock" }
         // The last tick ran the condition, the sequence*, its second child.
         let st = ex.statuses.clone().unwrap();
         assert!(st.contains(&(0, Success)) && st.contains(&(6, Success)));
+    }
+
+    const DECORATED: &str = r#"
+kind = "bt"
+root = "root"
+[nodes]
+root = { parallel = ["retry", "inv", "time"], success = 2 }
+retry = { retry = "dock", times = 1 }
+dock = { action = "Dock!", skill = "Dock" }
+inv = { inverter = "tucked" }
+tucked = { condition = "Tucked?", skill = "Arm-Tucked" }
+time = { timeout = "tuck", ms = 2500 }
+tuck = { action = "Tuck!", skill = "Tuck-Arm" }
+"#;
+
+    /// Dock fails once then succeeds (Retry absorbs the failure), the
+    /// inverted condition succeeds, and Tuck-Arm never finishes, so Timeout
+    /// fails it after 2.5 s of (scripted) time.
+    struct Decor {
+        t: f64,
+        docks: u32,
+    }
+
+    impl Leaves for Decor {
+        fn condition(&mut self, _: &Call) -> bool {
+            false
+        }
+        fn action(&mut self, _key: usize, call: &Call) -> Status {
+            match call {
+                Call::Dock => {
+                    self.docks += 1;
+                    if self.docks == 1 {
+                        Status::Failure
+                    } else {
+                        Status::Success
+                    }
+                }
+                _ => Status::Running,
+            }
+        }
+        fn now(&self) -> f64 {
+            self.t
+        }
+    }
+
+    #[test]
+    fn parallel_retry_inverter_and_timeout() {
+        let l = parse_str("d.toml", DECORATED, Path::new("."), &Limits::default()).unwrap();
+        let PolicyBody::Bt(bt) = &l.policy.body else {
+            panic!()
+        };
+        let calls = bt
+            .nodes
+            .iter()
+            .map(|n| {
+                n.skill.as_ref().map(|s| match s.skill.as_str() {
+                    "Dock" => Call::Dock,
+                    "Tuck-Arm" => Call::TuckArm,
+                    _ => Call::ArmTucked,
+                })
+            })
+            .collect();
+        let mut ex = BtExec::new(Arc::new(CompiledBt::new(bt, calls)), true);
+        let mut d = Decor { t: 0.0, docks: 0 };
+        // Tick 1: Dock fails, Retry says RUNNING; inverter SUCCESS; tuck RUNNING.
+        assert_eq!(ex.tick(&mut d), Status::Running);
+        d.t = 1.0;
+        // Tick 2: Dock succeeds: two successes reach the threshold.
+        assert_eq!(ex.tick(&mut d), Status::Success);
+        let st = ex.statuses.clone().unwrap();
+        let time_node = bt.nodes.iter().position(|n| n.id == "time").unwrap();
+        assert!(st.contains(&(time_node, Status::Running)));
+        d.t = 3.0;
+        ex.tick(&mut d);
+        let st = ex.statuses.clone().unwrap();
+        assert!(st.contains(&(time_node, Status::Failure)), "{st:?}");
     }
 
     const FSM: &str = r#"

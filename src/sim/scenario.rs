@@ -1034,4 +1034,21 @@ fail = "Pik"
         assert!(all.contains("did you mean `east-table`?"), "{all}");
         assert!(all.contains("unknown skill `Pik`"), "{all}");
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config::with_cases(64))]
+        /// Random edits of a valid scenario never panic: they parse or give
+        /// positioned errors.
+        #[test]
+        fn mutated_scenarios_never_panic(cut in 0usize..400, junk in "[a-z\\[\\]{}=\",0-9. ]{0,12}") {
+            let base = "seed = 1\n[world]\nrobot = [0.5, -1.5]\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"../paper/fig01-bt.toml\"\n[[disturbances]]\nat = 2.0\nmove = \"cube2\"\nto = [1.0, -1.0]\n";
+            let cut = cut.min(base.len());
+            let cut = (0..=cut).rev().find(|&i| base.is_char_boundary(i)).unwrap_or(0);
+            let text = format!("{}{junk}{}", &base[..cut], &base[cut..]);
+            match parse_text(&text) {
+                Ok(s) => proptest::prop_assert!(!s.policies.is_empty()),
+                Err(d) => proptest::prop_assert!(d.iter().any(|x| x.is_error())),
+            }
+        }
+    }
 }
