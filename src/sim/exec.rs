@@ -463,10 +463,9 @@ impl MachineExec {
                 }
                 Flow::Up(Some(container), o) => (container, o),
                 Flow::Enter(s) => {
-                    if let Some((g, t)) = c.guards[s].iter().find(|(g, _)| Self::holds(g, leaves)) {
-                        let _ = g;
+                    // A state left by a guard runs nothing (and is not noted).
+                    if let Some((_, t)) = c.guards[s].iter().find(|(g, _)| Self::holds(g, leaves)) {
                         flow = self.follow(s, t);
-                        self.note(s, Status::Success);
                         continue;
                     }
                     let st = match &c.m.states[s].body {

@@ -913,6 +913,24 @@ impl Reader {
     }
 }
 
+/// Span of the line `key = ...` (bare or quoted key) in a TOML text.
+fn key_span(text: &str, key: &str) -> Option<Range<usize>> {
+    let mut off = 0;
+    for line in text.split_inclusive('\n') {
+        let t = line.trim_start();
+        let lead = line.len() - t.len();
+        for k in [key.to_string(), format!("\"{key}\"")] {
+            if let Some(rest) = t.strip_prefix(&k)
+                && rest.trim_start().starts_with('=')
+            {
+                return Some(off + lead..off + lead + k.len());
+            }
+        }
+        off += line.len();
+    }
+    None
+}
+
 /// Checks that every binding of a policy runs in the world: positioned in the
 /// policy file at the node or state.
 pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Diagnostic>) {
@@ -935,15 +953,21 @@ pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Dia
                 if n.kind.arity() != crate::model::bt::Arity::Leaf {
                     continue;
                 }
+                // Nodes of an included subtree (`include/...`) have spans in
+                // the included file: point at the include in this file.
+                let span = match n.id.split_once('/') {
+                    None => n.span.clone(),
+                    Some((inc, _)) => src.as_ref().and_then(|f| key_span(&f.text, inc)),
+                };
                 match &n.skill {
                     Some(c) => {
                         if let Err(u) = skills::resolve(c, world) {
-                            push(format!("node `{}`", n.id), n.span.clone(), u);
+                            push(format!("node `{}`", n.id), span, u);
                         }
                     }
                     None => push(
                         format!("node `{}`", n.id),
-                        n.span.clone(),
+                        span,
                         Unresolved {
                             message: "no skill binding".into(),
                             hint: "the simulator needs `skill = \"...\"` on every leaf".into(),
@@ -1033,6 +1057,26 @@ fail = "Pik"
         assert!(all.contains("unknown station `east-tabel`"), "{all}");
         assert!(all.contains("did you mean `east-table`?"), "{all}");
         assert!(all.contains("unknown skill `Pik`"), "{all}");
+    }
+
+    #[test]
+    fn policy_errors_in_included_subtrees_point_at_the_include() {
+        let e = parse_text(
+            r#"
+[world]
+objects = { cube1 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig16a-bt.toml"
+"#,
+        )
+        .unwrap_err();
+        let first = e[0].to_string();
+        assert!(
+            first.contains("unknown object `cube2` in node `moma2/"),
+            "{first}"
+        );
+        assert!(first.contains("moma2         = { subtree"), "{first}");
+        assert_eq!(key_span("a = 1\n  \"b c\" = 2\n", "b c"), Some(8..13));
     }
 
     proptest::proptest! {
