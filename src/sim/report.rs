@@ -240,3 +240,60 @@ impl McReport {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::Limits;
+    use std::path::Path;
+
+    fn report(scenario: &str) -> SimReport {
+        let s = super::super::scenario::load(Path::new(scenario), &Limits::default()).unwrap();
+        let runs = super::super::run::run_scenario(&s, false);
+        SimReport::new(&s.name, scenario, s.seed, s.dt, runs)
+    }
+
+    #[test]
+    fn table_of_exp1_pick_fails() {
+        insta::assert_snapshot!(report("policies/scenarios/exp1-pick-fails.toml").table());
+    }
+
+    #[test]
+    fn json_has_the_contract_fields() {
+        let r = report("policies/scenarios/exp2-recharge.toml");
+        let v: serde_json::Value = serde_json::from_str(&r.json()).unwrap();
+        for k in ["scenario", "file", "seed", "dt", "policies", "verdicts"] {
+            assert!(v.get(k).is_some(), "{k}");
+        }
+        let p = &v["policies"][0];
+        for k in [
+            "policy",
+            "file",
+            "kind",
+            "convert",
+            "outcome",
+            "reason",
+            "goal_met",
+            "steps",
+            "completion_s",
+            "duration_s",
+            "distance_m",
+            "skills",
+            "events",
+            "final_world",
+            "recharge_latency_s",
+        ] {
+            assert!(p.get(k).is_some(), "{k}");
+        }
+        assert!(p.get("trace").is_none() && p.get("trajectory").is_none());
+        let t: serde_json::Value = serde_json::from_str(&r.trace_json()).unwrap();
+        assert!(t["policies"][0]["trace"].as_array().unwrap().is_empty());
+        assert!(
+            !t["policies"][0]["trajectory"]
+                .as_array()
+                .unwrap()
+                .is_empty()
+        );
+        assert_eq!(v["verdicts"][0]["match"], true);
+    }
+}
