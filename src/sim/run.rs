@@ -720,4 +720,68 @@ fail = "Move-To"
                 .any(|(k, st)| k == "Move-To cube2" && st == "RUNNING")
         );
     }
+
+    #[test]
+    fn a_dropped_cube_is_picked_again_and_a_blocked_goal_gives_up() {
+        let s = scenario(
+            r#"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+[[disturbances]]
+when = [{ if = "In-Hand", args = { object = "cube2" } }]
+drop = "cube2"
+"#,
+        );
+        let runs = run_scenario(&s, false);
+        for r in &runs {
+            assert_eq!(r.goal_met, Some(true), "{}", r.policy);
+            let picks = r
+                .skills
+                .iter()
+                .filter(|x| x.skill == "Pick" && x.outcome == "success");
+            assert_eq!(picks.count(), 2, "{}", r.policy);
+        }
+        // The BT notices the drop at once; the FSM only when Place fails.
+        assert!(
+            !runs[0]
+                .skills
+                .iter()
+                .any(|x| x.skill == "Place" && x.outcome == "failure")
+        );
+        assert!(
+            runs[1]
+                .skills
+                .iter()
+                .any(|x| x.skill == "Place" && x.outcome == "failure")
+        );
+
+        let s = scenario(
+            r#"
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+[[disturbances]]
+at = 0.0
+block = { name = "fence", rect = [-0.5, 1.4, 1.5, 1.5] }
+[[disturbances]]
+at = 0.0
+block = { name = "fence2", rect = [-0.5, 1.4, -0.4, 2.99] }
+[[disturbances]]
+at = 0.0
+block = { name = "fence3", rect = [1.4, 1.4, 1.5, 2.99] }
+"#,
+        );
+        for r in run_scenario(&s, false) {
+            assert_eq!(r.outcome, Outcome::Failure, "{}", r.policy);
+            assert!(r.reason.starts_with("gave up"), "{}", r.reason);
+        }
+    }
 }
