@@ -580,7 +580,8 @@ a = { action = "Tuck!", skill = "Tuck-Arm" }
 b = { action = "Dock!", skill = "Dock" }
 "#;
 
-    fn compile_bt(text: &str) -> CompiledBt {
+    /// Reads a BT and binds its leaves with `bind` (skill name -> call).
+    fn compile_bt(text: &str, bind: fn(&str) -> Call) -> CompiledBt {
         let l = parse_str("t.toml", text, Path::new("."), &Limits::default()).unwrap();
         let PolicyBody::Bt(bt) = &l.policy.body else {
             panic!()
@@ -588,21 +589,20 @@ b = { action = "Dock!", skill = "Dock" }
         let calls = bt
             .nodes
             .iter()
-            .map(|n| {
-                n.skill.as_ref().map(|s| match s.skill.as_str() {
-                    "Battery-Level" => Call::BatteryLevel(20.0),
-                    "Recharge" => Call::Recharge,
-                    "Tuck-Arm" => Call::TuckArm,
-                    _ => Call::Dock,
-                })
-            })
+            .map(|n| n.skill.as_ref().map(|s| bind(&s.skill)))
             .collect();
         CompiledBt::new(bt, calls)
     }
 
     #[test]
     fn reactive_fallback_preempts_and_memory_sequence_resumes() {
-        let mut ex = BtExec::new(Arc::new(compile_bt(BT)), true);
+        let bind = |s: &str| match s {
+            "Battery-Level" => Call::BatteryLevel(20.0),
+            "Recharge" => Call::Recharge,
+            "Tuck-Arm" => Call::TuckArm,
+            _ => Call::Dock,
+        };
+        let mut ex = BtExec::new(Arc::new(compile_bt(BT, bind)), true);
         let mut s = script();
         // Battery low: Recharge runs two ticks, then the memory sequence; a
         // finished action's successor starts in the same tick.
@@ -666,22 +666,18 @@ tuck = { action = "Tuck!", skill = "Tuck-Arm" }
 
     #[test]
     fn parallel_retry_inverter_and_timeout() {
-        let l = parse_str("d.toml", DECORATED, Path::new("."), &Limits::default()).unwrap();
-        let PolicyBody::Bt(bt) = &l.policy.body else {
-            panic!()
+        let bind = |s: &str| match s {
+            "Dock" => Call::Dock,
+            "Tuck-Arm" => Call::TuckArm,
+            _ => Call::ArmTucked,
         };
-        let calls = bt
-            .nodes
+        let compiled = Arc::new(compile_bt(DECORATED, bind));
+        let time_node = compiled
+            .kind
             .iter()
-            .map(|n| {
-                n.skill.as_ref().map(|s| match s.skill.as_str() {
-                    "Dock" => Call::Dock,
-                    "Tuck-Arm" => Call::TuckArm,
-                    _ => Call::ArmTucked,
-                })
-            })
-            .collect();
-        let mut ex = BtExec::new(Arc::new(CompiledBt::new(bt, calls)), true);
+            .position(|k| matches!(k, BtNodeKind::Timeout { .. }))
+            .unwrap();
+        let mut ex = BtExec::new(compiled, true);
         let mut d = Decor { t: 0.0, docks: 0 };
         // Tick 1: Dock fails, Retry says RUNNING; inverter SUCCESS; tuck RUNNING.
         assert_eq!(ex.tick(&mut d), Status::Running);
@@ -689,7 +685,6 @@ tuck = { action = "Tuck!", skill = "Tuck-Arm" }
         // Tick 2: Dock succeeds: two successes reach the threshold.
         assert_eq!(ex.tick(&mut d), Status::Success);
         let st = ex.statuses.clone().unwrap();
-        let time_node = bt.nodes.iter().position(|n| n.id == "time").unwrap();
         assert!(st.contains(&(time_node, Status::Running)));
         d.t = 3.0;
         ex.tick(&mut d);
