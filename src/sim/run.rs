@@ -521,11 +521,19 @@ pub struct McStats {
     pub recharges: u32,
 }
 
-/// The disturbances and failure rates of episode `i`.
+/// The disturbances and failure rates of episode `i`: the scenario's, with
+/// timed ones jittered, plus the `monte_carlo` battery drop and rates.
 pub fn episode(s: &Scenario, seed: u64, i: u32) -> (u64, Vec<Disturbance>, BTreeMap<String, f64>) {
     let ep_seed = SimRng::named(seed, &format!("episode-{i}")).next_u64();
     let mut rng = SimRng::named(ep_seed, "disturbances");
     let mut ds = s.disturbances.clone();
+    // Timed disturbances happen anywhere from half to one and a half times
+    // their scenario time.
+    for d in &mut ds {
+        if let When::At(t) = &mut d.when {
+            *t = (*t * rng.range(0.5, 1.5) * 10.0).round() / 10.0;
+        }
+    }
     if let Some((p, (lo, hi), (t0, t1))) = s.monte_carlo.battery_drop
         && rng.chance(p)
     {
