@@ -62,7 +62,10 @@ fn main() {
     let mut ex = BtExec::new(compiled, false);
     let mut leaves = Frozen(w);
     // Best of 5 rounds (the machine is shared; py_trees gets the same rule).
-    let n = 1_000_000u64;
+    let n: u64 = std::env::var("BTFSM_BENCH_TICKS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1_000_000);
     let mut dt = f64::INFINITY;
     for _ in 0..5 {
         let t0 = Instant::now();

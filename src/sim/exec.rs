@@ -39,23 +39,52 @@ pub trait Leaves {
     fn now(&self) -> f64;
 }
 
-/// A BT with its bindings resolved (shared by the runs of a scenario).
+/// A BT with its bindings resolved (shared by the runs of a scenario), laid
+/// out flat for ticking: one record per node, children in one array.
 #[derive(Debug)]
 pub struct CompiledBt {
-    pub kind: Vec<BtNodeKind>,
-    pub children: Vec<Vec<usize>>,
-    pub call: Vec<Option<Call>>,
+    pub nodes: Vec<XNode>,
+    kids: Vec<usize>,
     pub root: usize,
+}
+
+/// A node of a [`CompiledBt`].
+#[derive(Debug)]
+pub struct XNode {
+    pub kind: BtNodeKind,
+    pub call: Option<Call>,
+    /// Its children are `kids[start..start + len]`.
+    start: usize,
+    len: usize,
 }
 
 impl CompiledBt {
     pub fn new(bt: &Bt, call: Vec<Option<Call>>) -> Self {
+        let mut kids = Vec::new();
+        let nodes = bt
+            .nodes
+            .iter()
+            .zip(call)
+            .map(|(n, call)| {
+                let start = kids.len();
+                kids.extend_from_slice(&n.children);
+                XNode {
+                    kind: n.kind,
+                    call,
+                    start,
+                    len: n.children.len(),
+                }
+            })
+            .collect();
         CompiledBt {
-            kind: bt.nodes.iter().map(|n| n.kind).collect(),
-            children: bt.nodes.iter().map(|n| n.children.clone()).collect(),
-            call,
+            nodes,
+            kids,
             root: bt.root,
         }
+    }
+
+    fn kids(&self, n: &XNode) -> &[usize] {
+        &self.kids[n.start..n.start + n.len]
     }
 }
 
@@ -90,7 +119,7 @@ struct Frame {
 
 impl BtExec {
     pub fn new(bt: Arc<CompiledBt>, record: bool) -> Self {
-        let n = bt.kind.len();
+        let n = bt.nodes.len();
         BtExec {
             bt,
             node: vec![NodeState::default(); n],
@@ -100,14 +129,14 @@ impl BtExec {
         }
     }
 
-    fn enter(st: &mut [NodeState], kind: &[BtNodeKind], step: u64, n: usize, now: f64) -> Frame {
+    fn enter(st: &mut [NodeState], kind: BtNodeKind, step: u64, n: usize, now: f64) -> Frame {
         let ns = &mut st[n];
         if ns.last + 1 != step {
             ns.mem = 0;
             ns.t0 = now;
         }
         ns.last = step;
-        let i = match kind[n] {
+        let i = match kind {
             BtNodeKind::SequenceMemory | BtNodeKind::FallbackMemory => ns.mem as usize,
             _ => 0,
         };
@@ -133,20 +162,21 @@ impl BtExec {
         let now = leaves.now();
         let mut stack = std::mem::take(&mut self.stack);
         stack.clear();
-        let root = Self::enter(st, &bt.kind, step, bt.root, now);
+        let root = Self::enter(st, bt.nodes[bt.root].kind, step, bt.root, now);
         stack.push(root);
         let mut ret: Option<Status> = None;
         loop {
             let top = stack.len() - 1;
             let n = stack[top].node;
-            let kids = &bt.children[n];
+            let node = &bt.nodes[n];
+            let kids = bt.kids(node);
             let mut push = None;
-            let out: Status = match bt.kind[n] {
-                K::Action => match &bt.call[n] {
+            let out: Status = match node.kind {
+                K::Action => match &node.call {
                     Some(c) => leaves.action(n, c),
                     None => F,
                 },
-                K::Condition => match &bt.call[n] {
+                K::Condition => match &node.call {
                     Some(c) if leaves.condition(c) => S,
                     _ => F,
                 },
@@ -161,7 +191,8 @@ impl BtExec {
                         match r {
                             None if f.i < kids.len() => {
                                 let c = kids[f.i];
-                                let leaf = match (bt.kind[c], &bt.call[c]) {
+                                let cn = &bt.nodes[c];
+                                let leaf = match (cn.kind, &cn.call) {
                                     (K::Action, Some(call)) => leaves.action(c, call),
                                     (K::Condition, Some(call)) => {
                                         if leaves.condition(call) {
@@ -271,7 +302,8 @@ impl BtExec {
             };
             if let Some(c) = push {
                 // Leaves are evaluated in place (no frame): the hot path.
-                let leaf = match (bt.kind[c], &bt.call[c]) {
+                let cn = &bt.nodes[c];
+                let leaf = match (cn.kind, &cn.call) {
                     (K::Action, Some(call)) => Some(leaves.action(c, call)),
                     (K::Condition, Some(call)) => Some(if leaves.condition(call) { S } else { F }),
                     (K::Action | K::Condition, None) => Some(F),
@@ -285,7 +317,7 @@ impl BtExec {
                         ret = Some(r);
                     }
                     None => {
-                        let fr = Self::enter(st, &bt.kind, step, c, now);
+                        let fr = Self::enter(st, cn.kind, step, c, now);
                         stack.push(fr);
                     }
                 }
@@ -673,9 +705,9 @@ tuck = { action = "Tuck!", skill = "Tuck-Arm" }
         };
         let compiled = Arc::new(compile_bt(DECORATED, bind));
         let time_node = compiled
-            .kind
+            .nodes
             .iter()
-            .position(|k| matches!(k, BtNodeKind::Timeout { .. }))
+            .position(|x| matches!(x.kind, BtNodeKind::Timeout { .. }))
             .unwrap();
         let mut ex = BtExec::new(compiled, true);
         let mut d = Decor { t: 0.0, docks: 0 };
