@@ -67,6 +67,17 @@ pub enum ConvertTarget {
     Hfsm,
     /// TOML (normalised)
     Toml,
+    /// BehaviorTree.CPP XML, format 4 (behavior trees)
+    BtcppXml,
+    /// SCXML (FSMs and HFSMs)
+    Scxml,
+}
+
+/// `--assume-leaf`: how to read BehaviorTree.CPP leaves of unknown type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AssumeLeafArg {
+    Action,
+    Condition,
 }
 
 /// Input limits (documented defaults; see `format::Limits`).
@@ -78,6 +89,14 @@ pub struct LimitArgs {
     /// Most BT nodes or FSM states per policy, subtrees expanded
     #[arg(long, default_value_t = 2_000_000, hide_short_help = true)]
     pub max_nodes: usize,
+    /// BehaviorTree.CPP TreeNodesModel file declaring node types (repeatable),
+    /// e.g. Nav2's nav2_tree_nodes.xml
+    #[arg(long = "nodes-model", value_name = "FILE")]
+    pub nodes_model: Vec<PathBuf>,
+    /// Read BehaviorTree.CPP leaves of unknown type as actions or conditions
+    /// (default: an error listing the known types)
+    #[arg(long, value_enum, value_name = "KIND")]
+    pub assume_leaf: Option<AssumeLeafArg>,
 }
 
 impl LimitArgs {
@@ -85,6 +104,11 @@ impl LimitArgs {
         crate::format::Limits {
             max_file_bytes: self.max_file_bytes,
             max_nodes: self.max_nodes,
+            nodes_models: self.nodes_model.clone(),
+            assume_leaf: self.assume_leaf.map(|a| match a {
+                AssumeLeafArg::Action => crate::format::AssumeLeaf::Action,
+                AssumeLeafArg::Condition => crate::format::AssumeLeaf::Condition,
+            }),
             ..Default::default()
         }
     }

@@ -75,6 +75,9 @@ pub fn execute(cli: Cli) -> u8 {
             };
             let policy = match to {
                 ConvertTarget::Toml => l.policy,
+                ConvertTarget::BtcppXml | ConvertTarget::Scxml => {
+                    return super::convert::to_xml(&l.policy, to, output.as_deref());
+                }
                 ConvertTarget::Hfsm => {
                     match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
                         Ok(p) => p,
@@ -139,7 +142,7 @@ fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
 }
 
 /// Writes output to a file (atomically) or stdout.
-fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
+pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
     match path {
         Some(p) => match report::write_atomically(p, bytes) {
             Ok(()) => EXIT_OK,

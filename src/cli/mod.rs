@@ -4,6 +4,7 @@
 
 pub mod args;
 mod commands;
+mod convert;
 
 use clap::Parser;
 use std::ffi::OsString;

@@ -89,11 +89,11 @@ fn sorted_partition(mut diags: Vec<Diagnostic>) -> (Vec<Diagnostic>, Vec<Diagnos
     diags.into_iter().partition(Diagnostic::is_error)
 }
 
-fn canonical(p: &Path) -> PathBuf {
+pub(crate) fn canonical(p: &Path) -> PathBuf {
     std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
 }
 
-fn read_source(
+pub(crate) fn read_source(
     path: &Path,
     shown: &str,
     limits: &Limits,
@@ -606,6 +606,8 @@ impl Loader {
             children: Vec<(String, Range<usize>)>,
             skill: Option<SkillCall>,
             include: Option<Bt>,
+            type_name: Option<String>,
+            ports: BTreeMap<String, String>,
         }
         let mut raws: Vec<Raw> = Vec::with_capacity(ids.len());
         for (key, v) in nodes.iter() {
@@ -621,12 +623,14 @@ impl Loader {
             }
             self.node_budget -= 1;
             raws.push(match self.bt_node(cx, id, key.span(), v) {
-                Some((kind, label, children, skill, include)) => Raw {
+                Some(((kind, label, children, skill, include), (type_name, ports))) => Raw {
                     kind,
                     label,
                     children,
                     skill,
                     include,
+                    type_name,
+                    ports,
                 },
                 None => Raw {
                     kind: None,
@@ -634,6 +638,8 @@ impl Loader {
                     children: vec![],
                     skill: None,
                     include: None,
+                    type_name: None,
+                    ports: BTreeMap::new(),
                 },
             });
         }
@@ -839,6 +845,8 @@ impl Loader {
                     kind: raw.kind.expect("checked above"),
                     children: Vec::new(),
                     skill: raw.skill.take(),
+                    type_name: raw.type_name.take(),
+                    ports: std::mem::take(&mut raw.ports),
                     span: Some(ids[i].1.clone()),
                 }),
             }
@@ -864,11 +872,14 @@ impl Loader {
         key_span: Range<usize>,
         v: &Val<'_>,
     ) -> Option<(
-        Option<BtNodeKind>,
-        String,
-        Vec<(String, Range<usize>)>,
-        Option<SkillCall>,
-        Option<Bt>,
+        (
+            Option<BtNodeKind>,
+            String,
+            Vec<(String, Range<usize>)>,
+            Option<SkillCall>,
+            Option<Bt>,
+        ),
+        (Option<String>, BTreeMap<String, String>),
     )> {
         let DeValue::Table(t) = v.get_ref() else {
             self.err(
@@ -884,7 +895,9 @@ impl Loader {
             ));
             return None;
         };
-        const FIELDS: &[&str] = &["name", "skill", "args", "success", "times", "ms", "with"];
+        const FIELDS: &[&str] = &[
+            "name", "skill", "args", "success", "times", "ms", "with", "type", "ports",
+        ];
         let type_keys: Vec<(&str, &Val<'_>, Range<usize>)> = t
             .iter()
             .filter(|(k, _)| NODE_KEYWORDS.contains(&k.get_ref().as_ref()))
@@ -966,9 +979,14 @@ impl Loader {
             },
             "action" => BtNodeKind::Action,
             "condition" => BtNodeKind::Condition,
+            "control" => BtNodeKind::Control,
+            "decorator" => BtNodeKind::Decorator,
             "subtree" => {
                 let sub = self.include(cx, id, t, tval)?;
-                return Some((None, String::new(), vec![], None, Some(sub)));
+                return Some((
+                    (None, String::new(), vec![], None, Some(sub)),
+                    (None, BTreeMap::new()),
+                ));
             }
             _ => unreachable!("filtered by NODE_KEYWORDS"),
         };
@@ -982,6 +1000,7 @@ impl Loader {
                 "times" => matches!(kind, BtNodeKind::Repeat { .. } | BtNodeKind::Retry { .. }),
                 "ms" => matches!(kind, BtNodeKind::Timeout { .. }),
                 "with" => false,
+                "type" | "ports" => true,
                 _ => true,
             };
             if !fits {
@@ -1055,7 +1074,67 @@ impl Loader {
                 }
             },
         }
-        Some((Some(kind), label, children, skill, None))
+        let type_name = self.opt_str(cx, t, "type");
+        if matches!(kind, BtNodeKind::Control | BtNodeKind::Decorator) && type_name.is_none() {
+            self.err(cx, tspan, format!("{tkey} node `{id}` needs `type`"))
+                .hint = Some(
+                "write `type = \"IfThenElse\"`: the node's kind in the file it came from".into(),
+            );
+            return None;
+        }
+        let ports = self.ports(cx, t, id)?;
+        Some((
+            (Some(kind), label, children, skill, None),
+            (type_name, ports),
+        ))
+    }
+
+    /// Reads `ports = { name = "value", ... }` (values kept as text).
+    fn ports(
+        &mut self,
+        cx: &Ctx<'_>,
+        t: &DeTable<'_>,
+        id: &str,
+    ) -> Option<BTreeMap<String, String>> {
+        let mut out = BTreeMap::new();
+        let Some(pv) = t.get("ports") else {
+            return Some(out);
+        };
+        let DeValue::Table(pt) = pv.get_ref() else {
+            self.err(
+                cx,
+                pv.span(),
+                format!(
+                    "`ports` of node `{id}` must be a table, found {}",
+                    type_name(pv.get_ref())
+                ),
+            )
+            .hint = Some("write `ports = { num_cycles = \"3\" }`".into());
+            return None;
+        };
+        for (k, v) in pt.iter() {
+            match v.get_ref() {
+                DeValue::String(_)
+                | DeValue::Integer(_)
+                | DeValue::Float(_)
+                | DeValue::Boolean(_) => {
+                    out.insert(k.get_ref().to_string(), scalar_text(v.get_ref()));
+                }
+                other => {
+                    self.err(
+                        cx,
+                        v.span(),
+                        format!(
+                            "port `{}` of node `{id}` must be a string, found {}",
+                            k.get_ref(),
+                            type_name(other)
+                        ),
+                    );
+                    return None;
+                }
+            }
+        }
+        Some(out)
     }
 
     /// Reads an included subtree file.
@@ -1314,7 +1393,9 @@ impl Loader {
                 let allowed: &[&str] = if is_container {
                     &["label", "initial", "outcomes", "states", "on", "guards"]
                 } else {
-                    &["label", "skill", "args", "decision", "on", "guards"]
+                    &[
+                        "label", "skill", "args", "decision", "history", "on", "guards",
+                    ]
                 };
                 let before = self.diags.len();
                 self.check_keys(cx, st, allowed, &format!("field of state `{name}`"));
@@ -1334,6 +1415,31 @@ impl Loader {
                         }
                     },
                 };
+                let pseudo = match st.get("history") {
+                    None => None,
+                    Some(h) => match h.get_ref().as_str() {
+                        Some("shallow") => Some(crate::model::Pseudo::ShallowHistory),
+                        Some("deep") => Some(crate::model::Pseudo::DeepHistory),
+                        _ => {
+                            self.err(cx, h.span(), "`history` must be \"shallow\" or \"deep\"")
+                                .hint = Some(
+                                "an SCXML history pseudo-state; it also needs `decision = true`"
+                                    .into(),
+                            );
+                            ok = false;
+                            None
+                        }
+                    },
+                };
+                if pseudo.is_some() && !decision {
+                    self.err(
+                        cx,
+                        k.span(),
+                        format!("history state `{name}` must be a decision state"),
+                    )
+                    .hint = Some("add `decision = true`: a history state runs no skill".into());
+                    ok = false;
+                }
                 let body = if is_container {
                     if !hierarchical {
                         self.err(
@@ -1453,6 +1559,7 @@ impl Loader {
                     parent: container,
                     body,
                     transitions: Vec::new(),
+                    pseudo,
                     span: Some(k.span()),
                 });
                 raw_trs.push(trs);
@@ -1511,6 +1618,8 @@ impl Loader {
             .enumerate()
             .map(|(i, st)| ((st.parent, st.name.as_str()), i))
             .collect();
+        // Targets in other regions (SCXML imports) are written as paths.
+        let by_path: HashMap<String, usize> = (0..m.states.len()).map(|i| (m.path(i), i)).collect();
         let mut resolved_all: Vec<Vec<Transition>> = vec![Vec::new(); m.states.len()];
         for (si, trs) in raw_trs.into_iter().enumerate() {
             let region = m.region_of(si);
@@ -1545,6 +1654,8 @@ impl Loader {
                     Target::State(t)
                 } else if region.outcomes.contains(&target) {
                     Target::Outcome(target)
+                } else if let Some(&t) = by_path.get(&target) {
+                    Target::State(t)
                 } else {
                     let cands: Vec<&str> = region
                         .states
@@ -1570,6 +1681,7 @@ impl Loader {
             }
         }
         drop(by_name);
+        drop(by_path);
         for (st, trs) in m.states.iter_mut().zip(resolved_all) {
             st.transitions = trs;
         }
@@ -1621,9 +1733,8 @@ impl Loader {
                 }
             }
         }
-        if out.is_empty() {
-            self.err(cx, ov.span(), format!("{owner} needs at least one outcome"));
-        }
+        // `outcomes = []` is a machine that never terminates (as SCXML machines
+        // without `<final>` states are).
         out
     }
 
@@ -1700,6 +1811,14 @@ impl Loader {
                     return None;
                 }
                 terms
+            }
+            // A guard that names no condition of the skill library, only its
+            // `label` (an SCXML event or condition, kept as text).
+            None if !t.contains_key("if")
+                && !t.contains_key("unless")
+                && t.contains_key("label") =>
+            {
+                vec![]
             }
             None => vec![self.guard_term(cx, t, g.span(), &owner)?],
         };

@@ -98,7 +98,8 @@ fn bt_control_flow(bt: &Bt) -> ControlFlow {
                 | BtNodeKind::SequenceMemory
                 | BtNodeKind::Fallback
                 | BtNodeKind::FallbackMemory
-                | BtNodeKind::Parallel { .. } => {
+                | BtNodeKind::Parallel { .. }
+                | BtNodeKind::Control => {
                     // One outcome continues to the next sibling, the others return.
                     cf.arc(from, next.unwrap_or(out));
                     cf.arc(from, out);
