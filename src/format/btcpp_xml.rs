@@ -327,6 +327,8 @@ impl Loader<'_> {
     /// including one of its includers is a cycle.
     fn includes(&mut self, identity: PathBuf) {
         let mut chain: Vec<PathBuf> = vec![identity];
+        // The same chain as the user sees the paths (canonical ones differ by machine).
+        let mut shown_chain: Vec<String> = vec![self.docs[0].file.path.clone()];
         let mut loaded: HashSet<PathBuf> = chain.iter().cloned().collect();
         let mut work: Vec<(usize, usize)> = vec![(0, 0)];
         while let Some(&mut (d, ref mut pos)) = work.last_mut() {
@@ -335,6 +337,7 @@ impl Loader<'_> {
             if *pos >= kids.len() {
                 work.pop();
                 chain.pop();
+                shown_chain.pop();
                 continue;
             }
             let e = kids[*pos];
@@ -361,11 +364,8 @@ impl Loader<'_> {
             let full = self.dirs[d].join(&pval);
             let canon = super::toml::canonical(&full);
             if let Some(at) = chain.iter().position(|c| *c == canon) {
-                let mut names: Vec<String> = chain[at..]
-                    .iter()
-                    .map(|c| c.display().to_string())
-                    .collect();
-                names.push(canon.display().to_string());
+                let mut names: Vec<String> = shown_chain[at..].to_vec();
+                names.push(full.display().to_string());
                 self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
                     .hint =
                     Some("a file must not include itself, directly or through others".into());
@@ -419,6 +419,7 @@ impl Loader<'_> {
             self.dirs
                 .push(full.parent().unwrap_or(Path::new("")).to_path_buf());
             chain.push(canon);
+            shown_chain.push(shown);
             work.push((self.docs.len() - 1, 0));
         }
     }
@@ -819,18 +820,20 @@ impl Loader<'_> {
                 .chain(self.models.keys().map(String::as_str))
                 .collect();
             let did = suggest(&ty, cands);
-            let mut hint = String::new();
-            if !did.is_empty() {
-                hint.push_str(&did);
-                hint.push_str("; ");
-            }
-            if n == 0 {
-                hint.push_str("declare it in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition");
+            let remedy = if n == 0 {
+                format!(
+                    "declare it as `<Action ID=\"{ty}\"/>` or `<Condition ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition"
+                )
             } else {
-                hint.push_str(&format!(
+                format!(
                     "declare it as `<Control ID=\"{ty}\"/>` or `<Decorator ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE)"
-                ));
-            }
+                )
+            };
+            let hint = if did.starts_with("did you mean") {
+                format!("{did} or {remedy}")
+            } else {
+                remedy
+            };
             self.err(
                 d,
                 el.span.clone(),

@@ -109,6 +109,9 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
     // Pass 1: state-like elements in document order, with their parent state.
     // (element, kind, parent entry index)
     let mut found: Vec<(usize, Kind, Option<usize>)> = Vec::new();
+    // Ids inside unsupported `<parallel>` elements: transitions to them are
+    // not reported again.
+    let mut skipped: std::collections::HashSet<String> = std::collections::HashSet::new();
     let mut stack: Vec<(usize, Option<usize>)> = doc.elems[doc.root]
         .children
         .iter()
@@ -134,6 +137,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     "`<parallel>` states are not supported".into(),
                     "the paper's FSMs and HFSMs run one state per region; model each parallel region as its own machine",
                 );
+                let mut inner = vec![e];
+                while let Some(x) = inner.pop() {
+                    if let Some(id) = doc.elems[x].attr("id") {
+                        skipped.insert(id.to_string());
+                    }
+                    inner.extend(doc.elems[x].children.iter().copied());
+                }
                 continue;
             }
             _ => continue, // transitions, initial, executable content: read later
@@ -154,9 +164,6 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 stack.push((c, Some(idx)));
             }
         }
-    }
-    if diags.iter().any(Diagnostic::is_error) {
-        return None;
     }
     // Ids: unique in the document.
     let mut by_id: HashMap<String, usize> = HashMap::new();
@@ -440,6 +447,9 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
             let tid = targets[0];
             let Some(&tk) = by_id.get(tid) else {
+                if skipped.contains(tid) {
+                    continue;
+                }
                 let h = suggest(tid, ids.iter().map(String::as_str));
                 diags.push(
                     Diagnostic::error(format!(
@@ -473,7 +483,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             };
             let valid: Vec<String> = match &m.states[si].body {
                 StateBody::Container(r) => r.outcomes.clone(),
-                StateBody::Decision => vec![],
+                StateBody::Decision => vec!["RUNNING".to_string()],
                 StateBody::Task(_) => TASK_OUTCOMES.iter().map(|s| s.to_string()).collect(),
             };
             let span = Some(t.span.clone());

@@ -5,9 +5,11 @@
 //! from their label (`event`, `event [cond]`, `[cond]`; a label with spaces is a
 //! `cond`), history pseudo-states `<history>`.
 //!
-//! SCXML ids are unique in a document while model names are unique per region:
-//! a state keeps its name as id when no other state or final has it, else its
-//! path (`Container/name`), with the name in `btfsm:name`. Skill bindings,
+//! SCXML ids are unique XML names in a document while model names are unique per
+//! region and may hold spaces: a state's id is its name (or, when another state
+//! or final has the same name, its path), with characters outside XML names
+//! replaced by `_`; where the id differs from the name, the name is kept in
+//! `btfsm:name`. Skill bindings,
 //! display labels and decision states go in btfsm's namespace.
 
 use super::xml::{BTFSM_NS, escape_attr, escape_comment};
@@ -32,6 +34,24 @@ pub fn write_policy(p: &Policy) -> Result<String, NotAMachine> {
         });
     };
     Ok(write_machine(&p.name, p.description.as_deref(), m))
+}
+
+/// An SCXML id (an XML NCName: no spaces, no `/`) made from a name.
+fn xml_id(s: &str) -> String {
+    let mut id: String = s
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if !id.starts_with(|c: char| c.is_alphabetic() || c == '_') {
+        id.insert(0, '_');
+    }
+    id
 }
 
 /// Splits a guard label into SCXML `event` and `cond`.
@@ -72,6 +92,7 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
     }
     let mut used: HashSet<String> = HashSet::new();
     let mut unique = |cand: String| {
+        let cand = xml_id(&cand);
         let mut id = cand.clone();
         let mut k = 2;
         while used.contains(&id) {
