@@ -465,28 +465,41 @@ fn count_tree_nodes(path: &Path) -> usize {
     total
 }
 
-/// States of an SCXML file by the test's own scanner: every `<state>` and
-/// `<history>`, plus the `<final>` states of the top level (the machine's
-/// outcomes; nested finals are their container's outcomes, not vertices).
-fn count_scxml_vertices(path: &Path) -> usize {
+/// Vertices and arcs of an SCXML file's HFSM graph by the test's own scanner:
+/// every `<state>` and `<history>`, plus the `<final>` states of the top level
+/// (the machine's outcomes; nested finals are their container's outcomes, not
+/// vertices); one arc per `<transition>` with a target, plus one per state
+/// holding states (to its initial child).
+fn count_scxml_graph(path: &Path) -> (usize, usize) {
     let text = std::fs::read_to_string(path).expect("read");
-    let mut stack: Vec<String> = Vec::new();
-    let mut n = 0;
-    for (name, _, self_closing) in scan_tags(&text) {
+    // (element name, holds a state)
+    let mut stack: Vec<(String, bool)> = Vec::new();
+    let (mut n, mut arcs) = (0, 0);
+    for (name, attrs, self_closing) in scan_tags(&text) {
         if let Some(closed) = name.strip_prefix('/') {
-            assert_eq!(stack.pop().as_deref(), Some(closed));
+            let (open, compound) = stack.pop().expect("balanced");
+            assert_eq!(open, closed);
+            if compound {
+                arcs += 1;
+            }
             continue;
         }
         match name.as_str() {
-            "state" | "history" => n += 1,
-            "final" if stack.last().map(String::as_str) == Some("scxml") => n += 1,
+            "state" | "history" => {
+                n += 1;
+                if let Some(parent) = stack.last_mut().filter(|(p, _)| p == "state") {
+                    parent.1 = true;
+                }
+            }
+            "final" if stack.last().map(|(p, _)| p.as_str()) == Some("scxml") => n += 1,
+            "transition" if attr(&attrs, "target").is_some() => arcs += 1,
             _ => {}
         }
         if !self_closing {
-            stack.push(name);
+            stack.push((name, false));
         }
     }
-    n
+    (n, arcs)
 }
 
 #[test]
@@ -525,7 +538,9 @@ fn corpus_scxml_imports_analyzes_draws_and_validates() {
         assert_eq!(code, 0, "{file}: {stderr}");
         let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
         let p = &v["policies"][0];
-        assert_eq!(p["vertices"], count_scxml_vertices(&f) as u64, "{file}");
+        let (vertices, arcs) = count_scxml_graph(&f);
+        assert_eq!(p["vertices"], vertices as u64, "{file}");
+        assert_eq!(p["edges"], arcs as u64, "{file}");
         let (code, dot, stderr) = btfsm(&["dot", &file]);
         assert_eq!(code, 0, "{file}: {stderr}");
         assert!(dot.starts_with("digraph"));

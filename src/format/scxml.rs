@@ -359,13 +359,25 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
         }
     }
-    // Default: the first child state in document order.
-    let first = |m: &StateMachine, c: Option<usize>| {
-        m.states
-            .iter()
-            .enumerate()
-            .find(|(_, s)| s.parent == c && s.pseudo.is_none())
-            .map(|(i, _)| i)
+    // Default: the first child state in document order (one pass: states are
+    // in document order).
+    let mut first_child: Vec<Option<usize>> = vec![None; m.states.len()];
+    let mut first_top: Option<usize> = None;
+    for (i, st) in m.states.iter().enumerate() {
+        if st.pseudo.is_some() {
+            continue;
+        }
+        let slot = match st.parent {
+            None => &mut first_top,
+            Some(p) => &mut first_child[p],
+        };
+        if slot.is_none() {
+            *slot = Some(i);
+        }
+    }
+    let first = |_: &StateMachine, c: Option<usize>| match c {
+        None => first_top,
+        Some(c) => first_child[c],
     };
     if m.top.initial == usize::MAX {
         match first(&m, None) {
