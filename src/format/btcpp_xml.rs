@@ -256,22 +256,7 @@ fn load(
         models: BTreeMap::new(),
     };
     let policy = l.run(identity);
-    let (errors, warnings): (Vec<_>, Vec<_>) = l.diags.into_iter().partition(Diagnostic::is_error);
-    match policy {
-        Some(policy) if errors.is_empty() => Ok(Loaded {
-            path: file.path.clone(),
-            policy,
-            warnings,
-        }),
-        _ => {
-            let mut all = errors;
-            if all.is_empty() {
-                all.push(Diagnostic::error("invalid behavior tree").in_file(&file));
-            }
-            all.extend(warnings);
-            Err(all)
-        }
-    }
+    super::finish(&file, policy, l.diags, "behavior tree")
 }
 
 impl Loader<'_> {

@@ -9,9 +9,10 @@ pub mod toml;
 pub mod toml_write;
 pub mod xml;
 
-use crate::diagnostic::Diagnostic;
+use crate::diagnostic::{Diagnostic, SourceFile};
 use crate::model::Policy;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// A policy read from a file, with the warnings its validation produced.
 #[derive(Debug)]
@@ -103,5 +104,38 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
         FileFormat::Toml => toml::load_file(path, limits),
         FileFormat::BtcppXml => btcpp_xml::load_file(path, limits),
         FileFormat::Scxml => scxml::load_file(path, limits),
+    }
+}
+
+/// The result of reading `file`: the policy with its warnings, or every error
+/// followed by the warnings (each in file and source order). `what` names the
+/// policy in the fallback message when reading failed without an error.
+pub(crate) fn finish(
+    file: &Arc<SourceFile>,
+    policy: Option<Policy>,
+    mut diags: Vec<Diagnostic>,
+    what: &str,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    diags.sort_by_key(|d| {
+        (
+            d.file.as_ref().map(|f| f.path.clone()),
+            d.span.as_ref().map_or(0, |s| s.start),
+        )
+    });
+    let (errors, warnings): (Vec<_>, Vec<_>) = diags.into_iter().partition(Diagnostic::is_error);
+    match policy {
+        Some(policy) if errors.is_empty() => Ok(Loaded {
+            path: file.path.clone(),
+            policy,
+            warnings,
+        }),
+        _ => {
+            let mut all = errors;
+            if all.is_empty() {
+                all.push(Diagnostic::error(format!("invalid {what}")).in_file(file));
+            }
+            all.extend(warnings);
+            Err(all)
+        }
     }
 }

@@ -65,22 +65,7 @@ fn load(file: Arc<SourceFile>, limits: &Limits) -> Result<Loaded, Vec<Diagnostic
     let doc = xml::parse(&file).map_err(|d| vec![d])?;
     let mut diags: Vec<Diagnostic> = Vec::new();
     let policy = read(&doc, limits, &mut diags);
-    let (errors, warnings): (Vec<_>, Vec<_>) = diags.into_iter().partition(Diagnostic::is_error);
-    match policy {
-        Some(policy) if errors.is_empty() => Ok(Loaded {
-            path: file.path.clone(),
-            policy,
-            warnings,
-        }),
-        _ => {
-            let mut all = errors;
-            if all.is_empty() {
-                all.push(Diagnostic::error("invalid state machine").in_file(&file));
-            }
-            all.extend(warnings);
-            Err(all)
-        }
-    }
+    super::finish(&file, policy, diags, "state machine")
 }
 
 /// Is the element SCXML's (in its namespace, or in none)?

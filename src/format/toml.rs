@@ -60,33 +60,7 @@ fn load_source(
         node_budget: limits.max_nodes,
     };
     let policy = loader.policy(file, base);
-    let (errors, warnings) = sorted_partition(loader.diags);
-    match policy {
-        Some(policy) if errors.is_empty() => Ok(Loaded {
-            path: file.path.clone(),
-            policy,
-            warnings,
-        }),
-        _ => {
-            let mut all = errors;
-            if all.is_empty() {
-                all.push(Diagnostic::error("invalid policy").in_file(file));
-            }
-            all.extend(warnings);
-            Err(all)
-        }
-    }
-}
-
-/// Errors and warnings, each in file and source order.
-fn sorted_partition(mut diags: Vec<Diagnostic>) -> (Vec<Diagnostic>, Vec<Diagnostic>) {
-    diags.sort_by_key(|d| {
-        (
-            d.file.as_ref().map(|f| f.path.clone()),
-            d.span.as_ref().map_or(0, |s| s.start),
-        )
-    });
-    diags.into_iter().partition(Diagnostic::is_error)
+    super::finish(file, policy, loader.diags, "policy")
 }
 
 pub(crate) fn canonical(p: &Path) -> PathBuf {
