@@ -643,7 +643,10 @@ mod tests {
             &Limits::default(),
         )
         .unwrap_err();
-        assert!(e[0].message.contains("`<parallel>`"));
-        assert_eq!(e[0].location().unwrap().1, 2);
+        let p = e
+            .iter()
+            .find(|d| d.message.contains("`<parallel>`"))
+            .expect("parallel reported");
+        assert_eq!(p.location().unwrap().1, 2);
     }
 }
