@@ -741,7 +741,7 @@ impl Loader<'_> {
     fn node(&mut self, d: usize, el: &XElem) -> Option<BtNode> {
         let tag = el.name.as_str();
         let n = el.children.len();
-        let (ty, explicit_cat): (String, Option<Category>) = match tag {
+        let (mut ty, explicit_cat): (String, Option<Category>) = match tag {
             "Action" | "Condition" | "Control" | "Decorator" => {
                 let cat = match tag {
                     "Action" => Category::Action,
@@ -792,6 +792,7 @@ impl Loader<'_> {
             let (k, c, keep) = builtin_kind(real, el, n);
             consumed = c;
             type_kept = keep;
+            ty = real.to_string();
             (k, *cat)
         } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
             match a {
@@ -1100,6 +1101,53 @@ mod tests {
             "{}",
             e[0].message
         );
+    }
+
+    const SEED: &str = r#"<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <ReactiveSequence name="top">
+      <SubTree ID="Sub"/>
+      <Parallel success_count="-1"><AlwaysSuccess/><Script code="a:=1"/></Parallel>
+      <Repeat num_cycles="3"><Move-To target="cube2"/></Repeat>
+      <IfThenElse><Found/><Search/><AlwaysFailure/></IfThenElse>
+    </ReactiveSequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Sub"><Fallback><Condition ID="Robot-At" target="x"/><Dock/></Fallback></BehaviorTree>
+  <TreeNodesModel><Action ID="Search"/><Action ID="Dock"/><Condition ID="Found"/></TreeNodesModel>
+</root>"#;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
+
+        /// Mutated trees never panic: they read (and write and read back at the
+        /// same size) or give positioned errors.
+        #[test]
+        fn mutated_trees_never_panic(
+            cuts in proptest::collection::vec((0usize..2000, 0usize..8, "[<>/=\" a-zA-Z]{0,3}"), 1..4)
+        ) {
+            let mut text = SEED.to_string();
+            for (at, del, ins) in cuts {
+                let at = at % (text.len() + 1);
+                let end = (at + del).min(text.len());
+                if text.is_char_boundary(at) && text.is_char_boundary(end) {
+                    text.replace_range(at..end, &ins);
+                }
+            }
+            match parse(&text) {
+                Ok(l) => {
+                    let xml = crate::format::btcpp_xml_write::write_policy(&l.policy).expect("a BT");
+                    let back = parse(&xml).expect("written XML reads back");
+                    proptest::prop_assert_eq!(bt(&back).nodes.len(), bt(&l).nodes.len());
+                }
+                Err(ds) => proptest::prop_assert!(ds.iter().any(|d| d.is_error() && d.location().is_some())),
+            }
+        }
+
+        #[test]
+        fn random_text_never_panics(text in "\\PC{0,200}") {
+            let _ = parse(&text);
+            let _ = crate::format::scxml::parse_str("t.scxml", &text, &Limits::default());
+        }
     }
 
     #[test]

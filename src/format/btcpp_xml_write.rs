@@ -212,6 +212,16 @@ mod tests {
     use crate::format::btcpp_xml::parse_str;
     use std::path::Path;
 
+    /// Golden file: the paper's Fig. 5 BT as BehaviorTree.CPP XML.
+    #[test]
+    fn fig05_as_btcpp_xml() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper/fig05-bt.toml");
+        let p = crate::format::load(&path, &Limits::default())
+            .unwrap()
+            .policy;
+        insta::assert_snapshot!(write_policy(&p).unwrap());
+    }
+
     #[test]
     fn toml_tree_round_trips_through_xml() {
         let text = r#"kind = "bt"

@@ -635,6 +635,73 @@ mod tests {
         assert_eq!(m.states[4].transitions[0].target, Target::State(3));
     }
 
+    const SEED: &str = r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:qt="http://www.qt.io/2015/02/scxml-ext" version="1.0" initial="a">
+  <state id="a" initial="a1"><qt:editorinfo g="1"/>
+    <state id="a1"><transition event="SUCCESS" target="a2"/></state>
+    <state id="a2"><transition event="x" cond="In(a1)" target="done_a"/></state>
+    <history id="h" type="deep"><transition target="a1"/></history>
+    <final id="done_a"/>
+    <transition event="done_a" target="b"/>
+  </state>
+  <state id="b"><transition event="back" target="h"/><transition event="end" target="end"/></state>
+  <final id="end"/>
+</scxml>"#;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
+
+        /// Mutated machines never panic: they read (and write and read back
+        /// at the same size) or give positioned errors.
+        #[test]
+        fn mutated_machines_never_panic(
+            cuts in proptest::collection::vec((0usize..2000, 0usize..8, "[<>/=\" a-z0-9]{0,3}"), 1..4)
+        ) {
+            let mut text = SEED.to_string();
+            for (at, del, ins) in cuts {
+                let at = at % (text.len() + 1);
+                let end = (at + del).min(text.len());
+                if text.is_char_boundary(at) && text.is_char_boundary(end) {
+                    text.replace_range(at..end, &ins);
+                }
+            }
+            match parse_str("t.scxml", &text, &Limits::default()) {
+                Ok(l) => {
+                    let out = crate::format::scxml_write::write_policy(&l.policy).expect("a machine");
+                    let back = parse_str("back.scxml", &out, &Limits::default())
+                        .unwrap_or_else(|e| panic!("{out}\n{e:?}"));
+                    proptest::prop_assert_eq!(machine(&back).states.len(), machine(&l).states.len());
+                }
+                Err(ds) => proptest::prop_assert!(ds.iter().any(|d| d.is_error() && d.location().is_some())),
+            }
+        }
+    }
+
+    #[test]
+    fn seed_reads_and_round_trips() {
+        let l = parse_str("t.scxml", SEED, &Limits::default()).unwrap();
+        let m = machine(&l);
+        assert_eq!(m.top.outcomes, ["end"]);
+        assert_eq!(m.states.len(), 5);
+        let StateBody::Container(r) = &m.states[0].body else {
+            panic!()
+        };
+        assert_eq!(r.outcomes, ["done_a"]);
+        let out = crate::format::scxml_write::write_policy(&l.policy).unwrap();
+        let back = parse_str("b.scxml", &out, &Limits::default()).unwrap();
+        // Equal but for source positions.
+        let strip = |m: &StateMachine| {
+            let mut m = m.clone();
+            for st in &mut m.states {
+                st.span = None;
+                for t in &mut st.transitions {
+                    t.span = None;
+                }
+            }
+            m
+        };
+        assert_eq!(strip(machine(&back)), strip(m), "{out}");
+    }
+
     #[test]
     fn parallel_is_reported_with_its_position() {
         let e = parse_str(

@@ -260,6 +260,17 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
 mod tests {
     use super::*;
 
+    /// Golden file: the paper's Fig. 6 HFSM as SCXML.
+    #[test]
+    fn fig06_as_scxml() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper/fig06-hfsm.toml");
+        let p = crate::format::load(&path, &Default::default())
+            .unwrap()
+            .policy;
+        insta::assert_snapshot!(write_policy(&p).unwrap());
+    }
+
     #[test]
     fn labels_split_into_event_and_cond() {
         assert_eq!(split_label("go"), (Some("go"), None));
