@@ -4,7 +4,10 @@
 
 pub mod args;
 mod commands;
+mod compare;
 mod convert;
+mod edit;
+mod paper;
 
 use clap::Parser;
 use std::ffi::OsString;
