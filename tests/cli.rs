@@ -953,3 +953,22 @@ fn fixtures_in(dir: &str) -> Vec<PathBuf> {
     v.sort();
     v
 }
+
+#[test]
+fn compare_works_across_formats() {
+    let dir = scratch("cmp");
+    let xml = dir.join("fig07c.xml");
+    convert(Path::new("policies/paper/fig07c-bt.toml"), "btcpp-xml", &xml);
+    let (code, stdout, stderr) = btfsm(&[
+        "compare",
+        "--format",
+        "json",
+        "policies/paper/fig01-bt.toml",
+        &xml.display().to_string(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    // SPEC §5: Fig. 1 -> Fig. 7c is 8 edits, whichever format B is in.
+    assert_eq!(v["named"]["ged"], 8, "{stdout}");
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}

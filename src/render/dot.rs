@@ -633,6 +633,20 @@ impl<'o> Builder<'o> {
                     self.container_nodes(i, &s.label, &key[i], r, &outcome_box);
                     continue;
                 }
+                // SCXML history pseudo-states as in UML: a small circle with H / H*.
+                StateBody::Decision if s.pseudo.is_some() => {
+                    let h = match s.pseudo {
+                        Some(crate::model::Pseudo::DeepHistory) => "H*",
+                        _ => "H",
+                    };
+                    a.set("label", h)
+                        .set("shape", "circle")
+                        .set("fillcolor", "white")
+                        .set("fontsize", "10")
+                        .set("width", "0.3")
+                        .set("tooltip", &key[i])
+                        .style("filled");
+                }
                 StateBody::Decision => {
                     a.set("label", &s.label)
                         .set("shape", "diamond")
