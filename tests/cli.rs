@@ -958,7 +958,11 @@ fn fixtures_in(dir: &str) -> Vec<PathBuf> {
 fn compare_works_across_formats() {
     let dir = scratch("cmp");
     let xml = dir.join("fig07c.xml");
-    convert(Path::new("policies/paper/fig07c-bt.toml"), "btcpp-xml", &xml);
+    convert(
+        Path::new("policies/paper/fig07c-bt.toml"),
+        "btcpp-xml",
+        &xml,
+    );
     let (code, stdout, stderr) = btfsm(&[
         "compare",
         "--format",
