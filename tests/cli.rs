@@ -887,6 +887,99 @@ fn round_trip(src: &Path, via: &str, back: &str, ext_via: &str, ext_back: &str, 
         assert_eq!(d, 0, "{} -> {what}: named GED {d}\n{script}", src.display());
     }
     assert_eq!(a.kind(), c.kind());
+    if let Err(e) = same_model(&a, &c) {
+        panic!("{} -> {via} -> {back}: {e}", src.display());
+    }
+}
+
+/// The same policy up to source positions and arena order: BT nodes compared
+/// by id (label, kind, skill, type, ports, children), states by path (label,
+/// body, transitions in order).
+fn same_model(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> Result<(), String> {
+    use btfsm::model::{PolicyBody, StateBody, Target};
+    match (&a.body, &b.body) {
+        (PolicyBody::Bt(x), PolicyBody::Bt(y)) => {
+            let kids = |t: &btfsm::model::Bt, i: usize| -> Vec<String> {
+                t.nodes[i]
+                    .children
+                    .iter()
+                    .map(|&c| t.nodes[c].id.clone())
+                    .collect()
+            };
+            if x.nodes[x.root].id != y.nodes[y.root].id {
+                return Err("different roots".into());
+            }
+            for (i, n) in x.nodes.iter().enumerate() {
+                let j = y
+                    .nodes
+                    .iter()
+                    .position(|m| m.id == n.id)
+                    .ok_or(format!("node `{}` lost", n.id))?;
+                let m = &y.nodes[j];
+                let l = (
+                    &n.label,
+                    n.kind,
+                    &n.skill,
+                    &n.type_name,
+                    &n.ports,
+                    kids(x, i),
+                );
+                let r = (
+                    &m.label,
+                    m.kind,
+                    &m.skill,
+                    &m.type_name,
+                    &m.ports,
+                    kids(y, j),
+                );
+                if l != r {
+                    return Err(format!("node `{}`: {l:?} != {r:?}", n.id));
+                }
+            }
+            Ok(())
+        }
+        (PolicyBody::Machine(x), PolicyBody::Machine(y)) => {
+            let desc = |m: &btfsm::model::StateMachine, i: usize| {
+                let s = &m.states[i];
+                let body = match &s.body {
+                    StateBody::Container(r) => format!(
+                        "container initial={} outcomes={:?}",
+                        m.states[r.initial].name, r.outcomes
+                    ),
+                    other => format!("{other:?}"),
+                };
+                let trs: Vec<String> = s
+                    .transitions
+                    .iter()
+                    .map(|t| {
+                        let to = match &t.target {
+                            Target::State(j) => m.path(*j),
+                            Target::Outcome(o) => format!("outcome {o}"),
+                        };
+                        format!("{:?} -> {to}", t.trigger)
+                    })
+                    .collect();
+                format!("{} {body} {:?} {trs:?}", s.label, s.pseudo)
+            };
+            if (x.top.outcomes.clone(), x.states[x.top.initial].name.clone())
+                != (y.top.outcomes.clone(), y.states[y.top.initial].name.clone())
+            {
+                return Err("different top level".into());
+            }
+            for i in 0..x.states.len() {
+                let p = x.path(i);
+                let j = (0..y.states.len())
+                    .find(|&j| y.path(j) == p)
+                    .ok_or(format!("state `{p}` lost"))?;
+                let (l, r) = (desc(x, i), desc(y, j));
+                if l != r {
+                    return Err(format!("state `{p}`:\n  {l}\n  {r}"));
+                }
+            }
+            Ok(())
+        }
+        _ => Err("different kinds".into()),
+    }
 }
 
 #[test]

@@ -20,7 +20,8 @@
 //!   and attributes of other namespaces (Qt Creator's `qt:editorinfo`) are
 //!   ignored; btfsm's own namespace carries what SCXML has no place for
 //!   (`btfsm:name`, `btfsm:label`, `btfsm:skill`, `btfsm:arg.NAME`,
-//!   `btfsm:decision`), written by `btfsm convert --to scxml`.
+//!   `btfsm:decision` on states; `btfsm:label`, `btfsm:terms`, `btfsm:guard`
+//!   on transitions), written by `btfsm convert --to scxml`.
 //!
 //! The document is walked with explicit stacks (no recursion on nesting depth).
 
@@ -28,7 +29,7 @@ use super::btcpp_xml::arg_value;
 use super::xml::{self, BTFSM_NS, XDoc, XElem};
 use super::{Limits, Loaded};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
-use crate::model::skill::{Guard, SkillCall};
+use crate::model::skill::{Guard, GuardTerm, SkillCall};
 use crate::model::{
     Policy, PolicyBody, Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
@@ -486,7 +487,9 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             let span = Some(t.span.clone());
             match (event, cond) {
                 (Some(ev), None)
-                    if valid.iter().any(|v| v == ev) && !used_outcomes.iter().any(|u| u == ev) =>
+                    if t.btfsm_attr("guard") != Some("true")
+                        && valid.iter().any(|v| v == ev)
+                        && !used_outcomes.iter().any(|u| u == ev) =>
                 {
                     used_outcomes.push(ev.to_string());
                     outs.push(Transition {
@@ -496,14 +499,25 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     });
                 }
                 _ => {
-                    let label = match (event, cond) {
-                        (Some(ev), Some(c)) => format!("{ev} [{c}]"),
-                        (Some(ev), None) => ev.to_string(),
-                        (None, Some(c)) => format!("[{c}]"),
-                        (None, None) => String::new(),
+                    let label = t
+                        .btfsm_attr("label")
+                        .map_or_else(|| guard_label(event, cond), str::to_string);
+                    let all = match t.btfsm_attr("terms") {
+                        None => vec![],
+                        Some(text) => match parse_terms(text) {
+                            Some(all) => all,
+                            None => {
+                                diags.push(
+                                    Diagnostic::error(format!("unreadable `btfsm:terms` \"{text}\""))
+                                        .at(f, t.span.clone())
+                                        .hint("write conditions as `Skill(arg=value, ...)`, `not ` to negate, separated by `; `"),
+                                );
+                                continue;
+                            }
+                        },
                     };
                     guards.push(Transition {
-                        trigger: Trigger::Guard(Guard { all: vec![], label }),
+                        trigger: Trigger::Guard(Guard { all, label }),
                         target,
                         span,
                     });
@@ -525,6 +539,47 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         description: None,
         body: PolicyBody::Machine(m),
     })
+}
+
+/// The label of a guard read from SCXML: `event`, `event [cond]` or `[cond]`.
+pub fn guard_label(event: Option<&str>, cond: Option<&str>) -> String {
+    match (event, cond) {
+        (Some(ev), Some(c)) => format!("{ev} [{c}]"),
+        (Some(ev), None) => ev.to_string(),
+        (None, Some(c)) => format!("[{c}]"),
+        (None, None) => String::new(),
+    }
+}
+
+/// Guard conditions as written in `btfsm:terms`:
+/// `not In-Hand(object=cube2); Battery-Level(min=20)`.
+pub fn parse_terms(text: &str) -> Option<Vec<GuardTerm>> {
+    let mut out = Vec::new();
+    for part in text.split("; ") {
+        let (negate, rest) = match part.strip_prefix("not ") {
+            Some(r) => (true, r),
+            None => (false, part),
+        };
+        let open = rest.find('(')?;
+        let inner = rest[open + 1..].strip_suffix(')')?;
+        let skill = rest[..open].trim();
+        if skill.is_empty() {
+            return None;
+        }
+        let mut args = BTreeMap::new();
+        for kv in inner.split(", ").filter(|kv| !kv.is_empty()) {
+            let (k, v) = kv.split_once('=')?;
+            args.insert(k.to_string(), arg_value(v));
+        }
+        out.push(GuardTerm {
+            condition: SkillCall {
+                skill: skill.to_string(),
+                args,
+            },
+            negate,
+        });
+    }
+    Some(out)
 }
 
 /// The outcome name of a final state.

@@ -9,9 +9,11 @@
 //! region and may hold spaces: a state's id is its name (or, when another state
 //! or final has the same name, its path), with characters outside XML names
 //! replaced by `_`; where the id differs from the name, the name is kept in
-//! `btfsm:name`. Skill bindings,
-//! display labels and decision states go in btfsm's namespace.
+//! `btfsm:name`. Skill bindings, display labels, decision states, a guard's
+//! library conditions (`btfsm:terms`) and a label the event/cond split would not
+//! give back go in btfsm's namespace.
 
+use super::scxml::guard_label;
 use super::xml::{BTFSM_NS, escape_attr, escape_comment};
 use crate::model::{Policy, PolicyBody, Pseudo, StateBody, StateMachine, Target, Trigger};
 use std::collections::{HashMap, HashSet};
@@ -201,11 +203,32 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             _ => {}
         }
         let _ = writeln!(out, "{pad}<{tag}{attrs}>");
+        // Outcomes the reader takes an `event` for (see `format::scxml`).
+        let outcomes: Vec<&str> = match &s.body {
+            StateBody::Container(r) => r.outcomes.iter().map(String::as_str).collect(),
+            StateBody::Decision => vec!["RUNNING"],
+            StateBody::Task(_) => vec!["SUCCESS", "FAILURE", "RUNNING"],
+        };
         for t in &s.transitions {
             let (event, cond) = match &t.trigger {
                 Trigger::Outcome(o) => (Some(o.as_str()), None),
                 Trigger::Guard(g) => split_label(&g.label),
             };
+            // What SCXML cannot say, in btfsm's namespace: the exact label,
+            // the library conditions, and a guard that looks like an outcome.
+            let mut extra = String::new();
+            if let Trigger::Guard(g) = &t.trigger {
+                if guard_label(event, cond) != g.label {
+                    let _ = write!(extra, " btfsm:label=\"{}\"", escape_attr(&g.label));
+                }
+                if !g.all.is_empty() {
+                    let terms: Vec<String> = g.all.iter().map(ToString::to_string).collect();
+                    let _ = write!(extra, " btfsm:terms=\"{}\"", escape_attr(&terms.join("; ")));
+                }
+                if cond.is_none() && event.is_some_and(|e| outcomes.contains(&e)) {
+                    extra.push_str(" btfsm:guard=\"true\"");
+                }
+            }
             let target = match &t.target {
                 Target::State(j) => state_id[*j].clone(),
                 Target::Outcome(o) => outcome_id(i, o),
@@ -219,7 +242,7 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             }
             let _ = writeln!(
                 out,
-                "{pad}  <transition{ta} target=\"{}\"/>",
+                "{pad}  <transition{ta} target=\"{}\"{extra}/>",
                 escape_attr(&target)
             );
         }
