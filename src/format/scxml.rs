@@ -530,6 +530,18 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
     if diags.iter().any(Diagnostic::is_error) {
         return None;
     }
+    for (i, seen) in m.reachable().into_iter().enumerate() {
+        if !seen {
+            diags.push(
+                Diagnostic::warning(format!(
+                    "state `{}` is unreachable from the initial state",
+                    m.path(i)
+                ))
+                .at(f, m.states[i].span.clone().unwrap_or(0..0))
+                .hint("add a transition to it, or remove it"),
+            );
+        }
+    }
     let name = root
         .attr("name")
         .map(str::to_string)
@@ -755,6 +767,19 @@ mod tests {
             m
         };
         assert_eq!(strip(machine(&back)), strip(m), "{out}");
+    }
+
+    #[test]
+    fn unreachable_state_is_a_warning() {
+        let l = parse_str(
+            "t.scxml",
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\">\n  <state id=\"a\"/>\n  <state id=\"z\"/>\n</scxml>",
+            &Limits::default(),
+        )
+        .unwrap();
+        assert_eq!(l.warnings.len(), 1);
+        assert!(l.warnings[0].message.contains("`z` is unreachable"));
+        assert_eq!(l.warnings[0].location().unwrap().1, 3);
     }
 
     #[test]

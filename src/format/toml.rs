@@ -1867,22 +1867,7 @@ impl Loader {
 
     /// Warns about states that no transition can reach.
     fn unreachable_states(&mut self, cx: &Ctx<'_>, m: &StateMachine) {
-        let mut seen = vec![false; m.states.len()];
-        let mut stack = vec![m.top.initial];
-        while let Some(s) = stack.pop() {
-            if s >= seen.len() || seen[s] {
-                continue;
-            }
-            seen[s] = true;
-            if let StateBody::Container(r) = &m.states[s].body {
-                stack.push(r.initial);
-            }
-            for t in &m.states[s].transitions {
-                if let Target::State(n) = t.target {
-                    stack.push(n);
-                }
-            }
-        }
+        let seen = m.reachable();
         for (i, s) in m.states.iter().enumerate() {
             if !seen[i] {
                 self.warn(

@@ -189,6 +189,28 @@ impl StateMachine {
         parts.join("/")
     }
 
+    /// Which states the initial state reaches through transitions and
+    /// containers' initial states (explicit stack).
+    pub fn reachable(&self) -> Vec<bool> {
+        let mut seen = vec![false; self.states.len()];
+        let mut stack = vec![self.top.initial];
+        while let Some(s) = stack.pop() {
+            if s >= seen.len() || seen[s] {
+                continue;
+            }
+            seen[s] = true;
+            if let StateBody::Container(r) = &self.states[s].body {
+                stack.push(r.initial);
+            }
+            for t in &self.states[s].transitions {
+                if let Target::State(n) = t.target {
+                    stack.push(n);
+                }
+            }
+        }
+        seen
+    }
+
     /// Number of states that run an action skill or have no binding
     /// (not decisions, not containers): the paper's M.
     pub fn task_state_count(&self) -> usize {
