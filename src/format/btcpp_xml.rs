@@ -494,6 +494,18 @@ impl Loader<'_> {
                 );
                 continue;
             }
+            if let Some(prev) = self.models.get(id)
+                && prev.cat != cat
+            {
+                let was = prev.cat.tag();
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!("`{id}` is declared both as `{was}` and as `{}`", cat.tag()),
+                )
+                .hint = Some("keep one declaration per node type across the model files".into());
+                continue;
+            }
             self.models.insert(id.to_string(), ModelEntry { cat });
         }
     }
@@ -1091,6 +1103,21 @@ mod tests {
         assert_eq!(b.nodes[2].ports["code"], "x:=1");
         assert_eq!(b.nodes[3].kind, BtNodeKind::Decorator);
         assert_eq!(b.nodes[3].ports["delay_msec"], "5");
+    }
+
+    #[test]
+    fn conflicting_model_declarations_are_errors() {
+        let e = parse(
+            r#"<root><BehaviorTree ID="T"><Foo/></BehaviorTree>
+<TreeNodesModel><Action ID="Foo"/><Condition ID="Foo"/></TreeNodesModel></root>"#,
+        )
+        .unwrap_err();
+        assert!(
+            e[0].message
+                .contains("declared both as `Action` and as `Condition`"),
+            "{}",
+            e[0].message
+        );
     }
 
     #[test]
