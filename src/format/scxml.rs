@@ -257,16 +257,15 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         .states
         .iter()
         .any(|s| matches!(s.body, StateBody::Container(_)));
-    // A container's body replaced the skill a `btfsm:skill` gave; nothing else to do.
-    // Initial states.
+    // Initial states: (container, target id, position of the target).
     let region_owner = |k: Option<usize>| k.and_then(|p| state_of[p]);
-    let mut initial_of: Vec<(Option<usize>, usize, String, std::ops::Range<usize>)> = Vec::new(); // (container state, elem for position, target id, span)
+    let mut initial_of: Vec<(Option<usize>, String, std::ops::Range<usize>)> = Vec::new();
     {
         let top_init = root
             .attr_full("initial")
             .map(|a| (a.value.clone(), a.span.clone()));
         if let Some((v, s)) = top_init {
-            initial_of.push((None, doc.root, v, s));
+            initial_of.push((None, v, s));
         }
         for (k, (e, kind, _)) in found.iter().enumerate() {
             if !matches!(kind, Kind::State) {
@@ -278,7 +277,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
             let el = &doc.elems[*e];
             if let Some(a) = el.attr_full("initial") {
-                initial_of.push((Some(si), *e, a.value.clone(), a.span.clone()));
+                initial_of.push((Some(si), a.value.clone(), a.span.clone()));
             } else if let Some((_, ini)) = doc
                 .children(*e)
                 .find(|(_, c)| is_scxml(c) && c.name == "initial")
@@ -287,7 +286,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     .children_of_name(ini, "transition")
                     .and_then(|t| t.attr_full("target"))
                 {
-                    Some(a) => initial_of.push((Some(si), *e, a.value.clone(), a.span.clone())),
+                    Some(a) => initial_of.push((Some(si), a.value.clone(), a.span.clone())),
                     None => err(
                         diags,
                         ini,
@@ -298,7 +297,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
         }
     }
-    for (container, e, target, span) in initial_of {
+    for (container, target, span) in initial_of {
         let tid = target.trim();
         if tid.split_whitespace().count() > 1 {
             diags.push(
@@ -330,7 +329,6 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     .map(|(i, _)| ids_of_state(&ids, &state_of, i))
                     .collect();
                 let h = suggest(tid, region.iter().copied());
-                let _ = e;
                 diags.push(
                     Diagnostic::error(format!(
                         "initial `{tid}` is not a state directly inside its region"
@@ -403,7 +401,6 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
         }
     }
-    let _ = region_owner;
     // Transitions.
     for (k, (e, kind, _)) in found.iter().enumerate() {
         let Some(si) = state_of[k] else { continue };
