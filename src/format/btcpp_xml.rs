@@ -1152,14 +1152,7 @@ mod tests {
         fn mutated_trees_never_panic(
             cuts in proptest::collection::vec((0usize..2000, 0usize..8, "[<>/=\" a-zA-Z]{0,3}"), 1..4)
         ) {
-            let mut text = SEED.to_string();
-            for (at, del, ins) in cuts {
-                let at = at % (text.len() + 1);
-                let end = (at + del).min(text.len());
-                if text.is_char_boundary(at) && text.is_char_boundary(end) {
-                    text.replace_range(at..end, &ins);
-                }
-            }
+            let text = crate::format::xml::mutate(SEED, &cuts);
             match parse(&text) {
                 Ok(l) => {
                     let xml = crate::format::btcpp_xml_write::write_policy(&l.policy).expect("a BT");

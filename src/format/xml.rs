@@ -191,6 +191,21 @@ pub fn escape_comment(s: &str) -> String {
     s.replace("--", "- -")
 }
 
+/// Test helper: `seed` with each `(at, delete, insert)` edit applied (offsets
+/// wrap around; edits that would split a character are skipped).
+#[cfg(test)]
+pub fn mutate(seed: &str, cuts: &[(usize, usize, String)]) -> String {
+    let mut text = seed.to_string();
+    for (at, del, ins) in cuts {
+        let at = at % (text.len() + 1);
+        let end = (at + del).min(text.len());
+        if text.is_char_boundary(at) && text.is_char_boundary(end) {
+            text.replace_range(at..end, ins);
+        }
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
