@@ -3,12 +3,13 @@ CARGO ?= cargo
 BIN := target/release/btfsm
 POLICIES := $(wildcard policies/paper/*.toml)
 
-.PHONY: build run test bench clean
+.PHONY: build run test bench bench-ged clean paper-docs
 
 build:
 	$(CARGO) build --release --locked
 
 run: build
+	$(BIN) paper
 	@mkdir -p out
 	$(BIN) analyze $(POLICIES)
 	$(BIN) analyze $(POLICIES) --format json > out/analysis.json
@@ -24,9 +25,18 @@ test:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets --locked -- -D warnings
 	$(CARGO) test --locked
+	$(CARGO) run --quiet --locked -- paper --check
+
+# Regenerates docs/paper-results.md (a test fails when it is stale).
+paper-docs:
+	$(CARGO) run --quiet --locked -- paper --format markdown -o docs/paper-results.md
 
 bench: build
 	$(CARGO) bench --locked
+
+# btfsm vs NetworkX on the same GED pairs, in one run (docs/performance.md).
+bench-ged:
+	python3 bench/ged_vs_networkx.py
 
 clean:
 	rm -rf out

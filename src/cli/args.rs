@@ -50,6 +50,32 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
+    /// Graph edit distance between two policies, with the edit script
+    Compare {
+        /// The old policy
+        a: PathBuf,
+        /// The new policy
+        b: PathBuf,
+        /// Which GED: structural (any vertex to any vertex), labeled (same
+        /// vertex type only), named (by node id / state name), or all three
+        #[arg(long, value_enum, default_value_t = CompareMode::All)]
+        mode: CompareMode,
+        /// Time budget per mode for the exact search; when it runs out the
+        /// result is a certified interval with `exact: false`
+        #[arg(long, default_value_t = 2000, value_name = "MS")]
+        timeout_ms: u64,
+        #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
+        format: CompareFormat,
+        /// Also draw B with added elements red and A's removed ones dashed grey
+        /// (the edit script of --mode; named when all modes run)
+        #[arg(long, value_name = "OUT")]
+        dot: Option<PathBuf>,
+        /// With --dot: render through Graphviz instead of writing DOT
+        #[arg(long, value_enum, requires = "dot")]
+        render: Option<crate::render::dot::RenderFormat>,
+        #[command(flatten)]
+        limits: LimitArgs,
+    },
     /// Converts a policy into another representation
     Convert {
         file: PathBuf,
@@ -62,16 +88,69 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
+    /// Effort (Eq. 4/5) to make an FSM reactive: formula and measured named GED
+    Effort {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+        format: OutputFormat,
+        #[command(flatten)]
+        limits: LimitArgs,
+    },
+    /// Reproduces the paper's Tables I-III and effort examples from policies/paper
+    Paper(PaperArgs),
+    /// The paper's edit operations: insert a BT subtree, add an FSM state
+    Edit(Box<EditArgs>),
     /// Runs policies in the planar robot simulator and compares their behavior
     Sim(super::sim::SimArgs),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompareMode {
+    Structural,
+    Labeled,
+    Named,
+    All,
+}
+
+impl CompareMode {
+    /// The single GED mode selected, or `None` for all three.
+    pub fn selection(self) -> Option<crate::metrics::ged::GedMode> {
+        use crate::metrics::ged::GedMode;
+        match self {
+            CompareMode::Structural => Some(GedMode::Structural),
+            CompareMode::Labeled => Some(GedMode::Labeled),
+            CompareMode::Named => Some(GedMode::Named),
+            CompareMode::All => None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompareFormat {
+    Table,
+    Json,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ConvertTarget {
     /// The paper's BT -> HFSM construction (Fig. 5 -> Fig. 6)
     Hfsm,
+    /// The paper's sequential FSM -> fault-tolerant FSM construction (Fig. 2 -> Fig. 4)
+    FaultTolerant,
     /// TOML (normalised)
     Toml,
+    /// BehaviorTree.CPP XML, format 4 (behavior trees)
+    BtcppXml,
+    /// SCXML (FSMs and HFSMs)
+    Scxml,
+}
+
+/// `--assume-leaf`: how to read BehaviorTree.CPP leaves of unknown type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AssumeLeafArg {
+    Action,
+    Condition,
 }
 
 /// Input limits (documented defaults; see `format::Limits`).
@@ -83,6 +162,14 @@ pub struct LimitArgs {
     /// Most BT nodes or FSM states per policy, subtrees expanded
     #[arg(long, default_value_t = 2_000_000, hide_short_help = true)]
     pub max_nodes: usize,
+    /// BehaviorTree.CPP TreeNodesModel file declaring node types (repeatable),
+    /// e.g. Nav2's nav2_tree_nodes.xml
+    #[arg(long = "nodes-model", value_name = "FILE")]
+    pub nodes_model: Vec<PathBuf>,
+    /// Read BehaviorTree.CPP leaves of unknown type as actions or conditions
+    /// (default: an error listing the known types)
+    #[arg(long, value_enum, value_name = "KIND")]
+    pub assume_leaf: Option<AssumeLeafArg>,
 }
 
 impl LimitArgs {
@@ -90,7 +177,128 @@ impl LimitArgs {
         crate::format::Limits {
             max_file_bytes: self.max_file_bytes,
             max_nodes: self.max_nodes,
+            nodes_models: self.nodes_model.clone(),
+            assume_leaf: self.assume_leaf.map(|a| match a {
+                AssumeLeafArg::Action => crate::format::AssumeLeaf::Action,
+                AssumeLeafArg::Condition => crate::format::AssumeLeaf::Condition,
+            }),
             ..Default::default()
         }
     }
+}
+
+/// Flags of `btfsm paper`.
+#[derive(Debug, Clone, Args)]
+pub struct PaperArgs {
+    #[arg(long, value_enum, default_value_t = crate::report::paper::PaperFormat::Table)]
+    pub format: crate::report::paper::PaperFormat,
+    /// Exit 1 naming every cell whose computed value departs from DIR/tables/expected.toml
+    #[arg(long, conflicts_with = "record")]
+    pub check: bool,
+    /// Rewrite DIR/tables/expected.toml with the computed values (review the diff)
+    #[arg(long)]
+    pub record: bool,
+    /// Directory of the paper's policies (with tables/published.toml)
+    #[arg(long, value_name = "DIR", default_value = "policies/paper")]
+    pub policies: PathBuf,
+    /// Output file (default: stdout)
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub limits: LimitArgs,
+}
+
+/// Flags of `btfsm edit`.
+#[derive(Debug, Clone, Args)]
+pub struct EditArgs {
+    /// Policy to edit (TOML)
+    pub file: PathBuf,
+    /// Output file (default: stdout); the summary goes to stderr
+    #[arg(short, long, global = true)]
+    pub output: Option<PathBuf>,
+    #[command(subcommand)]
+    pub op: EditOp,
+    #[command(flatten)]
+    pub limits: LimitArgs,
+}
+
+#[derive(Debug, Clone, Subcommand)]
+pub enum EditOp {
+    /// Inserts a BT subtree (the root of another BT file) as a child of a node
+    InsertSubtree {
+        /// Id of the control node that receives the subtree
+        #[arg(long, value_name = "ID")]
+        parent: String,
+        /// Position among the parent's children (0 = first; default: last)
+        #[arg(long, value_name = "K")]
+        index: Option<usize>,
+        /// BT file whose tree is inserted (its node ids are kept)
+        #[arg(long, value_name = "SUB.toml")]
+        subtree: PathBuf,
+        /// Prefix for the inserted node ids (`P/id`), when they would collide
+        #[arg(long, value_name = "P")]
+        prefix: Option<String>,
+    },
+    /// Puts a new control node above the root (the paper's Figs. 7c, 7d)
+    WrapRoot {
+        #[arg(long, value_enum)]
+        kind: WrapKind,
+        /// Id of the new root
+        #[arg(long, value_name = "ID")]
+        id: String,
+        /// Display name (default: the kind's)
+        #[arg(long)]
+        name: Option<String>,
+    },
+    /// Adds an FSM state as the paper's sec. IV-A 1b does (Algorithm 1 for connected states)
+    AddState {
+        #[arg(long, value_enum)]
+        kind: AddKind,
+        /// Name of the new state
+        #[arg(long, value_name = "N")]
+        name: String,
+        /// Preceding state (sequential, alternative); connected: file position only
+        #[arg(long, value_name = "P")]
+        after: Option<String>,
+        /// Skill the state runs, e.g. Tuck-Arm
+        #[arg(long)]
+        skill: String,
+        /// Skill argument, `key=value` (repeatable)
+        #[arg(long = "arg", value_name = "KEY=VALUE")]
+        args: Vec<String>,
+        /// Connected: the guard every other state gets to the new one,
+        /// e.g. `not Battery-Level(min=20)`
+        #[arg(long, value_name = "COND")]
+        guard: Option<String>,
+        /// Label of --guard (default: the condition)
+        #[arg(long, value_name = "TEXT")]
+        guard_label: Option<String>,
+        /// The SELECTOR's guard to the new state (sequential; connected: default --guard),
+        /// e.g. `In-Hand(object=cube2) & not Arm-Tucked`
+        #[arg(long, value_name = "COND")]
+        selector_guard: Option<String>,
+        /// Label of --selector-guard (default: the condition)
+        #[arg(long, value_name = "TEXT")]
+        selector_guard_label: Option<String>,
+        /// Position of the SELECTOR's new guard among its guards (default:
+        /// sequential: right before the predecessor's; connected: first)
+        #[arg(long, value_name = "K")]
+        selector_guard_index: Option<usize>,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum WrapKind {
+    Sequence,
+    Fallback,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AddKind {
+    /// Between the predecessor and its SUCCESS successor (Figs. 8a, 8c)
+    Sequential,
+    /// Takes the predecessor's FAILURE arc (Fig. 8b)
+    Alternative,
+    /// Reached from every other state (Algorithm 1, Fig. 8d)
+    Connected,
 }

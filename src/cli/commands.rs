@@ -50,24 +50,27 @@ pub fn execute(cli: Cli) -> u8 {
             let Some((policy, opts)) = super::sim::dot_trace(&trace, &file, l.policy) else {
                 return EXIT_BAD_INPUT;
             };
-            let dot = crate::render::dot::policy_dot(&policy, &opts);
-            match render {
-                None => emit(output.as_deref(), dot.as_bytes()),
-                Some(fmt) => match crate::render::dot::render(&dot, fmt) {
-                    Ok(bytes) => {
-                        if output.is_none() && fmt != crate::render::dot::RenderFormat::Svg {
-                            eprintln!("error: {fmt} output is binary; write it to a file with -o");
-                            return EXIT_BAD_INPUT;
-                        }
-                        emit(output.as_deref(), &bytes)
-                    }
-                    Err(e) => {
-                        eprintln!("error: {e}");
-                        EXIT_BAD_INPUT
-                    }
-                },
-            }
+            draw(&policy, &opts, output.as_deref(), render)
         }
+        Command::Compare {
+            a,
+            b,
+            mode,
+            timeout_ms,
+            format,
+            dot,
+            render,
+            limits,
+        } => super::compare::execute(super::compare::CompareArgs {
+            a,
+            b,
+            mode,
+            timeout_ms,
+            format,
+            dot,
+            render,
+            limits: limits.limits(),
+        }),
         Command::Convert {
             file,
             to,
@@ -79,6 +82,23 @@ pub fn execute(cli: Cli) -> u8 {
             };
             let policy = match to {
                 ConvertTarget::Toml => l.policy,
+                ConvertTarget::BtcppXml | ConvertTarget::Scxml => {
+                    return super::convert::to_xml(&l.policy, to, output.as_deref());
+                }
+                ConvertTarget::FaultTolerant => {
+                    match crate::transform::fault_tolerant::fault_tolerant_policy(&l.policy) {
+                        Ok(p) => p,
+                        Err(errs) => {
+                            for e in errs {
+                                eprintln!(
+                                    "error: {}: {e}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
+                                    l.path
+                                );
+                            }
+                            return EXIT_BAD_INPUT;
+                        }
+                    }
+                }
                 ConvertTarget::Hfsm => {
                     match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
                         Ok(p) => p,
@@ -96,18 +116,51 @@ pub fn execute(cli: Cli) -> u8 {
             let text = crate::format::toml_write::write_policy(&policy);
             emit(output.as_deref(), text.as_bytes())
         }
+        Command::Effort {
+            files,
+            format,
+            limits,
+        } => super::paper::effort(&files, format, &limits.limits()),
+        Command::Paper(args) => super::paper::paper(&args),
+        Command::Edit(args) => super::edit::edit(&args),
         Command::Sim(args) => super::sim::execute(args),
     }
 }
 
+/// Draws a policy as DOT, or renders it through Graphviz, to `output` or
+/// stdout.
+pub(super) fn draw(
+    policy: &crate::model::Policy,
+    opts: &crate::render::dot::DotOptions,
+    output: Option<&Path>,
+    render: Option<crate::render::dot::RenderFormat>,
+) -> u8 {
+    use crate::render::dot::{self, RenderFormat};
+    let text = dot::policy_dot(policy, opts);
+    let Some(fmt) = render else {
+        return emit(output, text.as_bytes());
+    };
+    if output.is_none() && fmt != RenderFormat::Svg {
+        eprintln!("error: {fmt} output is binary; write it to a file with -o");
+        return EXIT_BAD_INPUT;
+    }
+    match dot::render(&text, fmt) {
+        Ok(bytes) => emit(output, &bytes),
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
+    }
+}
+
 /// Loads one file (see [`load_all`]).
-fn load_one(file: &Path, limits: &Limits) -> Option<Loaded> {
+pub(super) fn load_one(file: &Path, limits: &Limits) -> Option<Loaded> {
     load_all(&[file.to_path_buf()], limits).and_then(|mut v| v.pop())
 }
 
 /// Loads every file, printing all diagnostics (warnings too); `None` when any
 /// file has an error.
-fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>> {
+pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>> {
     let mut out = Vec::new();
     let mut failed = false;
     let stderr = std::io::stderr();

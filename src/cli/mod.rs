@@ -4,6 +4,10 @@
 
 pub mod args;
 mod commands;
+mod compare;
+mod convert;
+mod edit;
+mod paper;
 pub mod sim;
 
 use clap::Parser;

@@ -29,6 +29,7 @@ pub fn bt_vertex_type(kind: BtNodeKind) -> VertexType {
         BtNodeKind::SequenceMemory => VertexType::SequenceMemory,
         BtNodeKind::FallbackMemory => VertexType::FallbackMemory,
         BtNodeKind::Parallel { .. } => VertexType::Parallel,
+        BtNodeKind::Control => VertexType::Control,
         BtNodeKind::Action => VertexType::Action,
         BtNodeKind::Condition => VertexType::Condition,
         _ => VertexType::Decorator,
@@ -74,9 +75,9 @@ pub fn machine_graph(m: &StateMachine) -> PolicyGraph {
         m.states.len() + m.top.outcomes.len(),
         m.states.iter().map(|s| s.transitions.len() + 1).sum(),
     );
-    for (i, s) in m.states.iter().enumerate() {
+    for (s, key) in m.states.iter().zip(m.keys()) {
         g.add_node(Vertex {
-            key: m.path(i),
+            key,
             label: s.label.clone(),
             vtype: state_vertex_type(&s.body),
         });

@@ -3,4 +3,5 @@
 
 pub mod complexity;
 pub mod counts;
+pub mod effort;
 pub mod ged;

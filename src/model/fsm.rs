@@ -39,7 +39,19 @@ pub struct State {
     /// Transitions in file order: guards first (checked before the skill runs),
     /// then outcome transitions.
     pub transitions: Vec<Transition>,
+    /// The SCXML pseudo-state this state stands for (`None` for an ordinary
+    /// state); such a state has no skill and is drawn and exported as what it is.
+    pub pseudo: Option<Pseudo>,
     pub span: Option<Span>,
+}
+
+/// SCXML pseudo-states modelled as states of their region (W3C SCXML 3.10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pseudo {
+    /// `<history type="shallow">`: re-enters the region's last active child.
+    ShallowHistory,
+    /// `<history type="deep">`: re-enters the last active descendants.
+    DeepHistory,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -81,7 +93,8 @@ impl Trigger {
 
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Target {
-    /// A sibling state (same region).
+    /// A state: a sibling (same region) in TOML files; SCXML transitions may
+    /// also target a state of another region.
     State(StateIdx),
     /// One of the enclosing region's outcomes.
     Outcome(String),
@@ -99,6 +112,71 @@ impl StateMachine {
         }
     }
 
+    /// Each state's identity for `named` GED, edit scripts and diagrams
+    /// (SPEC §3): its name where that name is unique in the whole machine,
+    /// else its parent's key, `/`, and its name — the state's position under
+    /// its nearest uniquely named ancestor (the full path when there is none).
+    /// A BT converted to an HFSM keeps its node ids as keys, so wrapping a
+    /// subtree in a new container changes only what was really edited.
+    /// Keys are unique: should the rule ever give two states one key (a name
+    /// containing `/`), those states fall back to their full paths, numbered
+    /// by state index if even those clash.
+    pub fn keys(&self) -> Vec<String> {
+        use std::collections::HashMap;
+        let n = self.states.len();
+        let mut uses: HashMap<&str, usize> = HashMap::with_capacity(n);
+        for s in &self.states {
+            *uses.entry(s.name.as_str()).or_default() += 1;
+        }
+        for o in &self.top.outcomes {
+            *uses.entry(o.as_str()).or_default() += 1;
+        }
+        let mut key: Vec<Option<String>> = vec![None; n];
+        for c in self.parents_first() {
+            let name = &self.states[c].name;
+            key[c] = Some(match self.states[c].parent {
+                Some(p) if uses[name.as_str()] > 1 => {
+                    format!("{}/{name}", key[p].as_deref().unwrap_or_default())
+                }
+                _ => name.clone(),
+            });
+        }
+        let mut key: Vec<String> = key.into_iter().map(Option::unwrap_or_default).collect();
+        let mut seen: HashMap<&str, usize> = HashMap::with_capacity(n);
+        for k in key.iter().chain(&self.top.outcomes) {
+            *seen.entry(k.as_str()).or_default() += 1;
+        }
+        let clash: Vec<StateIdx> = (0..n).filter(|&i| seen[key[i].as_str()] > 1).collect();
+        for &i in &clash {
+            key[i] = self.path(i);
+        }
+        // A path can still equal a literal name with `/` in it: number those.
+        let mut seen: HashMap<String, usize> = HashMap::with_capacity(n);
+        for k in key.iter().chain(&self.top.outcomes) {
+            *seen.entry(k.clone()).or_default() += 1;
+        }
+        for i in clash {
+            if seen[&key[i]] > 1 {
+                key[i] = format!("{}#{i}", key[i]);
+            }
+        }
+        key
+    }
+
+    /// Every state once, each container before the states it holds (breadth
+    /// first from the top region; no recursion, whatever the nesting depth).
+    pub fn parents_first(&self) -> Vec<StateIdx> {
+        let mut order: Vec<StateIdx> = self.top.states.clone();
+        let mut i = 0;
+        while let Some(&s) = order.get(i) {
+            if let StateBody::Container(r) = &self.states[s].body {
+                order.extend_from_slice(&r.states);
+            }
+            i += 1;
+        }
+        order
+    }
+
     /// Path of names from the top level, joined with `/` (unique in the machine).
     pub fn path(&self, s: StateIdx) -> String {
         let mut parts = vec![self.states[s].name.as_str()];
@@ -111,6 +189,28 @@ impl StateMachine {
         parts.join("/")
     }
 
+    /// Which states the initial state reaches through transitions and
+    /// containers' initial states (explicit stack).
+    pub fn reachable(&self) -> Vec<bool> {
+        let mut seen = vec![false; self.states.len()];
+        let mut stack = vec![self.top.initial];
+        while let Some(s) = stack.pop() {
+            if s >= seen.len() || seen[s] {
+                continue;
+            }
+            seen[s] = true;
+            if let StateBody::Container(r) = &self.states[s].body {
+                stack.push(r.initial);
+            }
+            for t in &self.states[s].transitions {
+                if let Target::State(n) = t.target {
+                    stack.push(n);
+                }
+            }
+        }
+        seen
+    }
+
     /// Number of states that run an action skill or have no binding
     /// (not decisions, not containers): the paper's M.
     pub fn task_state_count(&self) -> usize {
@@ -118,5 +218,83 @@ impl StateMachine {
             .iter()
             .filter(|s| matches!(s.body, StateBody::Task(_)))
             .count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(name: &str, parent: Option<StateIdx>, body: StateBody) -> State {
+        State {
+            name: name.into(),
+            label: name.into(),
+            parent,
+            body,
+            transitions: Vec::new(),
+            pseudo: None,
+            span: None,
+        }
+    }
+
+    fn region(initial: StateIdx, states: Vec<StateIdx>) -> StateBody {
+        StateBody::Container(Region {
+            initial,
+            outcomes: vec!["SUCCESS".into()],
+            states,
+        })
+    }
+
+    #[test]
+    fn keys_are_names_unless_a_name_repeats() {
+        // A{Move, Pick}, B{Move, C{Move}}: `Move` repeats, so it is keyed by
+        // position under its nearest uniquely named ancestor.
+        let states = vec![
+            state("A", None, region(1, vec![1, 2])),
+            state("Move", Some(0), StateBody::Task(None)),
+            state("Pick", Some(0), StateBody::Task(None)),
+            state("B", None, region(4, vec![4, 5])),
+            state("Move", Some(3), StateBody::Task(None)),
+            state("C", Some(3), region(6, vec![6])),
+            state("Move", Some(5), StateBody::Task(None)),
+        ];
+        let m = StateMachine {
+            hierarchical: true,
+            top: Region {
+                initial: 0,
+                outcomes: vec!["SUCCESS".into()],
+                states: vec![0, 3],
+            },
+            states,
+        };
+        assert_eq!(
+            m.keys(),
+            ["A", "A/Move", "Pick", "B", "B/Move", "C", "C/Move"]
+        );
+        assert_eq!(m.path(6), "B/C/Move");
+        assert_eq!(m.parents_first(), [0, 3, 1, 2, 4, 5, 6]);
+    }
+
+    #[test]
+    fn keys_fall_back_to_paths_on_a_clash() {
+        // A state literally named `A/Move` would clash with A's `Move`.
+        let states = vec![
+            state("A", None, region(1, vec![1])),
+            state("Move", Some(0), StateBody::Task(None)),
+            state("A/Move", None, StateBody::Task(None)),
+            state("Move", None, StateBody::Task(None)),
+        ];
+        let m = StateMachine {
+            hierarchical: true,
+            top: Region {
+                initial: 0,
+                outcomes: vec![],
+                states: vec![0, 2, 3],
+            },
+            states,
+        };
+        let k = m.keys();
+        let unique: std::collections::BTreeSet<_> = k.iter().collect();
+        assert_eq!(unique.len(), k.len(), "{k:?}");
     }
 }

@@ -105,7 +105,7 @@ pub struct DotOptions {
     /// (the simulator highlights the one transition taken).
     pub arc_label_highlight: BTreeMap<(String, String, String), Highlight>,
     /// Removed vertices, drawn dashed grey: `(key, label)`. In an HFSM a ghost
-    /// whose key starts with a container's path and `/` is drawn in its cluster.
+    /// whose key starts with a container's key and `/` is drawn in its cluster.
     pub ghost_vertices: Vec<(String, String)>,
     /// Removed arcs, drawn dashed grey: `(from key, to key, label)`.
     pub ghost_arcs: Vec<(String, String, String)>,
@@ -450,8 +450,8 @@ struct Builder<'o> {
     used: HashSet<String>,
     /// Vertex key -> DOT node id, for arcs given by key (ghost arcs).
     by_key: HashMap<String, String>,
-    /// Container path -> container, for placing ghost vertices.
-    container_of_path: HashMap<String, usize>,
+    /// Container key -> container, for placing ghost vertices.
+    container_of_key: HashMap<String, usize>,
     /// Statements added to a cluster (`Some(container)`) or to the top level
     /// (`None`) besides its states: ghosts, clusters nested too deep.
     extra: HashMap<Option<usize>, Vec<Stmt>>,
@@ -487,7 +487,7 @@ impl<'o> Builder<'o> {
             edges: Vec::new(),
             used: HashSet::new(),
             by_key: HashMap::new(),
-            container_of_path: HashMap::new(),
+            container_of_key: HashMap::new(),
             extra: HashMap::new(),
             state_stmt: Vec::new(),
             header: Vec::new(),
@@ -585,47 +585,28 @@ impl<'o> Builder<'o> {
 
     fn machine(&mut self, m: &StateMachine) {
         let n = m.states.len();
-        // Paths and nesting levels, parents before children, without recursion.
-        let mut path: Vec<Option<String>> = vec![None; n];
+        // Nesting levels, parents before children, without recursion.
         let mut level = vec![0usize; n];
-        for i in 0..n {
-            let mut chain = Vec::new();
-            let mut cur = Some(i);
-            while let Some(c) = cur {
-                if path[c].is_some() {
-                    break;
-                }
-                chain.push(c);
-                cur = m.states[c].parent;
-            }
-            for &c in chain.iter().rev() {
-                let name = &m.states[c].name;
-                let (p, l) = match m.states[c].parent {
-                    Some(p) => (
-                        format!("{}/{}", path[p].as_deref().unwrap_or(""), name),
-                        level[p] + 1,
-                    ),
-                    None => (name.clone(), 0),
-                };
-                path[c] = Some(p);
-                level[c] = l;
-            }
+        for c in m.parents_first() {
+            level[c] = m.states[c].parent.map_or(0, |p| level[p] + 1);
         }
-        let path: Vec<String> = path.into_iter().map(Option::unwrap_or_default).collect();
+        // Vertices are identified by the graph's keys (SPEC §3 identity),
+        // so that highlights and ghosts given by key find them.
+        let key: Vec<String> = m.keys();
         let region = |i: usize| match &m.states[i].body {
             StateBody::Container(r) => Some(r),
             _ => None,
         };
-        let cluster_name = |i: usize| format!("cluster_{}", path[i]);
+        let cluster_name = |i: usize| format!("cluster_{}", key[i]);
 
         // Vertex ids first (states, top outcomes), then the extra outcome boxes
         // of the containers, so that every vertex keeps its key as its id.
-        let state_id: Vec<String> = path.iter().map(|p| self.vertex(p)).collect();
+        let state_id: Vec<String> = key.iter().map(|p| self.vertex(p)).collect();
         let top_outcome_id: Vec<String> = m.top.outcomes.iter().map(|o| self.vertex(o)).collect();
         let mut outcome_box: HashMap<(usize, &str), String> = HashMap::new();
-        for (i, p) in path.iter().enumerate() {
+        for (i, p) in key.iter().enumerate() {
             if let Some(r) = region(i) {
-                self.container_of_path.insert(p.clone(), i);
+                self.container_of_key.insert(p.clone(), i);
                 for o in &r.outcomes {
                     let id = self.fresh(&format!("{p}/{o}"));
                     outcome_box.insert((i, o.as_str()), id);
@@ -649,8 +630,22 @@ impl<'o> Builder<'o> {
             let mut a = Attrs::default();
             match &s.body {
                 StateBody::Container(r) => {
-                    self.container_nodes(i, &s.label, &path[i], r, &outcome_box);
+                    self.container_nodes(i, &s.label, &key[i], r, &outcome_box);
                     continue;
+                }
+                // SCXML history pseudo-states as in UML: a small circle with H / H*.
+                StateBody::Decision if s.pseudo.is_some() => {
+                    let h = match s.pseudo {
+                        Some(crate::model::Pseudo::DeepHistory) => "H*",
+                        _ => "H",
+                    };
+                    a.set("label", h)
+                        .set("shape", "circle")
+                        .set("fillcolor", "white")
+                        .set("fontsize", "10")
+                        .set("width", "0.3")
+                        .set("tooltip", &key[i])
+                        .style("filled");
                 }
                 StateBody::Decision => {
                     a.set("label", &s.label)
@@ -658,7 +653,7 @@ impl<'o> Builder<'o> {
                         .set("fillcolor", DECISION_FILL)
                         .set("fontsize", "10")
                         .set("margin", "0.02,0.02")
-                        .set("tooltip", &path[i])
+                        .set("tooltip", &key[i])
                         .style("filled");
                 }
                 StateBody::Task(call) => {
@@ -670,8 +665,8 @@ impl<'o> Builder<'o> {
                         a.set("fillcolor", ACTION_FILL);
                     }
                     let tip = match call {
-                        Some(c) => format!("{}: {c}", path[i]),
-                        None => path[i].clone(),
+                        Some(c) => format!("{}: {c}", key[i]),
+                        None => key[i].clone(),
                     };
                     a.set("tooltip", &tip).style("filled");
                 }
@@ -679,7 +674,7 @@ impl<'o> Builder<'o> {
             if s.parent.is_none() && m.top.initial == i {
                 a.set("penwidth", "2.2");
             }
-            a.node_highlight(self.vhl(&path[i]));
+            a.node_highlight(self.vhl(&key[i]));
             self.state_stmt[i] = Some(node_stmt(&state_id[i], a));
         }
         for (o, id) in m.top.outcomes.iter().zip(&top_outcome_id) {
@@ -727,7 +722,7 @@ impl<'o> Builder<'o> {
                 if region(j).is_some() {
                     a.set("lhead", &cluster_name(j));
                 }
-                a.edge_highlight(self.ahl(&path[i], &path[j], "initial"));
+                a.edge_highlight(self.ahl(&key[i], &key[j], "initial"));
                 self.edges.push(edge_stmt(&state_id[i], &state_id[j], a));
             }
             for t in &s.transitions {
@@ -745,12 +740,12 @@ impl<'o> Builder<'o> {
                         if region(j).is_some() && j != i {
                             a.set("lhead", &cluster_name(j));
                         }
-                        (state_id[j].clone(), path[j].clone())
+                        (state_id[j].clone(), key[j].clone())
                     }
                     Target::Outcome(o) => match s.parent {
                         Some(p) => {
                             let head = outcome_box.get(&(p, o.as_str())).unwrap_or(&state_id[p]);
-                            (head.clone(), path[p].clone())
+                            (head.clone(), key[p].clone())
                         }
                         None => {
                             let head = m
@@ -781,7 +776,7 @@ impl<'o> Builder<'o> {
                 a.set("label", &label)
                     .set("color", color)
                     .set("fontcolor", color);
-                a.edge_highlight(self.ahl(&path[i], &to_key, &label));
+                a.edge_highlight(self.ahl(&key[i], &to_key, &label));
                 self.edges.push(edge_stmt(&tail, &head, a));
             }
         }
@@ -793,7 +788,7 @@ impl<'o> Builder<'o> {
         &mut self,
         i: usize,
         label: &str,
-        path: &str,
+        key: &str,
         r: &crate::model::Region,
         outcome_box: &HashMap<(usize, &str), String>,
     ) {
@@ -804,7 +799,7 @@ impl<'o> Builder<'o> {
             .set("labeljust", "l")
             .set("color", "grey40")
             .style("rounded");
-        match self.vhl(path) {
+        match self.vhl(key) {
             Some(Highlight::Added) => {
                 ca.set("color", ADDED)
                     .set("fontcolor", ADDED)
@@ -824,13 +819,9 @@ impl<'o> Builder<'o> {
         let mut ea = Attrs::default();
         ea.set("shape", "point")
             .set("width", "0.12")
-            .set("tooltip", path);
-        ea.node_highlight(self.vhl(path));
-        let id = self
-            .by_key
-            .get(path)
-            .cloned()
-            .unwrap_or_else(|| path.into());
+            .set("tooltip", key);
+        ea.node_highlight(self.vhl(key));
+        let id = self.by_key.get(key).cloned().unwrap_or_else(|| key.into());
         header.push(node_stmt(&id, ea));
         self.header[i] = header;
 
@@ -851,7 +842,7 @@ impl<'o> Builder<'o> {
                 .set("margin", "0.04,0.02")
                 .set("color", color)
                 .set("fontcolor", color)
-                .set("tooltip", &format!("outcome {o} of {path}"))
+                .set("tooltip", &format!("outcome {o} of {key}"))
                 .style("rounded");
             footer.push(node_stmt(id, oa));
         }
@@ -900,23 +891,25 @@ impl<'o> Builder<'o> {
         }
     }
 
-    /// The cluster a ghost vertex belongs in: the longest container path that
+    /// The cluster a ghost vertex belongs in: the longest container key that
     /// prefixes its key.
     fn ghost_cluster(&self, key: &str) -> Option<usize> {
         key.rmatch_indices('/')
-            .find_map(|(at, _)| self.container_of_path.get(&key[..at]).copied())
+            .find_map(|(at, _)| self.container_of_key.get(&key[..at]).copied())
     }
 }
 
 /// Shape and label of a BT node.
 fn bt_node_attrs(n: &BtNode) -> Attrs {
     let mut a = Attrs::default();
-    let custom = n.label != n.kind.default_label();
+    let custom = n.label != n.kind.default_label() && Some(&n.label) != n.type_name.as_ref();
+    // Ports of imported nodes (BehaviorTree.CPP), one `name=value` line each.
+    let ports: String = n.ports.iter().map(|(k, v)| format!("\n{k}={v}")).collect();
     let control = |a: &mut Attrs, symbol: String| {
         let label = if custom {
-            format!("{symbol}\n{}", n.label)
+            format!("{symbol}\n{}{ports}", n.label)
         } else {
-            symbol
+            format!("{symbol}{ports}")
         };
         a.set("label", &label)
             .set("shape", "box")
@@ -933,12 +926,17 @@ fn bt_node_attrs(n: &BtNode) -> Attrs {
         BtNodeKind::Parallel { success } => {
             control(&mut a, format!("⇉ {success}/{}", n.children.len()))
         }
+        BtNodeKind::Control => control(
+            &mut a,
+            n.type_name.clone().unwrap_or_else(|| n.label.clone()),
+        ),
         BtNodeKind::Inverter
         | BtNodeKind::ForceSuccess
         | BtNodeKind::ForceFailure
         | BtNodeKind::Repeat { .. }
         | BtNodeKind::Retry { .. }
-        | BtNodeKind::Timeout { .. } => {
+        | BtNodeKind::Timeout { .. }
+        | BtNodeKind::Decorator => {
             let param = match n.kind {
                 BtNodeKind::Repeat { times: Some(t) } | BtNodeKind::Retry { times: t } => {
                     format!("\n×{t}")
@@ -947,7 +945,7 @@ fn bt_node_attrs(n: &BtNode) -> Attrs {
                 BtNodeKind::Timeout { ms } => format!("\n{ms} ms"),
                 _ => String::new(),
             };
-            a.set("label", &format!("{}{param}", n.label))
+            a.set("label", &format!("{}{param}{ports}", n.label))
                 .set("shape", "diamond")
                 .set("fillcolor", DECISION_FILL)
                 .set("fontsize", "9")
@@ -955,13 +953,13 @@ fn bt_node_attrs(n: &BtNode) -> Attrs {
                 .style("filled");
         }
         BtNodeKind::Action => {
-            a.set("label", &n.label)
+            a.set("label", &format!("{}{ports}", n.label))
                 .set("shape", "ellipse")
                 .set("fillcolor", ACTION_FILL)
                 .style("filled");
         }
         BtNodeKind::Condition => {
-            a.set("label", &n.label)
+            a.set("label", &format!("{}{ports}", n.label))
                 .set("shape", "ellipse")
                 .set("fillcolor", "white")
                 .set("fontname", "Helvetica-Oblique")
@@ -1144,10 +1142,7 @@ on = { SUCCESS = "SUCCESS", FAILURE = "FAILURE", RUNNING = "RUNNING" }
         // Two containers with three outcome boxes each.
         assert_matches_graph(&p, &dot, 6);
         assert!(dot.contains("subgraph cluster_fetch {"), "{dot}");
-        assert!(
-            dot.contains("subgraph \"cluster_fetch/at-cube\" {"),
-            "{dot}"
-        );
+        assert!(dot.contains("subgraph \"cluster_at-cube\" {"), "{dot}");
         insta::assert_snapshot!("hfsm", dot);
     }
 
@@ -1280,29 +1275,29 @@ root = 'go "home" now'
         let p = policy(HFSM);
         let mut opts = DotOptions::default();
         opts.ghost_vertices
-            .push(("fetch/at-cube/old".into(), "Old!".into()));
+            .push(("at-cube/old".into(), "Old!".into()));
         opts.arc_highlight
-            .insert(("fetch/pick".into(), "fetch".into()), Highlight::Removed);
+            .insert(("pick".into(), "fetch".into()), Highlight::Removed);
         opts.arc_label_highlight.insert(
-            ("fetch/pick".into(), "fetch".into(), "SUCCESS".into()),
+            ("pick".into(), "fetch".into(), "SUCCESS".into()),
             Highlight::Status(Status::Success),
         );
         let dot = policy_dot(&p, &opts);
         let cluster = dot
-            .find("subgraph \"cluster_fetch/at-cube\"")
+            .find("subgraph \"cluster_at-cube\"")
             .expect("inner cluster");
-        let ghost = dot.find("\"fetch/at-cube/old\"[").expect("ghost");
+        let ghost = dot.find("\"at-cube/old\"[").expect("ghost");
         assert!(ghost > cluster, "{dot}");
         // pick's SUCCESS goes to fetch's SUCCESS box, highlighted.
         let arc = dot
             .lines()
-            .find(|l| l.contains("\"fetch/pick\" -> \"fetch/SUCCESS\""))
+            .find(|l| l.contains("pick -> \"fetch/SUCCESS\""))
             .expect("arc to the outcome box");
         assert!(arc.contains("penwidth=3"), "{arc}");
         // Its parallel arcs get the (from, to) highlight.
         let other = dot
             .lines()
-            .find(|l| l.contains("\"fetch/pick\" -> \"fetch/FAILURE\""))
+            .find(|l| l.contains("pick -> \"fetch/FAILURE\""))
             .expect("parallel arc");
         assert!(other.contains("style=dashed"), "{other}");
         // fetch's own SUCCESS transition leaves from that box.
@@ -1331,6 +1326,7 @@ root = 'go "home" now'
                     states: vec![k + 1],
                 }),
                 transitions: vec![to_success()],
+                pseudo: None,
                 span: None,
             })
             .collect();
@@ -1340,6 +1336,7 @@ root = 'go "home" now'
             parent: Some(DEPTH - 1),
             body: StateBody::Task(None),
             transitions: vec![to_success()],
+            pseudo: None,
             span: None,
         });
         let p = Policy {

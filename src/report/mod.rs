@@ -1,6 +1,9 @@
 //! Reports: what `analyze` prints per policy, in table, JSON (the stable contract
 //! of SPEC §7) or CSV form, and the safe writing of output files.
 
+pub mod compare;
+pub mod effort;
+pub mod paper;
 pub mod table;
 
 use crate::format::Loaded;

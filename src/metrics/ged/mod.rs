@@ -156,8 +156,23 @@ pub fn ged_graphs(a: &GedGraph, b: &GedGraph, mode: GedMode, opts: &GedOptions) 
     } else {
         structural(a, b, &labeled, start, opts)
     };
-    let s = script::build(a, b, &map_ab);
-    // The script scores the mapping found, in the original graphs.
+    let mut s = script::build(a, b, &map_ab);
+    // Among mappings of equal cost, prefer the one by name: its script reads
+    // as the engineer's own edits rather than as an arbitrary rematching.
+    // It also tightens the upper bound when the search ran out of budget.
+    let mut by_name = script::named_mapping(a, b);
+    if mode == GedMode::Labeled {
+        for (u, m) in by_name.iter_mut().enumerate() {
+            if m.is_some_and(|v| a.labels()[u] != b.labels()[v]) {
+                *m = None;
+            }
+        }
+    }
+    let named = script::build(a, b, &by_name);
+    if named.cost() <= s.cost() {
+        s = named;
+    }
+    // The script scores the mapping kept, in the original graphs.
     let upper = s.cost();
     finish(lower.min(upper), upper, s)
 }

@@ -1,0 +1,150 @@
+//! `btfsm edit`: the paper's edit operations (`transform::edit`) on a policy
+//! file. The edited policy is written as TOML (to `-o` or stdout), after
+//! checking that it reads back as a valid policy; what the edit touched goes
+//! to stderr.
+
+use super::args::{AddKind, EditArgs, EditOp, WrapKind};
+use super::commands::{emit, load_one};
+use super::{EXIT_BAD_INPUT, EXIT_OK};
+use crate::model::{BtNodeKind, PolicyBody, SkillCall};
+use crate::transform::edit::{self, AddState, EditError, Touched};
+use std::collections::BTreeMap;
+
+pub fn edit(a: &EditArgs) -> u8 {
+    let limits = a.limits.limits();
+    let Some(loaded) = load_one(&a.file, &limits) else {
+        return EXIT_BAD_INPUT;
+    };
+    let mut policy = loaded.policy;
+    let kind = policy.kind();
+    let fail = |e: EditError| {
+        eprintln!("error: {}: {e}", loaded.path);
+        EXIT_BAD_INPUT
+    };
+    let wrong_kind = |op: &str, want: &str| {
+        eprintln!(
+            "error: {}: {op} edits {want}s, and this policy is a {kind}",
+            loaded.path
+        );
+        EXIT_BAD_INPUT
+    };
+    let touched: Touched = match (&a.op, &mut policy.body) {
+        (
+            EditOp::InsertSubtree {
+                parent,
+                index,
+                subtree,
+                prefix,
+            },
+            PolicyBody::Bt(bt),
+        ) => {
+            let Some(sub) = load_one(subtree, &limits) else {
+                return EXIT_BAD_INPUT;
+            };
+            let PolicyBody::Bt(sub_bt) = &sub.policy.body else {
+                eprintln!(
+                    "error: {}: the subtree must be a BT, and this is a {}",
+                    sub.path,
+                    sub.policy.kind()
+                );
+                return EXIT_BAD_INPUT;
+            };
+            match edit::insert_subtree(bt, parent, *index, sub_bt, prefix.as_deref()) {
+                Ok(t) => t,
+                Err(e) => return fail(e),
+            }
+        }
+        (EditOp::WrapRoot { kind, id, name }, PolicyBody::Bt(bt)) => {
+            let k = match kind {
+                WrapKind::Sequence => BtNodeKind::Sequence,
+                WrapKind::Fallback => BtNodeKind::Fallback,
+            };
+            match edit::wrap_root(bt, k, id, name.as_deref()) {
+                Ok(t) => t,
+                Err(e) => return fail(e),
+            }
+        }
+        (
+            EditOp::AddState {
+                kind,
+                name,
+                after,
+                skill,
+                args,
+                guard,
+                guard_label,
+                selector_guard,
+                selector_guard_label,
+                selector_guard_index,
+            },
+            PolicyBody::Machine(m),
+        ) => {
+            let mut call = SkillCall {
+                skill: skill.clone(),
+                args: BTreeMap::new(),
+            };
+            for kv in args {
+                let Some((k, v)) = kv.split_once('=') else {
+                    eprintln!(
+                        "error: invalid --arg `{kv}`\n  = hint: write key=value, e.g. --arg target=cube2"
+                    );
+                    return EXIT_BAD_INPUT;
+                };
+                call.args
+                    .insert(k.trim().to_string(), edit::parse_value(v.trim()));
+            }
+            let parse = |g: &Option<String>, l: &Option<String>| match g {
+                Some(text) => edit::parse_guard(text, l.as_deref()).map(Some),
+                None => Ok(None),
+            };
+            let (guard, selector_guard) = match (
+                parse(guard, guard_label),
+                parse(selector_guard, selector_guard_label),
+            ) {
+                (Ok(g), Ok(s)) => (g, s),
+                (Err(e), _) | (_, Err(e)) => return fail(e),
+            };
+            let spec = AddState {
+                kind: match kind {
+                    AddKind::Sequential => edit::AddKind::Sequential,
+                    AddKind::Alternative => edit::AddKind::Alternative,
+                    AddKind::Connected => edit::AddKind::Connected,
+                },
+                name: name.clone(),
+                after: after.clone(),
+                skill: call,
+                guard,
+                selector_guard,
+                selector_guard_index: *selector_guard_index,
+            };
+            match edit::add_state(m, &spec) {
+                Ok(t) => t,
+                Err(e) => return fail(e),
+            }
+        }
+        (EditOp::AddState { .. }, _) => return wrong_kind("add-state", "fsm"),
+        (_, _) => return wrong_kind("insert-subtree and wrap-root", "bt"),
+    };
+    let text = crate::format::toml_write::write_policy(&policy);
+    // The result must read back: an edit never writes an invalid file.
+    let base = a.file.parent().unwrap_or(std::path::Path::new(""));
+    if let Err(diags) = crate::format::toml::parse_str("edited policy", &text, base, &limits) {
+        eprintln!("error: the edited policy is not valid:");
+        for d in diags {
+            eprint!("{d}");
+        }
+        return EXIT_BAD_INPUT;
+    }
+    let code = emit(a.output.as_deref(), text.as_bytes());
+    if code == EXIT_OK {
+        eprintln!(
+            "edit: {} added, {} modified, transitions +{} -{} ({} unit edits)",
+            touched.added,
+            touched.modified,
+            touched.transitions_added,
+            touched.transitions_removed,
+            touched.edits()
+        );
+    }
+    code
+}

@@ -1,0 +1,85 @@
+//! `btfsm paper` and `btfsm effort`: load, compute through the library, print.
+
+use super::args::PaperArgs;
+use super::commands::{emit, load_all};
+use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
+use crate::format::Limits;
+use crate::metrics::effort::effort as compute_effort;
+use crate::metrics::ged::GedOptions;
+use crate::report::OutputFormat;
+use crate::report::effort::{EffortRow, render_effort};
+use crate::report::paper::{self, EXPECTED_FILE};
+use std::path::PathBuf;
+
+/// `btfsm effort FILE...`.
+pub fn effort(files: &[PathBuf], format: OutputFormat, limits: &Limits) -> u8 {
+    let Some(loaded) = load_all(files, limits) else {
+        return EXIT_BAD_INPUT;
+    };
+    let opts = GedOptions::default();
+    let rows: Vec<EffortRow> = loaded
+        .iter()
+        .map(|l| EffortRow::new(&l.path, &l.policy.name, &compute_effort(&l.policy, &opts).0))
+        .collect();
+    emit(None, render_effort(&rows, format).as_bytes())
+}
+
+/// `btfsm paper`.
+pub fn paper(a: &PaperArgs) -> u8 {
+    let report = match paper::build(&a.policies, &a.limits.limits(), &GedOptions::default()) {
+        Ok(r) => r,
+        Err(diags) => {
+            for d in diags {
+                eprint!("{d}");
+            }
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let expected_path = a.policies.join(EXPECTED_FILE);
+    if a.record {
+        let text = paper::expected_toml(&report);
+        let code = emit(Some(&expected_path), text.as_bytes());
+        if code == EXIT_OK {
+            eprintln!(
+                "recorded {} cells in `{}`",
+                report.rows.len(),
+                expected_path.display()
+            );
+        }
+        return code;
+    }
+    if a.check {
+        let expected = match paper::read_expected(&expected_path) {
+            Ok(e) => e,
+            Err(d) => {
+                eprint!("{d}");
+                return EXIT_BAD_INPUT;
+            }
+        };
+        let departures = paper::check(&report, &expected);
+        if departures.is_empty() {
+            eprintln!(
+                "paper check: all {} cells computed from `{}` match `{}`",
+                report.rows.len(),
+                a.policies.display(),
+                expected_path.display()
+            );
+            return EXIT_OK;
+        }
+        for d in &departures {
+            eprintln!("error: paper check: {d}");
+        }
+        eprintln!(
+            "error: paper check: {} cell{} departed from `{}`\n  = hint: if the change is deliberate, review it and run `btfsm paper --record --policies {}`",
+            departures.len(),
+            if departures.len() == 1 { "" } else { "s" },
+            expected_path.display(),
+            a.policies.display()
+        );
+        return EXIT_CHECK_FAILED;
+    }
+    emit(
+        a.output.as_deref(),
+        paper::render(&report, a.format).as_bytes(),
+    )
+}

@@ -1,0 +1,17 @@
+//! Helpers shared by the integration-test binaries.
+
+use std::process::Command;
+
+/// Runs the built `btfsm` in the crate root: (exit code, stdout, stderr).
+pub fn btfsm(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_btfsm"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run btfsm");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
