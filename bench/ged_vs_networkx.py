@@ -3,7 +3,7 @@
 
 Runs `cargo bench --bench ged`, which times btfsm's exact structural GED on the
 paper's policy pairs (SPEC §5, plus the HFSMs converted from the BT pairs) and on
-60 seeded random loop-free graphs of 8-12 vertices, and writes the graphs; then
+50 seeded random loop-free pairs of 8-12 vertices, and writes the graphs; then
 times NetworkX's `graph_edit_distance` (the paper's tool, installed from PyPI
 if missing) on the same graphs as MultiDiGraphs, and prints per pair both
 values, both times and the speed-up.

@@ -4,7 +4,8 @@
 # libFuzzer stats line of each run goes to fuzz/logs/TARGET.log. Crashes land
 # in fuzz/artifacts/TARGET/ (keep each as a regression test:
 # tests/fixtures/fuzz-regressions/, see docs/robustness.md).
-# Usage: fuzz/run.sh [TARGET...]   (default: every target in fuzz/Cargo.toml)
+# Usage: fuzz/run.sh [TARGET...]   (default: every target in fuzz/Cargo.toml:
+# toml_policy, compare, btcpp_xml, scxml, scenario)
 set -eu
 cd "$(dirname "$0")"
 SECONDS_EACH=${FUZZ_SECONDS:-600}
@@ -26,7 +27,18 @@ for t in $TARGETS; do
       for f in ../policies/paper/*.toml ../policies/paper/lib/*.toml ../tests/fixtures/valid/*.toml ../tests/fixtures/invalid/*.toml ../tests/fixtures/fuzz-regressions/*; do
         [ -f "$f" ] && cp "$f" "corpus/$t/seed-$(basename "$f")"
       done ;;
-    # Importers (add their seeds here): ../../shared/corpus/bt-xml, ../../shared/corpus/scxml
+    btcpp_xml)
+      for f in $(find ../../shared/corpus/bt-xml ../tests/fixtures -name '*.xml' 2>/dev/null); do
+        cp "$f" "corpus/$t/seed-$(echo "$f" | tr '/.' '__')"
+      done ;;
+    scxml)
+      for f in $(find ../../shared/corpus/scxml ../tests/fixtures -name '*.scxml' 2>/dev/null); do
+        cp "$f" "corpus/$t/seed-$(echo "$f" | tr '/.' '__')"
+      done ;;
+    scenario)
+      for f in ../policies/scenarios/*.toml ../tests/fixtures/sim-invalid/*.toml; do
+        [ -f "$f" ] && cp "$f" "corpus/$t/seed-$(basename "$f")"
+      done ;;
     *)
       for f in ../tests/fixtures/fuzz-regressions/*; do
         [ -f "$f" ] && cp "$f" "corpus/$t/"
@@ -34,7 +46,7 @@ for t in $TARGETS; do
   esac
   dict=""
   [ -f "$t.dict" ] && dict="-dict=$t.dict"
-  case $t in toml_policy|compare) dict="-dict=toml.dict" ;; esac
+  case $t in toml_policy|compare|scenario) dict="-dict=toml.dict" ;; esac
   echo "== fuzzing $t for ${SECONDS_EACH}s"
   nice cargo +nightly fuzz run "$t" "corpus/$t" -- \
     -max_total_time="$SECONDS_EACH" -timeout="$TIMEOUT" -rss_limit_mb="$RSS" \

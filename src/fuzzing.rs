@@ -5,8 +5,10 @@
 //! input (a written policy reads back to itself; a GED result is a certified
 //! interval whose edit script costs its upper bound).
 //!
-//! It is the body of the coverage-guided fuzz targets in `fuzz/` (one line
-//! each) and of the no-panic property tests of the normal suite, so that what
+//! Targets: `toml_policy`, `btcpp_xml`, `scxml` (bytes → `Loaded` →
+//! [`exercise`]), `scenario` (bytes → scenario → a short simulation) and
+//! `compare` (two policies → every GED mode). It is the body of the
+//! coverage-guided fuzz targets in `fuzz/` (one line each) and of the no-panic property tests of the normal suite, so that what
 //! fuzzing finds is guarded by `cargo test`. A new input format gets one
 //! function here (bytes → `Loaded` → [`exercise`]) and a fuzz target calling
 //! it; see docs/robustness.md.
@@ -27,6 +29,7 @@ pub fn limits() -> Limits {
         max_include_depth: 8,
         max_depth: 200,
         max_name_bytes: 4096,
+        ..Limits::default()
     }
 }
 
@@ -63,6 +66,62 @@ pub fn parse_toml(data: &[u8]) -> Option<Loaded> {
 pub fn toml_policy(data: &[u8]) {
     if let Some(l) = parse_toml(data) {
         exercise(&l);
+    }
+}
+
+/// Fuzz target `btcpp_xml`: any bytes through the BehaviorTree.CPP XML
+/// importer (includes resolve against `tests/fixtures/`) and downstream.
+pub fn btcpp_xml(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let base = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures"));
+    accepted(crate::format::btcpp_xml::parse_str(
+        "fuzz.xml",
+        text,
+        base,
+        &limits(),
+    ));
+}
+
+/// Fuzz target `scxml`: any bytes through the SCXML importer and downstream.
+pub fn scxml(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    accepted(crate::format::scxml::parse_str(
+        "fuzz.scxml",
+        text,
+        &limits(),
+    ));
+}
+
+/// Fuzz target `scenario`: any bytes as a simulator scenario (policies
+/// resolve against `policies/scenarios/`); an accepted one is run for at most
+/// 2000 steps per policy.
+pub fn scenario(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let base = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/policies/scenarios"));
+    let file = crate::diagnostic::SourceFile::new("fuzz-scenario.toml", text);
+    match crate::sim::scenario::parse(&file, base, &limits()) {
+        Ok(mut s) => {
+            s.max_steps = s.max_steps.min(2000);
+            let _ = crate::sim::run::run_scenario(&s, true);
+        }
+        Err(diags) => check_diagnostics(&diags),
+    }
+}
+
+/// An importer's result: checked diagnostics, or [`exercise`] when the
+/// policy is within the shape limits `format::load` enforces for every
+/// format.
+fn accepted(r: Result<Loaded, Vec<Diagnostic>>) {
+    match r {
+        Ok(l) if crate::format::check_shape(&l.policy, &limits()).is_none() => exercise(&l),
+        Ok(_) => {}
+        Err(diags) => check_diagnostics(&diags),
     }
 }
 
@@ -215,6 +274,9 @@ mod tests {
             match name.as_deref().and_then(|n| n.split('-').next()) {
                 Some("toml_policy") => toml_policy(&data),
                 Some("compare") => compare(&data),
+                Some("btcpp_xml") => btcpp_xml(&data),
+                Some("scxml") => scxml(&data),
+                Some("scenario") => scenario(&data),
                 other => panic!("{}: no fuzz target `{other:?}`", f.display()),
             }
         }

@@ -44,6 +44,9 @@ pub enum Command {
         /// Render with Graphviz's `dot` instead of printing DOT
         #[arg(long, value_enum)]
         render: Option<crate::render::dot::RenderFormat>,
+        /// Colour nodes by their status at --step in a `sim --trace` file
+        #[command(flatten)]
+        trace: super::sim::DotTraceArgs,
         #[command(flatten)]
         limits: LimitArgs,
     },
@@ -98,6 +101,8 @@ pub enum Command {
     Paper(PaperArgs),
     /// The paper's edit operations: insert a BT subtree, add an FSM state
     Edit(Box<EditArgs>),
+    /// Runs policies in the planar robot simulator and compares their behavior
+    Sim(super::sim::SimArgs),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -135,6 +140,17 @@ pub enum ConvertTarget {
     FaultTolerant,
     /// TOML (normalised)
     Toml,
+    /// BehaviorTree.CPP XML, format 4 (behavior trees)
+    BtcppXml,
+    /// SCXML (FSMs and HFSMs)
+    Scxml,
+}
+
+/// `--assume-leaf`: how to read BehaviorTree.CPP leaves of unknown type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AssumeLeafArg {
+    Action,
+    Condition,
 }
 
 /// Input limits (documented defaults; see `format::Limits`).
@@ -152,6 +168,14 @@ pub struct LimitArgs {
     /// Longest node id, state name, display name or label, in bytes
     #[arg(long, default_value_t = crate::format::DEFAULT_MAX_NAME_BYTES, hide_short_help = true)]
     pub max_name_bytes: usize,
+    /// BehaviorTree.CPP TreeNodesModel file declaring node types (repeatable),
+    /// e.g. Nav2's nav2_tree_nodes.xml
+    #[arg(long = "nodes-model", value_name = "FILE")]
+    pub nodes_model: Vec<PathBuf>,
+    /// Read BehaviorTree.CPP leaves of unknown type as actions or conditions
+    /// (default: an error listing the known types)
+    #[arg(long, value_enum, value_name = "KIND")]
+    pub assume_leaf: Option<AssumeLeafArg>,
 }
 
 impl LimitArgs {
@@ -161,6 +185,11 @@ impl LimitArgs {
             max_nodes: self.max_nodes,
             max_depth: self.max_depth,
             max_name_bytes: self.max_name_bytes,
+            nodes_models: self.nodes_model.clone(),
+            assume_leaf: self.assume_leaf.map(|a| match a {
+                AssumeLeafArg::Action => crate::format::AssumeLeaf::Action,
+                AssumeLeafArg::Condition => crate::format::AssumeLeaf::Condition,
+            }),
             ..Default::default()
         }
     }

@@ -41,12 +41,16 @@ pub fn execute(cli: Cli) -> u8 {
             file,
             output,
             render,
+            trace,
             limits,
         } => {
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            draw(&l.policy, &Default::default(), output.as_deref(), render)
+            let Some((policy, opts)) = super::sim::dot_trace(&trace, &file, l.policy) else {
+                return EXIT_BAD_INPUT;
+            };
+            draw(&policy, &opts, output.as_deref(), render)
         }
         Command::Compare {
             a,
@@ -78,6 +82,9 @@ pub fn execute(cli: Cli) -> u8 {
             };
             let policy = match to {
                 ConvertTarget::Toml => l.policy,
+                ConvertTarget::BtcppXml | ConvertTarget::Scxml => {
+                    return super::convert::to_xml(&l.policy, to, output.as_deref());
+                }
                 ConvertTarget::FaultTolerant => {
                     match crate::transform::fault_tolerant::fault_tolerant_policy(&l.policy) {
                         Ok(p) => p,
@@ -116,6 +123,7 @@ pub fn execute(cli: Cli) -> u8 {
         } => super::paper::effort(&files, format, &limits.limits()),
         Command::Paper(args) => super::paper::paper(&args),
         Command::Edit(args) => super::edit::edit(&args),
+        Command::Sim(args) => super::sim::execute(args),
     }
 }
 
@@ -174,7 +182,7 @@ pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>
     (!failed).then_some(out)
 }
 
-fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
+pub(super) fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
     let n = diags.iter().filter(|d| d.is_error()).count();
     for d in diags {
         let _ = write!(w, "{d}");

@@ -5,8 +5,10 @@
 pub mod args;
 mod commands;
 mod compare;
+mod convert;
 mod edit;
 mod paper;
+pub mod sim;
 
 use clap::Parser;
 use std::ffi::OsString;

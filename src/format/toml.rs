@@ -29,7 +29,7 @@ pub const TASK_OUTCOMES: &[&str] = &["SUCCESS", "FAILURE", "RUNNING"];
 /// Reads and validates a TOML policy file.
 pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
-    let file = read_source(path, &shown, limits, false)?;
+    let file = read_source(path, &shown, limits)?;
     let base = path.parent().unwrap_or(Path::new(""));
     load_source(&file, canonical(path), base, limits)
 }
@@ -73,58 +73,53 @@ fn load_source(
         loader.diags.push(d);
         policy = None;
     }
-    let (mut errors, mut warnings) = sorted_partition(loader.diags);
+    // Counted messages, said last (at the end of the file).
+    let end = file.text.len()..file.text.len();
     if loader.dropped_errors > 0 {
-        errors.push(
+        loader.diags.push(
             Diagnostic::error(format!(
                 "{} more errors not shown (the first {MAX_DIAGNOSTICS} messages are)",
                 loader.dropped_errors
             ))
-            .in_file(file),
+            .at(file, end.clone()),
         );
     }
     if loader.dropped_warnings > 0 {
-        warnings.push(
+        loader.diags.push(
             Diagnostic::warning(format!(
                 "{} more warnings not shown",
                 loader.dropped_warnings
             ))
-            .in_file(file),
+            .at(file, end),
         );
     }
-    match policy {
-        Some(policy) if errors.is_empty() => Ok(Loaded {
-            path: file.path.clone(),
-            policy,
-            warnings,
-        }),
-        _ => {
-            let mut all = errors;
-            if all.is_empty() {
-                all.push(Diagnostic::error("invalid policy").in_file(file));
-            }
-            all.extend(warnings);
-            Err(all)
-        }
-    }
+    super::finish(file, policy, loader.diags, "policy")
 }
 
-/// Errors and warnings, each in file and source order.
-fn sorted_partition(mut diags: Vec<Diagnostic>) -> (Vec<Diagnostic>, Vec<Diagnostic>) {
-    diags.sort_by_key(|d| {
-        (
-            d.file.as_ref().map(|f| f.path.clone()),
-            d.span.as_ref().map_or(0, |s| s.start),
-        )
-    });
-    diags.into_iter().partition(Diagnostic::is_error)
-}
-
-fn canonical(p: &Path) -> PathBuf {
+pub(crate) fn canonical(p: &Path) -> PathBuf {
     std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
 }
 
-fn read_source(
+/// Reads a policy file named on the command line (a pipe or device is read
+/// up to the size limit).
+pub(crate) fn read_source(
+    path: &Path,
+    shown: &str,
+    limits: &Limits,
+) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
+    read_file(path, shown, limits, false)
+}
+
+/// Reads a file another file includes: it must be a regular file.
+pub(crate) fn read_included(
+    path: &Path,
+    shown: &str,
+    limits: &Limits,
+) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
+    read_file(path, shown, limits, true)
+}
+
+fn read_file(
     path: &Path,
     shown: &str,
     limits: &Limits,
@@ -768,6 +763,8 @@ impl Loader {
             children: Vec<(String, Range<usize>)>,
             skill: Option<SkillCall>,
             include: Option<Bt>,
+            type_name: Option<String>,
+            ports: BTreeMap<String, String>,
         }
         let mut raws: Vec<Raw> = Vec::with_capacity(ids.len());
         for (key, v) in nodes.iter() {
@@ -783,12 +780,14 @@ impl Loader {
             }
             self.node_budget -= 1;
             raws.push(match self.bt_node(cx, id, key.span(), v) {
-                Some((kind, label, children, skill, include)) => Raw {
+                Some(((kind, label, children, skill, include), (type_name, ports))) => Raw {
                     kind,
                     label,
                     children,
                     skill,
                     include,
+                    type_name,
+                    ports,
                 },
                 None => Raw {
                     kind: None,
@@ -796,6 +795,8 @@ impl Loader {
                     children: vec![],
                     skill: None,
                     include: None,
+                    type_name: None,
+                    ports: BTreeMap::new(),
                 },
             });
         }
@@ -1001,6 +1002,8 @@ impl Loader {
                     kind: raw.kind.expect("checked above"),
                     children: Vec::new(),
                     skill: raw.skill.take(),
+                    type_name: raw.type_name.take(),
+                    ports: std::mem::take(&mut raw.ports),
                     span: Some(ids[i].1.clone()),
                 }),
             }
@@ -1026,11 +1029,14 @@ impl Loader {
         key_span: Range<usize>,
         v: &Val<'_>,
     ) -> Option<(
-        Option<BtNodeKind>,
-        String,
-        Vec<(String, Range<usize>)>,
-        Option<SkillCall>,
-        Option<Bt>,
+        (
+            Option<BtNodeKind>,
+            String,
+            Vec<(String, Range<usize>)>,
+            Option<SkillCall>,
+            Option<Bt>,
+        ),
+        (Option<String>, BTreeMap<String, String>),
     )> {
         let DeValue::Table(t) = v.get_ref() else {
             self.err(
@@ -1046,7 +1052,9 @@ impl Loader {
             ));
             return None;
         };
-        const FIELDS: &[&str] = &["name", "skill", "args", "success", "times", "ms", "with"];
+        const FIELDS: &[&str] = &[
+            "name", "skill", "args", "success", "times", "ms", "with", "type", "ports",
+        ];
         let type_keys: Vec<(&str, &Val<'_>, Range<usize>)> = t
             .iter()
             .filter(|(k, _)| NODE_KEYWORDS.contains(&k.get_ref().as_ref()))
@@ -1128,9 +1136,14 @@ impl Loader {
             },
             "action" => BtNodeKind::Action,
             "condition" => BtNodeKind::Condition,
+            "control" => BtNodeKind::Control,
+            "decorator" => BtNodeKind::Decorator,
             "subtree" => {
                 let sub = self.include(cx, id, t, tval)?;
-                return Some((None, String::new(), vec![], None, Some(sub)));
+                return Some((
+                    (None, String::new(), vec![], None, Some(sub)),
+                    (None, BTreeMap::new()),
+                ));
             }
             _ => unreachable!("filtered by NODE_KEYWORDS"),
         };
@@ -1144,6 +1157,7 @@ impl Loader {
                 "times" => matches!(kind, BtNodeKind::Repeat { .. } | BtNodeKind::Retry { .. }),
                 "ms" => matches!(kind, BtNodeKind::Timeout { .. }),
                 "with" => false,
+                "type" | "ports" => true,
                 _ => true,
             };
             if !fits {
@@ -1217,7 +1231,67 @@ impl Loader {
                 }
             },
         }
-        Some((Some(kind), label, children, skill, None))
+        let type_name = self.opt_str(cx, t, "type");
+        if matches!(kind, BtNodeKind::Control | BtNodeKind::Decorator) && type_name.is_none() {
+            self.err(cx, tspan, format!("{tkey} node `{id}` needs `type`"))
+                .hint = Some(
+                "write `type = \"IfThenElse\"`: the node's kind in the file it came from".into(),
+            );
+            return None;
+        }
+        let ports = self.ports(cx, t, id)?;
+        Some((
+            (Some(kind), label, children, skill, None),
+            (type_name, ports),
+        ))
+    }
+
+    /// Reads `ports = { name = "value", ... }` (values kept as text).
+    fn ports(
+        &mut self,
+        cx: &Ctx<'_>,
+        t: &DeTable<'_>,
+        id: &str,
+    ) -> Option<BTreeMap<String, String>> {
+        let mut out = BTreeMap::new();
+        let Some(pv) = t.get("ports") else {
+            return Some(out);
+        };
+        let DeValue::Table(pt) = pv.get_ref() else {
+            self.err(
+                cx,
+                pv.span(),
+                format!(
+                    "`ports` of node `{id}` must be a table, found {}",
+                    type_name(pv.get_ref())
+                ),
+            )
+            .hint = Some("write `ports = { num_cycles = \"3\" }`".into());
+            return None;
+        };
+        for (k, v) in pt.iter() {
+            match v.get_ref() {
+                DeValue::String(_)
+                | DeValue::Integer(_)
+                | DeValue::Float(_)
+                | DeValue::Boolean(_) => {
+                    out.insert(k.get_ref().to_string(), scalar_text(v.get_ref()));
+                }
+                other => {
+                    self.err(
+                        cx,
+                        v.span(),
+                        format!(
+                            "port `{}` of node `{id}` must be a string, found {}",
+                            k.get_ref(),
+                            type_name(other)
+                        ),
+                    );
+                    return None;
+                }
+            }
+        }
+        Some(out)
     }
 
     /// Reads an included subtree file.
@@ -1304,7 +1378,7 @@ impl Loader {
     ) -> Option<Bt> {
         let tval = t.get("subtree").expect("a subtree node");
         let shown = path.display().to_string();
-        let file = match read_source(path, &shown, &self.limits, true) {
+        let file = match read_included(path, &shown, &self.limits) {
             Ok(f) => f,
             Err(mut ds) => {
                 let msg = ds.remove(0).message;
@@ -1533,7 +1607,9 @@ impl Loader {
                 let allowed: &[&str] = if is_container {
                     &["label", "initial", "outcomes", "states", "on", "guards"]
                 } else {
-                    &["label", "skill", "args", "decision", "on", "guards"]
+                    &[
+                        "label", "skill", "args", "decision", "history", "on", "guards",
+                    ]
                 };
                 let before = self.problems();
                 self.check_keys(cx, st, allowed, &format!("field of state `{name}`"));
@@ -1553,6 +1629,31 @@ impl Loader {
                         }
                     },
                 };
+                let pseudo = match st.get("history") {
+                    None => None,
+                    Some(h) => match h.get_ref().as_str() {
+                        Some("shallow") => Some(crate::model::Pseudo::ShallowHistory),
+                        Some("deep") => Some(crate::model::Pseudo::DeepHistory),
+                        _ => {
+                            self.err(cx, h.span(), "`history` must be \"shallow\" or \"deep\"")
+                                .hint = Some(
+                                "an SCXML history pseudo-state; it also needs `decision = true`"
+                                    .into(),
+                            );
+                            ok = false;
+                            None
+                        }
+                    },
+                };
+                if pseudo.is_some() && !decision {
+                    self.err(
+                        cx,
+                        k.span(),
+                        format!("history state `{name}` must be a decision state"),
+                    )
+                    .hint = Some("add `decision = true`: a history state runs no skill".into());
+                    ok = false;
+                }
                 let body = if is_container {
                     if !hierarchical {
                         self.err(
@@ -1672,6 +1773,7 @@ impl Loader {
                     parent: container,
                     body,
                     transitions: Vec::new(),
+                    pseudo,
                     span: Some(k.span()),
                 });
                 raw_trs.push(trs);
@@ -1730,6 +1832,8 @@ impl Loader {
             .enumerate()
             .map(|(i, st)| ((st.parent, st.name.as_str()), i))
             .collect();
+        // Targets in other regions (SCXML imports) are written as paths.
+        let by_path: HashMap<String, usize> = (0..m.states.len()).map(|i| (m.path(i), i)).collect();
         let mut resolved_all: Vec<Vec<Transition>> = vec![Vec::new(); m.states.len()];
         for (si, trs) in raw_trs.into_iter().enumerate() {
             let region = m.region_of(si);
@@ -1764,6 +1868,8 @@ impl Loader {
                     Target::State(t)
                 } else if region.outcomes.contains(&target) {
                     Target::Outcome(target)
+                } else if let Some(&t) = by_path.get(&target) {
+                    Target::State(t)
                 } else {
                     let cands: Vec<&str> = region
                         .states
@@ -1789,6 +1895,7 @@ impl Loader {
             }
         }
         drop(by_name);
+        drop(by_path);
         for (st, trs) in m.states.iter_mut().zip(resolved_all) {
             st.transitions = trs;
         }
@@ -1840,9 +1947,8 @@ impl Loader {
                 }
             }
         }
-        if out.is_empty() {
-            self.err(cx, ov.span(), format!("{owner} needs at least one outcome"));
-        }
+        // `outcomes = []` is a machine that never terminates (as SCXML machines
+        // without `<final>` states are).
         out
     }
 
@@ -1920,6 +2026,14 @@ impl Loader {
                 }
                 terms
             }
+            // A guard that names no condition of the skill library, only its
+            // `label` (an SCXML event or condition, kept as text).
+            None if !t.contains_key("if")
+                && !t.contains_key("unless")
+                && t.contains_key("label") =>
+            {
+                vec![]
+            }
             None => vec![self.guard_term(cx, t, g.span(), &owner)?],
         };
         let Some(to_v) = t.get("to") else {
@@ -1993,22 +2107,7 @@ impl Loader {
 
     /// Warns about states that no transition can reach.
     fn unreachable_states(&mut self, cx: &Ctx<'_>, m: &StateMachine) {
-        let mut seen = vec![false; m.states.len()];
-        let mut stack = vec![m.top.initial];
-        while let Some(s) = stack.pop() {
-            if s >= seen.len() || seen[s] {
-                continue;
-            }
-            seen[s] = true;
-            if let StateBody::Container(r) = &m.states[s].body {
-                stack.push(r.initial);
-            }
-            for t in &m.states[s].transitions {
-                if let Target::State(n) = t.target {
-                    stack.push(n);
-                }
-            }
-        }
+        let seen = m.reachable();
         for (i, s) in m.states.iter().enumerate() {
             if !seen[i] {
                 self.warn(

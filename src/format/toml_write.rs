@@ -2,8 +2,8 @@
 //! `btfsm convert`). Reading the output gives back the same policy.
 
 use crate::model::{
-    ArgValue, Bt, BtNodeKind, Guard, Policy, PolicyBody, SkillCall, StateBody, StateMachine,
-    Target, Trigger,
+    ArgValue, Bt, BtNodeKind, Guard, Policy, PolicyBody, Pseudo, SkillCall, StateBody,
+    StateMachine, Target, Trigger,
 };
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -119,6 +119,17 @@ fn write_bt(out: &mut String, bt: &Bt) {
         {
             fields.push(format!("name = {}", quote(&n.label)));
         }
+        if let Some(t) = &n.type_name {
+            fields.push(format!("type = {}", quote(t)));
+        }
+        if !n.ports.is_empty() {
+            let ports: Vec<String> = n
+                .ports
+                .iter()
+                .map(|(k, v)| format!("{} = {}", key(k), quote(v)))
+                .collect();
+            fields.push(format!("ports = {{ {} }}", ports.join(", ")));
+        }
         let _ = writeln!(out, "{} = {{ {} }}", key(&n.id), fields.join(", "));
     }
 }
@@ -135,6 +146,10 @@ fn guard_inline(g: &Guard, to: &str) -> String {
         }
         s
     };
+    if g.all.is_empty() {
+        // A guard known only by its label (an SCXML event or condition).
+        return format!("{{ to = {}, label = {} }}", quote(to), quote(&g.label));
+    }
     let cond = if g.all.len() == 1 {
         term(&g.all[0])
     } else {
@@ -177,6 +192,15 @@ fn write_machine(out: &mut String, m: &StateMachine) {
             StateBody::Task(None) => {}
             StateBody::Decision => {
                 let _ = writeln!(out, "decision = true");
+                match s.pseudo {
+                    Some(Pseudo::ShallowHistory) => {
+                        let _ = writeln!(out, "history = \"shallow\"");
+                    }
+                    Some(Pseudo::DeepHistory) => {
+                        let _ = writeln!(out, "history = \"deep\"");
+                    }
+                    None => {}
+                }
             }
             StateBody::Container(r) => {
                 let _ = writeln!(out, "initial = {}", quote(&m.states[r.initial].name));
@@ -185,6 +209,8 @@ fn write_machine(out: &mut String, m: &StateMachine) {
             }
         }
         let target = |t: &Target| match t {
+            // A state of another region (SCXML imports) by its path.
+            Target::State(j) if m.states[*j].parent != s.parent => m.path(*j),
             Target::State(j) => m.states[*j].name.clone(),
             Target::Outcome(o) => o.clone(),
         };

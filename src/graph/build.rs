@@ -29,6 +29,7 @@ pub fn bt_vertex_type(kind: BtNodeKind) -> VertexType {
         BtNodeKind::SequenceMemory => VertexType::SequenceMemory,
         BtNodeKind::FallbackMemory => VertexType::FallbackMemory,
         BtNodeKind::Parallel { .. } => VertexType::Parallel,
+        BtNodeKind::Control => VertexType::Control,
         BtNodeKind::Action => VertexType::Action,
         BtNodeKind::Condition => VertexType::Condition,
         _ => VertexType::Decorator,

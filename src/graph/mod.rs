@@ -16,6 +16,9 @@ pub enum VertexType {
     SequenceMemory,
     FallbackMemory,
     Parallel,
+    /// A control node of a kind without its own type (BehaviorTree.CPP
+    /// `IfThenElse`, Nav2 `RecoveryNode`, ...).
+    Control,
     Decorator,
     Action,
     Condition,
@@ -39,6 +42,7 @@ impl VertexType {
             VertexType::SequenceMemory => "sequence_memory",
             VertexType::FallbackMemory => "fallback_memory",
             VertexType::Parallel => "parallel",
+            VertexType::Control => "control",
             VertexType::Decorator => "decorator",
             VertexType::Action => "action",
             VertexType::Condition => "condition",

@@ -22,7 +22,7 @@
 //! does not reduce, and its FSM keeps a value above 1.
 
 use crate::graph::PolicyGraph;
-use crate::model::{Bt, BtNodeKind, Policy, PolicyBody, StateBody, StateMachine, Target};
+use crate::model::{Bt, BtNodeKind, Policy, PolicyBody, StateBody, StateMachine, Target, Trigger};
 use std::collections::{BTreeSet, VecDeque};
 
 /// McCabe's `a + s - n + 1` on a policy graph (sinks = vertices without
@@ -98,7 +98,8 @@ fn bt_control_flow(bt: &Bt) -> ControlFlow {
                 | BtNodeKind::SequenceMemory
                 | BtNodeKind::Fallback
                 | BtNodeKind::FallbackMemory
-                | BtNodeKind::Parallel { .. } => {
+                | BtNodeKind::Parallel { .. }
+                | BtNodeKind::Control => {
                     // One outcome continues to the next sibling, the others return.
                     cf.arc(from, next.unwrap_or(out));
                     cf.arc(from, out);
@@ -123,8 +124,17 @@ fn bt_control_flow(bt: &Bt) -> ControlFlow {
 }
 
 /// FSM/HFSM control flow: a task or decision state is one vertex, a container
-/// has IN (-> its initial state) and OUT (its own transitions); outcomes of the
-/// top level merge into EXIT.
+/// has IN (-> its initial state) and OUT; outcomes of the top level merge into
+/// EXIT.
+///
+/// A container's transition on one of its region's outcomes leaves from OUT:
+/// the region has finished with that outcome (every BT converted to an HFSM
+/// is built this way). Any other transition of a container — a guard, or an
+/// event its region does not produce (SCXML's `userAbort` on a compound
+/// state) — preempts whatever state inside is active, so it leaves from an
+/// ANY vertex that every state directly inside reaches, and that the ANY
+/// vertices of nested containers reach in turn: one vertex and one arc per
+/// state, linear whatever the nesting.
 fn machine_control_flow(m: &StateMachine) -> ControlFlow {
     let mut cf = ControlFlow::new();
     let n = m.states.len();
@@ -140,9 +150,33 @@ fn machine_control_flow(m: &StateMachine) -> ControlFlow {
             exit[i] = v;
         }
     }
+    let preempts = |i: usize, t: &crate::model::Transition| match (&m.states[i].body, &t.trigger) {
+        (StateBody::Container(r), Trigger::Outcome(o)) => !r.outcomes.contains(o),
+        (StateBody::Container(_), Trigger::Guard(_)) => true,
+        _ => false,
+    };
+    // ANY vertices, for containers with preempting transitions and those
+    // nested in one (parents first).
+    let mut any: Vec<Option<usize>> = vec![None; n];
+    for c in m.parents_first() {
+        let own = m.states[c].transitions.iter().any(|t| preempts(c, t));
+        let inherited = m.states[c].parent.is_some_and(|p| any[p].is_some());
+        if matches!(m.states[c].body, StateBody::Container(_)) && (own || inherited) {
+            let v = cf.vertex();
+            any[c] = Some(v);
+            if let Some(up) = m.states[c].parent.and_then(|p| any[p]) {
+                cf.arc(v, up);
+            }
+        }
+    }
     for (i, s) in m.states.iter().enumerate() {
         if let StateBody::Container(r) = &s.body {
             cf.arc(entry[i], entry[r.initial]);
+        }
+        if !matches!(s.body, StateBody::Container(_))
+            && let Some(up) = s.parent.and_then(|p| any[p])
+        {
+            cf.arc(exit[i], up);
         }
         for t in &s.transitions {
             let to = match &t.target {
@@ -152,7 +186,11 @@ fn machine_control_flow(m: &StateMachine) -> ControlFlow {
                     None => 0,
                 },
             };
-            cf.arc(exit[i], to);
+            let from = match any[i] {
+                Some(v) if preempts(i, t) => v,
+                _ => exit[i],
+            };
+            cf.arc(from, to);
         }
     }
     cf.entry = entry[m.top.initial];
@@ -312,5 +350,57 @@ mod tests {
         );
         let direct = c.succ.iter().map(Vec::len).sum::<usize>() as i64 + 1 - 4 + 1;
         assert!(reduce(&c).cyclomatic() <= direct);
+    }
+
+    fn hfsm(text: &str) -> Policy {
+        crate::format::toml::parse_str(
+            "t.toml",
+            text,
+            std::path::Path::new(""),
+            &Default::default(),
+        )
+        .expect("valid")
+        .policy
+    }
+
+    /// A container `work` running a -> b -> `done`; b may also end it with
+    /// `stopped`; `leave` takes `work` to `idle`, which goes back to `work`.
+    fn with_container_transition(leave: &str) -> Policy {
+        hfsm(&format!(
+            r#"
+kind = "hfsm"
+initial = "work"
+outcomes = ["SUCCESS"]
+[states.work]
+initial = "a"
+outcomes = ["done", "stopped"]
+{leave}
+[states.work.states.a]
+skill = "Move-To"
+args = {{ target = "cube1" }}
+on = {{ SUCCESS = "b", RUNNING = "a" }}
+[states.work.states.b]
+skill = "Pick"
+args = {{ object = "cube1" }}
+on = {{ SUCCESS = "done", FAILURE = "stopped", RUNNING = "b" }}
+[states.idle]
+skill = "Recharge"
+on = {{ SUCCESS = "work" }}
+"#
+        ))
+    }
+
+    #[test]
+    fn container_events_preempt_from_inside() {
+        // On one of the region's outcomes the arc leaves once the region has
+        // finished: a while loop around `work`, structured.
+        let on_outcome = r#"on = { done = "SUCCESS", stopped = "idle" }"#;
+        assert_eq!(essential(&with_container_transition(on_outcome)), 1);
+        // A guard (or an SCXML event the region never produces, such as
+        // `userAbort` on a compound state) fires from `a` or `b`: the loop is
+        // left from two places inside, not structured.
+        let on_guard = r#"on = { done = "SUCCESS" }
+guards = [{ unless = "Battery-Level", args = { min = 20 }, to = "idle" }]"#;
+        assert!(essential(&with_container_transition(on_guard)) > 1);
     }
 }

@@ -2,6 +2,7 @@
 //! trees of any depth are walked without recursion.
 
 use super::{SkillCall, Span};
+use std::collections::BTreeMap;
 
 /// Index of a node in [`Bt::nodes`].
 pub type NodeIdx = usize;
@@ -23,6 +24,14 @@ pub struct BtNode {
     pub children: Vec<NodeIdx>,
     /// Skill binding of a leaf.
     pub skill: Option<SkillCall>,
+    /// The node type name in the file it was read from when it says more than
+    /// `kind` (a BehaviorTree.CPP type such as `IfThenElse`, `RecoveryNode`,
+    /// `PipelineSequence`); kept for DOT, JSON and export.
+    pub type_name: Option<String>,
+    /// Ports and attributes of the node as written (BehaviorTree.CPP ports such
+    /// as `num_cycles="3"`), in name order; empty for skill-bound leaves, whose
+    /// arguments are in `skill`.
+    pub ports: BTreeMap<String, String>,
     pub span: Option<Span>,
 }
 
@@ -58,6 +67,14 @@ pub enum BtNodeKind {
     },
     Action,
     Condition,
+    /// A control node of a kind the tool does not model (BehaviorTree.CPP's
+    /// `IfThenElse`, `WhileDoElse`, `Switch3`, Nav2's `RecoveryNode`, ...);
+    /// [`BtNode::type_name`] keeps the original kind. Counted as a control node.
+    Control,
+    /// A decorator of a kind the tool does not model (`RunOnce`, `Delay`,
+    /// Nav2's `RateController`, ...), with its original kind in
+    /// [`BtNode::type_name`].
+    Decorator,
 }
 
 /// How many children a node type takes.
@@ -85,6 +102,8 @@ impl BtNodeKind {
             BtNodeKind::Timeout { .. } => "timeout",
             BtNodeKind::Action => "action",
             BtNodeKind::Condition => "condition",
+            BtNodeKind::Control => "control",
+            BtNodeKind::Decorator => "decorator",
         }
     }
 
@@ -96,7 +115,8 @@ impl BtNodeKind {
             | BtNodeKind::ForceFailure
             | BtNodeKind::Repeat { .. }
             | BtNodeKind::Retry { .. }
-            | BtNodeKind::Timeout { .. } => Arity::One,
+            | BtNodeKind::Timeout { .. }
+            | BtNodeKind::Decorator => Arity::One,
             _ => Arity::AtLeastOne,
         }
     }
@@ -125,6 +145,8 @@ impl BtNodeKind {
             BtNodeKind::Timeout { .. } => "Timeout",
             BtNodeKind::Action => "Action",
             BtNodeKind::Condition => "Condition",
+            BtNodeKind::Control => "Control",
+            BtNodeKind::Decorator => "Decorator",
         }
     }
 }
@@ -144,6 +166,8 @@ pub const NODE_KEYWORDS: &[&str] = &[
     "timeout",
     "action",
     "condition",
+    "control",
+    "decorator",
     "subtree",
 ];
 
@@ -191,6 +215,8 @@ mod tests {
             kind: BtNodeKind::Action,
             children: vec![],
             skill: None,
+            type_name: None,
+            ports: BTreeMap::new(),
             span: None,
         }
     }

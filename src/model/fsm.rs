@@ -39,7 +39,19 @@ pub struct State {
     /// Transitions in file order: guards first (checked before the skill runs),
     /// then outcome transitions.
     pub transitions: Vec<Transition>,
+    /// The SCXML pseudo-state this state stands for (`None` for an ordinary
+    /// state); such a state has no skill and is drawn and exported as what it is.
+    pub pseudo: Option<Pseudo>,
     pub span: Option<Span>,
+}
+
+/// SCXML pseudo-states modelled as states of their region (W3C SCXML 3.10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pseudo {
+    /// `<history type="shallow">`: re-enters the region's last active child.
+    ShallowHistory,
+    /// `<history type="deep">`: re-enters the last active descendants.
+    DeepHistory,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -81,7 +93,8 @@ impl Trigger {
 
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Target {
-    /// A sibling state (same region).
+    /// A state: a sibling (same region) in TOML files; SCXML transitions may
+    /// also target a state of another region.
     State(StateIdx),
     /// One of the enclosing region's outcomes.
     Outcome(String),
@@ -176,6 +189,28 @@ impl StateMachine {
         parts.join("/")
     }
 
+    /// Which states the initial state reaches through transitions and
+    /// containers' initial states (explicit stack).
+    pub fn reachable(&self) -> Vec<bool> {
+        let mut seen = vec![false; self.states.len()];
+        let mut stack = vec![self.top.initial];
+        while let Some(s) = stack.pop() {
+            if s >= seen.len() || seen[s] {
+                continue;
+            }
+            seen[s] = true;
+            if let StateBody::Container(r) = &self.states[s].body {
+                stack.push(r.initial);
+            }
+            for t in &self.states[s].transitions {
+                if let Target::State(n) = t.target {
+                    stack.push(n);
+                }
+            }
+        }
+        seen
+    }
+
     /// Number of states that run an action skill or have no binding
     /// (not decisions, not containers): the paper's M.
     pub fn task_state_count(&self) -> usize {
@@ -197,6 +232,7 @@ mod tests {
             parent,
             body,
             transitions: Vec::new(),
+            pseudo: None,
             span: None,
         }
     }

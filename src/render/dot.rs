@@ -633,6 +633,20 @@ impl<'o> Builder<'o> {
                     self.container_nodes(i, &s.label, &key[i], r, &outcome_box);
                     continue;
                 }
+                // SCXML history pseudo-states as in UML: a small circle with H / H*.
+                StateBody::Decision if s.pseudo.is_some() => {
+                    let h = match s.pseudo {
+                        Some(crate::model::Pseudo::DeepHistory) => "H*",
+                        _ => "H",
+                    };
+                    a.set("label", h)
+                        .set("shape", "circle")
+                        .set("fillcolor", "white")
+                        .set("fontsize", "10")
+                        .set("width", "0.3")
+                        .set("tooltip", &key[i])
+                        .style("filled");
+                }
                 StateBody::Decision => {
                     a.set("label", &s.label)
                         .set("shape", "diamond")
@@ -888,12 +902,14 @@ impl<'o> Builder<'o> {
 /// Shape and label of a BT node.
 fn bt_node_attrs(n: &BtNode) -> Attrs {
     let mut a = Attrs::default();
-    let custom = n.label != n.kind.default_label();
+    let custom = n.label != n.kind.default_label() && Some(&n.label) != n.type_name.as_ref();
+    // Ports of imported nodes (BehaviorTree.CPP), one `name=value` line each.
+    let ports: String = n.ports.iter().map(|(k, v)| format!("\n{k}={v}")).collect();
     let control = |a: &mut Attrs, symbol: String| {
         let label = if custom {
-            format!("{symbol}\n{}", n.label)
+            format!("{symbol}\n{}{ports}", n.label)
         } else {
-            symbol
+            format!("{symbol}{ports}")
         };
         a.set("label", &label)
             .set("shape", "box")
@@ -910,12 +926,17 @@ fn bt_node_attrs(n: &BtNode) -> Attrs {
         BtNodeKind::Parallel { success } => {
             control(&mut a, format!("⇉ {success}/{}", n.children.len()))
         }
+        BtNodeKind::Control => control(
+            &mut a,
+            n.type_name.clone().unwrap_or_else(|| n.label.clone()),
+        ),
         BtNodeKind::Inverter
         | BtNodeKind::ForceSuccess
         | BtNodeKind::ForceFailure
         | BtNodeKind::Repeat { .. }
         | BtNodeKind::Retry { .. }
-        | BtNodeKind::Timeout { .. } => {
+        | BtNodeKind::Timeout { .. }
+        | BtNodeKind::Decorator => {
             let param = match n.kind {
                 BtNodeKind::Repeat { times: Some(t) } | BtNodeKind::Retry { times: t } => {
                     format!("\n×{t}")
@@ -924,7 +945,7 @@ fn bt_node_attrs(n: &BtNode) -> Attrs {
                 BtNodeKind::Timeout { ms } => format!("\n{ms} ms"),
                 _ => String::new(),
             };
-            a.set("label", &format!("{}{param}", n.label))
+            a.set("label", &format!("{}{param}{ports}", n.label))
                 .set("shape", "diamond")
                 .set("fillcolor", DECISION_FILL)
                 .set("fontsize", "9")
@@ -932,13 +953,13 @@ fn bt_node_attrs(n: &BtNode) -> Attrs {
                 .style("filled");
         }
         BtNodeKind::Action => {
-            a.set("label", &n.label)
+            a.set("label", &format!("{}{ports}", n.label))
                 .set("shape", "ellipse")
                 .set("fillcolor", ACTION_FILL)
                 .style("filled");
         }
         BtNodeKind::Condition => {
-            a.set("label", &n.label)
+            a.set("label", &format!("{}{ports}", n.label))
                 .set("shape", "ellipse")
                 .set("fillcolor", "white")
                 .set("fontname", "Helvetica-Oblique")
@@ -1305,6 +1326,7 @@ root = 'go "home" now'
                     states: vec![k + 1],
                 }),
                 transitions: vec![to_success()],
+                pseudo: None,
                 span: None,
             })
             .collect();
@@ -1314,6 +1336,7 @@ root = 'go "home" now'
             parent: Some(DEPTH - 1),
             body: StateBody::Task(None),
             transitions: vec![to_success()],
+            pseudo: None,
             span: None,
         });
         let p = Policy {

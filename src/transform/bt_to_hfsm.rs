@@ -53,6 +53,8 @@ pub fn bt_to_hfsm(bt: &Bt) -> Result<StateMachine, Vec<Unsupported>> {
                     | BtNodeKind::Repeat { .. }
                     | BtNodeKind::Retry { .. }
                     | BtNodeKind::Timeout { .. }
+                    | BtNodeKind::Control
+                    | BtNodeKind::Decorator
             )
             .then(|| Unsupported {
                 id: n.id.clone(),
@@ -84,6 +86,7 @@ pub fn bt_to_hfsm(bt: &Bt) -> Result<StateMachine, Vec<Unsupported>> {
                 })
             },
             transitions: Vec::new(),
+            pseudo: None,
             span: None,
         })
         .collect();

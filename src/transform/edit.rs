@@ -156,6 +156,8 @@ pub fn insert_subtree(
             kind: n.kind,
             children: n.children.iter().map(|&c| slot[c]).collect(),
             skill: n.skill.clone(),
+            type_name: n.type_name.clone(),
+            ports: n.ports.clone(),
             span: None,
         });
     }
@@ -194,6 +196,8 @@ pub fn wrap_root(
         kind,
         children: vec![bt.root],
         skill: None,
+        type_name: None,
+        ports: Default::default(),
         span: None,
     });
     bt.root = bt.nodes.len() - 1;
@@ -362,6 +366,7 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
         parent: None,
         body: StateBody::Task(Some(spec.skill.clone())),
         transitions: Vec::new(),
+        pseudo: None,
         span: None,
     };
     let mut touched = Touched {

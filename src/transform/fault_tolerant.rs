@@ -241,6 +241,7 @@ pub fn fault_tolerant(m: &StateMachine) -> Result<StateMachine, Vec<FaultToleran
                 parent: None,
                 body: StateBody::Decision,
                 transitions: Vec::new(),
+                pseudo: None,
                 span: None,
             });
             let idx = out.states.len() - 1;

@@ -1,4 +1,4 @@
-//! Helpers shared by the integration-test binaries.
+//! Helpers shared by the modules of the integration-test binary.
 
 use std::process::Command;
 

@@ -1,0 +1,108 @@
+//! Simulator benchmark (issue 5): ticks per second of the 80-node five-cube BT
+//! of Fig. 16a against a frozen world (the same leaf answers as
+//! bench/py_trees_tick.py gives py_trees), steps per second of the full
+//! simulation of exp4-five-cubes, and the time of 1,000 Monte Carlo episodes of
+//! it on all cores. Run with `bench/sim_vs_py_trees.sh` to get the py_trees
+//! figure and the ratio in the same run, or `cargo bench --bench sim`.
+
+use btfsm::format::{Limits, load};
+use btfsm::model::PolicyBody;
+use btfsm::sim::exec::{BtExec, CompiledBt, Leaves};
+use btfsm::sim::run::{monte_carlo, run_scenario};
+use btfsm::sim::scenario;
+use btfsm::sim::skills::{Call, Status, condition, resolve};
+use btfsm::sim::world::{Place, World};
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Conditions evaluated against a world that does not change; every action
+/// returns RUNNING (as the py_trees dummies do).
+struct Frozen(World);
+
+impl Leaves for Frozen {
+    fn condition(&mut self, call: &Call) -> bool {
+        condition(call, &self.0)
+    }
+    fn action(&mut self, _key: usize, _call: &Call) -> Status {
+        Status::Running
+    }
+    fn now(&self) -> f64 {
+        0.0
+    }
+}
+
+fn main() {
+    let limits = Limits::default();
+    let s = scenario::load(
+        Path::new("policies/scenarios/exp4-five-cubes.toml"),
+        &limits,
+    )
+    .expect("scenario");
+    let l = load(Path::new("policies/paper/fig16a-bt.toml"), &limits).expect("policy");
+    let PolicyBody::Bt(bt) = &l.policy.body else {
+        panic!("fig16a is a BT")
+    };
+    // Mid-task: cubes 1 and 2 delivered, cube3 in the gripper, robot away
+    // from the delivery station; the tick visits 19 of the 80 nodes.
+    let mut w = s.world.clone();
+    let delivery = w.layout.station("delivery").expect("delivery");
+    for o in &mut w.objects {
+        o.found = true;
+    }
+    w.objects[0].place = Place::At(delivery);
+    w.objects[1].place = Place::At(delivery);
+    w.objects[2].place = Place::Held;
+    let calls = bt
+        .nodes
+        .iter()
+        .map(|n| n.skill.as_ref().and_then(|c| resolve(c, &w).ok()))
+        .collect();
+    let compiled = Arc::new(CompiledBt::new(bt, calls));
+    let mut ex = BtExec::new(compiled, false);
+    let mut leaves = Frozen(w);
+    // Best of 5 rounds (the machine is shared; py_trees gets the same rule).
+    let n: u64 = std::env::var("BTFSM_BENCH_TICKS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1_000_000);
+    let mut dt = f64::INFINITY;
+    for _ in 0..5 {
+        let t0 = Instant::now();
+        let mut running = 0u64;
+        for _ in 0..n {
+            if ex.tick(&mut leaves) == Status::Running {
+                running += 1;
+            }
+        }
+        dt = dt.min(t0.elapsed().as_secs_f64());
+        assert_eq!(running, n);
+    }
+    println!("btfsm_bt_ticks_per_s {:.0}", n as f64 / dt);
+    if std::env::var_os("BTFSM_BENCH_TICKS_ONLY").is_some() {
+        return;
+    }
+
+    let t0 = Instant::now();
+    let mut steps = 0u64;
+    for _ in 0..20 {
+        steps += run_scenario(&s, false).iter().map(|r| r.steps).sum::<u64>();
+    }
+    let dt = t0.elapsed().as_secs_f64();
+    println!("btfsm_sim_steps_per_s {:.0}", steps as f64 / dt);
+
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let t0 = Instant::now();
+    let stats = monte_carlo(&s, 1000, 7, threads);
+    let dt = t0.elapsed().as_secs_f64();
+    println!(
+        "btfsm_monte_carlo_1000_episodes_s {dt:.2} ({} policies, {threads} threads)",
+        stats.len()
+    );
+    for st in stats {
+        println!(
+            "  {}: success rate {:.3}, mean completion {:?} s",
+            st.policy, st.success_rate, st.mean_completion_s
+        );
+    }
+}

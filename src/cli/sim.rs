@@ -1,0 +1,192 @@
+//! `btfsm sim`: runs the policies of a scenario in the planar simulator and
+//! prints outcomes, executed skills, final worlds and behavior-match verdicts
+//! (SPEC §6, §7); `--runs N` runs seeded Monte Carlo episodes instead.
+
+use super::commands::{emit, print_diagnostics};
+use super::{EXIT_BAD_INPUT, EXIT_OK};
+use crate::report::OutputFormat;
+use crate::sim::report::{McReport, SimReport};
+use crate::sim::{plot, run, scenario};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct SimArgs {
+    /// Scenario file (TOML)
+    pub scenario: PathBuf,
+    /// Output format (table or json)
+    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+    pub format: OutputFormat,
+    /// Write the full trace (every step of every run) as JSON
+    #[arg(long, value_name = "OUT.json")]
+    pub trace: Option<PathBuf>,
+    /// Draw the room and each policy's trajectory as SVG
+    #[arg(long, value_name = "OUT.svg")]
+    pub plot: Option<PathBuf>,
+    /// Run N seeded episodes with randomized disturbances and failure rates
+    #[arg(long, value_name = "N")]
+    pub runs: Option<u32>,
+    /// Seed of the episodes (default: the scenario's seed)
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+    /// Worker threads for --runs (default: the number of cores)
+    #[arg(long)]
+    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+pub fn execute(a: SimArgs) -> u8 {
+    if a.format == OutputFormat::Csv {
+        eprintln!("error: `sim` prints `table` or `json`, not `csv`");
+        return EXIT_BAD_INPUT;
+    }
+    let mut s = match scenario::load(&a.scenario, &a.limits.limits()) {
+        Ok(s) => s,
+        Err(d) => {
+            print_diagnostics(&mut std::io::stderr().lock(), &d);
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let file = a.scenario.display().to_string();
+    if let Some(n) = a.runs {
+        if a.trace.is_some() || a.plot.is_some() {
+            eprintln!("error: --trace and --plot record one run; leave them out with --runs");
+            return EXIT_BAD_INPUT;
+        }
+        let seed = a.seed.unwrap_or(s.seed);
+        let threads = a
+            .threads
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+        let t0 = std::time::Instant::now();
+        let stats = run::monte_carlo(&s, n, seed, threads);
+        let rep = McReport {
+            scenario: s.name.clone(),
+            seed,
+            runs: n,
+            threads: threads.max(1).min(n.max(1) as usize),
+            millis: t0.elapsed().as_millis(),
+            policies: stats,
+        };
+        let text = match a.format {
+            OutputFormat::Json => rep.json(),
+            _ => rep.table(),
+        };
+        return emit(None, text.as_bytes());
+    }
+    if let Some(seed) = a.seed {
+        s.seed = seed;
+    }
+    let runs = run::run_scenario(&s, a.trace.is_some());
+    let rep = SimReport::new(&s.name, &file, s.seed, s.dt, runs);
+    if let Some(p) = &a.trace
+        && emit(Some(p), rep.trace_json().as_bytes()) != EXIT_OK
+    {
+        return EXIT_BAD_INPUT;
+    }
+    if let Some(p) = &a.plot
+        && emit(Some(p), plot::svg(&s, &rep.policies).as_bytes()) != EXIT_OK
+    {
+        return EXIT_BAD_INPUT;
+    }
+    let text = match a.format {
+        OutputFormat::Json => rep.json(),
+        _ => rep.table(),
+    };
+    emit(None, text.as_bytes())
+}
+
+/// `btfsm dot FILE --trace TRACE.json --step K [--policy NAME]`.
+#[derive(Debug, Clone, Args)]
+pub struct DotTraceArgs {
+    /// A trace written by `btfsm sim --trace`
+    #[arg(long, value_name = "TRACE.json", requires = "step")]
+    pub trace: Option<PathBuf>,
+    /// Step of the trace to show (0 is the first step)
+    #[arg(long, value_name = "K", requires = "trace")]
+    pub step: Option<usize>,
+    /// Which policy of the trace (default: the one run from FILE, unconverted)
+    #[arg(long, value_name = "NAME", requires = "trace")]
+    pub policy: Option<String>,
+}
+
+/// The policy to draw and its highlights: with `--trace`, every node or state
+/// ticked at step K coloured by its status (RUNNING yellow, SUCCESS green,
+/// FAILURE red); a trace of a converted HFSM converts FILE the same way.
+/// `None` after printing an error.
+pub fn dot_trace(
+    a: &DotTraceArgs,
+    file: &std::path::Path,
+    policy: crate::model::Policy,
+) -> Option<(crate::model::Policy, crate::render::dot::DotOptions)> {
+    use crate::render::dot::{Highlight, Status};
+    let (Some(trace), Some(step)) = (&a.trace, a.step) else {
+        return Some((policy, Default::default()));
+    };
+    let fail = |m: String| {
+        eprintln!("error: {m}");
+        None
+    };
+    let text = match std::fs::read_to_string(trace) {
+        Ok(t) => t,
+        Err(e) => return fail(format!("cannot read `{}`: {e}", trace.display())),
+    };
+    let v: serde_json::Value = match serde_json::from_str(&text) {
+        Ok(v) => v,
+        Err(e) => {
+            return fail(format!(
+                "`{}` is not a trace written by `btfsm sim --trace`: {e}",
+                trace.display()
+            ));
+        }
+    };
+    let empty = Vec::new();
+    let runs = v["policies"].as_array().unwrap_or(&empty);
+    let canon = |p: &str| std::fs::canonicalize(p).ok();
+    let me = std::fs::canonicalize(file).ok();
+    let run = match &a.policy {
+        Some(name) => runs.iter().find(|r| r["policy"] == name.as_str()),
+        None => runs
+            .iter()
+            .find(|r| r["convert"].is_null() && canon(r["file"].as_str().unwrap_or("")) == me)
+            .or_else(|| {
+                runs.iter()
+                    .find(|r| canon(r["file"].as_str().unwrap_or("")) == me)
+            }),
+    };
+    let Some(run) = run else {
+        let names: Vec<&str> = runs.iter().filter_map(|r| r["policy"].as_str()).collect();
+        return fail(format!(
+            "no policy of `{}` in the trace `{}`\n  = hint: choose one with --policy: {}",
+            file.display(),
+            trace.display(),
+            names.join(", ")
+        ));
+    };
+    let steps = run["trace"].as_array().unwrap_or(&empty);
+    let Some(st) = steps.get(step) else {
+        return fail(format!(
+            "step {step} is past the end of the trace of `{}` ({} steps, 0 to {})",
+            run["policy"].as_str().unwrap_or(""),
+            steps.len(),
+            steps.len().saturating_sub(1)
+        ));
+    };
+    let policy = if run["convert"] == "hfsm" {
+        match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
+            Ok(p) => p,
+            Err(e) => return fail(e[0].to_string()),
+        }
+    } else {
+        policy
+    };
+    let mut opts = crate::render::dot::DotOptions::default();
+    for pair in st["statuses"].as_array().unwrap_or(&empty) {
+        if let (Some(k), Some(s)) = (pair[0].as_str(), pair[1].as_str())
+            && let Some(s) = Status::from_outcome(s)
+        {
+            opts.highlight.insert(k.to_string(), Highlight::Status(s));
+        }
+    }
+    Some((policy, opts))
+}

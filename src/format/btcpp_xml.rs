@@ -1,0 +1,1180 @@
+//! BehaviorTree.CPP XML (formats 3 and 4, as documented at behaviortree.dev and
+//! used by Nav2 and Groot2) read into the BT model.
+//!
+//! - `<root>` holds `<BehaviorTree ID>` definitions, `<include path>` (relative to
+//!   the including file; cycles rejected) and `<TreeNodesModel>`; the tree run is
+//!   `main_tree_to_execute`, or the only tree of the main file.
+//! - Nodes in compact (`<Sequence>`) or explicit (`<Action ID="...">`) syntax.
+//!   `<SubTree ID>` (and format 3's `<SubTreePlus>`) is expanded in place: the
+//!   subtree's root takes the SubTree element's place, as TOML subtree includes
+//!   do, so counts are those of the expanded tree; recursion is rejected.
+//! - Built-in types map onto the model (see [`BUILTINS`] and the README table);
+//!   other types are resolved through a `<TreeNodesModel>` (in the files read or
+//!   given with `--nodes-model`), or `--assume-leaf` decides for leaves.
+//! - Node identity (for `named` GED): a `btfsm:id` attribute when present (written
+//!   by `btfsm convert`), else the `name` attribute when no other node of the
+//!   expanded tree has that name, else the parent's identity and the child's
+//!   position (`Parent/2`); the root without a name takes the tree's ID.
+//!
+//! The expansion walks an explicit stack (no recursion on input depth).
+
+use super::xml::{self, XDoc, XElem};
+use super::{AssumeLeaf, Limits, Loaded};
+use crate::diagnostic::{Diagnostic, SourceFile, suggest};
+use crate::model::skill::{self, ArgValue, SkillCall, SkillKind};
+use crate::model::{Bt, BtNode, BtNodeKind, Policy, PolicyBody};
+use std::collections::{BTreeMap, HashMap, HashSet};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// What a node type is, as a `<TreeNodesModel>` says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Category {
+    Action,
+    Condition,
+    Control,
+    Decorator,
+}
+
+impl Category {
+    pub fn tag(self) -> &'static str {
+        match self {
+            Category::Action => "Action",
+            Category::Condition => "Condition",
+            Category::Control => "Control",
+            Category::Decorator => "Decorator",
+        }
+    }
+}
+
+/// BehaviorTree.CPP's built-in node types (formats 3 and 4) and their category.
+/// How each maps onto the model is [`builtin_kind`].
+pub const BUILTINS: &[(&str, Category)] = &[
+    ("Sequence", Category::Control),
+    ("ReactiveSequence", Category::Control),
+    ("SequenceWithMemory", Category::Control),
+    ("SequenceStar", Category::Control),
+    ("AsyncSequence", Category::Control),
+    ("Fallback", Category::Control),
+    ("ReactiveFallback", Category::Control),
+    ("AsyncFallback", Category::Control),
+    ("Parallel", Category::Control),
+    ("ParallelAll", Category::Control),
+    ("IfThenElse", Category::Control),
+    ("WhileDoElse", Category::Control),
+    ("Switch2", Category::Control),
+    ("Switch3", Category::Control),
+    ("Switch4", Category::Control),
+    ("Switch5", Category::Control),
+    ("Switch6", Category::Control),
+    ("ManualSelector", Category::Control),
+    ("TryCatch", Category::Control),
+    ("Inverter", Category::Decorator),
+    ("ForceSuccess", Category::Decorator),
+    ("ForceFailure", Category::Decorator),
+    ("RetryUntilSuccessful", Category::Decorator),
+    ("RetryUntilSuccesful", Category::Decorator),
+    ("Repeat", Category::Decorator),
+    ("Timeout", Category::Decorator),
+    ("Delay", Category::Decorator),
+    ("KeepRunningUntilFailure", Category::Decorator),
+    ("RunOnce", Category::Decorator),
+    ("Precondition", Category::Decorator),
+    ("LoopInt", Category::Decorator),
+    ("LoopDouble", Category::Decorator),
+    ("LoopString", Category::Decorator),
+    ("LoopBool", Category::Decorator),
+    ("EntryUpdated", Category::Decorator),
+    ("SkipUnlessUpdated", Category::Decorator),
+    ("WaitValueUpdated", Category::Decorator),
+    ("BlackboardCheckInt", Category::Decorator),
+    ("BlackboardCheckDouble", Category::Decorator),
+    ("BlackboardCheckString", Category::Decorator),
+    ("BlackboardCheckBool", Category::Decorator),
+    ("AlwaysSuccess", Category::Action),
+    ("AlwaysFailure", Category::Action),
+    ("Script", Category::Action),
+    ("SetBlackboard", Category::Action),
+    ("UnsetBlackboard", Category::Action),
+    ("Sleep", Category::Action),
+    ("ScriptCondition", Category::Condition),
+    ("WasEntryUpdated", Category::Condition),
+];
+
+/// The category of a built-in type.
+pub fn builtin(name: &str) -> Option<Category> {
+    BUILTINS.iter().find(|(n, _)| *n == name).map(|(_, c)| *c)
+}
+
+/// The model kind of a built-in type with `n` children, the attributes that the
+/// kind carries (not kept as ports), and whether the type name must be kept
+/// (it is not the one [`canonical_type`] gives the kind).
+pub fn builtin_kind(
+    name: &str,
+    e: &XElem,
+    n: usize,
+) -> (BtNodeKind, &'static [&'static str], bool) {
+    let int = |a: &str| e.attr(a).and_then(|v| v.trim().parse::<i64>().ok());
+    match name {
+        "Sequence" => (BtNodeKind::SequenceMemory, &[], false),
+        "ReactiveSequence" => (BtNodeKind::Sequence, &[], false),
+        "SequenceWithMemory" | "SequenceStar" | "AsyncSequence" => {
+            (BtNodeKind::SequenceMemory, &[], true)
+        }
+        "Fallback" => (BtNodeKind::FallbackMemory, &[], false),
+        "ReactiveFallback" => (BtNodeKind::Fallback, &[], false),
+        "AsyncFallback" => (BtNodeKind::FallbackMemory, &[], true),
+        "Parallel" => {
+            // Format 4: success_count (negative: counted from the number of
+            // children, -1 = all); format 3: success_threshold / threshold.
+            let (attr, v) = ["success_count", "success_threshold", "threshold"]
+                .iter()
+                .find_map(|a| e.attr(a).map(|_| (*a, int(a))))
+                .unwrap_or(("", Some(-1)));
+            match v {
+                Some(c) => {
+                    let nn = n as i64;
+                    let s = if c < 0 { nn + c + 1 } else { c };
+                    let success = s.clamp(1, nn.max(1)) as usize;
+                    let keep = attr != "success_count";
+                    let consumed: &'static [&'static str] = match attr {
+                        "success_count" => &["success_count"],
+                        "success_threshold" => &["success_threshold"],
+                        "threshold" => &["threshold"],
+                        _ => &[],
+                    };
+                    (BtNodeKind::Parallel { success }, consumed, keep)
+                }
+                None => (BtNodeKind::Control, &[], true),
+            }
+        }
+        "ParallelAll" => (BtNodeKind::Parallel { success: n.max(1) }, &[], true),
+        "Inverter" => (BtNodeKind::Inverter, &[], false),
+        "ForceSuccess" => (BtNodeKind::ForceSuccess, &[], false),
+        "ForceFailure" => (BtNodeKind::ForceFailure, &[], false),
+        "RetryUntilSuccessful" | "RetryUntilSuccesful" => match int("num_attempts") {
+            Some(t) if t >= 0 => (
+                BtNodeKind::Retry {
+                    times: t.min(u32::MAX as i64) as u32,
+                },
+                &["num_attempts"],
+                name != "RetryUntilSuccessful",
+            ),
+            _ => (BtNodeKind::Decorator, &[], true),
+        },
+        "Repeat" => match int("num_cycles") {
+            Some(t) if t >= 0 => (
+                BtNodeKind::Repeat {
+                    times: Some(t.min(u32::MAX as i64) as u32),
+                },
+                &["num_cycles"],
+                false,
+            ),
+            Some(-1) => (BtNodeKind::Repeat { times: None }, &["num_cycles"], false),
+            _ => (BtNodeKind::Decorator, &[], true),
+        },
+        "Timeout" => match int("msec") {
+            Some(ms) if ms >= 0 => (BtNodeKind::Timeout { ms: ms as u64 }, &["msec"], false),
+            _ => (BtNodeKind::Decorator, &[], true),
+        },
+        _ => match builtin(name) {
+            Some(Category::Control) => (BtNodeKind::Control, &[], true),
+            Some(Category::Decorator) => (BtNodeKind::Decorator, &[], true),
+            Some(Category::Condition) => (BtNodeKind::Condition, &[], true),
+            _ => (BtNodeKind::Action, &[], true),
+        },
+    }
+}
+
+/// The BehaviorTree.CPP type written for a model kind that carries no type name.
+pub fn canonical_type(kind: BtNodeKind) -> Option<&'static str> {
+    Some(match kind {
+        BtNodeKind::Sequence => "ReactiveSequence",
+        BtNodeKind::Fallback => "ReactiveFallback",
+        BtNodeKind::SequenceMemory => "Sequence",
+        BtNodeKind::FallbackMemory => "Fallback",
+        BtNodeKind::Parallel { .. } => "Parallel",
+        BtNodeKind::Inverter => "Inverter",
+        BtNodeKind::ForceSuccess => "ForceSuccess",
+        BtNodeKind::ForceFailure => "ForceFailure",
+        BtNodeKind::Repeat { .. } => "Repeat",
+        BtNodeKind::Retry { .. } => "RetryUntilSuccessful",
+        BtNodeKind::Timeout { .. } => "Timeout",
+        _ => return None,
+    })
+}
+
+/// Reads a BehaviorTree.CPP XML file (with its includes).
+pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    let file = super::toml::read_source(path, &shown, limits)?;
+    let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    load(file, super::toml::canonical(path), base, limits)
+}
+
+/// Reads BehaviorTree.CPP XML from text; includes resolve against `base`.
+pub fn parse_str(
+    name: &str,
+    text: &str,
+    base: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let file = SourceFile::new(name, text);
+    load(file, PathBuf::from(name), base.to_path_buf(), limits)
+}
+
+/// A type declared in a `<TreeNodesModel>`.
+#[derive(Debug, Clone)]
+struct ModelEntry {
+    cat: Category,
+}
+
+struct Loader<'l> {
+    limits: &'l Limits,
+    diags: Vec<Diagnostic>,
+    docs: Vec<XDoc>,
+    dirs: Vec<PathBuf>,
+    /// Tree ID -> (document, `<BehaviorTree>` element).
+    trees: BTreeMap<String, (usize, usize)>,
+    models: BTreeMap<String, ModelEntry>,
+}
+
+fn load(
+    file: Arc<SourceFile>,
+    identity: PathBuf,
+    base: PathBuf,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let main = xml::parse(&file).map_err(|d| vec![d])?;
+    let mut l = Loader {
+        limits,
+        diags: Vec::new(),
+        docs: vec![main],
+        dirs: vec![base],
+        trees: BTreeMap::new(),
+        models: BTreeMap::new(),
+    };
+    let policy = l.run(identity);
+    super::finish(&file, policy, l.diags, "behavior tree")
+}
+
+impl Loader<'_> {
+    fn err(&mut self, d: usize, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
+        let f = self.docs[d].file.clone();
+        self.diags.push(Diagnostic::error(msg).at(&f, span));
+        self.diags.last_mut().expect("just pushed")
+    }
+
+    fn warn(&mut self, d: usize, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
+        let f = self.docs[d].file.clone();
+        self.diags.push(Diagnostic::warning(msg).at(&f, span));
+        self.diags.last_mut().expect("just pushed")
+    }
+
+    fn run(&mut self, identity: PathBuf) -> Option<Policy> {
+        let root = self.docs[0].root;
+        if self.docs[0].elems[root].name != "root" {
+            let span = self.docs[0].elems[root].span.clone();
+            let found = self.docs[0].elems[root].name.clone();
+            self.err(
+                0,
+                span,
+                format!("expected `<root>` as the document element, found `<{found}>`"),
+            )
+            .hint = Some(
+                "a BehaviorTree.CPP file is `<root BTCPP_format=\"4\"><BehaviorTree ID=\"...\">...</BehaviorTree></root>`"
+                    .into(),
+            );
+            return None;
+        }
+        self.includes(identity);
+        let extra = self.limits.nodes_models.clone();
+        for m in &extra {
+            self.nodes_model_file(m);
+        }
+        for d in 0..self.docs.len() {
+            self.definitions(d);
+        }
+        if self.diags.iter().any(Diagnostic::is_error) {
+            return None;
+        }
+        let (tree_id, (d, e)) = self.main_tree()?;
+        let bt = self.expand(&tree_id, d, e)?;
+        Some(Policy {
+            name: tree_id,
+            description: None,
+            body: PolicyBody::Bt(bt),
+        })
+    }
+
+    /// Loads `<include path>` files depth-first with an explicit stack; a file
+    /// including one of its includers is a cycle.
+    fn includes(&mut self, identity: PathBuf) {
+        let mut chain: Vec<PathBuf> = vec![identity];
+        // The same chain as the user sees the paths (canonical ones differ by machine).
+        let mut shown_chain: Vec<String> = vec![self.docs[0].file.path.clone()];
+        let mut loaded: HashSet<PathBuf> = chain.iter().cloned().collect();
+        let mut work: Vec<(usize, usize)> = vec![(0, 0)];
+        while let Some(&mut (d, ref mut pos)) = work.last_mut() {
+            let root = self.docs[d].root;
+            let kids = &self.docs[d].elems[root].children;
+            if *pos >= kids.len() {
+                work.pop();
+                chain.pop();
+                shown_chain.pop();
+                continue;
+            }
+            let e = kids[*pos];
+            *pos += 1;
+            let el = self.docs[d].elems[e].clone();
+            if el.name != "include" {
+                continue;
+            }
+            if el.attr("ros_pkg").is_some() {
+                self.err(
+                    d,
+                    el.span.clone(),
+                    "includes from ROS packages (`ros_pkg`) are not supported",
+                )
+                .hint = Some("give `path` relative to this file".into());
+                continue;
+            }
+            let Some(p) = el.attr_full("path") else {
+                self.err(d, el.span.clone(), "`<include>` needs a `path`")
+                    .hint = Some("write `<include path=\"subtrees/other.xml\"/>`".into());
+                continue;
+            };
+            let (pval, pspan) = (p.value.clone(), p.span.clone());
+            let full = self.dirs[d].join(&pval);
+            let canon = super::toml::canonical(&full);
+            if let Some(at) = chain.iter().position(|c| *c == canon) {
+                let mut names: Vec<String> = shown_chain[at..].to_vec();
+                names.push(full.display().to_string());
+                self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
+                    .hint =
+                    Some("a file must not include itself, directly or through others".into());
+                continue;
+            }
+            if loaded.contains(&canon) {
+                continue; // already read through another include
+            }
+            if chain.len() > self.limits.max_include_depth {
+                self.err(
+                    d,
+                    pspan,
+                    format!(
+                        "includes nested deeper than {}",
+                        self.limits.max_include_depth
+                    ),
+                );
+                continue;
+            }
+            let shown = full.display().to_string();
+            let file = match super::toml::read_included(&full, &shown, self.limits) {
+                Ok(f) => f,
+                Err(mut ds) => {
+                    let msg = ds.remove(0).message;
+                    self.err(d, pspan, msg).hint =
+                        Some("`path` is relative to the including file".into());
+                    continue;
+                }
+            };
+            let doc = match xml::parse(&file) {
+                Ok(doc) => doc,
+                Err(diag) => {
+                    self.diags.push(diag);
+                    continue;
+                }
+            };
+            if doc.elems[doc.root].name != "root" {
+                let span = doc.elems[doc.root].span.clone();
+                self.docs.push(doc);
+                let nd = self.docs.len() - 1;
+                self.err(
+                    nd,
+                    span,
+                    "expected `<root>` as the document element of an included file",
+                );
+                self.docs.pop();
+                continue;
+            }
+            loaded.insert(canon.clone());
+            self.docs.push(doc);
+            self.dirs
+                .push(full.parent().unwrap_or(Path::new("")).to_path_buf());
+            chain.push(canon);
+            shown_chain.push(shown);
+            work.push((self.docs.len() - 1, 0));
+        }
+    }
+
+    /// Reads a `--nodes-model` file: a `<root>` holding a `<TreeNodesModel>`, or a
+    /// bare `<TreeNodesModel>`.
+    fn nodes_model_file(&mut self, path: &Path) {
+        let shown = path.display().to_string();
+        let file = match super::toml::read_source(path, &shown, self.limits) {
+            Ok(f) => f,
+            Err(ds) => {
+                self.diags.extend(ds);
+                return;
+            }
+        };
+        let doc = match xml::parse(&file) {
+            Ok(doc) => doc,
+            Err(d) => {
+                self.diags.push(d);
+                return;
+            }
+        };
+        let root = doc.root;
+        let models: Vec<usize> = if doc.elems[root].name == "TreeNodesModel" {
+            vec![root]
+        } else {
+            doc.children(root)
+                .filter(|(_, e)| e.name == "TreeNodesModel")
+                .map(|(i, _)| i)
+                .collect()
+        };
+        self.docs.push(doc);
+        let d = self.docs.len() - 1;
+        self.dirs.push(PathBuf::new());
+        if models.is_empty() {
+            self.err(d, self.docs[d].elems[root].span.clone(), "no `<TreeNodesModel>` in this file")
+                .hint = Some("a nodes model is `<root><TreeNodesModel><Action ID=\"...\"/>...</TreeNodesModel></root>`".into());
+        }
+        for m in models {
+            self.read_model(d, m);
+        }
+    }
+
+    fn read_model(&mut self, d: usize, m: usize) {
+        let kids = self.docs[d].elems[m].children.clone();
+        for k in kids {
+            let el = self.docs[d].elems[k].clone();
+            let cat = match el.name.as_str() {
+                "Action" => Category::Action,
+                "Condition" => Category::Condition,
+                "Control" => Category::Control,
+                "Decorator" => Category::Decorator,
+                "SubTree" => continue,
+                other => {
+                    let h = suggest(
+                        other,
+                        ["Action", "Condition", "Control", "Decorator", "SubTree"],
+                    );
+                    self.err(
+                        d,
+                        el.span.clone(),
+                        format!("unknown entry `<{other}>` in `<TreeNodesModel>`"),
+                    )
+                    .hint = Some(h);
+                    continue;
+                }
+            };
+            let Some(id) = el.attr("ID") else {
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!("`<{}>` in `<TreeNodesModel>` needs an `ID`", el.name),
+                );
+                continue;
+            };
+            if let Some(b) = builtin(id)
+                && b != cat
+            {
+                self.warn(
+                    d,
+                    el.span.clone(),
+                    format!(
+                        "`{id}` is a built-in {} type; the model's `{}` is ignored",
+                        b.tag().to_lowercase(),
+                        cat.tag()
+                    ),
+                );
+                continue;
+            }
+            if let Some(prev) = self.models.get(id)
+                && prev.cat != cat
+            {
+                let was = prev.cat.tag();
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!("`{id}` is declared both as `{was}` and as `{}`", cat.tag()),
+                )
+                .hint = Some("keep one declaration per node type across the model files".into());
+                continue;
+            }
+            self.models.insert(id.to_string(), ModelEntry { cat });
+        }
+    }
+
+    /// Collects `<BehaviorTree>` definitions and `<TreeNodesModel>` entries.
+    fn definitions(&mut self, d: usize) {
+        let root = self.docs[d].root;
+        if self.docs[d].elems[root].name != "root" {
+            return; // a bare nodes-model file
+        }
+        if let Some(v) = self.docs[d].elems[root].attr_full("BTCPP_format")
+            && v.value != "3"
+            && v.value != "4"
+        {
+            let span = v.span.clone();
+            let val = v.value.clone();
+            self.warn(
+                d,
+                span,
+                format!("unknown `BTCPP_format` \"{val}\"; read as format 4"),
+            )
+            .hint = Some("BehaviorTree.CPP writes `BTCPP_format=\"4\"` (or \"3\")".into());
+        }
+        let kids = self.docs[d].elems[root].children.clone();
+        for k in kids {
+            let el = self.docs[d].elems[k].clone();
+            match el.name.as_str() {
+                "BehaviorTree" => {
+                    let id = el.attr("ID").unwrap_or("MainTree").to_string();
+                    if let Some(&(pd, pe)) = self.trees.get(&id) {
+                        let (l, c) = {
+                            let f = &self.docs[pd].file;
+                            f.line_col(self.docs[pd].elems[pe].span.start)
+                        };
+                        let first = format!("{}:{l}:{c}", self.docs[pd].file.path);
+                        self.err(d, el.span.clone(), format!("tree `{id}` is defined twice"))
+                            .hint = Some(format!(
+                            "the first definition is at {first}; give each `<BehaviorTree>` its own `ID`"
+                        ));
+                        continue;
+                    }
+                    let n = el.children.len();
+                    if n != 1 {
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            format!("tree `{id}` must hold exactly one root node, found {n}"),
+                        )
+                        .hint = Some("wrap several nodes in a `<Sequence>` or `<Fallback>`".into());
+                        continue;
+                    }
+                    self.trees.insert(id, (d, k));
+                }
+                "TreeNodesModel" => self.read_model(d, k),
+                "include" => {}
+                other => {
+                    let h = suggest(other, ["BehaviorTree", "TreeNodesModel", "include"]);
+                    self.warn(
+                        d,
+                        el.span.clone(),
+                        format!("`<{other}>` under `<root>` is ignored"),
+                    )
+                    .hint = Some(h);
+                }
+            }
+        }
+    }
+
+    /// The tree to run: `main_tree_to_execute`, or the only tree of the main file.
+    fn main_tree(&mut self) -> Option<(String, (usize, usize))> {
+        let root = self.docs[0].root;
+        let all: Vec<String> = self.trees.keys().cloned().collect();
+        if let Some(a) = self.docs[0].elems[root].attr_full("main_tree_to_execute") {
+            let (v, span) = (a.value.clone(), a.span.clone());
+            return match self.trees.get(&v) {
+                Some(&t) => Some((v, t)),
+                None => {
+                    let h = suggest(&v, all.iter().map(String::as_str));
+                    self.err(
+                        0,
+                        span,
+                        format!("`main_tree_to_execute` names unknown tree `{v}`"),
+                    )
+                    .hint = Some(h);
+                    None
+                }
+            };
+        }
+        let local: Vec<(&String, &(usize, usize))> =
+            self.trees.iter().filter(|(_, (d, _))| *d == 0).collect();
+        match local.as_slice() {
+            [(id, t)] => Some(((*id).clone(), **t)),
+            [] if self.trees.len() == 1 => {
+                let (id, t) = self.trees.iter().next().expect("one tree");
+                Some((id.clone(), *t))
+            }
+            [] => {
+                let span = self.docs[0].elems[root].span.clone();
+                self.err(0, span, "no `<BehaviorTree>` in this file").hint = Some(
+                    "add `<BehaviorTree ID=\"Main\">...</BehaviorTree>` under `<root>`".into(),
+                );
+                None
+            }
+            many => {
+                let ids: Vec<String> = many.iter().map(|(id, _)| format!("`{id}`")).collect();
+                let span = self.docs[0].elems[root].span.clone();
+                self.err(
+                    0,
+                    span,
+                    format!("{} trees and no `main_tree_to_execute`", many.len()),
+                )
+                .hint = Some(format!(
+                    "add `main_tree_to_execute` with one of {}",
+                    ids.join(", ")
+                ));
+                None
+            }
+        }
+    }
+
+    /// Expands the tree from its root element into the arena (pre-order, explicit
+    /// stack), resolving every node's type and expanding SubTrees.
+    fn expand(&mut self, tree_id: &str, d0: usize, e0: usize) -> Option<Bt> {
+        struct Item {
+            d: usize,
+            e: usize,
+            parent: Option<usize>,
+            /// Index into `frames`: the SubTree expansion this element is in.
+            frame: usize,
+            /// `name` of the SubTree element this root replaces.
+            name_override: Option<String>,
+        }
+        // (tree ID, parent frame)
+        let mut frames: Vec<(String, Option<usize>)> = vec![(tree_id.to_string(), None)];
+        let root_el = self.docs[d0].elems[e0].children[0];
+        let mut stack = vec![Item {
+            d: d0,
+            e: root_el,
+            parent: None,
+            frame: 0,
+            name_override: None,
+        }];
+        let mut nodes: Vec<BtNode> = Vec::new();
+        let mut names: Vec<Option<String>> = Vec::new();
+        let mut explicit: Vec<Option<String>> = Vec::new();
+        let mut failed = false;
+        let mut budget = self.limits.max_nodes;
+        while let Some(it) = stack.pop() {
+            let el = self.docs[it.d].elems[it.e].clone();
+            let tag = el.name.as_str();
+            // SubTree: the referenced tree's root takes this element's place.
+            if tag == "SubTree" || tag == "SubTreePlus" {
+                let Some(id) = el.attr("ID").map(str::to_string) else {
+                    self.err(it.d, el.span.clone(), "`<SubTree>` needs an `ID`");
+                    failed = true;
+                    continue;
+                };
+                let Some(&(sd, se)) = self.trees.get(&id) else {
+                    let h = suggest(&id, self.trees.keys().map(String::as_str));
+                    self.err(
+                        it.d,
+                        el.span.clone(),
+                        format!("unknown tree `{id}` in `<SubTree>`"),
+                    )
+                    .hint = Some(h);
+                    failed = true;
+                    continue;
+                };
+                let mut chain = vec![];
+                let mut f = Some(it.frame);
+                let mut recursive = false;
+                while let Some(fi) = f {
+                    chain.push(frames[fi].0.clone());
+                    if frames[fi].0 == id {
+                        recursive = true;
+                    }
+                    f = frames[fi].1;
+                }
+                if recursive {
+                    chain.reverse();
+                    chain.push(id.clone());
+                    self.err(it.d, el.span.clone(), format!("recursive subtree: {}", chain.join(" -> ")))
+                        .hint = Some("a tree must not contain itself as a `<SubTree>`, directly or through others".into());
+                    failed = true;
+                    continue;
+                }
+                frames.push((id, Some(it.frame)));
+                let child = self.docs[sd].elems[se].children[0];
+                stack.push(Item {
+                    d: sd,
+                    e: child,
+                    parent: it.parent,
+                    frame: frames.len() - 1,
+                    name_override: el.attr("name").map(str::to_string).or(it.name_override),
+                });
+                continue;
+            }
+            if budget == 0 {
+                self.err(
+                    it.d,
+                    el.span.clone(),
+                    format!("more than {} nodes", self.limits.max_nodes),
+                )
+                .hint = Some("raise the limit with --max-nodes".into());
+                return None;
+            }
+            budget -= 1;
+            let Some(node) = self.node(it.d, &el) else {
+                failed = true;
+                continue;
+            };
+            let idx = nodes.len();
+            if let Some(p) = it.parent {
+                nodes[p].children.push(idx);
+            }
+            names.push(
+                it.name_override
+                    .or_else(|| el.attr("name").map(str::to_string)),
+            );
+            explicit.push(el.btfsm_attr("id").map(str::to_string));
+            nodes.push(node);
+            for &c in el.children.iter().rev() {
+                stack.push(Item {
+                    d: it.d,
+                    e: c,
+                    parent: Some(idx),
+                    frame: it.frame,
+                    name_override: None,
+                });
+            }
+        }
+        if failed || nodes.is_empty() {
+            return None;
+        }
+        let children: Vec<Vec<usize>> = nodes.iter().map(|n| n.children.clone()).collect();
+        let (ids, _) = derive_ids(&children, 0, tree_id, &names, |i, _| explicit[i].clone());
+        for (n, id) in nodes.iter_mut().zip(ids) {
+            n.id = id;
+        }
+        Some(Bt { nodes, root: 0 })
+    }
+
+    /// One node: its kind, label, type name and ports; arity is checked here
+    /// on the element (a SubTree child counts as one).
+    fn node(&mut self, d: usize, el: &XElem) -> Option<BtNode> {
+        let tag = el.name.as_str();
+        let n = el.children.len();
+        let (mut ty, explicit_cat): (String, Option<Category>) = match tag {
+            "Action" | "Condition" | "Control" | "Decorator" => {
+                let cat = match tag {
+                    "Action" => Category::Action,
+                    "Condition" => Category::Condition,
+                    "Control" => Category::Control,
+                    _ => Category::Decorator,
+                };
+                match el.attr("ID") {
+                    Some(id) => (id.to_string(), Some(cat)),
+                    None => {
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            format!("`<{tag}>` needs an `ID` naming its type"),
+                        )
+                        .hint = Some(format!(
+                            "write `<{tag} ID=\"MyNode\"/>`, or the compact `<MyNode/>`"
+                        ));
+                        return None;
+                    }
+                }
+            }
+            _ => (tag.to_string(), None),
+        };
+        let mut type_kept = true;
+        let mut consumed: &[&str] = &[];
+        let (kind, cat) = if let Some(cat) = builtin(&ty) {
+            let (k, c, keep) = builtin_kind(&ty, el, n);
+            consumed = c;
+            type_kept = keep;
+            (k, cat)
+        } else if let Some(cat) = explicit_cat {
+            (generic(cat), cat)
+        } else if let Some(m) = self.models.get(&ty) {
+            (generic(m.cat), m.cat)
+        } else if let Some((real, cat)) = BUILTINS.iter().find(|(b, _)| b.eq_ignore_ascii_case(&ty))
+        {
+            self.warn(
+                d,
+                el.span.clone(),
+                format!(
+                    "`{ty}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`"
+                ),
+            )
+            .hint = Some(format!(
+                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{ty}>`)"
+            ));
+            let (k, c, keep) = builtin_kind(real, el, n);
+            consumed = c;
+            type_kept = keep;
+            ty = real.to_string();
+            (k, *cat)
+        } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
+            match a {
+                AssumeLeaf::Action => (BtNodeKind::Action, Category::Action),
+                AssumeLeaf::Condition => (BtNodeKind::Condition, Category::Condition),
+            }
+        } else {
+            let cands: Vec<&str> = BUILTINS
+                .iter()
+                .map(|(b, _)| *b)
+                .chain(self.models.keys().map(String::as_str))
+                .collect();
+            let did = suggest(&ty, cands);
+            let remedy = if n == 0 {
+                format!(
+                    "declare it as `<Action ID=\"{ty}\"/>` or `<Condition ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition"
+                )
+            } else {
+                format!(
+                    "declare it as `<Control ID=\"{ty}\"/>` or `<Decorator ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE)"
+                )
+            };
+            let hint = if did.starts_with("did you mean") {
+                format!("{did} or {remedy}")
+            } else {
+                remedy
+            };
+            self.err(
+                d,
+                el.span.clone(),
+                format!(
+                    "unknown node type `{ty}` ({n} child{})",
+                    if n == 1 { "" } else { "ren" }
+                ),
+            )
+            .hint = Some(hint);
+            return None;
+        };
+        // Arity of the element (a SubTree child is one node).
+        let bad = match cat {
+            Category::Action | Category::Condition => n != 0,
+            Category::Decorator => n != 1,
+            Category::Control => n == 0,
+        };
+        if bad {
+            let want = match cat {
+                Category::Action | Category::Condition => "no children",
+                Category::Decorator => "exactly one child",
+                Category::Control => "at least one child",
+            };
+            self.err(
+                d,
+                el.span.clone(),
+                format!(
+                    "`{ty}` is a {} and takes {want}, found {n}",
+                    cat.tag().to_lowercase()
+                ),
+            )
+            .hint = Some(match cat {
+                Category::Decorator => "wrap several children in a `<Sequence>`".into(),
+                Category::Control => "give it children, or use a leaf".into(),
+                _ => "a leaf has no children; is the type right in the `<TreeNodesModel>`?".into(),
+            });
+            return None;
+        }
+        let mut ports: BTreeMap<String, String> = el
+            .attrs
+            .iter()
+            .filter(|a| {
+                a.ns.is_none()
+                    && a.name != "name"
+                    && a.name != "ID"
+                    && !consumed.contains(&a.name.as_str())
+            })
+            .map(|a| (a.name.clone(), a.value.clone()))
+            .collect();
+        // A leaf whose type is a skill of the shared library, with arguments
+        // that fit the skill, is bound to it.
+        let mut skill_call = None;
+        if let (BtNodeKind::Action | BtNodeKind::Condition, Some(sk), Some(params)) =
+            (kind, skill::skill_kind(&ty), skill::skill_params(&ty))
+        {
+            let want = if kind == BtNodeKind::Action {
+                SkillKind::Action
+            } else {
+                SkillKind::Condition
+            };
+            let fits = sk == want
+                && ports.keys().all(|k| params.iter().any(|(p, _)| p == k))
+                && params.iter().all(|(p, req)| !req || ports.contains_key(*p));
+            if fits {
+                skill_call = Some(SkillCall {
+                    skill: ty.clone(),
+                    args: std::mem::take(&mut ports)
+                        .into_iter()
+                        .map(|(k, v)| (k, arg_value(&v)))
+                        .collect(),
+                });
+                type_kept = false;
+            }
+        }
+        let label = el
+            .attr("name")
+            .map(str::to_string)
+            .unwrap_or_else(|| ty.clone());
+        Some(BtNode {
+            id: String::new(),
+            label,
+            kind,
+            children: Vec::new(),
+            skill: skill_call,
+            type_name: type_kept.then(|| ty.clone()),
+            ports,
+            span: Some(el.span.clone()),
+        })
+    }
+}
+
+fn generic(cat: Category) -> BtNodeKind {
+    match cat {
+        Category::Action => BtNodeKind::Action,
+        Category::Condition => BtNodeKind::Condition,
+        Category::Control => BtNodeKind::Control,
+        Category::Decorator => BtNodeKind::Decorator,
+    }
+}
+
+/// A skill argument from attribute text: integer, float, boolean or string.
+pub fn arg_value(v: &str) -> ArgValue {
+    if let Ok(i) = v.parse::<i64>() {
+        ArgValue::Int(i)
+    } else if let Ok(x) = v.parse::<f64>()
+        && x.is_finite()
+        && v.chars().any(|c| c.is_ascii_digit())
+    {
+        ArgValue::Float(x)
+    } else if v == "true" || v == "false" {
+        ArgValue::Bool(v == "true")
+    } else {
+        ArgValue::Str(v.to_string())
+    }
+}
+
+/// Longest identity made from positions before falling back to the pre-order
+/// index (keeps identities short on degenerate deep trees).
+const MAX_POSITIONAL_ID: usize = 200;
+
+/// Node identities of an XML tree (see the module documentation), in pre-order
+/// from `root`. `explicit(i, derived)` may give node `i` an identity of its own
+/// instead of the derived one (the reader passes `btfsm:id`; the writer passes
+/// the model's id where it differs, and learns from the returned flags which
+/// nodes need a `btfsm:id`). Returns the identities and, per node, whether it
+/// was explicit.
+pub fn derive_ids(
+    children: &[Vec<usize>],
+    root: usize,
+    tree_id: &str,
+    names: &[Option<String>],
+    mut explicit: impl FnMut(usize, &str) -> Option<String>,
+) -> (Vec<String>, Vec<bool>) {
+    let mut count: HashMap<&str, usize> = HashMap::new();
+    for n in names.iter().flatten() {
+        *count.entry(n.as_str()).or_default() += 1;
+    }
+    let mut ids = vec![String::new(); children.len()];
+    let mut flags = vec![false; children.len()];
+    let mut used: HashSet<String> = HashSet::new();
+    // (node, parent, position among its siblings)
+    let mut stack: Vec<(usize, Option<usize>, usize)> = vec![(root, None, 0)];
+    let mut order = 0usize;
+    while let Some((i, parent, pos)) = stack.pop() {
+        let mut cand = match (&names[i], parent) {
+            (Some(n), _) if count.get(n.as_str()) == Some(&1) => n.clone(),
+            (_, None) => tree_id.to_string(),
+            (_, Some(p)) => format!("{}/{pos}", ids[p]),
+        };
+        if cand.len() > MAX_POSITIONAL_ID {
+            cand = format!("{tree_id}#{order}");
+        }
+        if used.contains(&cand) {
+            let mut k = 2;
+            while used.contains(&format!("{cand}~{k}")) {
+                k += 1;
+            }
+            cand = format!("{cand}~{k}");
+        }
+        let id = match explicit(i, &cand) {
+            Some(x) => {
+                flags[i] = true;
+                x
+            }
+            None => cand,
+        };
+        used.insert(id.clone());
+        ids[i] = id;
+        order += 1;
+        for (k, &c) in children[i].iter().enumerate().rev() {
+            stack.push((c, Some(i), k));
+        }
+    }
+    (ids, flags)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Loaded, Vec<Diagnostic>> {
+        parse_str("t.xml", text, Path::new("."), &Limits::default())
+    }
+
+    fn bt(l: &Loaded) -> &Bt {
+        match &l.policy.body {
+            PolicyBody::Bt(b) => b,
+            _ => panic!("not a BT"),
+        }
+    }
+
+    #[test]
+    fn compact_and_explicit_syntax_with_subtrees() {
+        let l = parse(
+            r#"<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <ReactiveSequence name="top">
+      <SubTree ID="Sub"/>
+      <Action ID="Move-To" target="cube2"/>
+      <Repeat num_cycles="3"><AlwaysSuccess/></Repeat>
+    </ReactiveSequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Sub">
+    <Fallback><Condition ID="Found"/><Search/></Fallback>
+  </BehaviorTree>
+  <TreeNodesModel><Action ID="Search"/></TreeNodesModel>
+</root>"#,
+        )
+        .unwrap();
+        let b = bt(&l);
+        assert_eq!(b.nodes.len(), 7);
+        assert_eq!(b.nodes[0].kind, BtNodeKind::Sequence);
+        assert_eq!(b.nodes[0].id, "top");
+        assert_eq!(b.nodes[1].kind, BtNodeKind::FallbackMemory);
+        assert_eq!(b.nodes[1].id, "top/0");
+        assert_eq!(b.nodes[3].kind, BtNodeKind::Action);
+        assert_eq!(b.nodes[3].skill.as_ref().unwrap().skill, "Search");
+        let mt = &b.nodes[4];
+        assert_eq!(
+            mt.skill.as_ref().unwrap().args["target"],
+            ArgValue::Str("cube2".into())
+        );
+        assert_eq!(b.nodes[5].kind, BtNodeKind::Repeat { times: Some(3) });
+        assert!(b.nodes[5].ports.is_empty());
+        assert_eq!(l.policy.name, "Main");
+    }
+
+    #[test]
+    fn recursion_is_rejected_with_position() {
+        let e = parse(
+            r#"<root main_tree_to_execute="A">
+  <BehaviorTree ID="A"><Sequence><SubTree ID="B"/></Sequence></BehaviorTree>
+  <BehaviorTree ID="B"><SubTree ID="A"/></BehaviorTree>
+</root>"#,
+        )
+        .unwrap_err();
+        assert!(
+            e[0].message.contains("recursive subtree: A -> B -> A"),
+            "{}",
+            e[0].message
+        );
+        assert_eq!(e[0].location().unwrap().1, 3);
+    }
+
+    #[test]
+    fn unknown_type_lists_choices_or_is_assumed() {
+        let text = r#"<root><BehaviorTree ID="T"><Sequence><Sequenc/><Foo/></Sequence></BehaviorTree></root>"#;
+        let e = parse(text).unwrap_err();
+        assert!(e[0].message.contains("unknown node type `Sequenc`"));
+        assert!(e[0].hint.as_ref().unwrap().contains("Sequence"));
+        let lim = Limits {
+            assume_leaf: Some(AssumeLeaf::Condition),
+            ..Default::default()
+        };
+        let l = parse_str("t.xml", text, Path::new("."), &lim).unwrap();
+        assert_eq!(bt(&l).nodes[1].kind, BtNodeKind::Condition);
+        assert_eq!(bt(&l).nodes[1].type_name.as_deref(), Some("Sequenc"));
+    }
+
+    #[test]
+    fn generic_controls_keep_their_type_and_ports() {
+        let l = parse(
+            r#"<root><BehaviorTree ID="T"><IfThenElse name="ite"><AlwaysSuccess/><Script code="x:=1"/><Delay delay_msec="5"><AlwaysFailure/></Delay></IfThenElse></BehaviorTree></root>"#,
+        )
+        .unwrap();
+        let b = bt(&l);
+        assert_eq!(b.nodes[0].kind, BtNodeKind::Control);
+        assert_eq!(b.nodes[0].type_name.as_deref(), Some("IfThenElse"));
+        assert_eq!(b.nodes[2].ports["code"], "x:=1");
+        assert_eq!(b.nodes[3].kind, BtNodeKind::Decorator);
+        assert_eq!(b.nodes[3].ports["delay_msec"], "5");
+    }
+
+    #[test]
+    fn conflicting_model_declarations_are_errors() {
+        let e = parse(
+            r#"<root><BehaviorTree ID="T"><Foo/></BehaviorTree>
+<TreeNodesModel><Action ID="Foo"/><Condition ID="Foo"/></TreeNodesModel></root>"#,
+        )
+        .unwrap_err();
+        assert!(
+            e[0].message
+                .contains("declared both as `Action` and as `Condition`"),
+            "{}",
+            e[0].message
+        );
+    }
+
+    #[test]
+    fn decorator_arity_is_checked() {
+        let e = parse(r#"<root><BehaviorTree ID="T"><Inverter><AlwaysSuccess/><AlwaysSuccess/></Inverter></BehaviorTree></root>"#).unwrap_err();
+        assert!(
+            e[0].message.contains("takes exactly one child, found 2"),
+            "{}",
+            e[0].message
+        );
+    }
+
+    const SEED: &str = r#"<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <ReactiveSequence name="top">
+      <SubTree ID="Sub"/>
+      <Parallel success_count="-1"><AlwaysSuccess/><Script code="a:=1"/></Parallel>
+      <Repeat num_cycles="3"><Move-To target="cube2"/></Repeat>
+      <IfThenElse><Found/><Search/><AlwaysFailure/></IfThenElse>
+    </ReactiveSequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Sub"><Fallback><Condition ID="Robot-At" target="x"/><Dock/></Fallback></BehaviorTree>
+  <TreeNodesModel><Action ID="Search"/><Action ID="Dock"/><Condition ID="Found"/></TreeNodesModel>
+</root>"#;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
+
+        /// Mutated trees never panic: they read (and write and read back at the
+        /// same size) or give positioned errors.
+        #[test]
+        fn mutated_trees_never_panic(
+            cuts in proptest::collection::vec((0usize..2000, 0usize..8, "[<>/=\" a-zA-Z]{0,3}"), 1..4)
+        ) {
+            let text = crate::format::xml::mutate(SEED, &cuts);
+            match parse(&text) {
+                Ok(l) => {
+                    let xml = crate::format::btcpp_xml_write::write_policy(&l.policy).expect("a BT");
+                    let back = parse(&xml).expect("written XML reads back");
+                    proptest::prop_assert_eq!(bt(&back).nodes.len(), bt(&l).nodes.len());
+                }
+                Err(ds) => proptest::prop_assert!(ds.iter().any(|d| d.is_error() && d.location().is_some())),
+            }
+        }
+
+        #[test]
+        fn random_text_never_panics(text in "\\PC{0,200}") {
+            let _ = parse(&text);
+            let _ = crate::format::scxml::parse_str("t.scxml", &text, &Limits::default());
+        }
+    }
+
+    #[test]
+    fn repeated_names_fall_back_to_positions() {
+        let children = vec![vec![1, 2], vec![], vec![]];
+        let names = vec![None, Some("x".to_string()), Some("x".to_string())];
+        let (ids, _) = derive_ids(&children, 0, "T", &names, |_, _| None);
+        assert_eq!(ids, ["T", "T/0", "T/1"]);
+    }
+}

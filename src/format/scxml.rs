@@ -1,0 +1,789 @@
+//! SCXML (W3C State Chart XML, 2015 Recommendation) read into the FSM/HFSM model.
+//!
+//! - `<scxml initial>` and nested `<state>`: a state holding states is a container,
+//!   so a machine with any is an HFSM, else an FSM. A region's initial state is
+//!   its `initial` attribute, its `<initial><transition target>`, or its first
+//!   child state in document order (SCXML 3.3).
+//! - `<final>` states are the outcomes of their region (top level: the machine's
+//!   outcomes, vertices of the graph; inside a container: the container's).
+//! - `<transition event cond target>`: an event that is an outcome the source
+//!   state can return (`SUCCESS`, `FAILURE`, `RUNNING` of a task state, a
+//!   container's final states) with no `cond` becomes an outcome transition;
+//!   every other transition becomes a guard labelled `event`, `event [cond]` or
+//!   `[cond]`. Targets may be in other regions (SCXML allows it). Transitions
+//!   without a target change no state and are not counted (a warning says so).
+//! - `<history>` is modelled as a decision pseudo-state of its region (its
+//!   default transition, if any, is its guard); `<parallel>`, transitions with
+//!   several targets, and transitions into a final state of another region are
+//!   reported as unsupported with their position.
+//! - Executable content (`<onentry>`, `<send>`, `<script>`, ...) and elements
+//!   and attributes of other namespaces (Qt Creator's `qt:editorinfo`) are
+//!   ignored; btfsm's own namespace carries what SCXML has no place for
+//!   (`btfsm:name`, `btfsm:label`, `btfsm:skill`, `btfsm:arg.NAME`,
+//!   `btfsm:decision` on states; `btfsm:label`, `btfsm:terms`, `btfsm:guard`
+//!   on transitions), written by `btfsm convert --to scxml`.
+//!
+//! The document is walked with explicit stacks (no recursion on nesting depth).
+
+use super::btcpp_xml::arg_value;
+use super::xml::{self, BTFSM_NS, XDoc, XElem};
+use super::{Limits, Loaded};
+use crate::diagnostic::{Diagnostic, SourceFile, suggest};
+use crate::model::skill::{Guard, GuardTerm, SkillCall};
+use crate::model::{
+    Policy, PolicyBody, Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
+};
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+use std::sync::Arc;
+
+/// The SCXML namespace.
+pub const SCXML_NS: &str = "http://www.w3.org/2005/07/scxml";
+
+/// Outcomes a task state returns (as in the TOML format).
+const TASK_OUTCOMES: &[&str] = &["SUCCESS", "FAILURE", "RUNNING"];
+
+/// Reads an SCXML file.
+pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    let file = super::toml::read_source(path, &shown, limits)?;
+    load(file, limits)
+}
+
+/// Reads SCXML from text.
+pub fn parse_str(name: &str, text: &str, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    load(SourceFile::new(name, text), limits)
+}
+
+/// A state-like element found in the document.
+enum Kind {
+    State,
+    History(Pseudo),
+    Final,
+}
+
+fn load(file: Arc<SourceFile>, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    let doc = xml::parse(&file).map_err(|d| vec![d])?;
+    let mut diags: Vec<Diagnostic> = Vec::new();
+    let policy = read(&doc, limits, &mut diags);
+    super::finish(&file, policy, diags, "state machine")
+}
+
+/// Is the element SCXML's (in its namespace, or in none)?
+fn is_scxml(e: &XElem) -> bool {
+    e.ns.is_none() || e.ns.as_deref() == Some(SCXML_NS)
+}
+
+fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Policy> {
+    let f = &doc.file;
+    let err = |diags: &mut Vec<Diagnostic>, e: &XElem, msg: String, hint: &str| {
+        diags.push(Diagnostic::error(msg).at(f, e.span.clone()).hint(hint));
+    };
+    let root = &doc.elems[doc.root];
+    if root.name != "scxml" || !is_scxml(root) {
+        err(
+            diags,
+            root,
+            format!(
+                "expected `<scxml>` as the document element, found `<{}>`",
+                root.name
+            ),
+            "an SCXML file is `<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" initial=\"...\">`",
+        );
+        return None;
+    }
+    // Pass 1: state-like elements in document order, with their parent state.
+    // (element, kind, parent entry index)
+    let mut found: Vec<(usize, Kind, Option<usize>)> = Vec::new();
+    // Ids inside unsupported `<parallel>` elements: transitions to them are
+    // not reported again.
+    let mut skipped: std::collections::HashSet<String> = std::collections::HashSet::new();
+    let mut stack: Vec<(usize, Option<usize>)> = doc.elems[doc.root]
+        .children
+        .iter()
+        .rev()
+        .map(|&c| (c, None))
+        .collect();
+    while let Some((e, parent)) = stack.pop() {
+        let el = &doc.elems[e];
+        if !is_scxml(el) {
+            continue; // foreign namespace (editor data)
+        }
+        let kind = match el.name.as_str() {
+            "state" => Kind::State,
+            "final" => Kind::Final,
+            "history" => Kind::History(match el.attr("type") {
+                Some("deep") => Pseudo::DeepHistory,
+                _ => Pseudo::ShallowHistory,
+            }),
+            "parallel" => {
+                err(
+                    diags,
+                    el,
+                    "`<parallel>` states are not supported".into(),
+                    "the paper's FSMs and HFSMs run one state per region; model each parallel region as its own machine",
+                );
+                let mut inner = vec![e];
+                while let Some(x) = inner.pop() {
+                    if let Some(id) = doc.elems[x].attr("id") {
+                        skipped.insert(id.to_string());
+                    }
+                    inner.extend(doc.elems[x].children.iter().copied());
+                }
+                continue;
+            }
+            _ => continue, // transitions, initial, executable content: read later
+        };
+        if found.len() >= limits.max_nodes {
+            err(
+                diags,
+                el,
+                format!("more than {} states", limits.max_nodes),
+                "raise the limit with --max-nodes",
+            );
+            return None;
+        }
+        let idx = found.len();
+        found.push((e, kind, parent));
+        if matches!(found[idx].1, Kind::State) {
+            for &c in el.children.iter().rev() {
+                stack.push((c, Some(idx)));
+            }
+        }
+    }
+    // Ids: unique in the document.
+    let mut by_id: HashMap<String, usize> = HashMap::new();
+    let mut generated = 0usize;
+    let mut ids: Vec<String> = Vec::with_capacity(found.len());
+    for (k, (e, _, _)) in found.iter().enumerate() {
+        let el = &doc.elems[*e];
+        let id = match el.attr("id") {
+            Some(id) => id.to_string(),
+            None => {
+                generated += 1;
+                format!("_{}{generated}", el.name)
+            }
+        };
+        if by_id.insert(id.clone(), k).is_some() {
+            err(
+                diags,
+                el,
+                format!("duplicate id `{id}`"),
+                "every state id in an SCXML document is unique",
+            );
+        }
+        ids.push(id);
+    }
+    // Model states (not finals), in document order.
+    let mut m = StateMachine {
+        hierarchical: false,
+        top: Region {
+            initial: usize::MAX,
+            outcomes: vec![],
+            states: vec![],
+        },
+        states: Vec::new(),
+    };
+    let mut state_of: Vec<Option<usize>> = vec![None; found.len()];
+    for (k, (e, kind, parent)) in found.iter().enumerate() {
+        let el = &doc.elems[*e];
+        let name = el.btfsm_attr("name").unwrap_or(&ids[k]).to_string();
+        let pstate = parent.and_then(|p| state_of[p]);
+        if let Kind::Final = kind {
+            match pstate {
+                None => m.top.outcomes.push(name),
+                Some(p) => {
+                    if let StateBody::Container(r) = &mut m.states[p].body {
+                        r.outcomes.push(name);
+                    } else {
+                        m.states[p].body = StateBody::Container(Region {
+                            initial: usize::MAX,
+                            outcomes: vec![name],
+                            states: vec![],
+                        });
+                    }
+                }
+            }
+            continue;
+        }
+        let si = m.states.len();
+        state_of[k] = Some(si);
+        let body = match kind {
+            Kind::History(_) => StateBody::Decision,
+            _ if el.btfsm_attr("decision") == Some("true") => StateBody::Decision,
+            _ => StateBody::Task(el.btfsm_attr("skill").map(|s| {
+                SkillCall {
+                    skill: s.to_string(),
+                    args: el
+                        .attrs
+                        .iter()
+                        .filter(|a| a.ns.as_deref() == Some(BTFSM_NS))
+                        .filter_map(|a| {
+                            a.name
+                                .strip_prefix("arg.")
+                                .map(|k| (k.to_string(), arg_value(&a.value)))
+                        })
+                        .collect::<BTreeMap<_, _>>(),
+                }
+            })),
+        };
+        m.states.push(State {
+            label: el.btfsm_attr("label").unwrap_or(&name).to_string(),
+            name,
+            parent: pstate,
+            body,
+            transitions: Vec::new(),
+            pseudo: match kind {
+                Kind::History(p) => Some(*p),
+                _ => None,
+            },
+            span: Some(el.span.clone()),
+        });
+        match pstate {
+            None => m.top.states.push(si),
+            Some(p) => match &mut m.states[p].body {
+                StateBody::Container(r) => r.states.push(si),
+                _ => {
+                    m.states[p].body = StateBody::Container(Region {
+                        initial: usize::MAX,
+                        outcomes: vec![],
+                        states: vec![si],
+                    })
+                }
+            },
+        }
+    }
+    m.hierarchical = m
+        .states
+        .iter()
+        .any(|s| matches!(s.body, StateBody::Container(_)));
+    // Initial states: (container, target id, position of the target).
+    let region_owner = |k: Option<usize>| k.and_then(|p| state_of[p]);
+    let mut initial_of: Vec<(Option<usize>, String, std::ops::Range<usize>)> = Vec::new();
+    {
+        let top_init = root
+            .attr_full("initial")
+            .map(|a| (a.value.clone(), a.span.clone()));
+        if let Some((v, s)) = top_init {
+            initial_of.push((None, v, s));
+        }
+        for (k, (e, kind, _)) in found.iter().enumerate() {
+            if !matches!(kind, Kind::State) {
+                continue;
+            }
+            let Some(si) = state_of[k] else { continue };
+            if !matches!(m.states[si].body, StateBody::Container(_)) {
+                continue;
+            }
+            let el = &doc.elems[*e];
+            if let Some(a) = el.attr_full("initial") {
+                initial_of.push((Some(si), a.value.clone(), a.span.clone()));
+            } else if let Some((_, ini)) = doc
+                .children(*e)
+                .find(|(_, c)| is_scxml(c) && c.name == "initial")
+            {
+                match doc
+                    .children_of_name(ini, "transition")
+                    .and_then(|t| t.attr_full("target"))
+                {
+                    Some(a) => initial_of.push((Some(si), a.value.clone(), a.span.clone())),
+                    None => err(
+                        diags,
+                        ini,
+                        "`<initial>` needs a `<transition target>`".into(),
+                        "write `<initial><transition target=\"FIRST\"/></initial>`",
+                    ),
+                }
+            }
+        }
+    }
+    for (container, target, span) in initial_of {
+        let tid = target.trim();
+        if tid.split_whitespace().count() > 1 {
+            diags.push(
+                Diagnostic::error(format!("initial `{tid}` names several states"))
+                    .at(f, span)
+                    .hint("only one initial state per region is supported (several are for `<parallel>`)"),
+            );
+            continue;
+        }
+        let ok = by_id
+            .get(tid)
+            .and_then(|&k| state_of[k])
+            .filter(|&s| m.states[s].parent == container);
+        match ok {
+            Some(s) => match container {
+                None => m.top.initial = s,
+                Some(c) => {
+                    if let StateBody::Container(r) = &mut m.states[c].body {
+                        r.initial = s;
+                    }
+                }
+            },
+            None => {
+                let region: Vec<&str> = m
+                    .states
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, st)| st.parent == container && st.pseudo.is_none())
+                    .map(|(i, _)| ids_of_state(&ids, &state_of, i))
+                    .collect();
+                let h = suggest(tid, region.iter().copied());
+                diags.push(
+                    Diagnostic::error(format!(
+                        "initial `{tid}` is not a state directly inside its region"
+                    ))
+                    .at(f, span)
+                    .hint(if h.is_empty() {
+                        "name a child state of this region".to_string()
+                    } else {
+                        h
+                    }),
+                );
+            }
+        }
+    }
+    // Default: the first child state in document order (one pass: states are
+    // in document order).
+    let mut first_child: Vec<Option<usize>> = vec![None; m.states.len()];
+    let mut first_top: Option<usize> = None;
+    for (i, st) in m.states.iter().enumerate() {
+        if st.pseudo.is_some() {
+            continue;
+        }
+        let slot = match st.parent {
+            None => &mut first_top,
+            Some(p) => &mut first_child[p],
+        };
+        if slot.is_none() {
+            *slot = Some(i);
+        }
+    }
+    let first = |_: &StateMachine, c: Option<usize>| match c {
+        None => first_top,
+        Some(c) => first_child[c],
+    };
+    if m.top.initial == usize::MAX {
+        match first(&m, None) {
+            Some(s) => m.top.initial = s,
+            None => {
+                err(
+                    diags,
+                    root,
+                    "the machine has no states".into(),
+                    "add `<state id=\"...\"/>` under `<scxml>`",
+                );
+                return None;
+            }
+        }
+    }
+    for c in 0..m.states.len() {
+        let needs = matches!(&m.states[c].body, StateBody::Container(r) if r.initial == usize::MAX);
+        if needs {
+            let fs = first(&m, Some(c));
+            match fs {
+                Some(s) => {
+                    if let StateBody::Container(r) = &mut m.states[c].body {
+                        r.initial = s;
+                    }
+                }
+                None => {
+                    let span = m.states[c].span.clone().unwrap_or(0..0);
+                    diags.push(
+                        Diagnostic::error(format!(
+                            "state `{}` holds only final states",
+                            m.states[c].name
+                        ))
+                        .at(f, span)
+                        .hint("a compound state needs a state to start in; make it a plain state"),
+                    );
+                }
+            }
+        }
+    }
+    // Transitions.
+    for (k, (e, kind, _)) in found.iter().enumerate() {
+        let Some(si) = state_of[k] else { continue };
+        if matches!(kind, Kind::Final) {
+            continue;
+        }
+        let mut used_outcomes: Vec<String> = Vec::new();
+        let mut guards: Vec<Transition> = Vec::new();
+        let mut outs: Vec<Transition> = Vec::new();
+        for (_, t) in doc
+            .children(*e)
+            .filter(|(_, c)| is_scxml(c) && c.name == "transition")
+        {
+            let event = t.attr("event").map(str::trim).filter(|s| !s.is_empty());
+            let cond = t.attr("cond").map(str::trim).filter(|s| !s.is_empty());
+            let Some(ta) = t.attr_full("target") else {
+                diags.push(
+                    Diagnostic::warning(format!(
+                        "transition of `{}` has no target; it changes no state and is not counted",
+                        ids[k]
+                    ))
+                    .at(f, t.span.clone())
+                    .hint("give it a `target` to make it an arc of the machine's graph"),
+                );
+                continue;
+            };
+            let targets: Vec<&str> = ta.value.split_whitespace().collect();
+            if targets.len() != 1 {
+                diags.push(
+                    Diagnostic::error(format!(
+                        "transition of `{}` has {} targets",
+                        ids[k],
+                        targets.len()
+                    ))
+                    .at(f, ta.span.clone())
+                    .hint("give exactly one target (several are for `<parallel>` regions)"),
+                );
+                continue;
+            }
+            let tid = targets[0];
+            let Some(&tk) = by_id.get(tid) else {
+                if skipped.contains(tid) {
+                    continue;
+                }
+                let h = suggest(tid, ids.iter().map(String::as_str));
+                diags.push(
+                    Diagnostic::error(format!(
+                        "unknown state `{tid}` in transition of `{}`",
+                        ids[k]
+                    ))
+                    .at(f, ta.span.clone())
+                    .hint(h),
+                );
+                continue;
+            };
+            let target = match state_of[tk] {
+                Some(ts) => Target::State(ts),
+                None => {
+                    // A final state: an outcome of the source's own region.
+                    let fparent = region_owner(found[tk].2);
+                    if fparent == m.states[si].parent {
+                        Target::Outcome(m_final_name(doc, &found, &ids, tk))
+                    } else {
+                        diags.push(
+                            Diagnostic::error(format!(
+                                "transition from `{}` to final state `{tid}` of another region",
+                                ids[k]
+                            ))
+                            .at(f, ta.span.clone())
+                            .hint("only a final state of the source's own region (its parent's outcome) is supported"),
+                        );
+                        continue;
+                    }
+                }
+            };
+            let valid: Vec<String> = match &m.states[si].body {
+                StateBody::Container(r) => r.outcomes.clone(),
+                StateBody::Decision => vec!["RUNNING".to_string()],
+                StateBody::Task(_) => TASK_OUTCOMES.iter().map(|s| s.to_string()).collect(),
+            };
+            let span = Some(t.span.clone());
+            match (event, cond) {
+                (Some(ev), None)
+                    if t.btfsm_attr("guard") != Some("true")
+                        && valid.iter().any(|v| v == ev)
+                        && !used_outcomes.iter().any(|u| u == ev) =>
+                {
+                    used_outcomes.push(ev.to_string());
+                    outs.push(Transition {
+                        trigger: Trigger::Outcome(ev.to_string()),
+                        target,
+                        span,
+                    });
+                }
+                _ => {
+                    let label = t
+                        .btfsm_attr("label")
+                        .map_or_else(|| guard_label(event, cond), str::to_string);
+                    let all = match t.btfsm_attr("terms") {
+                        None => vec![],
+                        Some(text) => match parse_terms(text) {
+                            Some(all) => all,
+                            None => {
+                                diags.push(
+                                    Diagnostic::error(format!("unreadable `btfsm:terms` \"{text}\""))
+                                        .at(f, t.span.clone())
+                                        .hint("write conditions as `Skill(arg=value, ...)`, `not ` to negate, separated by `; `"),
+                                );
+                                continue;
+                            }
+                        },
+                    };
+                    guards.push(Transition {
+                        trigger: Trigger::Guard(Guard { all, label }),
+                        target,
+                        span,
+                    });
+                }
+            }
+        }
+        guards.extend(outs);
+        m.states[si].transitions = guards;
+    }
+    if diags.iter().any(Diagnostic::is_error) {
+        return None;
+    }
+    for (i, seen) in m.reachable().into_iter().enumerate() {
+        if !seen {
+            diags.push(
+                Diagnostic::warning(format!(
+                    "state `{}` is unreachable from the initial state",
+                    m.path(i)
+                ))
+                .at(f, m.states[i].span.clone().unwrap_or(0..0))
+                .hint("add a transition to it, or remove it"),
+            );
+        }
+    }
+    let name = root
+        .attr("name")
+        .map(str::to_string)
+        .unwrap_or_else(|| file_stem(&f.path));
+    Some(Policy {
+        name,
+        description: None,
+        body: PolicyBody::Machine(m),
+    })
+}
+
+/// The label of a guard read from SCXML: `event`, `event [cond]` or `[cond]`.
+pub fn guard_label(event: Option<&str>, cond: Option<&str>) -> String {
+    match (event, cond) {
+        (Some(ev), Some(c)) => format!("{ev} [{c}]"),
+        (Some(ev), None) => ev.to_string(),
+        (None, Some(c)) => format!("[{c}]"),
+        (None, None) => String::new(),
+    }
+}
+
+/// Guard conditions as written in `btfsm:terms`:
+/// `not In-Hand(object=cube2); Battery-Level(min=20)`.
+pub fn parse_terms(text: &str) -> Option<Vec<GuardTerm>> {
+    let mut out = Vec::new();
+    for part in text.split("; ") {
+        let (negate, rest) = match part.strip_prefix("not ") {
+            Some(r) => (true, r),
+            None => (false, part),
+        };
+        let open = rest.find('(')?;
+        let inner = rest[open + 1..].strip_suffix(')')?;
+        let skill = rest[..open].trim();
+        if skill.is_empty() {
+            return None;
+        }
+        let mut args = BTreeMap::new();
+        for kv in inner.split(", ").filter(|kv| !kv.is_empty()) {
+            let (k, v) = kv.split_once('=')?;
+            args.insert(k.to_string(), arg_value(v));
+        }
+        out.push(GuardTerm {
+            condition: SkillCall {
+                skill: skill.to_string(),
+                args,
+            },
+            negate,
+        });
+    }
+    Some(out)
+}
+
+/// The outcome name of a final state.
+fn m_final_name(
+    doc: &XDoc,
+    found: &[(usize, Kind, Option<usize>)],
+    ids: &[String],
+    k: usize,
+) -> String {
+    doc.elems[found[k].0]
+        .btfsm_attr("name")
+        .unwrap_or(&ids[k])
+        .to_string()
+}
+
+fn ids_of_state<'a>(ids: &'a [String], state_of: &[Option<usize>], s: usize) -> &'a str {
+    state_of
+        .iter()
+        .position(|x| *x == Some(s))
+        .map_or("", |k| ids[k].as_str())
+}
+
+fn file_stem(path: &str) -> String {
+    Path::new(path)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("machine")
+        .to_string()
+}
+
+impl XDoc {
+    /// The first SCXML child element of `e` with a given name.
+    pub fn children_of_name(&self, e: &XElem, name: &str) -> Option<&XElem> {
+        e.children
+            .iter()
+            .map(|&c| &self.elems[c])
+            .find(|c| is_scxml(c) && c.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn machine(l: &Loaded) -> &StateMachine {
+        match &l.policy.body {
+            PolicyBody::Machine(m) => m,
+            _ => panic!("not a machine"),
+        }
+    }
+
+    #[test]
+    fn flat_machine_with_final_and_events() {
+        let l = parse_str(
+            "t.scxml",
+            r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="a">
+  <state id="a"><transition event="go" target="b"/><transition event="SUCCESS" target="done"/></state>
+  <state id="b"><transition cond="x &gt; 1" target="a"/><transition event="e" cond="y" target="b"/></state>
+  <final id="done"/>
+</scxml>"#,
+            &Limits::default(),
+        )
+        .unwrap();
+        let m = machine(&l);
+        assert!(!m.hierarchical);
+        assert_eq!(m.top.outcomes, ["done"]);
+        assert_eq!(m.states.len(), 2);
+        let labels: Vec<String> = m.states[1]
+            .transitions
+            .iter()
+            .map(|t| t.trigger.label())
+            .collect();
+        assert_eq!(labels, ["[x > 1]", "e [y]"]);
+        assert_eq!(
+            m.states[0].transitions[1].trigger,
+            Trigger::Outcome("SUCCESS".into())
+        );
+        assert_eq!(
+            m.states[0].transitions[1].target,
+            Target::Outcome("done".into())
+        );
+    }
+
+    #[test]
+    fn nested_states_history_and_foreign_namespaces() {
+        let l = parse_str(
+            "t.scxml",
+            r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:qt="http://www.qt.io/2015/02/scxml-ext" version="1.0">
+  <qt:editorinfo initialGeometry="1"/>
+  <state id="p"><qt:editorinfo geometry="2"/>
+    <state id="c1"><transition event="t" target="c2"/></state>
+    <state id="c2"/>
+    <history id="h"/>
+  </state>
+  <state id="q"><transition event="back" target="h"/></state>
+</scxml>"#,
+            &Limits::default(),
+        )
+        .unwrap();
+        let m = machine(&l);
+        assert!(m.hierarchical);
+        assert_eq!(m.states.len(), 5);
+        assert_eq!(m.states[3].pseudo, Some(Pseudo::ShallowHistory));
+        let StateBody::Container(r) = &m.states[0].body else {
+            panic!()
+        };
+        assert_eq!(m.states[r.initial].name, "c1");
+        assert_eq!(m.states[4].transitions[0].target, Target::State(3));
+    }
+
+    const SEED: &str = r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:qt="http://www.qt.io/2015/02/scxml-ext" version="1.0" initial="a">
+  <state id="a" initial="a1"><qt:editorinfo g="1"/>
+    <state id="a1"><transition event="SUCCESS" target="a2"/></state>
+    <state id="a2"><transition event="x" cond="In(a1)" target="done_a"/></state>
+    <history id="h" type="deep"><transition target="a1"/></history>
+    <final id="done_a"/>
+    <transition event="done_a" target="b"/>
+  </state>
+  <state id="b"><transition event="back" target="h"/><transition event="end" target="end"/></state>
+  <final id="end"/>
+</scxml>"#;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
+
+        /// Mutated machines never panic: they read (and write and read back
+        /// at the same size) or give positioned errors.
+        #[test]
+        fn mutated_machines_never_panic(
+            cuts in proptest::collection::vec((0usize..2000, 0usize..8, "[<>/=\" a-z0-9]{0,3}"), 1..4)
+        ) {
+            let text = crate::format::xml::mutate(SEED, &cuts);
+            match parse_str("t.scxml", &text, &Limits::default()) {
+                Ok(l) => {
+                    let out = crate::format::scxml_write::write_policy(&l.policy).expect("a machine");
+                    let back = parse_str("back.scxml", &out, &Limits::default())
+                        .unwrap_or_else(|e| panic!("{out}\n{e:?}"));
+                    proptest::prop_assert_eq!(machine(&back).states.len(), machine(&l).states.len());
+                }
+                Err(ds) => proptest::prop_assert!(ds.iter().any(|d| d.is_error() && d.location().is_some())),
+            }
+        }
+    }
+
+    #[test]
+    fn seed_reads_and_round_trips() {
+        let l = parse_str("t.scxml", SEED, &Limits::default()).unwrap();
+        let m = machine(&l);
+        assert_eq!(m.top.outcomes, ["end"]);
+        assert_eq!(m.states.len(), 5);
+        let StateBody::Container(r) = &m.states[0].body else {
+            panic!()
+        };
+        assert_eq!(r.outcomes, ["done_a"]);
+        let out = crate::format::scxml_write::write_policy(&l.policy).unwrap();
+        let back = parse_str("b.scxml", &out, &Limits::default()).unwrap();
+        // Equal but for source positions.
+        let strip = |m: &StateMachine| {
+            let mut m = m.clone();
+            for st in &mut m.states {
+                st.span = None;
+                for t in &mut st.transitions {
+                    t.span = None;
+                }
+            }
+            m
+        };
+        assert_eq!(strip(machine(&back)), strip(m), "{out}");
+    }
+
+    #[test]
+    fn unreachable_state_is_a_warning() {
+        let l = parse_str(
+            "t.scxml",
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\">\n  <state id=\"a\"/>\n  <state id=\"z\"/>\n</scxml>",
+            &Limits::default(),
+        )
+        .unwrap();
+        assert_eq!(l.warnings.len(), 1);
+        assert!(l.warnings[0].message.contains("`z` is unreachable"));
+        assert_eq!(l.warnings[0].location().unwrap().1, 3);
+    }
+
+    #[test]
+    fn parallel_is_reported_with_its_position() {
+        let e = parse_str(
+            "t.scxml",
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\">\n  <parallel id=\"p\"/>\n</scxml>",
+            &Limits::default(),
+        )
+        .unwrap_err();
+        let p = e
+            .iter()
+            .find(|d| d.message.contains("`<parallel>`"))
+            .expect("parallel reported");
+        assert_eq!(p.location().unwrap().1, 2);
+    }
+}

@@ -1,0 +1,305 @@
+//! Writes an FSM or HFSM as SCXML (used by `btfsm convert --to scxml`), so that
+//! `format::scxml` reads back the same machine: states become `<state>` (containers
+//! nested), outcomes `<final>` states of their region, outcome transitions
+//! `<transition event="SUCCESS">`, guards `<transition event cond>` split back
+//! from their label (`event`, `event [cond]`, `[cond]`; a label with spaces is a
+//! `cond`), history pseudo-states `<history>`.
+//!
+//! SCXML ids are unique XML names in a document while model names are unique per
+//! region and may hold spaces: a state's id is its name (or, when another state
+//! or final has the same name, its path), with characters outside XML names
+//! replaced by `_`; where the id differs from the name, the name is kept in
+//! `btfsm:name`. Skill bindings, display labels, decision states, a guard's
+//! library conditions (`btfsm:terms`) and a label the event/cond split would not
+//! give back go in btfsm's namespace.
+
+use super::scxml::guard_label;
+use super::xml::{BTFSM_NS, escape_attr, escape_comment};
+use crate::model::{Policy, PolicyBody, Pseudo, StateBody, StateMachine, Target, Trigger};
+use std::collections::{HashMap, HashSet};
+use std::fmt::Write;
+
+/// Why a policy cannot be written as SCXML.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "`{name}` is a behavior tree; SCXML holds state machines (convert it with --to hfsm first, then to scxml)"
+)]
+pub struct NotAMachine {
+    pub name: String,
+}
+
+/// SCXML text of an FSM or HFSM policy.
+pub fn write_policy(p: &Policy) -> Result<String, NotAMachine> {
+    let PolicyBody::Machine(m) = &p.body else {
+        return Err(NotAMachine {
+            name: p.name.clone(),
+        });
+    };
+    Ok(write_machine(&p.name, p.description.as_deref(), m))
+}
+
+/// An SCXML id (an XML NCName: no spaces, no `/`) made from a name.
+fn xml_id(s: &str) -> String {
+    let mut id: String = s
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if !id.starts_with(|c: char| c.is_alphabetic() || c == '_') {
+        id.insert(0, '_');
+    }
+    id
+}
+
+/// Splits a guard label into SCXML `event` and `cond`.
+pub fn split_label(label: &str) -> (Option<&str>, Option<&str>) {
+    let l = label.trim();
+    if l.is_empty() {
+        return (None, None);
+    }
+    if let Some(inner) = l.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+        return (None, Some(inner));
+    }
+    if let Some(open) = l.find(" [")
+        && l.ends_with(']')
+        && !l[..open].contains(char::is_whitespace)
+    {
+        return (Some(&l[..open]), Some(&l[open + 2..l.len() - 1]));
+    }
+    if l.contains(char::is_whitespace) {
+        (None, Some(l))
+    } else {
+        (Some(l), None)
+    }
+}
+
+fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> String {
+    // Names of every state and every final; ids must be unique.
+    let mut count: HashMap<&str, usize> = HashMap::new();
+    for s in &m.states {
+        *count.entry(s.name.as_str()).or_default() += 1;
+        if let StateBody::Container(r) = &s.body {
+            for o in &r.outcomes {
+                *count.entry(o.as_str()).or_default() += 1;
+            }
+        }
+    }
+    for o in &m.top.outcomes {
+        *count.entry(o.as_str()).or_default() += 1;
+    }
+    let mut used: HashSet<String> = HashSet::new();
+    let mut unique = |cand: String| {
+        let cand = xml_id(&cand);
+        let mut id = cand.clone();
+        let mut k = 2;
+        while used.contains(&id) {
+            id = format!("{cand}~{k}");
+            k += 1;
+        }
+        used.insert(id.clone());
+        id
+    };
+    // Top-level finals keep their names (they are vertices, keyed by name).
+    let top_final: Vec<String> = m.top.outcomes.iter().map(|o| unique(o.clone())).collect();
+    let state_id: Vec<String> = (0..m.states.len())
+        .map(|i| {
+            let n = &m.states[i].name;
+            unique(if count[n.as_str()] == 1 {
+                n.clone()
+            } else {
+                m.path(i)
+            })
+        })
+        .collect();
+    let final_id: Vec<Vec<String>> = (0..m.states.len())
+        .map(|i| match &m.states[i].body {
+            StateBody::Container(r) => r
+                .outcomes
+                .iter()
+                .map(|o| {
+                    unique(if count[o.as_str()] == 1 {
+                        o.clone()
+                    } else {
+                        format!("{}/{o}", m.path(i))
+                    })
+                })
+                .collect(),
+            _ => vec![],
+        })
+        .collect();
+    let mut out = String::new();
+    // The final id of outcome `o` in the region a state is in.
+    let outcome_id = |src: usize, o: &str| -> String {
+        match m.states[src].parent {
+            None => m
+                .top
+                .outcomes
+                .iter()
+                .position(|x| x == o)
+                .map_or(o.to_string(), |k| top_final[k].clone()),
+            Some(p) => match &m.states[p].body {
+                StateBody::Container(r) => r
+                    .outcomes
+                    .iter()
+                    .position(|x| x == o)
+                    .map_or(o.to_string(), |k| final_id[p][k].clone()),
+                _ => o.to_string(),
+            },
+        }
+    };
+    // Pre-order with close events.
+    let mut stack: Vec<(usize, usize, bool)> =
+        m.top.states.iter().rev().map(|&s| (s, 1, false)).collect();
+    while let Some((i, depth, close)) = stack.pop() {
+        let s = &m.states[i];
+        let pad = "  ".repeat(depth);
+        let tag = if s.pseudo.is_some() {
+            "history"
+        } else {
+            "state"
+        };
+        if close {
+            if let StateBody::Container(r) = &s.body {
+                for fid in &final_id[i] {
+                    let _ = write!(out, "{pad}  <final id=\"{}\"", escape_attr(fid));
+                    let k = final_id[i].iter().position(|x| x == fid).unwrap_or(0);
+                    if *fid != r.outcomes[k] {
+                        let _ = write!(out, " btfsm:name=\"{}\"", escape_attr(&r.outcomes[k]));
+                    }
+                    out.push_str("/>\n");
+                }
+            }
+            let _ = writeln!(out, "{pad}</{tag}>");
+            continue;
+        }
+        let mut attrs = format!(" id=\"{}\"", escape_attr(&state_id[i]));
+        match s.pseudo {
+            Some(Pseudo::ShallowHistory) => attrs.push_str(" type=\"shallow\""),
+            Some(Pseudo::DeepHistory) => attrs.push_str(" type=\"deep\""),
+            None => {}
+        }
+        if let StateBody::Container(r) = &s.body {
+            let _ = write!(attrs, " initial=\"{}\"", escape_attr(&state_id[r.initial]));
+        }
+        if state_id[i] != s.name {
+            let _ = write!(attrs, " btfsm:name=\"{}\"", escape_attr(&s.name));
+        }
+        if s.label != s.name {
+            let _ = write!(attrs, " btfsm:label=\"{}\"", escape_attr(&s.label));
+        }
+        match &s.body {
+            StateBody::Task(Some(call)) => {
+                let _ = write!(attrs, " btfsm:skill=\"{}\"", escape_attr(&call.skill));
+                for (k, v) in &call.args {
+                    let _ = write!(attrs, " btfsm:arg.{k}=\"{}\"", escape_attr(&v.to_string()));
+                }
+            }
+            StateBody::Decision if s.pseudo.is_none() => attrs.push_str(" btfsm:decision=\"true\""),
+            _ => {}
+        }
+        let _ = writeln!(out, "{pad}<{tag}{attrs}>");
+        // Outcomes the reader takes an `event` for (see `format::scxml`).
+        let outcomes: Vec<&str> = match &s.body {
+            StateBody::Container(r) => r.outcomes.iter().map(String::as_str).collect(),
+            StateBody::Decision => vec!["RUNNING"],
+            StateBody::Task(_) => vec!["SUCCESS", "FAILURE", "RUNNING"],
+        };
+        for t in &s.transitions {
+            let (event, cond) = match &t.trigger {
+                Trigger::Outcome(o) => (Some(o.as_str()), None),
+                Trigger::Guard(g) => split_label(&g.label),
+            };
+            // What SCXML cannot say, in btfsm's namespace: the exact label,
+            // the library conditions, and a guard that looks like an outcome.
+            let mut extra = String::new();
+            if let Trigger::Guard(g) = &t.trigger {
+                if guard_label(event, cond) != g.label {
+                    let _ = write!(extra, " btfsm:label=\"{}\"", escape_attr(&g.label));
+                }
+                if !g.all.is_empty() {
+                    let terms: Vec<String> = g.all.iter().map(ToString::to_string).collect();
+                    let _ = write!(extra, " btfsm:terms=\"{}\"", escape_attr(&terms.join("; ")));
+                }
+                if cond.is_none() && event.is_some_and(|e| outcomes.contains(&e)) {
+                    extra.push_str(" btfsm:guard=\"true\"");
+                }
+            }
+            let target = match &t.target {
+                Target::State(j) => state_id[*j].clone(),
+                Target::Outcome(o) => outcome_id(i, o),
+            };
+            let mut ta = String::new();
+            if let Some(e) = event {
+                let _ = write!(ta, " event=\"{}\"", escape_attr(e));
+            }
+            if let Some(c) = cond {
+                let _ = write!(ta, " cond=\"{}\"", escape_attr(c));
+            }
+            let _ = writeln!(
+                out,
+                "{pad}  <transition{ta} target=\"{}\"{extra}/>",
+                escape_attr(&target)
+            );
+        }
+        stack.push((i, depth, true));
+        if let StateBody::Container(r) = &s.body {
+            for &c in r.states.iter().rev() {
+                stack.push((c, depth + 1, false));
+            }
+        }
+    }
+    for (fid, o) in top_final.iter().zip(&m.top.outcomes) {
+        let _ = write!(out, "  <final id=\"{}\"", escape_attr(fid));
+        if fid != o {
+            let _ = write!(out, " btfsm:name=\"{}\"", escape_attr(o));
+        }
+        out.push_str("/>\n");
+    }
+    out.push_str("</scxml>\n");
+    let mut head = String::new();
+    head.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    if let Some(d) = description {
+        let _ = writeln!(head, "<!-- {} -->", escape_comment(d));
+    }
+    let _ = write!(
+        head,
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" name=\"{}\" initial=\"{}\"",
+        escape_attr(name),
+        escape_attr(&state_id[m.top.initial])
+    );
+    if out.contains(" btfsm:") {
+        let _ = write!(head, " xmlns:btfsm=\"{BTFSM_NS}\"");
+    }
+    head.push_str(">\n");
+    head + &out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Golden file: the paper's Fig. 6 HFSM as SCXML.
+    #[test]
+    fn fig06_as_scxml() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper/fig06-hfsm.toml");
+        let p = crate::format::load(&path, &Default::default())
+            .unwrap()
+            .policy;
+        insta::assert_snapshot!(write_policy(&p).unwrap());
+    }
+
+    #[test]
+    fn labels_split_into_event_and_cond() {
+        assert_eq!(split_label("go"), (Some("go"), None));
+        assert_eq!(split_label("go [x > 1]"), (Some("go"), Some("x > 1")));
+        assert_eq!(split_label("[x]"), (None, Some("x")));
+        assert_eq!(split_label("battery < 20%"), (None, Some("battery < 20%")));
+        assert_eq!(split_label(""), (None, None));
+    }
+}

@@ -1,0 +1,15 @@
+//! The planar robot simulator (SPEC §6): a deterministic, seeded 2D world after
+//! the paper's Experiments 1-5, one skill library shared by every policy kind,
+//! BT/FSM/HFSM executors, scenario files with disturbances, traces and the
+//! behavior-match verdict, SVG plots in the style of the paper's Fig. 17, and
+//! Monte Carlo episodes.
+
+pub mod exec;
+pub mod plot;
+pub mod report;
+pub mod rng;
+pub mod run;
+pub mod scenario;
+pub mod skills;
+pub mod trace;
+pub mod world;

@@ -1,0 +1,795 @@
+//! Runs policies in a scenario (SPEC §6): each policy on its own copy of the
+//! world with the same seed, stepped until it is done and no timed disturbance
+//! is pending, until it chatters or gives up, or until the step budget runs out.
+//! Also the `--runs N` Monte Carlo episodes, run in parallel over the cores
+//! (deterministic: episode i has its own seed and results are combined in
+//! episode order).
+
+use super::exec::{BtExec, CompiledBt, CompiledMachine, Leaves, MachineExec};
+use super::rng::SimRng;
+use super::scenario::{Disturbance, Effect, PolicyEntry, Scenario, When};
+use super::skills::{self, Call, Running, Status, Target};
+use super::trace::{Event, FinalWorld, Outcome, Run, SkillRecord, Step};
+use super::world::{P2, Place, World};
+use crate::model::PolicyBody;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// A policy ready to run: bindings resolved against the scenario's world.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    pub name: String,
+    pub file: String,
+    pub kind: String,
+    pub convert: Option<String>,
+    pub exec: Compiled,
+    /// Node id / state path per key (for statuses).
+    pub keys: Arc<Vec<String>>,
+}
+
+#[derive(Debug, Clone)]
+pub enum Compiled {
+    Bt(Arc<CompiledBt>),
+    Machine(Arc<CompiledMachine>),
+}
+
+/// Resolves the bindings of a scenario's policies (validated when the scenario
+/// was read, so resolution cannot fail here; an unresolvable binding would run
+/// as a failing leaf).
+pub fn prepare(s: &Scenario) -> Vec<Prepared> {
+    s.policies
+        .iter()
+        .map(|e| prepare_one(e, &s.world))
+        .collect()
+}
+
+fn prepare_one(e: &PolicyEntry, w: &World) -> Prepared {
+    let (exec, keys) = match &e.policy.body {
+        PolicyBody::Bt(bt) => {
+            let calls = bt
+                .nodes
+                .iter()
+                .map(|n| n.skill.as_ref().and_then(|c| skills::resolve(c, w).ok()))
+                .collect();
+            (
+                Compiled::Bt(Arc::new(CompiledBt::new(bt, calls))),
+                bt.nodes.iter().map(|n| n.id.clone()).collect(),
+            )
+        }
+        PolicyBody::Machine(m) => {
+            let cm = CompiledMachine::new(m, |c| skills::resolve(c, w).or(Err(()))).unwrap_or_else(
+                |_| {
+                    CompiledMachine::new(m, |c| {
+                        Ok::<_, ()>(skills::resolve(c, w).unwrap_or(Call::Found))
+                    })
+                    .expect("infallible")
+                },
+            );
+            (
+                Compiled::Machine(Arc::new(cm)),
+                (0..m.states.len()).map(|i| m.path(i)).collect(),
+            )
+        }
+    };
+    Prepared {
+        name: e.policy.name.clone(),
+        file: e.file.display().to_string(),
+        kind: e.policy.kind().to_string(),
+        convert: e.convert.clone(),
+        exec,
+        keys: Arc::new(keys),
+    }
+}
+
+/// Injected faults: "fail the next N times" and failure rates.
+#[derive(Debug, Clone)]
+struct Faults {
+    next: BTreeMap<String, u32>,
+    rates: BTreeMap<String, f64>,
+    rng: SimRng,
+}
+
+impl Faults {
+    fn doomed(&mut self, skill: &str) -> bool {
+        if let Some(n) = self.next.get_mut(skill)
+            && *n > 0
+        {
+            *n -= 1;
+            return true;
+        }
+        match self.rates.get(skill) {
+            Some(&p) => self.rng.chance(p),
+            None => false,
+        }
+    }
+}
+
+/// The robot as the executors see it: the world, the running actions and the
+/// records.
+struct Robot {
+    world: World,
+    dt: f64,
+    live: Vec<Option<Running>>,
+    ticked: Vec<bool>,
+    records: Vec<SkillRecord>,
+    events: Vec<Event>,
+    faults: Faults,
+    log: bool,
+    last_failed: Option<Call>,
+    switches: u32,
+    failures: u32,
+    mark: u64,
+    low_at: Option<f64>,
+    latencies: Vec<f64>,
+}
+
+/// The arguments of a resolved call, by name.
+pub fn call_args(c: &Call, w: &World) -> BTreeMap<String, String> {
+    let tgt = |t: &Target| match *t {
+        Target::Station(s) => w.layout.stations[s].0.clone(),
+        Target::Object(o) => w.objects[o].name.clone(),
+    };
+    let obj = |o: usize| w.objects[o].name.clone();
+    let st = |s: usize| w.layout.stations[s].0.clone();
+    let mut m = BTreeMap::new();
+    match c {
+        Call::MoveTo { target, .. } | Call::RobotAt(target) => {
+            m.insert("target".into(), tgt(target));
+        }
+        Call::Pick { object } | Call::InHand(object) => {
+            m.insert("object".into(), obj(*object));
+        }
+        Call::Place { object, at } | Call::ObjectAt { object, at } => {
+            m.insert("object".into(), obj(*object));
+            m.insert("at".into(), st(*at));
+        }
+        Call::BatteryLevel(x) => {
+            m.insert("min".into(), x.to_string());
+        }
+        _ => {}
+    }
+    m
+}
+
+impl Robot {
+    fn event(&mut self, kind: &str, text: String) {
+        if self.log {
+            self.events.push(Event {
+                t: round3(self.world.time),
+                kind: kind.into(),
+                text,
+                x: self.world.robot.0,
+                y: self.world.robot.1,
+            });
+        }
+    }
+
+    fn sync_progress(&mut self) {
+        if self.world.progress != self.mark {
+            self.mark = self.world.progress;
+            self.switches = 0;
+            self.failures = 0;
+        }
+    }
+
+    fn close(&mut self, rec: usize, outcome: &str) {
+        let t = round3(self.world.time);
+        let r = &mut self.records[rec];
+        r.outcome = outcome.into();
+        r.end = Some(t);
+        if self.log {
+            let text = r.text();
+            self.event("end", text);
+        }
+    }
+
+    /// Cancels the actions that were not ticked in this step.
+    fn end_step(&mut self) {
+        for k in 0..self.live.len() {
+            if !self.ticked[k]
+                && let Some(mut r) = self.live[k].take()
+            {
+                r.cancel(&mut self.world);
+                self.close(r.record, "cancelled");
+            }
+            self.ticked[k] = false;
+        }
+    }
+}
+
+fn round3(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0
+}
+
+impl Leaves for Robot {
+    fn condition(&mut self, call: &Call) -> bool {
+        skills::condition(call, &self.world)
+    }
+
+    fn action(&mut self, key: usize, call: &Call) -> Status {
+        self.ticked[key] = true;
+        if self.live[key].as_ref().is_none_or(|r| r.call != *call) {
+            if let Some(mut old) = self.live[key].take() {
+                old.cancel(&mut self.world);
+                self.close(old.record, "cancelled");
+            }
+            self.sync_progress();
+            // Every start counts, except a retry of the action that just failed.
+            if self.last_failed != Some(*call) {
+                self.switches += 1;
+            }
+            self.last_failed = None;
+            let doomed = self.faults.doomed(call.name());
+            if *call == Call::Recharge
+                && let Some(t) = self.low_at.take()
+            {
+                self.latencies.push(round3(self.world.time - t));
+            }
+            self.records.push(SkillRecord {
+                skill: call.name().into(),
+                args: call_args(call, &self.world),
+                outcome: "running".into(),
+                start: round3(self.world.time),
+                end: None,
+            });
+            if self.log {
+                let text = self.records.last().expect("pushed").text();
+                self.event("start", text.trim_end_matches(" -> running").to_string());
+            }
+            self.live[key] = Some(Running::new(*call, doomed, self.records.len() - 1));
+        }
+        let r = self.live[key].as_mut().expect("started above");
+        let s = r.tick(&mut self.world, self.dt);
+        if s != Status::Running {
+            let rec = r.record;
+            self.live[key] = None;
+            self.close(
+                rec,
+                if s == Status::Success {
+                    "success"
+                } else {
+                    "failure"
+                },
+            );
+            if s == Status::Failure {
+                self.sync_progress();
+                self.failures += 1;
+                self.last_failed = Some(*call);
+            }
+        }
+        s
+    }
+
+    fn now(&self) -> f64 {
+        self.world.time
+    }
+}
+
+/// What to record in a run.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    /// Events, trajectory and executed skills (off only for Monte Carlo).
+    pub log: bool,
+    /// Per-step statuses (for `--trace`).
+    pub trace: bool,
+}
+
+/// Applies a disturbance's effect.
+fn apply(d: &Disturbance, r: &mut Robot) {
+    let w = &mut r.world;
+    match &d.effect {
+        Effect::Battery(b) => w.battery = *b,
+        Effect::Move { object, to } => w.objects[*object].place = Place::At(*to),
+        Effect::Drop { object } => {
+            if w.objects[*object].place == Place::Held {
+                w.objects[*object].place = Place::At(w.robot);
+            }
+        }
+        Effect::Fail { skill, times } => *r.faults.next.entry(skill.clone()).or_insert(0) += times,
+        Effect::Block(rect) => w.block(rect.clone()),
+        Effect::Emergency(b) => w.emergency = *b,
+    }
+    r.world.progress += 1;
+    r.event("disturbance", d.text.clone());
+}
+
+fn holds(terms: &[(Call, bool)], w: &World) -> bool {
+    terms.iter().all(|(c, neg)| skills::condition(c, w) != *neg)
+}
+
+/// Runs one policy in a scenario.
+pub fn run_policy(
+    s: &Scenario,
+    p: &Prepared,
+    world: World,
+    disturbances: &[Disturbance],
+    rates: BTreeMap<String, f64>,
+    seed: u64,
+    opts: RunOptions,
+) -> Run {
+    let n = p.keys.len();
+    let mut robot = Robot {
+        world,
+        dt: s.dt,
+        live: vec![None; n],
+        ticked: vec![false; n],
+        records: Vec::new(),
+        events: Vec::new(),
+        faults: Faults {
+            next: BTreeMap::new(),
+            rates,
+            rng: SimRng::named(seed, "skill-faults"),
+        },
+        log: opts.log,
+        last_failed: None,
+        switches: 0,
+        failures: 0,
+        mark: 0,
+        low_at: None,
+        latencies: Vec::new(),
+    };
+    enum Ex {
+        Bt(BtExec),
+        M(MachineExec),
+    }
+    let mut ex = match &p.exec {
+        Compiled::Bt(b) => Ex::Bt(BtExec::new(b.clone(), opts.trace)),
+        Compiled::Machine(m) => Ex::M(MachineExec::new(m.clone(), opts.trace)),
+    };
+    let mut fired = vec![false; disturbances.len()];
+    let mut first_done: Option<f64> = None;
+    let mut completion: Option<f64> = None;
+    let mut low = false;
+    let mut trajectory: Vec<P2> = Vec::new();
+    let mut trace: Vec<Step> = Vec::new();
+    let mut ended: Option<(Outcome, String)> = None;
+    let mut steps = 0;
+    let mut last = Status::Running;
+    if opts.log {
+        trajectory.push(robot.world.robot);
+    }
+    while steps < s.max_steps {
+        steps += 1;
+        let now = robot.world.time + 1e-9;
+        for (i, d) in disturbances.iter().enumerate() {
+            if fired[i] {
+                continue;
+            }
+            let go = match &d.when {
+                When::At(t) => now >= *t,
+                When::AfterDone(dl) => first_done.is_some_and(|f| now >= f + dl),
+                When::Holds(terms) => holds(terms, &robot.world),
+            };
+            if go {
+                fired[i] = true;
+                apply(d, &mut robot);
+            }
+        }
+        let lowb = robot.world.battery <= robot.world.params.low_battery;
+        if lowb && !low {
+            robot.low_at = Some(robot.world.time);
+            let b = robot.world.battery;
+            robot.event("battery-low", format!("battery at {b:.1}%"));
+        }
+        low = lowb;
+        last = match &mut ex {
+            Ex::Bt(b) => b.tick(&mut robot),
+            Ex::M(m) => m.step(&mut robot),
+        };
+        robot.end_step();
+        robot.world.advance(s.dt);
+        if opts.log {
+            trajectory.push(robot.world.robot);
+        }
+        if opts.trace {
+            let st = match &ex {
+                Ex::Bt(b) => b.statuses.as_ref(),
+                Ex::M(m) => m.statuses.as_ref(),
+            };
+            let running = robot
+                .live
+                .iter()
+                .flatten()
+                .map(|r| {
+                    robot.records[r.record]
+                        .text()
+                        .trim_end_matches(" -> running")
+                        .to_string()
+                })
+                .collect();
+            trace.push(Step {
+                t: round3(robot.world.time),
+                x: robot.world.robot.0,
+                y: robot.world.robot.1,
+                yaw: robot.world.yaw,
+                battery: (robot.world.battery * 100.0).round() / 100.0,
+                running,
+                statuses: st
+                    .map(|v| {
+                        v.iter()
+                            .map(|(k, s)| (p.keys[*k].clone(), s.as_str().to_string()))
+                            .collect()
+                    })
+                    .unwrap_or_default(),
+            });
+        }
+        let finished = match &ex {
+            Ex::Bt(_) => None,
+            Ex::M(m) => m.finished.clone(),
+        };
+        let done = last == Status::Success && finished.as_ref().is_none_or(|f| f.0 == "SUCCESS");
+        if done {
+            if completion.is_none() || first_done.is_none() {
+                robot.event("done", "the policy reports SUCCESS".into());
+            }
+            first_done.get_or_insert(robot.world.time);
+            completion.get_or_insert(robot.world.time);
+        } else {
+            completion = None;
+        }
+        let pending = disturbances
+            .iter()
+            .zip(&fired)
+            .any(|(d, f)| !f && matches!(d.when, When::At(_) | When::AfterDone(_)));
+        if robot.switches > s.chatter_switches {
+            let text = format!("{} actions started without progress", robot.switches);
+            robot.event("chattering", text.clone());
+            ended = Some((Outcome::Chattering, text));
+            break;
+        }
+        if robot.failures > s.max_failures {
+            let text = format!(
+                "gave up after {} failed actions without progress",
+                robot.failures
+            );
+            ended = Some((Outcome::Failure, text));
+            break;
+        }
+        if !pending && (done || finished.is_some()) {
+            break;
+        }
+    }
+    // Whatever still runs at the end stays `running` in the records.
+    let finished = match &ex {
+        Ex::Bt(_) => None,
+        Ex::M(m) => m.finished.clone(),
+    };
+    let (outcome, reason) = ended.unwrap_or_else(|| match finished {
+        Some((o, why)) if o == "SUCCESS" => (Outcome::Success, why),
+        Some((_, why)) => (Outcome::Failure, why),
+        None if last == Status::Success => (Outcome::Success, "the root returned SUCCESS".into()),
+        None => (
+            Outcome::Timeout,
+            format!("step budget of {} steps exhausted", s.max_steps),
+        ),
+    });
+    let goal_met = s.goal.as_ref().map(|g| holds(g, &robot.world));
+    Run {
+        policy: p.name.clone(),
+        file: p.file.clone(),
+        kind: p.kind.clone(),
+        convert: p.convert.clone(),
+        outcome,
+        reason,
+        goal_met,
+        steps,
+        completion_s: completion.map(round3),
+        duration_s: round3(robot.world.time),
+        distance_m: round3(robot.world.odometer),
+        skills: robot.records,
+        events: robot.events,
+        final_world: FinalWorld::of(&robot.world),
+        recharge_latency_s: robot.latencies,
+        trajectory,
+        trace,
+    }
+}
+
+/// Runs every policy of a scenario once (the scenario's own seed and
+/// disturbances).
+pub fn run_scenario(s: &Scenario, trace: bool) -> Vec<Run> {
+    prepare(s)
+        .iter()
+        .map(|p| {
+            run_policy(
+                s,
+                p,
+                s.world.clone(),
+                &s.disturbances,
+                s.rates.clone(),
+                s.seed,
+                RunOptions { log: true, trace },
+            )
+        })
+        .collect()
+}
+
+/// Per-policy figures of `--runs N`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct McStats {
+    pub policy: String,
+    pub runs: u32,
+    pub successes: u32,
+    pub success_rate: f64,
+    pub chattering: u32,
+    pub timeouts: u32,
+    pub failures: u32,
+    /// Mean completion time of the successful episodes, s.
+    pub mean_completion_s: Option<f64>,
+    /// Mean latency from a battery-low event to the start of Recharge, s.
+    pub mean_recharge_latency_s: Option<f64>,
+    pub recharges: u32,
+}
+
+/// The disturbances and failure rates of episode `i`: the scenario's, with
+/// timed ones jittered, plus the `monte_carlo` battery drop and rates.
+pub fn episode(s: &Scenario, seed: u64, i: u32) -> (u64, Vec<Disturbance>, BTreeMap<String, f64>) {
+    let ep_seed = SimRng::named(seed, &format!("episode-{i}")).next_u64();
+    let mut rng = SimRng::named(ep_seed, "disturbances");
+    let mut ds = s.disturbances.clone();
+    // Timed disturbances happen anywhere from half to one and a half times
+    // their scenario time.
+    for d in &mut ds {
+        if let When::At(t) = &mut d.when {
+            *t = (*t * rng.range(0.5, 1.5) * 10.0).round() / 10.0;
+        }
+    }
+    if let Some((p, (lo, hi), (t0, t1))) = s.monte_carlo.battery_drop
+        && rng.chance(p)
+    {
+        let level = rng.range(lo, hi).round();
+        let at = (rng.range(t0, t1) * 10.0).round() / 10.0;
+        ds.push(Disturbance {
+            when: When::At(at),
+            effect: Effect::Battery(level),
+            text: format!("battery set to {level}%"),
+        });
+    }
+    let mut rates = s.rates.clone();
+    for (k, v) in &s.monte_carlo.rates {
+        let e = rates.entry(k.clone()).or_insert(0.0);
+        *e = 1.0 - (1.0 - *e) * (1.0 - v);
+    }
+    (ep_seed, ds, rates)
+}
+
+/// Runs `runs` seeded episodes of every policy on `threads` threads.
+pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<McStats> {
+    let prepared = prepare(s);
+    let threads = threads.max(1).min(runs.max(1) as usize);
+    // results[policy][episode] = (outcome, goal, completion, latencies)
+    type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
+    let mut per_thread: Vec<Vec<(u32, usize, Res)>> = Vec::new();
+    std::thread::scope(|sc| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                let prepared = &prepared;
+                sc.spawn(move || {
+                    let mut out = Vec::new();
+                    let mut i = t as u32;
+                    while i < runs {
+                        let (ep_seed, ds, rates) = episode(s, seed, i);
+                        for (k, p) in prepared.iter().enumerate() {
+                            let r = run_policy(
+                                s,
+                                p,
+                                s.world.clone(),
+                                &ds,
+                                rates.clone(),
+                                ep_seed,
+                                RunOptions {
+                                    log: false,
+                                    trace: false,
+                                },
+                            );
+                            out.push((
+                                i,
+                                k,
+                                (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s),
+                            ));
+                        }
+                        i += threads as u32;
+                    }
+                    out
+                })
+            })
+            .collect();
+        for h in handles {
+            per_thread.push(h.join().expect("episode thread"));
+        }
+    });
+    let mut all: Vec<(u32, usize, Res)> = per_thread.into_iter().flatten().collect();
+    all.sort_by_key(|(i, k, _)| (*k, *i));
+    prepared
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mine: Vec<&Res> = all
+                .iter()
+                .filter(|(_, kk, _)| *kk == k)
+                .map(|(_, _, r)| r)
+                .collect();
+            let ok: Vec<&&Res> = mine
+                .iter()
+                .filter(|r| r.0 == Outcome::Success && r.1 != Some(false))
+                .collect();
+            let comp: Vec<f64> = ok.iter().filter_map(|r| r.2).collect();
+            let lat: Vec<f64> = mine.iter().flat_map(|r| r.3.iter().copied()).collect();
+            let mean =
+                |v: &[f64]| (!v.is_empty()).then(|| round3(v.iter().sum::<f64>() / v.len() as f64));
+            let count = |o: Outcome| mine.iter().filter(|r| r.0 == o).count() as u32;
+            McStats {
+                policy: p.name.clone(),
+                runs,
+                successes: ok.len() as u32,
+                success_rate: if runs == 0 {
+                    0.0
+                } else {
+                    round3(ok.len() as f64 / runs as f64)
+                },
+                chattering: count(Outcome::Chattering),
+                timeouts: count(Outcome::Timeout),
+                failures: runs
+                    - ok.len() as u32
+                    - count(Outcome::Chattering)
+                    - count(Outcome::Timeout),
+                mean_completion_s: mean(&comp),
+                mean_recharge_latency_s: mean(&lat),
+                recharges: lat.len() as u32,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostic::SourceFile;
+    use crate::format::Limits;
+    use std::path::Path;
+
+    fn scenario(text: &str) -> Scenario {
+        let f = SourceFile::new("t.toml", text);
+        super::super::scenario::parse(&f, Path::new("policies/scenarios"), &Limits::default())
+            .expect("valid scenario")
+    }
+
+    const FLAKY: &str = r#"
+seed = 11
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[rates]
+Pick = 0.5
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+[monte_carlo]
+battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
+"#;
+
+    #[test]
+    fn runs_are_deterministic_given_the_seed() {
+        let s = scenario(FLAKY);
+        let a = run_scenario(&s, false);
+        let b = run_scenario(&s, false);
+        assert_eq!(a[0].skills, b[0].skills);
+        assert_eq!(a[0].trajectory, b[0].trajectory);
+        // With a 50% grasp failure rate some seed makes a Pick fail.
+        let failed = (0..10u64).any(|seed| {
+            let mut s = s.clone();
+            s.seed = seed;
+            run_scenario(&s, false)[0]
+                .skills
+                .iter()
+                .any(|r| r.skill == "Pick" && r.outcome == "failure")
+        });
+        assert!(failed);
+    }
+
+    #[test]
+    fn monte_carlo_does_not_depend_on_the_number_of_threads() {
+        let s = scenario(FLAKY);
+        let one = monte_carlo(&s, 6, 3, 1);
+        let two = monte_carlo(&s, 6, 3, 2);
+        assert_eq!(one, two);
+        assert_eq!(one.len(), 2);
+        assert_eq!(one[0].runs, 6);
+        // Every episode drops the battery, so every policy recharges.
+        assert!(
+            one.iter()
+                .all(|p| p.recharges == 0 || p.mean_recharge_latency_s.is_some())
+        );
+        assert!(one.iter().all(|p| p.success_rate > 0.0));
+    }
+
+    #[test]
+    fn a_sequential_policy_without_a_failure_arc_fails() {
+        let s = scenario(
+            r#"
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+[[disturbances]]
+at = 0.0
+fail = "Move-To"
+"#,
+        );
+        let r = &run_scenario(&s, true)[0];
+        assert_eq!(r.outcome, Outcome::Failure);
+        assert_eq!(r.skills.len(), 1);
+        assert!(!r.trace.is_empty());
+        assert!(
+            r.trace[0]
+                .statuses
+                .iter()
+                .any(|(k, st)| k == "Move-To cube2" && st == "RUNNING")
+        );
+    }
+
+    #[test]
+    fn a_dropped_cube_is_picked_again_and_a_blocked_goal_gives_up() {
+        let s = scenario(
+            r#"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+[[disturbances]]
+when = [{ if = "In-Hand", args = { object = "cube2" } }]
+drop = "cube2"
+"#,
+        );
+        let runs = run_scenario(&s, false);
+        for r in &runs {
+            assert_eq!(r.goal_met, Some(true), "{}", r.policy);
+            let picks = r
+                .skills
+                .iter()
+                .filter(|x| x.skill == "Pick" && x.outcome == "success");
+            assert_eq!(picks.count(), 2, "{}", r.policy);
+        }
+        // The BT notices the drop at once; the FSM only when Place fails.
+        assert!(
+            !runs[0]
+                .skills
+                .iter()
+                .any(|x| x.skill == "Place" && x.outcome == "failure")
+        );
+        assert!(
+            runs[1]
+                .skills
+                .iter()
+                .any(|x| x.skill == "Place" && x.outcome == "failure")
+        );
+
+        let s = scenario(
+            r#"
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+[[disturbances]]
+at = 0.0
+block = { name = "fence", rect = [-0.5, 1.4, 1.5, 1.5] }
+[[disturbances]]
+at = 0.0
+block = { name = "fence2", rect = [-0.5, 1.4, -0.4, 2.99] }
+[[disturbances]]
+at = 0.0
+block = { name = "fence3", rect = [1.4, 1.4, 1.5, 2.99] }
+"#,
+        );
+        for r in run_scenario(&s, false) {
+            assert_eq!(r.outcome, Outcome::Failure, "{}", r.policy);
+            assert!(r.reason.starts_with("gave up"), "{}", r.reason);
+        }
+    }
+}

@@ -1,0 +1,1093 @@
+//! Scenario files (SPEC §6): the world, the policies to run (paths relative to
+//! the scenario), the seed, skill failure rates and disturbances at a time or on
+//! a trigger. Read from TOML and validated completely before any run; every
+//! problem is a positioned [`Diagnostic`] (file, line, column, what would be
+//! valid). The format is documented in the README ("Simulator").
+
+use super::skills::{self, Call, Unresolved};
+use super::world::{Layout, Object, P2, Params, Place, Rect, World};
+use crate::diagnostic::{Diagnostic, SourceFile, suggest};
+use crate::format::{self, Limits};
+use crate::model::{Policy, PolicyBody, SkillCall, StateBody, skill::SKILLS};
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
+
+type Val<'i> = Spanned<DeValue<'i>>;
+
+/// A policy of a scenario.
+#[derive(Debug, Clone)]
+pub struct PolicyEntry {
+    /// The file as written in the scenario, resolved against its folder.
+    pub file: PathBuf,
+    /// `Some("hfsm")` when the scenario asks to convert the BT to an HFSM.
+    pub convert: Option<String>,
+    /// The policy as run (converted when asked).
+    pub policy: Policy,
+}
+
+/// When a disturbance fires.
+#[derive(Debug, Clone, PartialEq)]
+pub enum When {
+    /// At this simulated time, s.
+    At(f64),
+    /// This many seconds after the policy first reports that it is done.
+    AfterDone(f64),
+    /// The first step at which every term holds.
+    Holds(Vec<(Call, bool)>),
+}
+
+/// What a disturbance does.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Effect {
+    Battery(f64),
+    Move { object: usize, to: P2 },
+    Drop { object: usize },
+    Fail { skill: String, times: u32 },
+    Block(Rect),
+    Emergency(bool),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disturbance {
+    pub when: When,
+    pub effect: Effect,
+    /// Human text for events and the report.
+    pub text: String,
+}
+
+/// `(probability, level range in percent, time window in s)` of a random
+/// battery drop.
+pub type BatteryDrop = (f64, (f64, f64), (f64, f64));
+
+/// Randomisation of `--runs` episodes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MonteCarlo {
+    /// Extra failure probability per start of a skill.
+    pub rates: BTreeMap<String, f64>,
+    /// `(probability, level range, time window)` of a battery drop.
+    pub battery_drop: Option<BatteryDrop>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    pub name: String,
+    pub description: Option<String>,
+    pub seed: u64,
+    /// Step length, s.
+    pub dt: f64,
+    pub max_steps: u64,
+    /// Action starts (retries of a failed action excepted) without progress
+    /// in the world that count as chattering.
+    pub chatter_switches: u32,
+    /// Action failures without progress after which a run gives up.
+    pub max_failures: u32,
+    pub world: World,
+    pub policies: Vec<PolicyEntry>,
+    pub rates: BTreeMap<String, f64>,
+    pub disturbances: Vec<Disturbance>,
+    /// The task's goal (all terms hold at the end), if given.
+    pub goal: Option<Vec<(Call, bool)>>,
+    pub monte_carlo: MonteCarlo,
+}
+
+/// Reads and validates a scenario and the policies it names.
+pub fn load(path: &Path, limits: &Limits) -> Result<Scenario, Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    // Bounded by --max-file-bytes, pipes and devices included.
+    let file = format::toml::read_source(path, &shown, limits)?;
+    let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    parse(&file, &base, limits)
+}
+
+/// Parses a scenario from a source file; policies resolve against `base`.
+pub fn parse(
+    file: &Arc<SourceFile>,
+    base: &Path,
+    limits: &Limits,
+) -> Result<Scenario, Vec<Diagnostic>> {
+    let mut r = Reader {
+        file: file.clone(),
+        diags: Vec::new(),
+    };
+    let (doc, errors) = DeTable::parse_recoverable(&file.text);
+    if !errors.is_empty() {
+        return Err(errors
+            .iter()
+            .take(20)
+            .map(|e| {
+                Diagnostic::error(format!(
+                    "invalid TOML: {}",
+                    e.message().trim().trim_end_matches('.')
+                ))
+                .at(file, e.span().unwrap_or(0..0))
+                .hint("see the scenario format in the README (Simulator)")
+            })
+            .collect());
+    }
+    let s = r.scenario(doc.get_ref(), base, limits);
+    match s {
+        Some(s) if r.diags.iter().all(|d| !d.is_error()) => Ok(s),
+        _ => {
+            if r.diags.is_empty() {
+                r.diags
+                    .push(Diagnostic::error("invalid scenario").in_file(file));
+            }
+            // The scenario's own problems first, then those of its policies.
+            r.diags.sort_by_key(|d| {
+                (
+                    d.file.as_ref().map(|f| f.path != file.path),
+                    d.file.as_ref().map(|f| f.path.clone()),
+                    d.span.as_ref().map_or(0, |s| s.start),
+                )
+            });
+            Err(r.diags)
+        }
+    }
+}
+
+struct Reader {
+    file: Arc<SourceFile>,
+    diags: Vec<Diagnostic>,
+}
+
+fn num(v: &DeValue<'_>) -> Option<f64> {
+    match v {
+        DeValue::Integer(i) => i64::from_str_radix(&i.as_str().replace('_', ""), i.radix())
+            .ok()
+            .map(|x| x as f64),
+        DeValue::Float(f) => f.as_str().replace('_', "").parse().ok(),
+        _ => None,
+    }
+}
+
+const TOP_KEYS: &[&str] = &[
+    "name",
+    "description",
+    "seed",
+    "dt",
+    "max_steps",
+    "chatter_switches",
+    "max_failures",
+    "goal",
+    "world",
+    "policies",
+    "rates",
+    "disturbances",
+    "monte_carlo",
+];
+
+impl Reader {
+    fn err(&mut self, span: Range<usize>, msg: impl Into<String>, hint: impl Into<String>) {
+        self.diags
+            .push(Diagnostic::error(msg).at(&self.file, span).hint(hint));
+    }
+
+    fn keys(&mut self, t: &DeTable<'_>, allowed: &[&str], what: &str) {
+        for (k, _) in t.iter() {
+            if !allowed.contains(&k.get_ref().as_ref()) {
+                let h = suggest(k.get_ref(), allowed.iter().copied());
+                self.err(k.span(), format!("unknown {what} `{}`", k.get_ref()), h);
+            }
+        }
+    }
+
+    fn number(&mut self, v: &Val<'_>, what: &str, min: f64, max: f64) -> Option<f64> {
+        match num(v.get_ref()) {
+            Some(x) if (min..=max).contains(&x) => Some(x),
+            Some(x) => {
+                self.err(
+                    v.span(),
+                    format!("{what} must be between {min} and {max}, found {x}"),
+                    format!("write a number from {min} to {max}"),
+                );
+                None
+            }
+            None => {
+                self.err(
+                    v.span(),
+                    format!("{what} must be a number"),
+                    "write e.g. `1.5`",
+                );
+                None
+            }
+        }
+    }
+
+    fn string(&mut self, v: &Val<'_>, what: &str) -> Option<String> {
+        match v.get_ref().as_str() {
+            Some(s) => Some(s.to_string()),
+            None => {
+                self.err(
+                    v.span(),
+                    format!("{what} must be a string"),
+                    "write it in quotes",
+                );
+                None
+            }
+        }
+    }
+
+    fn table<'a, 'i>(&mut self, v: &'a Val<'i>, what: &str) -> Option<&'a DeTable<'i>> {
+        match v.get_ref().as_table() {
+            Some(t) => Some(t),
+            None => {
+                self.err(
+                    v.span(),
+                    format!("{what} must be a table"),
+                    "write `{ ... }`",
+                );
+                None
+            }
+        }
+    }
+
+    fn array<'a, 'i>(&mut self, v: &'a Val<'i>, what: &str) -> Option<&'a [Val<'i>]> {
+        match v.get_ref().as_array() {
+            Some(a) => Some(a),
+            None => {
+                self.err(
+                    v.span(),
+                    format!("{what} must be an array"),
+                    "write `[ ... ]`",
+                );
+                None
+            }
+        }
+    }
+
+    /// `[x, y]` numbers.
+    fn point(&mut self, v: &Val<'_>, what: &str) -> Option<P2> {
+        if let Some(a) = v.get_ref().as_array()
+            && a.len() == 2
+            && let (Some(x), Some(y)) = (num(a[0].get_ref()), num(a[1].get_ref()))
+        {
+            return Some((x, y));
+        }
+        self.err(
+            v.span(),
+            format!("{what} must be a position `[x, y]` in metres"),
+            "write e.g. `[0.5, 2.1]`",
+        );
+        None
+    }
+
+    /// A station name or `[x, y]`; checked free of walls and obstacles.
+    fn pose(&mut self, v: &Val<'_>, what: &str, layout: &Layout, radius: f64) -> Option<P2> {
+        let p = match v.get_ref().as_str() {
+            Some(name) => match layout.station(name) {
+                Some(p) => p,
+                None => {
+                    let h = suggest(name, layout.stations.iter().map(|(n, _)| n.as_str()));
+                    self.err(v.span(), format!("unknown station `{name}`"), h);
+                    return None;
+                }
+            },
+            None => self.point(v, what)?,
+        };
+        if let Err(what_hit) = layout.check_free(p, radius) {
+            self.err(
+                v.span(),
+                format!(
+                    "{what} ({}, {}) is inside {what_hit}",
+                    p.0, p.1
+                ),
+                format!(
+                    "the robot (radius {radius} m) must fit inside the room [{}, {}] x [{}, {}] clear of the obstacles",
+                    layout.room.x0, layout.room.x1, layout.room.y0, layout.room.y1
+                ),
+            );
+            return None;
+        }
+        Some(p)
+    }
+
+    fn unresolved(&mut self, span: Range<usize>, u: Unresolved) {
+        self.err(span, u.message, u.hint);
+    }
+
+    /// A condition term `{ if = "Skill", args = {...} }` or `unless`.
+    fn term(&mut self, v: &Val<'_>, world: &World) -> Option<(Call, bool)> {
+        let t = self.table(v, "a condition")?;
+        self.keys(t, &["if", "unless", "args"], "field of a condition");
+        let (neg, c) = match (t.get("if"), t.get("unless")) {
+            (Some(c), None) => (false, c),
+            (None, Some(c)) => (true, c),
+            _ => {
+                self.err(
+                    v.span(),
+                    "a condition needs exactly one of `if` or `unless`",
+                    "write `{ if = \"In-Hand\", args = { object = \"cube2\" } }`",
+                );
+                return None;
+            }
+        };
+        let name = self.string(c, "the condition")?;
+        let mut args = BTreeMap::new();
+        if let Some(a) = t.get("args") {
+            for (k, v) in self.table(a, "`args`")?.iter() {
+                let val = match v.get_ref() {
+                    DeValue::String(s) => crate::model::ArgValue::Str(s.to_string()),
+                    other => match num(other) {
+                        Some(x) => crate::model::ArgValue::Float(x),
+                        None => {
+                            self.err(v.span(), "an argument must be a name or a number", "");
+                            return None;
+                        }
+                    },
+                };
+                args.insert(k.get_ref().to_string(), val);
+            }
+        }
+        if skills::resolve(
+            &SkillCall {
+                skill: name.clone(),
+                args: BTreeMap::new(),
+            },
+            world,
+        )
+        .is_err_and(|u| u.message.starts_with("unknown skill"))
+        {
+            let conds = crate::model::skill::skill_names(crate::model::SkillKind::Condition);
+            self.err(
+                c.span(),
+                format!("unknown condition `{name}`"),
+                suggest(&name, conds),
+            );
+            return None;
+        }
+        match skills::resolve(&SkillCall { skill: name, args }, world) {
+            Ok(call) if !call.is_action() => Some((call, neg)),
+            Ok(call) => {
+                self.err(
+                    c.span(),
+                    format!("`{}` is an action, not a condition", call.name()),
+                    "conditions: Robot-At, In-Hand, Object-At, Battery-Level, Arm-Tucked, Found, No-Emergency",
+                );
+                None
+            }
+            Err(u) => {
+                self.unresolved(v.span(), u);
+                None
+            }
+        }
+    }
+
+    fn terms(&mut self, v: &Val<'_>, world: &World) -> Option<Vec<(Call, bool)>> {
+        let a = self.array(v, "a list of conditions")?;
+        let mut out = Vec::new();
+        for t in a {
+            out.push(self.term(t, world)?);
+        }
+        Some(out)
+    }
+
+    fn world(&mut self, v: Option<&Val<'_>>) -> Option<World> {
+        let mut layout = Layout::paper_room();
+        let mut params = Params::default();
+        let mut robot = layout.station("start").expect("the paper room has a start");
+        let mut objects = Vec::new();
+        let mut battery = 100.0;
+        let Some(v) = v else {
+            return Some(World::new(layout, params, robot, objects));
+        };
+        let t = self.table(v, "`world`")?;
+        self.keys(
+            t,
+            &[
+                "robot",
+                "battery",
+                "params",
+                "obstacles",
+                "stations",
+                "objects",
+            ],
+            "field of `world`",
+        );
+        if let Some(p) = t.get("params") {
+            let pt = self.table(p, "`world.params`")?;
+            const PARAMS: &[&str] = &[
+                "max_speed",
+                "drain_per_m",
+                "drain_per_s",
+                "charge_per_s",
+                "low_battery",
+                "camera_range",
+                "manipulation_s",
+            ];
+            self.keys(pt, PARAMS, "world parameter");
+            for (k, v) in pt.iter() {
+                let Some(x) = self.number(v, &format!("`{}`", k.get_ref()), 0.0, 1000.0) else {
+                    continue;
+                };
+                match k.get_ref().as_ref() {
+                    "max_speed" => params.max_speed = x.max(0.01),
+                    "drain_per_m" => params.drain_per_m = x,
+                    "drain_per_s" => params.drain_per_s = x,
+                    "charge_per_s" => params.charge_per_s = x.max(0.01),
+                    "low_battery" => params.low_battery = x,
+                    "camera_range" => params.camera_range = x,
+                    "manipulation_s" => params.manipulation_s = x,
+                    _ => {}
+                }
+            }
+        }
+        if let Some(o) = t.get("obstacles") {
+            for ob in self.array(o, "`world.obstacles`")?.iter() {
+                if let Some(r) = self.rect(ob) {
+                    layout.obstacles.push(r);
+                }
+            }
+        }
+        if let Some(s) = t.get("stations") {
+            for (k, v) in self.table(s, "`world.stations`")?.iter() {
+                if let Some(p) = self.point(v, "a station") {
+                    let name = k.get_ref().to_string();
+                    match layout.stations.iter_mut().find(|(n, _)| *n == name) {
+                        Some(st) => st.1 = p,
+                        None => layout.stations.push((name, p)),
+                    }
+                }
+            }
+            // Checked after every obstacle is known.
+            for (k, v) in self.table(s, "`world.stations`")?.iter() {
+                let _ = self.pose(
+                    v,
+                    &format!("station `{}`", k.get_ref()),
+                    &layout,
+                    params.robot_radius,
+                );
+            }
+        }
+        if let Some(b) = t.get("battery")
+            && let Some(x) = self.number(b, "`battery`", 0.0, 100.0)
+        {
+            battery = x;
+        }
+        if let Some(rv) = t.get("robot")
+            && let Some(p) = self.pose(rv, "the robot's start", &layout, params.robot_radius)
+        {
+            robot = p;
+        }
+        if let Some(ov) = t.get("objects") {
+            for (k, v) in self.table(ov, "`world.objects`")?.iter() {
+                let name = k.get_ref().to_string();
+                let Some(ot) = self.table(v, &format!("object `{name}`")) else {
+                    continue;
+                };
+                self.keys(ot, &["at", "found"], "field of an object");
+                let Some(at) = ot.get("at") else {
+                    self.err(
+                        v.span(),
+                        format!("object `{name}` needs `at`"),
+                        "write `at = \"east-table\"` or `at = [1.7, 0.0]`",
+                    );
+                    continue;
+                };
+                let Some(p) = self.pose(
+                    at,
+                    &format!("object `{name}`"),
+                    &layout,
+                    params.robot_radius,
+                ) else {
+                    continue;
+                };
+                let found = match ot.get("found") {
+                    Some(f) => match f.get_ref() {
+                        DeValue::Boolean(b) => *b,
+                        _ => {
+                            self.err(f.span(), "`found` must be true or false", "");
+                            true
+                        }
+                    },
+                    None => true,
+                };
+                objects.push(Object {
+                    name,
+                    place: Place::At(p),
+                    found,
+                });
+            }
+        }
+        let mut w = World::new(layout, params, robot, objects);
+        w.battery = battery;
+        Some(w)
+    }
+
+    fn rect(&mut self, v: &Val<'_>) -> Option<Rect> {
+        let t = self.table(v, "an obstacle")?;
+        self.keys(t, &["name", "rect"], "field of an obstacle");
+        let name = match t.get("name") {
+            Some(n) => self.string(n, "`name`")?,
+            None => "obstacle".into(),
+        };
+        let Some(rv) = t.get("rect") else {
+            self.err(v.span(), "an obstacle needs `rect = [x0, y0, x1, y1]`", "");
+            return None;
+        };
+        let nums: Vec<f64> = rv
+            .get_ref()
+            .as_array()
+            .map(|a| a.iter().filter_map(|x| num(x.get_ref())).collect())
+            .unwrap_or_default();
+        if nums.len() != 4 || nums[0] == nums[2] || nums[1] == nums[3] {
+            self.err(
+                rv.span(),
+                "`rect` must be four numbers `[x0, y0, x1, y1]` with x0 != x1 and y0 != y1",
+                "write e.g. `rect = [-0.5, 1.2, 0.5, 1.4]`",
+            );
+            return None;
+        }
+        Some(Rect::new(&name, nums[0], nums[1], nums[2], nums[3]))
+    }
+
+    fn skill_name(&mut self, v: &Val<'_>) -> Option<String> {
+        let s = self.string(v, "the skill")?;
+        if SKILLS.iter().any(|(n, _, _)| *n == s) {
+            Some(s)
+        } else {
+            let h = suggest(&s, SKILLS.iter().map(|(n, _, _)| *n));
+            self.err(v.span(), format!("unknown skill `{s}`"), h);
+            None
+        }
+    }
+
+    fn rates(&mut self, v: &Val<'_>) -> Option<BTreeMap<String, f64>> {
+        let t = self.table(v, "`rates`")?;
+        let mut out = BTreeMap::new();
+        for (k, v) in t.iter() {
+            let name = k.get_ref().to_string();
+            if !SKILLS.iter().any(|(n, _, _)| *n == name) {
+                let h = suggest(&name, SKILLS.iter().map(|(n, _, _)| *n));
+                self.err(k.span(), format!("unknown skill `{name}`"), h);
+                continue;
+            }
+            if let Some(p) = self.number(v, &format!("the failure rate of `{name}`"), 0.0, 1.0) {
+                out.insert(name, p);
+            }
+        }
+        Some(out)
+    }
+
+    fn disturbance(&mut self, v: &Val<'_>, world: &World) -> Option<Disturbance> {
+        let t = self.table(v, "a disturbance")?;
+        self.keys(
+            t,
+            &[
+                "at",
+                "after_done",
+                "when",
+                "battery",
+                "move",
+                "to",
+                "drop",
+                "fail",
+                "times",
+                "block",
+                "emergency",
+            ],
+            "field of a disturbance",
+        );
+        let whens: Vec<&str> = ["at", "after_done", "when"]
+            .into_iter()
+            .filter(|k| t.contains_key(*k))
+            .collect();
+        if whens.len() != 1 {
+            self.err(
+                v.span(),
+                "a disturbance needs exactly one trigger: `at`, `after_done` or `when`",
+                "write `at = 12.0` (seconds), `after_done = 2.0` or `when = [{ if = \"In-Hand\", args = { object = \"cube2\" } }]`",
+            );
+            return None;
+        }
+        let when = match whens[0] {
+            "at" => When::At(self.number(t.get("at").expect("checked above"), "`at`", 0.0, 1e9)?),
+            "after_done" => When::AfterDone(self.number(
+                t.get("after_done").expect("checked above"),
+                "`after_done`",
+                0.0,
+                1e9,
+            )?),
+            _ => When::Holds(self.terms(t.get("when").expect("checked above"), world)?),
+        };
+        let effects: Vec<&str> = ["battery", "move", "drop", "fail", "block", "emergency"]
+            .into_iter()
+            .filter(|k| t.contains_key(*k))
+            .collect();
+        if effects.len() != 1 {
+            self.err(
+                v.span(),
+                "a disturbance needs exactly one effect: `battery`, `move`, `drop`, `fail`, `block` or `emergency`",
+                "write e.g. `battery = 15` or `move = \"cube2\", to = \"east-table\"`",
+            );
+            return None;
+        }
+        let obj = |r: &mut Self, key: &str| -> Option<usize> {
+            let v = &t[key];
+            let name = r.string(v, &format!("`{key}`"))?;
+            match world.object_index(&name) {
+                Some(i) => Some(i),
+                None => {
+                    let h = suggest(&name, world.objects.iter().map(|o| o.name.as_str()));
+                    r.err(v.span(), format!("unknown object `{name}`"), h);
+                    None
+                }
+            }
+        };
+        let (effect, text) = match effects[0] {
+            "battery" => {
+                let b = self.number(
+                    t.get("battery").expect("checked above"),
+                    "`battery`",
+                    0.0,
+                    100.0,
+                )?;
+                (Effect::Battery(b), format!("battery set to {b}%"))
+            }
+            "move" => {
+                let o = obj(self, "move")?;
+                let Some(to) = t.get("to") else {
+                    self.err(
+                        v.span(),
+                        "`move` needs `to`",
+                        "write `to = \"east-table\"` or `to = [1.7, 0.0]`",
+                    );
+                    return None;
+                };
+                let p = self.pose(
+                    to,
+                    "the new place",
+                    &world.layout,
+                    world.params.robot_radius,
+                )?;
+                (
+                    Effect::Move { object: o, to: p },
+                    format!("{} moved to ({}, {})", world.objects[o].name, p.0, p.1),
+                )
+            }
+            "drop" => {
+                let o = obj(self, "drop")?;
+                (
+                    Effect::Drop { object: o },
+                    format!("{} dropped", world.objects[o].name),
+                )
+            }
+            "fail" => {
+                let s = self.skill_name(t.get("fail").expect("checked above"))?;
+                let n = match t.get("times") {
+                    Some(n) => self.number(n, "`times`", 1.0, 1e6)? as u32,
+                    None => 1,
+                };
+                (
+                    Effect::Fail {
+                        skill: s.clone(),
+                        times: n,
+                    },
+                    format!(
+                        "{s} fails the next {n} time{}",
+                        if n == 1 { "" } else { "s" }
+                    ),
+                )
+            }
+            "block" => {
+                let r = self.rect(t.get("block").expect("checked above"))?;
+                let text = format!("path blocked by {}", r.name);
+                (Effect::Block(r), text)
+            }
+            _ => match t.get("emergency").expect("checked above").get_ref() {
+                DeValue::Boolean(b) => (
+                    Effect::Emergency(*b),
+                    if *b {
+                        "emergency".into()
+                    } else {
+                        "emergency over".into()
+                    },
+                ),
+                _ => {
+                    self.err(
+                        t.get("emergency").expect("checked above").span(),
+                        "`emergency` must be true or false",
+                        "",
+                    );
+                    return None;
+                }
+            },
+        };
+        Some(Disturbance { when, effect, text })
+    }
+
+    fn scenario(&mut self, t: &DeTable<'_>, base: &Path, limits: &Limits) -> Option<Scenario> {
+        self.keys(t, TOP_KEYS, "top-level key");
+        let name = match t.get("name") {
+            Some(n) => self.string(n, "`name`")?,
+            None => Path::new(&self.file.path)
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        };
+        let description = match t.get("description") {
+            Some(d) => self.string(d, "`description`"),
+            None => None,
+        };
+        let seed = t
+            .get("seed")
+            .and_then(|v| self.number(v, "`seed`", 0.0, 9.0e15))
+            .unwrap_or(1.0) as u64;
+        let dt = t
+            .get("dt")
+            .and_then(|v| self.number(v, "`dt`", 0.001, 10.0))
+            .unwrap_or(0.1);
+        let max_steps = t
+            .get("max_steps")
+            .and_then(|v| self.number(v, "`max_steps`", 1.0, 1e6))
+            .unwrap_or(20_000.0) as u64;
+        let chatter_switches = t
+            .get("chatter_switches")
+            .and_then(|v| self.number(v, "`chatter_switches`", 2.0, 1e6))
+            .unwrap_or(12.0) as u32;
+        let max_failures = t
+            .get("max_failures")
+            .and_then(|v| self.number(v, "`max_failures`", 1.0, 1e6))
+            .unwrap_or(50.0) as u32;
+        let world = self.world(t.get("world"))?;
+        let rates = match t.get("rates") {
+            Some(r) => self.rates(r)?,
+            None => BTreeMap::new(),
+        };
+        let goal = match t.get("goal") {
+            Some(g) => Some(self.terms(g, &world)?),
+            None => None,
+        };
+        let mut disturbances = Vec::new();
+        if let Some(d) = t.get("disturbances") {
+            for x in self.array(d, "`disturbances`")? {
+                if let Some(d) = self.disturbance(x, &world) {
+                    disturbances.push(d);
+                }
+            }
+        }
+        let mut monte_carlo = MonteCarlo::default();
+        if let Some(m) = t.get("monte_carlo") {
+            let mt = self.table(m, "`monte_carlo`")?;
+            self.keys(mt, &["rates", "battery_drop"], "field of `monte_carlo`");
+            if let Some(r) = mt.get("rates") {
+                monte_carlo.rates = self.rates(r)?;
+            }
+            if let Some(b) = mt.get("battery_drop") {
+                let bt = self.table(b, "`battery_drop`")?;
+                self.keys(
+                    bt,
+                    &["probability", "level", "window"],
+                    "field of `battery_drop`",
+                );
+                let p = bt
+                    .get("probability")
+                    .and_then(|v| self.number(v, "`probability`", 0.0, 1.0))
+                    .unwrap_or(0.5);
+                let level = bt
+                    .get("level")
+                    .and_then(|v| self.point(v, "`level`"))
+                    .unwrap_or((5.0, 19.0));
+                let window = bt
+                    .get("window")
+                    .and_then(|v| self.point(v, "`window`"))
+                    .unwrap_or((5.0, 60.0));
+                monte_carlo.battery_drop = Some((p, level, window));
+            }
+        }
+        let mut policies = Vec::new();
+        match t.get("policies") {
+            None => self.err(
+                0..0,
+                "a scenario needs at least one policy",
+                "add `[[policies]]` with `file = \"../paper/fig01-bt.toml\"`",
+            ),
+            Some(p) => {
+                for e in self.array(p, "`policies`")? {
+                    if let Some(pe) = self.policy(e, base, limits, &world) {
+                        policies.push(pe);
+                    }
+                }
+            }
+        }
+        Some(Scenario {
+            name,
+            description,
+            seed,
+            dt,
+            max_steps,
+            chatter_switches,
+            max_failures,
+            world,
+            policies,
+            rates,
+            disturbances,
+            goal,
+            monte_carlo,
+        })
+    }
+
+    fn policy(
+        &mut self,
+        v: &Val<'_>,
+        base: &Path,
+        limits: &Limits,
+        world: &World,
+    ) -> Option<PolicyEntry> {
+        let t = self.table(v, "a policy entry")?;
+        self.keys(t, &["file", "convert"], "field of a policy entry");
+        let Some(f) = t.get("file") else {
+            self.err(
+                v.span(),
+                "a policy entry needs `file`",
+                "write `file = \"../paper/fig01-bt.toml\"` (relative to the scenario)",
+            );
+            return None;
+        };
+        let rel = self.string(f, "`file`")?;
+        let path = base.join(&rel);
+        let convert = match t.get("convert") {
+            None => None,
+            Some(c) => match c.get_ref().as_str() {
+                Some("hfsm") => Some("hfsm".to_string()),
+                _ => {
+                    self.err(c.span(), "`convert` must be \"hfsm\"", "write `convert = \"hfsm\"` to run the BT converted to an HFSM (Fig. 5 -> Fig. 6)");
+                    return None;
+                }
+            },
+        };
+        if !path.is_file() {
+            self.err(
+                f.span(),
+                format!("policy file `{rel}` not found"),
+                format!(
+                    "paths are relative to the scenario's folder (`{}`)",
+                    base.display()
+                ),
+            );
+            return None;
+        }
+        let loaded = match format::load(&path, limits) {
+            Ok(l) => l,
+            Err(d) => {
+                self.diags.extend(d);
+                return None;
+            }
+        };
+        let mut policy = loaded.policy;
+        if convert.is_some() {
+            if !matches!(policy.body, PolicyBody::Bt(_)) {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` is not a BT and cannot be converted"),
+                    "remove `convert`",
+                );
+                return None;
+            }
+            match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
+                Ok(p) => policy = p,
+                Err(e) => {
+                    self.err(
+                        f.span(),
+                        e[0].to_string(),
+                        "only sequence, fallback and simple decorators convert",
+                    );
+                    return None;
+                }
+            }
+        }
+        check_bindings(&policy, &loaded.path, world, &mut self.diags);
+        Some(PolicyEntry {
+            file: path,
+            convert,
+            policy,
+        })
+    }
+}
+
+/// Span of the line `key = ...` (bare or quoted key) in a TOML text.
+fn key_span(text: &str, key: &str) -> Option<Range<usize>> {
+    let mut off = 0;
+    for line in text.split_inclusive('\n') {
+        let t = line.trim_start();
+        let lead = line.len() - t.len();
+        for k in [key.to_string(), format!("\"{key}\"")] {
+            if let Some(rest) = t.strip_prefix(&k)
+                && rest.trim_start().starts_with('=')
+            {
+                return Some(off + lead..off + lead + k.len());
+            }
+        }
+        off += line.len();
+    }
+    None
+}
+
+/// Checks that every binding of a policy runs in the world: positioned in the
+/// policy file at the node or state.
+pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Diagnostic>) {
+    let src = std::fs::read_to_string(path)
+        .map(|t| SourceFile::new(path, t))
+        .ok();
+    let mut push = |what: String, span: Option<Range<usize>>, u: Unresolved| {
+        let mut d = Diagnostic::error(format!("{} in {what}", u.message)).hint(u.hint);
+        if let Some(f) = &src {
+            d = match span {
+                Some(s) => d.at(f, s),
+                None => d.in_file(f),
+            };
+        }
+        diags.push(d);
+    };
+    match &p.body {
+        PolicyBody::Bt(bt) => {
+            for n in &bt.nodes {
+                if n.kind.arity() != crate::model::bt::Arity::Leaf {
+                    continue;
+                }
+                // Nodes of an included subtree (`include/...`) have spans in
+                // the included file: point at the include in this file.
+                let span = match n.id.split_once('/') {
+                    None => n.span.clone(),
+                    Some((inc, _)) => src.as_ref().and_then(|f| key_span(&f.text, inc)),
+                };
+                match &n.skill {
+                    Some(c) => {
+                        if let Err(u) = skills::resolve(c, world) {
+                            push(format!("node `{}`", n.id), span, u);
+                        }
+                    }
+                    None => push(
+                        format!("node `{}`", n.id),
+                        span,
+                        Unresolved {
+                            message: "no skill binding".into(),
+                            hint: "the simulator needs `skill = \"...\"` on every leaf".into(),
+                        },
+                    ),
+                }
+            }
+        }
+        PolicyBody::Machine(m) => {
+            for (i, s) in m.states.iter().enumerate() {
+                let mut calls: Vec<&SkillCall> = Vec::new();
+                match &s.body {
+                    StateBody::Task(Some(c)) => calls.push(c),
+                    StateBody::Task(None) => push(
+                        format!("state `{}`", m.path(i)),
+                        s.span.clone(),
+                        Unresolved {
+                            message: "no skill binding".into(),
+                            hint: "the simulator needs `skill = \"...\"` on every state that is not a decision or container".into(),
+                        },
+                    ),
+                    _ => {}
+                }
+                for t in &s.transitions {
+                    if let crate::model::Trigger::Guard(g) = &t.trigger {
+                        calls.extend(g.all.iter().map(|x| &x.condition));
+                    }
+                }
+                for c in calls {
+                    if let Err(u) = skills::resolve(c, world) {
+                        push(format!("state `{}`", m.path(i)), s.span.clone(), u);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_text(text: &str) -> Result<Scenario, Vec<Diagnostic>> {
+        let f = SourceFile::new("s.toml", text);
+        parse(&f, Path::new("policies/scenarios"), &Limits::default())
+    }
+
+    #[test]
+    fn reads_a_scenario() {
+        let s = parse_text(
+            r#"
+seed = 3
+[world]
+robot = "start"
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[disturbances]]
+at = 4.0
+battery = 15
+"#,
+        )
+        .unwrap();
+        assert_eq!(s.seed, 3);
+        assert_eq!(s.policies.len(), 1);
+        assert_eq!(s.disturbances[0].effect, Effect::Battery(15.0));
+    }
+
+    #[test]
+    fn reports_unknown_names_and_poses_in_walls() {
+        let e = parse_text(
+            r#"
+[world]
+robot = [3.5, 0.0]
+objects = { cube2 = { at = "east-tabel" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[disturbances]]
+at = 1.0
+fail = "Pik"
+"#,
+        )
+        .unwrap_err();
+        let text: Vec<String> = e.iter().map(|d| d.to_string()).collect();
+        let all = text.join("");
+        assert!(all.contains("inside a wall"), "{all}");
+        assert!(all.contains("unknown station `east-tabel`"), "{all}");
+        assert!(all.contains("did you mean `east-table`?"), "{all}");
+        assert!(all.contains("unknown skill `Pik`"), "{all}");
+    }
+
+    #[test]
+    fn policy_errors_in_included_subtrees_point_at_the_include() {
+        let e = parse_text(
+            r#"
+[world]
+objects = { cube1 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig16a-bt.toml"
+"#,
+        )
+        .unwrap_err();
+        let first = e[0].to_string();
+        assert!(
+            first.contains("unknown object `cube2` in node `moma2/"),
+            "{first}"
+        );
+        assert!(first.contains("moma2         = { subtree"), "{first}");
+        assert_eq!(key_span("a = 1\n  \"b c\" = 2\n", "b c"), Some(8..13));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config::with_cases(64))]
+        /// Random edits of a valid scenario never panic: they parse or give
+        /// positioned errors.
+        #[test]
+        fn mutated_scenarios_never_panic(cut in 0usize..400, junk in "[a-z\\[\\]{}=\",0-9. ]{0,12}") {
+            let base = "seed = 1\n[world]\nrobot = [0.5, -1.5]\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"../paper/fig01-bt.toml\"\n[[disturbances]]\nat = 2.0\nmove = \"cube2\"\nto = [1.0, -1.0]\n";
+            let cut = cut.min(base.len());
+            let cut = (0..=cut).rev().find(|&i| base.is_char_boundary(i)).unwrap_or(0);
+            let text = format!("{}{junk}{}", &base[..cut], &base[cut..]);
+            match parse_text(&text) {
+                Ok(s) => proptest::prop_assert!(!s.policies.is_empty()),
+                Err(d) => proptest::prop_assert!(d.iter().any(|x| x.is_error())),
+            }
+        }
+    }
+}

@@ -1,0 +1,302 @@
+//! What a run records (SPEC §6): per step the time, pose, battery, running skills
+//! and node/state statuses; the executed skills with arguments and outcomes;
+//! events; the final world; the outcome. Also the behavior-match verdict between
+//! two runs: equal ordered sequence of executed skills (with arguments and
+//! outcomes) and equal final world, with the first divergence and the trajectory
+//! distance (discrete Fréchet distance, Eiter and Mannila 1994).
+
+use super::world::{P2, Place, World, dist};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// One execution of an action skill.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SkillRecord {
+    pub skill: String,
+    pub args: BTreeMap<String, String>,
+    /// `success`, `failure`, `cancelled` (preempted), or `running` at the end.
+    pub outcome: String,
+    pub start: f64,
+    pub end: Option<f64>,
+}
+
+impl SkillRecord {
+    /// `Pick(object=cube2) -> success`.
+    pub fn text(&self) -> String {
+        let args: Vec<String> = self.args.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        format!("{}({}) -> {}", self.skill, args.join(", "), self.outcome)
+    }
+
+    fn same(&self, o: &SkillRecord) -> bool {
+        self.skill == o.skill && self.args == o.args && self.outcome == o.outcome
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Event {
+    pub t: f64,
+    /// `start`, `end`, `battery-low`, `disturbance`, `done`, `chattering`, ...
+    pub kind: String,
+    pub text: String,
+    pub x: f64,
+    pub y: f64,
+}
+
+/// One step of a trace.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Step {
+    pub t: f64,
+    pub x: f64,
+    pub y: f64,
+    pub yaw: f64,
+    pub battery: f64,
+    /// Action skills running after the step.
+    pub running: Vec<String>,
+    /// Node id (BT) or state path (FSM/HFSM) of everything ticked in the step,
+    /// with its status.
+    pub statuses: Vec<(String, String)>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObjectState {
+    pub x: f64,
+    pub y: f64,
+    /// The station the object is at, if any.
+    pub at: Option<String>,
+    pub held: bool,
+    pub found: bool,
+}
+
+/// The world at the end of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FinalWorld {
+    pub robot: [f64; 2],
+    /// The station the robot is at, if any.
+    pub robot_at: Option<String>,
+    pub battery: f64,
+    pub holding: Option<String>,
+    pub arm_tucked: bool,
+    pub shut_down: bool,
+    pub objects: BTreeMap<String, ObjectState>,
+}
+
+fn cm(x: f64) -> f64 {
+    (x * 100.0).round() / 100.0
+}
+
+impl FinalWorld {
+    pub fn of(w: &World) -> Self {
+        FinalWorld {
+            robot: [cm(w.robot.0), cm(w.robot.1)],
+            robot_at: w.robot_station().map(str::to_string),
+            battery: (w.battery * 10.0).round() / 10.0,
+            holding: w.held().map(|i| w.objects[i].name.clone()),
+            arm_tucked: w.arm_tucked,
+            shut_down: w.shut_down,
+            objects: w
+                .objects
+                .iter()
+                .enumerate()
+                .map(|(i, o)| {
+                    let p = w.object_pos(i);
+                    (
+                        o.name.clone(),
+                        ObjectState {
+                            x: cm(p.0),
+                            y: cm(p.1),
+                            at: w.object_station(i).map(str::to_string),
+                            held: o.place == Place::Held,
+                            found: o.found,
+                        },
+                    )
+                })
+                .collect(),
+        }
+    }
+
+    /// The discrete state compared by the verdict: where each object is (its
+    /// station, or its position to the centimetre), what is held, the arm, the
+    /// robot's station (or position to the centimetre). The battery level is
+    /// reported but not compared (it depends on timing to the step).
+    pub fn same_state(&self, o: &FinalWorld) -> bool {
+        type Key = (String, Option<String>, bool, bool, Option<[f64; 2]>);
+        let objs = |f: &FinalWorld| -> Vec<Key> {
+            f.objects
+                .iter()
+                .map(|(n, s)| {
+                    (
+                        n.clone(),
+                        s.at.clone(),
+                        s.held,
+                        s.found,
+                        s.at.is_none().then_some([s.x, s.y]),
+                    )
+                })
+                .collect()
+        };
+        let robot = |f: &FinalWorld| match &f.robot_at {
+            Some(s) => (Some(s.clone()), None),
+            None => (None, Some(f.robot)),
+        };
+        objs(self) == objs(o)
+            && self.holding == o.holding
+            && self.arm_tucked == o.arm_tucked
+            && self.shut_down == o.shut_down
+            && robot(self) == robot(o)
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outcome {
+    /// The policy reported SUCCESS (BT root, machine outcome `SUCCESS`).
+    Success,
+    /// The machine ended with another outcome, or the run gave up after too
+    /// many failed actions without progress.
+    Failure,
+    /// Switched between actions without progress (the paper's Fig. 3).
+    Chattering,
+    /// The step budget ran out.
+    Timeout,
+}
+
+impl Outcome {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Outcome::Success => "success",
+            Outcome::Failure => "failure",
+            Outcome::Chattering => "chattering",
+            Outcome::Timeout => "timeout",
+        }
+    }
+}
+
+/// Everything a run records.
+#[derive(Debug, Clone, Serialize)]
+pub struct Run {
+    pub policy: String,
+    pub file: String,
+    pub kind: String,
+    pub convert: Option<String>,
+    pub outcome: Outcome,
+    pub reason: String,
+    /// Whether the scenario's goal holds at the end (`None`: no goal given).
+    pub goal_met: Option<bool>,
+    pub steps: u64,
+    /// Time at which the policy last reported it was done, s.
+    pub completion_s: Option<f64>,
+    pub duration_s: f64,
+    pub distance_m: f64,
+    pub skills: Vec<SkillRecord>,
+    pub events: Vec<Event>,
+    pub final_world: FinalWorld,
+    /// Latencies from a battery-low event to the start of Recharge, s.
+    pub recharge_latency_s: Vec<f64>,
+    #[serde(skip)]
+    pub trajectory: Vec<P2>,
+    #[serde(skip)]
+    pub trace: Vec<Step>,
+}
+
+/// Where two runs first differ.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Divergence {
+    /// Index in the executed-skill lists.
+    pub index: usize,
+    pub a: Option<String>,
+    pub b: Option<String>,
+}
+
+/// The behavior-match verdict between two runs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    pub a: String,
+    pub b: String,
+    #[serde(rename = "match")]
+    pub matches: bool,
+    pub same_skills: bool,
+    pub same_final_world: bool,
+    pub first_divergence: Option<Divergence>,
+    /// Discrete Fréchet distance between the two trajectories, m.
+    pub trajectory_distance_m: f64,
+}
+
+pub fn verdict(a: &Run, b: &Run) -> Verdict {
+    let n = a.skills.len().max(b.skills.len());
+    let first = (0..n).find(|&i| match (a.skills.get(i), b.skills.get(i)) {
+        (Some(x), Some(y)) => !x.same(y),
+        _ => true,
+    });
+    let same_world = a.final_world.same_state(&b.final_world);
+    Verdict {
+        a: a.policy.clone(),
+        b: b.policy.clone(),
+        matches: first.is_none() && same_world,
+        same_skills: first.is_none(),
+        same_final_world: same_world,
+        first_divergence: first.map(|i| Divergence {
+            index: i,
+            a: a.skills.get(i).map(SkillRecord::text),
+            b: b.skills.get(i).map(SkillRecord::text),
+        }),
+        trajectory_distance_m: (frechet(&a.trajectory, &b.trajectory) * 1000.0).round() / 1000.0,
+    }
+}
+
+/// Keeps the points where the robot moved, at most `max` of them.
+fn thin(p: &[P2], max: usize) -> Vec<P2> {
+    let mut out: Vec<P2> = Vec::new();
+    for &q in p {
+        if out.last().is_none_or(|&l| dist(l, q) > 1e-6) {
+            out.push(q);
+        }
+    }
+    if out.len() > max {
+        let stride = out.len().div_ceil(max);
+        let last = *out.last().expect("non-empty");
+        out = out.into_iter().step_by(stride).collect();
+        out.push(last);
+    }
+    out
+}
+
+/// Discrete Fréchet distance (rolling rows, O(n m) time, O(m) memory).
+pub fn frechet(a: &[P2], b: &[P2]) -> f64 {
+    let (a, b) = (thin(a, 3000), thin(b, 3000));
+    if a.is_empty() || b.is_empty() {
+        return 0.0;
+    }
+    let mut prev = vec![0.0f64; b.len()];
+    let mut cur = vec![0.0f64; b.len()];
+    for (i, &p) in a.iter().enumerate() {
+        for (j, &q) in b.iter().enumerate() {
+            let d = dist(p, q);
+            cur[j] = match (i, j) {
+                (0, 0) => d,
+                (0, _) => cur[j - 1].max(d),
+                (_, 0) => prev[0].max(d),
+                _ => prev[j].min(prev[j - 1]).min(cur[j - 1]).max(d),
+            };
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    prev[b.len() - 1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frechet_of_shifted_paths() {
+        let a: Vec<P2> = (0..10).map(|i| (i as f64, 0.0)).collect();
+        let b: Vec<P2> = (0..10).map(|i| (i as f64, 1.0)).collect();
+        assert!((frechet(&a, &b) - 1.0).abs() < 1e-12);
+        assert_eq!(frechet(&a, &a), 0.0);
+        // Waiting in place does not change the distance.
+        let mut c = a.clone();
+        c.insert(3, (3.0, 0.0));
+        assert_eq!(frechet(&a, &c), 0.0);
+    }
+}

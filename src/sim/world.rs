@@ -1,0 +1,656 @@
+//! The planar world of the simulator (SPEC §6), modelled on the room of the
+//! paper's Experiments 1-5 (sec. V, Fig. 17): walls, tables as rectangular
+//! obstacles, named station poses (delivery (0.5, 2.1), charging (0.5, -2.0),
+//! inspection (-1.0, -1.0), the fetch tables), five search waypoints and cubes
+//! on the tables. The robot is a holonomic disc with a speed limit, a gripper
+//! holding at most one object, an arm that is tucked or not, a camera with a
+//! range, and a battery that drains with distance and time.
+//!
+//! Navigation plans on an occupancy grid (obstacles inflated by the robot's
+//! radius) with A* (Hart, Nilsson and Raphael 1968) and shortens the grid path
+//! by line-of-sight checks against the exact rectangles ("string pulling").
+//!
+//! An object's position is the pose from which the robot grasps it (the near
+//! edge of its table); "at a station" means within [`World::station_radius`].
+
+use std::collections::BinaryHeap;
+use std::sync::Arc;
+
+/// A point or pose position in metres.
+pub type P2 = (f64, f64);
+
+pub fn dist(a: P2, b: P2) -> f64 {
+    ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt()
+}
+
+/// An axis-aligned rectangle `[x0, y0, x1, y1]` (x0 < x1, y0 < y1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rect {
+    pub name: String,
+    pub x0: f64,
+    pub y0: f64,
+    pub x1: f64,
+    pub y1: f64,
+}
+
+impl Rect {
+    pub fn new(name: &str, x0: f64, y0: f64, x1: f64, y1: f64) -> Self {
+        Rect {
+            name: name.into(),
+            x0: x0.min(x1),
+            y0: y0.min(y1),
+            x1: x0.max(x1),
+            y1: y0.max(y1),
+        }
+    }
+
+    fn inflated(&self, r: f64) -> Rect {
+        Rect {
+            name: self.name.clone(),
+            x0: self.x0 - r,
+            y0: self.y0 - r,
+            x1: self.x1 + r,
+            y1: self.y1 + r,
+        }
+    }
+
+    fn contains(&self, p: P2) -> bool {
+        p.0 > self.x0 && p.0 < self.x1 && p.1 > self.y0 && p.1 < self.y1
+    }
+
+    /// Does the segment a-b pass through the open rectangle (slab method)?
+    fn hits_segment(&self, a: P2, b: P2) -> bool {
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for (p, d, lo, hi) in [(a.0, dx, self.x0, self.x1), (a.1, dy, self.y0, self.y1)] {
+            if d.abs() < 1e-12 {
+                if p <= lo || p >= hi {
+                    return false;
+                }
+            } else {
+                let (mut ta, mut tb) = ((lo - p) / d, (hi - p) / d);
+                if ta > tb {
+                    std::mem::swap(&mut ta, &mut tb);
+                }
+                t0 = t0.max(ta);
+                t1 = t1.min(tb);
+                if t0 >= t1 {
+                    return false;
+                }
+            }
+        }
+        t1 - t0 > 1e-9
+    }
+}
+
+/// Where an object is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Place {
+    At(P2),
+    /// In the robot's gripper.
+    Held,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    pub name: String,
+    pub place: Place,
+    /// Seen by the camera (or known from the start).
+    pub found: bool,
+}
+
+/// Physical constants of a world (defaults: the paper's room and a TIAGo-like
+/// base).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Params {
+    /// Robot radius (obstacles are inflated by it), m.
+    pub robot_radius: f64,
+    /// Top speed of Move-To, m/s (Safe-Move-To and Dock go at half of it).
+    pub max_speed: f64,
+    /// Battery drain per metre driven, percent.
+    pub drain_per_m: f64,
+    /// Battery drain per second, percent.
+    pub drain_per_s: f64,
+    /// Charging rate at the charging station, percent per second.
+    pub charge_per_s: f64,
+    /// Battery level at or below which the "battery low" event is logged.
+    pub low_battery: f64,
+    /// Camera range for Search, m.
+    pub camera_range: f64,
+    /// Distance within which an object counts as at a station, m.
+    pub station_radius: f64,
+    /// Distance within which the robot counts as at a target, m.
+    pub at_tolerance: f64,
+    /// Duration of Pick and Place, s.
+    pub manipulation_s: f64,
+    /// Duration of Tuck-Arm and Shut-Down, s.
+    pub arm_s: f64,
+    /// Planner grid resolution, m.
+    pub grid: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            robot_radius: 0.2,
+            max_speed: 0.5,
+            drain_per_m: 1.0,
+            drain_per_s: 0.05,
+            charge_per_s: 20.0,
+            low_battery: 20.0,
+            camera_range: 1.6,
+            station_radius: 0.3,
+            at_tolerance: 0.02,
+            manipulation_s: 1.5,
+            arm_s: 0.5,
+            grid: 0.1,
+        }
+    }
+}
+
+/// The static layout: room, obstacles, stations, waypoints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    /// The room's inner walls `[x0, y0, x1, y1]`.
+    pub room: Rect,
+    pub obstacles: Vec<Rect>,
+    /// Named poses, in order (delivery, charging, inspection, tables...).
+    pub stations: Vec<(String, P2)>,
+    /// Search waypoints, visited in order.
+    pub waypoints: Vec<P2>,
+}
+
+impl Layout {
+    /// The paper's room (SPEC §6): a 6 m x 6 m room with a central table, two
+    /// fetch tables, the delivery table, the charger and the inspection table.
+    pub fn paper_room() -> Self {
+        Layout {
+            room: Rect::new("room", -3.0, -3.0, 3.0, 3.0),
+            obstacles: vec![
+                Rect::new("central table", -0.8, 0.4, 0.8, 1.0),
+                Rect::new("east table", 2.0, -1.2, 2.6, 1.0),
+                Rect::new("west table", -2.6, 0.2, -2.0, 2.0),
+                Rect::new("delivery table", 0.1, 2.4, 0.9, 2.9),
+                Rect::new("charger", 0.3, -2.9, 0.7, -2.4),
+                Rect::new("inspection table", -1.7, -1.4, -1.3, -0.6),
+            ],
+            stations: vec![
+                ("delivery".into(), (0.5, 2.1)),
+                ("charging".into(), (0.5, -2.0)),
+                ("inspection".into(), (-1.0, -1.0)),
+                ("east-table".into(), (1.7, 0.0)),
+                ("west-table".into(), (-1.7, 1.1)),
+                ("central-table".into(), (0.0, 0.1)),
+                ("start".into(), (-2.0, -2.2)),
+            ],
+            waypoints: vec![
+                (-1.0, -2.0),
+                (1.4, -1.6),
+                (1.2, 1.4),
+                (-0.9, 1.6),
+                (-1.2, 0.0),
+            ],
+        }
+    }
+
+    pub fn station(&self, name: &str) -> Option<P2> {
+        self.stations
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, p)| *p)
+    }
+
+    /// Is a robot centred at `p` clear of walls and obstacles? `Err` names what
+    /// it collides with.
+    pub fn check_free(&self, p: P2, radius: f64) -> Result<(), String> {
+        let r = &self.room;
+        if p.0 - radius < r.x0 || p.0 + radius > r.x1 || p.1 - radius < r.y0 || p.1 + radius > r.y1
+        {
+            return Err("a wall".into());
+        }
+        match self
+            .obstacles
+            .iter()
+            .find(|o| o.inflated(radius).contains(p))
+        {
+            Some(o) => Err(format!("the {}", o.name)),
+            None => Ok(()),
+        }
+    }
+}
+
+/// An occupancy grid with A* planning, shared (read-only) by the copies of a
+/// world until an obstacle is added.
+#[derive(Debug, Clone)]
+pub struct Planner {
+    origin: P2,
+    res: f64,
+    w: usize,
+    h: usize,
+    free: Vec<bool>,
+    /// Obstacles inflated by the robot radius (for line-of-sight checks).
+    inflated: Vec<Rect>,
+    walls: Rect,
+}
+
+impl Planner {
+    pub fn new(layout: &Layout, p: &Params) -> Self {
+        let r = &layout.room;
+        let res = p.grid;
+        let w = ((r.x1 - r.x0) / res).ceil() as usize;
+        let h = ((r.y1 - r.y0) / res).ceil() as usize;
+        let inflated: Vec<Rect> = layout
+            .obstacles
+            .iter()
+            .map(|o| o.inflated(p.robot_radius))
+            .collect();
+        let walls = Rect::new(
+            "walls",
+            r.x0 + p.robot_radius,
+            r.y0 + p.robot_radius,
+            r.x1 - p.robot_radius,
+            r.y1 - p.robot_radius,
+        );
+        let mut pl = Planner {
+            origin: (r.x0, r.y0),
+            res,
+            w,
+            h,
+            free: vec![false; w * h],
+            inflated,
+            walls,
+        };
+        for j in 0..h {
+            for i in 0..w {
+                let c = pl.center(i, j);
+                pl.free[j * w + i] = pl.point_free(c);
+            }
+        }
+        pl
+    }
+
+    fn center(&self, i: usize, j: usize) -> P2 {
+        (
+            self.origin.0 + (i as f64 + 0.5) * self.res,
+            self.origin.1 + (j as f64 + 0.5) * self.res,
+        )
+    }
+
+    fn cell(&self, p: P2) -> (usize, usize) {
+        let i = ((p.0 - self.origin.0) / self.res).floor().max(0.0) as usize;
+        let j = ((p.1 - self.origin.1) / self.res).floor().max(0.0) as usize;
+        (i.min(self.w - 1), j.min(self.h - 1))
+    }
+
+    fn point_free(&self, p: P2) -> bool {
+        let wl = &self.walls;
+        p.0 >= wl.x0
+            && p.0 <= wl.x1
+            && p.1 >= wl.y0
+            && p.1 <= wl.y1
+            && !self.inflated.iter().any(|o| o.contains(p))
+    }
+
+    fn segment_free(&self, a: P2, b: P2) -> bool {
+        self.point_free(a)
+            && self.point_free(b)
+            && !self.inflated.iter().any(|o| o.hits_segment(a, b))
+    }
+
+    /// A collision-free polyline from `a` to `b` (without `a`), or `None`.
+    pub fn plan(&self, a: P2, b: P2) -> Option<Vec<P2>> {
+        if self.segment_free(a, b) {
+            return Some(vec![b]);
+        }
+        if !self.point_free(b) {
+            return None;
+        }
+        let start = self.nearest_free_cell(a)?;
+        let goal = self.nearest_free_cell(b)?;
+        let cells = self.astar(start, goal)?;
+        // Points: a, cell centres, b; then string pulling.
+        let mut pts = Vec::with_capacity(cells.len() + 2);
+        pts.push(a);
+        pts.extend(cells.iter().map(|&(i, j)| self.center(i, j)));
+        pts.push(b);
+        let mut out = Vec::new();
+        let mut k = 0;
+        while k + 1 < pts.len() {
+            let mut next = k + 1;
+            for m in (k + 2..pts.len()).rev() {
+                if self.segment_free(pts[k], pts[m]) {
+                    next = m;
+                    break;
+                }
+            }
+            out.push(pts[next]);
+            k = next;
+        }
+        Some(out)
+    }
+
+    fn nearest_free_cell(&self, p: P2) -> Option<(usize, usize)> {
+        let (ci, cj) = self.cell(p);
+        let mut best: Option<((usize, usize), f64)> = None;
+        for r in 0..4i64 {
+            for dj in -r..=r {
+                for di in -r..=r {
+                    let (i, j) = (ci as i64 + di, cj as i64 + dj);
+                    if i < 0 || j < 0 || i >= self.w as i64 || j >= self.h as i64 {
+                        continue;
+                    }
+                    let (i, j) = (i as usize, j as usize);
+                    if self.free[j * self.w + i] && self.segment_free(p, self.center(i, j)) {
+                        let d = dist(p, self.center(i, j));
+                        if best.is_none_or(|(_, bd)| d < bd) {
+                            best = Some(((i, j), d));
+                        }
+                    }
+                }
+            }
+            if best.is_some() {
+                return best.map(|(c, _)| c);
+            }
+        }
+        None
+    }
+
+    fn astar(&self, s: (usize, usize), g: (usize, usize)) -> Option<Vec<(usize, usize)>> {
+        #[derive(PartialEq)]
+        struct Item(f64, usize);
+        impl Eq for Item {}
+        impl PartialOrd for Item {
+            fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+                Some(self.cmp(o))
+            }
+        }
+        impl Ord for Item {
+            fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+                o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
+            }
+        }
+        let n = self.w * self.h;
+        let idx = |(i, j): (usize, usize)| j * self.w + i;
+        let (si, gi) = (idx(s), idx(g));
+        let h = |k: usize| {
+            let (dx, dy) = (
+                (k % self.w).abs_diff(g.0) as f64,
+                (k / self.w).abs_diff(g.1) as f64,
+            );
+            dx.max(dy) + (std::f64::consts::SQRT_2 - 1.0) * dx.min(dy)
+        };
+        let mut cost = vec![f64::INFINITY; n];
+        let mut prev = vec![usize::MAX; n];
+        let mut open = BinaryHeap::new();
+        cost[si] = 0.0;
+        open.push(Item(h(si), si));
+        while let Some(Item(_, k)) = open.pop() {
+            if k == gi {
+                let mut path = vec![g];
+                let mut c = k;
+                while c != si {
+                    c = prev[c];
+                    path.push((c % self.w, c / self.w));
+                }
+                path.reverse();
+                return Some(path);
+            }
+            let (i, j) = ((k % self.w) as i64, (k / self.w) as i64);
+            for (di, dj) in [
+                (1, 0),
+                (-1, 0),
+                (0, 1),
+                (0, -1),
+                (1, 1),
+                (1, -1),
+                (-1, 1),
+                (-1, -1),
+            ] {
+                let (ni, nj) = (i + di, j + dj);
+                if ni < 0 || nj < 0 || ni >= self.w as i64 || nj >= self.h as i64 {
+                    continue;
+                }
+                let nk = nj as usize * self.w + ni as usize;
+                if !self.free[nk] {
+                    continue;
+                }
+                // No corner cutting.
+                if di != 0
+                    && dj != 0
+                    && (!self.free[j as usize * self.w + ni as usize]
+                        || !self.free[nj as usize * self.w + i as usize])
+                {
+                    continue;
+                }
+                let step = if di != 0 && dj != 0 {
+                    std::f64::consts::SQRT_2
+                } else {
+                    1.0
+                };
+                let c = cost[k] + step;
+                if c < cost[nk] {
+                    cost[nk] = c;
+                    prev[nk] = k;
+                    open.push(Item(c + h(nk), nk));
+                }
+            }
+        }
+        None
+    }
+}
+
+/// The dynamic state of a world plus its layout.
+#[derive(Debug, Clone)]
+pub struct World {
+    pub params: Params,
+    pub layout: Arc<Layout>,
+    pub planner: Arc<Planner>,
+    /// Bumped when an obstacle is added (running navigations replan).
+    pub map_version: u32,
+    /// Simulated time, s.
+    pub time: f64,
+    pub robot: P2,
+    pub yaw: f64,
+    /// Percent, 0..=100.
+    pub battery: f64,
+    /// `true` while the robot is on the charger and charging is not complete:
+    /// the battery monitor reports "not ready" until the charge completes.
+    pub charging: bool,
+    pub arm_tucked: bool,
+    pub emergency: bool,
+    pub shut_down: bool,
+    pub objects: Vec<Object>,
+    /// Distance driven, m.
+    pub odometer: f64,
+    /// Incremented on every change of the discrete world state that a task
+    /// step makes (pick, place, object found, charge complete, dock, a
+    /// disturbance); chattering is switching actions without it changing.
+    pub progress: u64,
+}
+
+impl World {
+    pub fn new(layout: Layout, params: Params, robot: P2, objects: Vec<Object>) -> Self {
+        let planner = Arc::new(Planner::new(&layout, &params));
+        World {
+            params,
+            layout: Arc::new(layout),
+            planner,
+            map_version: 0,
+            time: 0.0,
+            robot,
+            yaw: 0.0,
+            battery: 100.0,
+            charging: false,
+            arm_tucked: true,
+            emergency: false,
+            shut_down: false,
+            objects,
+            odometer: 0.0,
+            progress: 0,
+        }
+    }
+
+    pub fn object_index(&self, name: &str) -> Option<usize> {
+        self.objects.iter().position(|o| o.name == name)
+    }
+
+    pub fn held(&self) -> Option<usize> {
+        self.objects.iter().position(|o| o.place == Place::Held)
+    }
+
+    /// Where an object is (the robot's position when held).
+    pub fn object_pos(&self, i: usize) -> P2 {
+        match self.objects[i].place {
+            Place::At(p) => p,
+            Place::Held => self.robot,
+        }
+    }
+
+    /// Adds an obstacle (a blocked path) and rebuilds the planner.
+    pub fn block(&mut self, r: Rect) {
+        let mut layout = (*self.layout).clone();
+        layout.obstacles.push(r);
+        self.planner = Arc::new(Planner::new(&layout, &self.params));
+        self.layout = Arc::new(layout);
+        self.map_version += 1;
+    }
+
+    /// Moves the robot toward `goal` by at most `speed * dt`, draining the
+    /// battery; returns `true` on arrival.
+    pub fn drive_toward(&mut self, goal: P2, speed: f64, dt: f64) -> bool {
+        let d = dist(self.robot, goal);
+        let step = speed * dt;
+        if d > 1e-12 {
+            self.yaw = (goal.1 - self.robot.1).atan2(goal.0 - self.robot.0);
+        }
+        if d <= step {
+            self.robot = goal;
+            self.drain(d);
+            true
+        } else {
+            let f = step / d;
+            self.robot = (
+                self.robot.0 + (goal.0 - self.robot.0) * f,
+                self.robot.1 + (goal.1 - self.robot.1) * f,
+            );
+            self.drain(step);
+            false
+        }
+    }
+
+    fn drain(&mut self, metres: f64) {
+        self.odometer += metres;
+        self.battery = (self.battery - metres * self.params.drain_per_m).max(0.0);
+    }
+
+    /// Time passes: the clock advances and the battery drains.
+    pub fn advance(&mut self, dt: f64) {
+        self.time += dt;
+        if !self.charging {
+            self.battery = (self.battery - self.params.drain_per_s * dt).max(0.0);
+        }
+    }
+
+    /// The station whose pose the robot is at, if any.
+    pub fn robot_station(&self) -> Option<&str> {
+        self.layout
+            .stations
+            .iter()
+            .find(|(_, p)| dist(*p, self.robot) <= self.params.at_tolerance)
+            .map(|(n, _)| n.as_str())
+    }
+
+    /// The station an object is at, if any.
+    pub fn object_station(&self, i: usize) -> Option<&str> {
+        let Place::At(p) = self.objects[i].place else {
+            return None;
+        };
+        self.layout
+            .stations
+            .iter()
+            .find(|(_, s)| dist(*s, p) <= self.params.station_radius)
+            .map(|(n, _)| n.as_str())
+    }
+
+    /// Marks the objects within camera range as found; returns how many were new.
+    pub fn look(&mut self) -> usize {
+        let (r, range) = (self.robot, self.params.camera_range);
+        let mut new = 0;
+        for i in 0..self.objects.len() {
+            if !self.objects[i].found && dist(self.object_pos(i), r) <= range {
+                self.objects[i].found = true;
+                new += 1;
+            }
+        }
+        new
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn world() -> World {
+        World::new(
+            Layout::paper_room(),
+            Params::default(),
+            (-2.0, -2.2),
+            vec![],
+        )
+    }
+
+    #[test]
+    fn stations_of_the_paper_room_are_free() {
+        let l = Layout::paper_room();
+        for (n, p) in &l.stations {
+            assert!(l.check_free(*p, 0.2).is_ok(), "{n}");
+        }
+        for p in &l.waypoints {
+            assert!(l.check_free(*p, 0.2).is_ok(), "{p:?}");
+        }
+        assert_eq!(l.station("delivery"), Some((0.5, 2.1)));
+        assert!(l.check_free((3.5, 0.0), 0.2).unwrap_err().contains("wall"));
+        assert!(
+            l.check_free((0.0, 0.7), 0.2)
+                .unwrap_err()
+                .contains("central")
+        );
+    }
+
+    #[test]
+    fn planner_goes_around_the_central_table() {
+        let w = world();
+        let (a, b) = ((0.0, -0.3), (0.0, 1.5));
+        let path = w.planner.plan(a, b).expect("a path");
+        assert!(path.len() >= 2, "{path:?}");
+        let mut prev = a;
+        let mut len = 0.0;
+        for &p in &path {
+            assert!(w.planner.segment_free(prev, p), "{prev:?} -> {p:?}");
+            len += dist(prev, p);
+            prev = p;
+        }
+        assert_eq!(prev, b);
+        assert!(len > 1.8 && len < 3.5, "{len}");
+    }
+
+    #[test]
+    fn blocked_goal_has_no_path() {
+        let mut w = world();
+        w.block(Rect::new("wall", -3.0, 1.2, 3.0, 1.3));
+        assert!(w.planner.plan((0.0, -0.3), (0.5, 2.1)).is_none());
+        assert_eq!(w.map_version, 1);
+    }
+
+    #[test]
+    fn driving_drains_the_battery() {
+        let mut w = world();
+        let mut n = 0;
+        while !w.drive_toward((-1.0, -2.2), 0.5, 0.1) {
+            n += 1;
+        }
+        assert_eq!(n, 19);
+        assert!((w.odometer - 1.0).abs() < 1e-9);
+        assert!((w.battery - 99.0).abs() < 1e-9);
+    }
+}

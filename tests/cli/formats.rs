@@ -1,0 +1,527 @@
+//! BehaviorTree.CPP XML and SCXML through the binary: the corpus of real
+//! files in ../shared/corpus, round trips at named GED 0, cross-format compare.
+
+use super::*;
+
+const CORPUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/corpus");
+
+fn nav2_model() -> String {
+    format!("{CORPUS}/bt-xml/nav2/nav2_tree_nodes.xml")
+}
+
+/// Every file of the corpus with a given extension, recursively, sorted.
+fn corpus_files(ext: &str) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut dirs = vec![PathBuf::from(CORPUS)];
+    while let Some(d) = dirs.pop() {
+        for e in std::fs::read_dir(&d).expect("corpus dir (../shared/corpus)") {
+            let p = e.expect("entry").path();
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p.extension().is_some_and(|e| e == ext) {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// Corpus XML files that hold behavior trees (not the nodes model).
+fn corpus_trees() -> Vec<PathBuf> {
+    let trees: Vec<PathBuf> = corpus_files("xml")
+        .into_iter()
+        .filter(|p| {
+            std::fs::read_to_string(p)
+                .expect("read")
+                .contains("<BehaviorTree")
+        })
+        .collect();
+    assert!(trees.len() >= 8, "corpus trees: {trees:?}");
+    trees
+}
+
+/// A tag: name (`/name` for an end tag), attributes, self-closing.
+type Tag = (String, Vec<(String, String)>, bool);
+
+/// An XML tag found by the test's own scanner (independent of the reader):
+/// `(name, attributes, self-closing)` for a start tag, `("/name", ..)` for an
+/// end tag. Comments, declarations and processing instructions are skipped.
+fn scan_tags(text: &str) -> Vec<Tag> {
+    let mut out = Vec::new();
+    let mut rest = text;
+    while let Some(i) = rest.find('<') {
+        rest = &rest[i..];
+        let skip_to = |r: &str, end: &str| r.find(end).map_or(r.len(), |j| j + end.len());
+        if rest.starts_with("<!--") {
+            rest = &rest[skip_to(rest, "-->")..];
+            continue;
+        }
+        if rest.starts_with("<?") {
+            rest = &rest[skip_to(rest, "?>")..];
+            continue;
+        }
+        if rest.starts_with("<!") {
+            rest = &rest[skip_to(rest, ">")..];
+            continue;
+        }
+        // Up to the closing '>' outside quotes.
+        let mut quote = None;
+        let mut end = rest.len();
+        for (j, c) in rest.char_indices().skip(1) {
+            match (quote, c) {
+                (None, '"' | '\'') => quote = Some(c),
+                (Some(q), c) if c == q => quote = None,
+                (None, '>') => {
+                    end = j;
+                    break;
+                }
+                _ => {}
+            }
+        }
+        let inner = &rest[1..end];
+        rest = &rest[(end + 1).min(rest.len())..];
+        let self_closing = inner.ends_with('/');
+        let inner = inner.trim_end_matches('/');
+        let name_end = inner
+            .find(|c: char| c.is_whitespace())
+            .unwrap_or(inner.len());
+        let name = inner[..name_end].to_string();
+        let mut attrs = Vec::new();
+        let mut a = inner[name_end..].trim_start();
+        while let Some(eq) = a.find('=') {
+            let key = a[..eq].trim().to_string();
+            let v = a[eq + 1..].trim_start();
+            let q = v.chars().next().unwrap_or('"');
+            let close = v[1..].find(q).map_or(v.len(), |k| k + 1);
+            attrs.push((key, v[1..close].to_string()));
+            a = v[(close + 1).min(v.len())..].trim_start();
+        }
+        out.push((name, attrs, self_closing));
+    }
+    out
+}
+
+fn attr<'a>(attrs: &'a [(String, String)], k: &str) -> Option<&'a str> {
+    attrs.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str())
+}
+
+/// Tree nodes of the tree a BehaviorTree.CPP file runs, counted by the test's
+/// own scanner: start tags inside `<BehaviorTree>`, each `<SubTree ID>` replaced
+/// by the count of the tree it names (trees of included files too).
+fn count_tree_nodes(path: &Path) -> usize {
+    // tree ID -> (own nodes, SubTree IDs used)
+    let mut trees: std::collections::HashMap<String, (usize, Vec<String>)> = Default::default();
+    let mut main: Option<String> = None;
+    let mut first_local: Vec<String> = Vec::new();
+    let mut files = vec![(path.to_path_buf(), true)];
+    while let Some((f, is_main)) = files.pop() {
+        let text = std::fs::read_to_string(&f).expect("read");
+        let mut current: Option<String> = None;
+        for (name, attrs, _) in scan_tags(&text) {
+            match name.as_str() {
+                "root" if is_main => main = attr(&attrs, "main_tree_to_execute").map(String::from),
+                "include" => files.push((
+                    f.parent()
+                        .expect("dir")
+                        .join(attr(&attrs, "path").expect("path")),
+                    false,
+                )),
+                "BehaviorTree" => {
+                    let id = attr(&attrs, "ID").expect("ID").to_string();
+                    if is_main {
+                        first_local.push(id.clone());
+                    }
+                    trees.insert(id.clone(), (0, vec![]));
+                    current = Some(id);
+                }
+                "/BehaviorTree" => current = None,
+                n if n.starts_with('/') => {}
+                _ => {
+                    if let Some(t) = &current {
+                        let e = trees.get_mut(t).expect("tree");
+                        if name == "SubTree" {
+                            e.1.push(attr(&attrs, "ID").expect("ID").to_string());
+                        } else {
+                            e.0 += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let main = main.unwrap_or_else(|| first_local[0].clone());
+    let mut total = 0;
+    let mut todo = vec![main];
+    while let Some(t) = todo.pop() {
+        let (own, subs) = &trees[&t];
+        total += own;
+        todo.extend(subs.iter().cloned());
+    }
+    total
+}
+
+/// Vertices and arcs of an SCXML file's HFSM graph by the test's own scanner:
+/// every `<state>` and `<history>`, plus the `<final>` states of the top level
+/// (the machine's outcomes; nested finals are their container's outcomes, not
+/// vertices); one arc per `<transition>` with a target, plus one per state
+/// holding states (to its initial child).
+fn count_scxml_graph(path: &Path) -> (usize, usize) {
+    let text = std::fs::read_to_string(path).expect("read");
+    // (element name, holds a state)
+    let mut stack: Vec<(String, bool)> = Vec::new();
+    let (mut n, mut arcs) = (0, 0);
+    for (name, attrs, self_closing) in scan_tags(&text) {
+        if let Some(closed) = name.strip_prefix('/') {
+            let (open, compound) = stack.pop().expect("balanced");
+            assert_eq!(open, closed);
+            if compound {
+                arcs += 1;
+            }
+            continue;
+        }
+        match name.as_str() {
+            "state" | "history" => {
+                n += 1;
+                if let Some(parent) = stack.last_mut().filter(|(p, _)| p == "state") {
+                    parent.1 = true;
+                }
+            }
+            "final" if stack.last().map(|(p, _)| p.as_str()) == Some("scxml") => n += 1,
+            "transition" if attr(&attrs, "target").is_some() => arcs += 1,
+            _ => {}
+        }
+        if !self_closing {
+            stack.push((name, false));
+        }
+    }
+    (n, arcs)
+}
+
+#[test]
+fn corpus_trees_import_analyze_draw_and_validate() {
+    let model = nav2_model();
+    for f in corpus_trees() {
+        let file = f.display().to_string();
+        let base = ["--nodes-model", model.as_str(), file.as_str()];
+        let (code, stdout, stderr) =
+            btfsm(&[&["analyze", "--format", "json"][..], &base[..]].concat());
+        assert_eq!(code, 0, "{file}: {stderr}");
+        let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+        let p = &v["policies"][0];
+        assert_eq!(p["kind"], "bt", "{file}");
+        let expected = count_tree_nodes(&f) as u64;
+        assert_eq!(p["vertices"], expected, "{file}: vertices");
+        assert_eq!(p["edges"], expected - 1, "{file}: a tree has V - 1 edges");
+        assert_eq!(p["essential_cc"], 1, "{file}");
+        let (code, dot, stderr) = btfsm(&[&["dot"][..], &base[..]].concat());
+        assert_eq!(code, 0, "{file}: {stderr}");
+        assert!(dot.starts_with("digraph"));
+        assert_eq!(dot.matches(" -> ").count() as u64, expected - 1, "{file}");
+        let (code, _, stderr) = btfsm(&[&["validate"][..], &base[..]].concat());
+        assert_eq!(code, 0, "{file}: {stderr}");
+        assert!(stderr.contains(": ok (bt"), "{stderr}");
+    }
+}
+
+#[test]
+fn corpus_scxml_imports_analyzes_draws_and_validates() {
+    let files = corpus_files("scxml");
+    assert!(!files.is_empty());
+    for f in files {
+        let file = f.display().to_string();
+        let (code, stdout, stderr) = btfsm(&["analyze", "--format", "json", &file]);
+        assert_eq!(code, 0, "{file}: {stderr}");
+        let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+        let p = &v["policies"][0];
+        let (vertices, arcs) = count_scxml_graph(&f);
+        assert_eq!(p["vertices"], vertices as u64, "{file}");
+        assert_eq!(p["edges"], arcs as u64, "{file}");
+        let (code, dot, stderr) = btfsm(&["dot", &file]);
+        assert_eq!(code, 0, "{file}: {stderr}");
+        assert!(dot.starts_with("digraph"));
+        let (code, _, stderr) = btfsm(&["validate", &file]);
+        assert_eq!(code, 0, "{file}: {stderr}");
+    }
+    // The PackML machine: nested states make it an HFSM; its history state
+    // and the Qt editor data do not break the import.
+    let (_, stdout, _) = btfsm(&[
+        "analyze",
+        "--format",
+        "json",
+        &format!("{CORPUS}/scxml/packml_demo_sm.scxml"),
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    assert_eq!(v["policies"][0]["kind"], "hfsm");
+}
+
+#[test]
+fn nav2_trees_need_their_nodes_model_or_assume_leaf() {
+    let f = format!("{CORPUS}/bt-xml/nav2/follow_point.xml");
+    let (code, _, stderr) = btfsm(&["validate", &f]);
+    assert_eq!(code, 2);
+    assert!(
+        stderr.contains("unknown node type `PipelineSequence` (4 children)"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("--nodes-model FILE"), "{stderr}");
+    // A leaf-only unknown type is settled by --assume-leaf.
+    let f = format!("{CORPUS}/bt-xml/nav2/odometry_calibration.xml");
+    let (code, _, stderr) = btfsm(&["validate", &f]);
+    assert_eq!(code, 2, "{stderr}");
+    let (code, _, stderr) = btfsm(&["validate", "--assume-leaf", "action", &f]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
+#[test]
+fn lowercase_builtin_in_nav2_example_is_a_warning() {
+    let f = format!("{CORPUS}/bt-xml/nav2/docking_application_example.xml");
+    let (code, _, stderr) = btfsm(&["validate", "--nodes-model", &nav2_model(), &f]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("warning: `inverter` is not a BehaviorTree.CPP node type"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("docking_application_example.xml:22:13"),
+        "{stderr}"
+    );
+}
+
+/// A scratch directory for converted files.
+fn scratch(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("btfsm-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("tmp");
+    d
+}
+
+/// `btfsm convert FILE --to TARGET -o OUT` (with the Nav2 model).
+fn convert(file: &Path, to: &str, out: &Path) {
+    let (code, _, stderr) = btfsm(&[
+        "convert",
+        "--nodes-model",
+        &nav2_model(),
+        &file.display().to_string(),
+        "--to",
+        to,
+        "-o",
+        &out.display().to_string(),
+    ]);
+    assert_eq!(code, 0, "convert {} --to {to}: {stderr}", file.display());
+}
+
+fn load(p: &Path) -> btfsm::model::Policy {
+    let limits = btfsm::format::Limits {
+        nodes_models: vec![PathBuf::from(nav2_model())],
+        ..Default::default()
+    };
+    match btfsm::format::load(p, &limits) {
+        Ok(l) => l.policy,
+        Err(d) => panic!("{}: {d:?}", p.display()),
+    }
+}
+
+/// Named GED between two policies, with the edit script on failure.
+fn named_ged(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> (u64, String) {
+    use btfsm::metrics::ged::{GedMode, GedOptions, ged};
+    let (ga, gb) = (btfsm::graph::policy_graph(a), btfsm::graph::policy_graph(b));
+    assert_eq!(ga.vertex_count(), gb.vertex_count());
+    let r = ged(&ga, &gb, GedMode::Named, &GedOptions::default());
+    (r.ged, format!("{:?}", r.edit_script))
+}
+
+/// A -> X -> A through two converters gives named GED 0 at every step.
+fn round_trip(src: &Path, via: &str, back: &str, ext_via: &str, ext_back: &str, dir: &Path) {
+    let stem = src.file_stem().expect("stem").to_string_lossy();
+    let mid = dir.join(format!("{stem}.{ext_via}"));
+    let end = dir.join(format!("{stem}.back.{ext_back}"));
+    convert(src, via, &mid);
+    convert(&mid, back, &end);
+    let (a, b, c) = (load(src), load(&mid), load(&end));
+    for (x, y, what) in [(&a, &b, via), (&a, &c, back)] {
+        let (d, script) = named_ged(x, y);
+        assert_eq!(d, 0, "{} -> {what}: named GED {d}\n{script}", src.display());
+    }
+    assert_eq!(a.kind(), c.kind());
+    if let Err(e) = same_model(&a, &c) {
+        panic!("{} -> {via} -> {back}: {e}", src.display());
+    }
+}
+
+/// The same policy up to source positions and arena order: BT nodes compared
+/// by id (label, kind, skill, type, ports, children), states by path (label,
+/// body, transitions in order).
+fn same_model(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> Result<(), String> {
+    use btfsm::model::{PolicyBody, StateBody, Target};
+    match (&a.body, &b.body) {
+        (PolicyBody::Bt(x), PolicyBody::Bt(y)) => {
+            let kids = |t: &btfsm::model::Bt, i: usize| -> Vec<String> {
+                t.nodes[i]
+                    .children
+                    .iter()
+                    .map(|&c| t.nodes[c].id.clone())
+                    .collect()
+            };
+            if x.nodes[x.root].id != y.nodes[y.root].id {
+                return Err("different roots".into());
+            }
+            for (i, n) in x.nodes.iter().enumerate() {
+                let j = y
+                    .nodes
+                    .iter()
+                    .position(|m| m.id == n.id)
+                    .ok_or(format!("node `{}` lost", n.id))?;
+                let m = &y.nodes[j];
+                let l = (
+                    &n.label,
+                    n.kind,
+                    &n.skill,
+                    &n.type_name,
+                    &n.ports,
+                    kids(x, i),
+                );
+                let r = (
+                    &m.label,
+                    m.kind,
+                    &m.skill,
+                    &m.type_name,
+                    &m.ports,
+                    kids(y, j),
+                );
+                if l != r {
+                    return Err(format!("node `{}`: {l:?} != {r:?}", n.id));
+                }
+            }
+            Ok(())
+        }
+        (PolicyBody::Machine(x), PolicyBody::Machine(y)) => {
+            let desc = |m: &btfsm::model::StateMachine, i: usize| {
+                let s = &m.states[i];
+                let body = match &s.body {
+                    StateBody::Container(r) => format!(
+                        "container initial={} outcomes={:?}",
+                        m.states[r.initial].name, r.outcomes
+                    ),
+                    other => format!("{other:?}"),
+                };
+                let trs: Vec<String> = s
+                    .transitions
+                    .iter()
+                    .map(|t| {
+                        let to = match &t.target {
+                            Target::State(j) => m.path(*j),
+                            Target::Outcome(o) => format!("outcome {o}"),
+                        };
+                        format!("{:?} -> {to}", t.trigger)
+                    })
+                    .collect();
+                format!("{} {body} {:?} {trs:?}", s.label, s.pseudo)
+            };
+            if (x.top.outcomes.clone(), x.states[x.top.initial].name.clone())
+                != (y.top.outcomes.clone(), y.states[y.top.initial].name.clone())
+            {
+                return Err("different top level".into());
+            }
+            for i in 0..x.states.len() {
+                let p = x.path(i);
+                let j = (0..y.states.len())
+                    .find(|&j| y.path(j) == p)
+                    .ok_or(format!("state `{p}` lost"))?;
+                let (l, r) = (desc(x, i), desc(y, j));
+                if l != r {
+                    return Err(format!("state `{p}`:\n  {l}\n  {r}"));
+                }
+            }
+            Ok(())
+        }
+        _ => Err("different kinds".into()),
+    }
+}
+
+#[test]
+fn bundled_bts_round_trip_through_btcpp_xml_at_named_ged_0() {
+    let dir = scratch("bt-rt");
+    let mut n = 0;
+    for f in fixtures_in("policies/paper") {
+        if load(&f).kind() == btfsm::model::PolicyKind::Bt {
+            round_trip(&f, "btcpp-xml", "toml", "xml", "toml", &dir);
+            n += 1;
+        }
+    }
+    assert!(n >= 14, "{n} BTs");
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn corpus_trees_round_trip_through_toml_at_named_ged_0() {
+    let dir = scratch("xml-rt");
+    for f in corpus_trees() {
+        round_trip(&f, "toml", "btcpp-xml", "toml", "xml", &dir);
+    }
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn machines_round_trip_through_scxml_at_named_ged_0() {
+    let dir = scratch("scxml-rt");
+    let mut n = 0;
+    for f in fixtures_in("policies/paper") {
+        if load(&f).kind() != btfsm::model::PolicyKind::Bt {
+            round_trip(&f, "scxml", "toml", "scxml", "toml", &dir);
+            n += 1;
+        }
+    }
+    assert!(n >= 12, "{n} machines");
+    for f in corpus_files("scxml") {
+        round_trip(&f, "toml", "scxml", "toml", "scxml", &dir);
+    }
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn converting_to_the_wrong_family_is_a_clear_error() {
+    let (code, _, stderr) = btfsm(&[
+        "convert",
+        "policies/paper/fig04-fsm.toml",
+        "--to",
+        "btcpp-xml",
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("holds behavior trees only"), "{stderr}");
+    let (code, _, stderr) = btfsm(&["convert", "policies/paper/fig01-bt.toml", "--to", "scxml"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("--to hfsm first"), "{stderr}");
+}
+
+fn fixtures_in(dir: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(dir))
+        .expect("dir")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn compare_works_across_formats() {
+    let dir = scratch("cmp");
+    let xml = dir.join("fig07c.xml");
+    convert(
+        Path::new("policies/paper/fig07c-bt.toml"),
+        "btcpp-xml",
+        &xml,
+    );
+    let (code, stdout, stderr) = btfsm(&[
+        "compare",
+        "--format",
+        "json",
+        "policies/paper/fig01-bt.toml",
+        &xml.display().to_string(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    // SPEC §5: Fig. 1 -> Fig. 7c is 8 edits, whichever format B is in.
+    assert_eq!(v["named"]["ged"], 8, "{stdout}");
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}

@@ -1,0 +1,250 @@
+//! `btfsm sim` through the binary: the behavior-match verdicts of SPEC §6,
+//! determinism, bad scenarios, and `dot --trace`.
+
+use super::*;
+
+fn sim_json(scenario: &str) -> serde_json::Value {
+    let (code, stdout, stderr) = btfsm(&["sim", scenario, "--format", "json"]);
+    assert_eq!(code, 0, "{stderr}");
+    serde_json::from_str(&stdout).expect("sim prints JSON")
+}
+
+fn sim_policy<'a>(v: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    v["policies"]
+        .as_array()
+        .expect("policies")
+        .iter()
+        .find(|p| p["policy"] == name)
+        .unwrap_or_else(|| panic!("no policy `{name}` in {v}"))
+}
+
+fn sim_verdict(v: &serde_json::Value, a: &str, b: &str) -> bool {
+    let x = v["verdicts"]
+        .as_array()
+        .expect("verdicts")
+        .iter()
+        .find(|x| (x["a"] == a && x["b"] == b) || (x["a"] == b && x["b"] == a))
+        .unwrap_or_else(|| panic!("no verdict {a} / {b}"));
+    x["match"].as_bool().expect("bool")
+}
+
+const BT1: &str = "Fig. 1 BT baseline";
+const HFSM1: &str = "Fig. 1 BT baseline (HFSM)";
+const FSM4: &str = "Fig. 4 FSM fault tolerant";
+const FSM2: &str = "Fig. 2 FSM sequential";
+
+#[test]
+fn sim_exp1_bt_fsm_and_hfsm_match_and_the_sequential_fsm_fails_on_a_failed_pick() {
+    let v = sim_json("policies/scenarios/exp1-nominal.toml");
+    for (a, b) in [(BT1, HFSM1), (BT1, FSM4), (BT1, FSM2)] {
+        assert!(sim_verdict(&v, a, b), "{a} vs {b} in exp1-nominal");
+    }
+    let v = sim_json("policies/scenarios/exp1-pick-fails.toml");
+    assert!(sim_verdict(&v, BT1, HFSM1));
+    assert!(sim_verdict(&v, BT1, FSM4));
+    assert!(!sim_verdict(&v, BT1, FSM2));
+    for p in [BT1, HFSM1, FSM4] {
+        assert_eq!(sim_policy(&v, p)["outcome"], "success", "{p}");
+        let skills = sim_policy(&v, p)["skills"].as_array().unwrap();
+        assert_eq!(skills[1]["skill"], "Pick");
+        assert_eq!(skills[1]["outcome"], "failure");
+        assert_eq!(skills[2]["outcome"], "success");
+    }
+    let fsm2 = sim_policy(&v, FSM2);
+    assert_eq!(fsm2["outcome"], "failure");
+    assert_eq!(fsm2["goal_met"], false);
+    assert!(fsm2["reason"].as_str().unwrap().contains("Pick cube2"));
+}
+
+#[test]
+fn sim_only_the_bt_fetches_the_cube_again_after_the_task_is_done() {
+    let v = sim_json("policies/scenarios/exp1-cube-moved-after-done.toml");
+    let picks = |p: &str| {
+        sim_policy(&v, p)["skills"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|s| s["skill"] == "Pick" && s["outcome"] == "success")
+            .count()
+    };
+    assert_eq!(picks(BT1), 2);
+    assert_eq!(picks(FSM4), 1);
+    assert_eq!(picks(HFSM1), 1);
+    assert_eq!(
+        sim_policy(&v, BT1)["final_world"]["objects"]["cube2"]["at"],
+        "delivery"
+    );
+    assert_eq!(
+        sim_policy(&v, FSM4)["final_world"]["objects"]["cube2"]["at"],
+        "west-table"
+    );
+    assert!(!sim_verdict(&v, BT1, FSM4));
+    assert!(sim_verdict(&v, HFSM1, FSM4));
+}
+
+#[test]
+fn sim_recharge_docking_arena_and_five_cubes_match() {
+    let cases = [
+        (
+            "exp2-recharge",
+            "Fig. 7d BT recharge",
+            "Fig. 8d FSM recharge",
+        ),
+        ("exp3-docking", "Fig. 15 BT docking", "Fig. 15 FSM docking"),
+        ("exp5-arena", "Fig. 15 BT docking", "Fig. 15 FSM docking"),
+        (
+            "exp4-five-cubes",
+            "Fig. 16a BT five cubes",
+            "Fig. 16b FSM five cubes",
+        ),
+    ];
+    for (scn, bt, fsm) in cases {
+        let v = sim_json(&format!("policies/scenarios/{scn}.toml"));
+        assert!(sim_verdict(&v, bt, fsm), "{scn}");
+        for p in [bt, fsm] {
+            let r = sim_policy(&v, p);
+            assert_eq!(r["outcome"], "success", "{scn} {p}");
+            assert_eq!(r["goal_met"], true, "{scn} {p}");
+            // Every one of these scenarios makes the robot recharge.
+            assert!(
+                r["skills"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .any(|s| s["skill"] == "Recharge" && s["outcome"] == "success"),
+                "{scn} {p}"
+            );
+        }
+    }
+}
+
+#[test]
+fn sim_reports_the_fig03_bt_as_chattering() {
+    let v = sim_json("policies/scenarios/fig03-chattering.toml");
+    let r = sim_policy(&v, "Fig. 3 BT chattering");
+    assert_eq!(r["outcome"], "chattering");
+    assert!(r["steps"].as_u64().unwrap() < 1000);
+    assert_eq!(sim_policy(&v, BT1)["outcome"], "success");
+}
+
+#[test]
+fn sim_is_deterministic() {
+    let a = btfsm(&[
+        "sim",
+        "policies/scenarios/exp3-docking.toml",
+        "--format",
+        "json",
+    ]);
+    let b = btfsm(&[
+        "sim",
+        "policies/scenarios/exp3-docking.toml",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(a, b);
+}
+
+/// A scenario naming an unknown object, station or skill, or a pose inside a
+/// wall or table, exits 2 with the recorded positioned messages.
+#[test]
+fn sim_rejects_bad_scenarios_with_positioned_messages() {
+    let bless = std::env::var_os("BLESS").is_some();
+    let mut failures = Vec::new();
+    let files = fixtures("sim-invalid");
+    assert!(files.len() >= 5);
+    for f in files {
+        let (code, stdout, stderr) = btfsm(&["sim", &rel(&f)]);
+        let expected_path = f.with_extension("stderr");
+        if bless {
+            std::fs::write(&expected_path, &stderr).expect("write expected");
+        }
+        let expected = std::fs::read_to_string(&expected_path).unwrap_or_default();
+        let positioned = stderr
+            .lines()
+            .any(|l| l.trim_start().starts_with("--> ") && l.matches(':').count() >= 2);
+        if code != 2 || !stdout.is_empty() || stderr != expected || !positioned {
+            failures.push(format!(
+                "{}: exit {code}\n--- stderr\n{stderr}--- expected\n{expected}",
+                rel(&f)
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn dot_colours_nodes_by_their_status_at_a_trace_step() {
+    let dir = std::env::temp_dir().join(format!("btfsm-dot-trace-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let trace = dir.join("exp2.json");
+    let plot = dir.join("exp2.svg");
+    let (code, _, stderr) = btfsm(&[
+        "sim",
+        "policies/scenarios/exp2-recharge.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(
+        svg.starts_with("<svg")
+            && svg.contains("central table")
+            && svg.contains("Fig. 8d FSM recharge")
+    );
+    // Step 45 (t = 4.5 s): the battery is low and the robot drives to the charger.
+    let (code, dot, stderr) = btfsm(&[
+        "dot",
+        "policies/paper/fig07d-bt.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--step",
+        "45",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let line = |id: &str| {
+        dot.lines()
+            .find(|l| l.trim_start().starts_with(id))
+            .unwrap_or("")
+            .to_string()
+    };
+    assert!(line("recharge[").contains("fillcolor=gold"), "{dot}");
+    assert!(
+        line("\"battery-ok\"[").contains("fillcolor=tomato"),
+        "{dot}"
+    );
+    assert!(line("root[").contains("fillcolor=gold"), "{dot}");
+    assert!(!line("pick[").contains("gold"), "{dot}");
+    let (code, dot, _) = btfsm(&[
+        "dot",
+        "policies/paper/fig08d-fsm.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--step",
+        "45",
+    ]);
+    assert_eq!(code, 0);
+    assert!(
+        line_of(&dot, "Recharge[").contains("fillcolor=gold"),
+        "{dot}"
+    );
+    let (code, _, stderr) = btfsm(&[
+        "dot",
+        "policies/paper/fig07d-bt.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+        "--step",
+        "999999",
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("past the end of the trace"), "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn line_of(dot: &str, id: &str) -> String {
+    dot.lines()
+        .find(|l| l.trim_start().starts_with(id))
+        .unwrap_or("")
+        .to_string()
+}
