@@ -13,6 +13,7 @@ TIMEOUT=${FUZZ_TIMEOUT:-10}
 RSS=${FUZZ_RSS_MB:-2048}
 TARGETS=${*:-$(cargo +nightly fuzz list)}
 mkdir -p logs
+failed=""
 for t in $TARGETS; do
   mkdir -p "corpus/$t"
   case $t in
@@ -56,6 +57,10 @@ for t in $TARGETS; do
   cat "logs/$t.log"
   if ls "artifacts/$t"/crash-* "artifacts/$t"/timeout-* "artifacts/$t"/oom-* >/dev/null 2>&1; then
     echo "fuzz: $t found failing inputs in fuzz/artifacts/$t/" >&2
-    exit 1
+    failed="$failed $t"
   fi
 done
+if [ -n "$failed" ]; then
+  echo "fuzz: failing inputs for:$failed" >&2
+  exit 1
+fi
