@@ -225,7 +225,14 @@ pub fn suggest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -
         }
         _ if cands.is_empty() => "nothing is defined here".to_string(),
         _ => {
-            let shown: Vec<String> = cands.iter().take(12).map(|c| format!("`{c}`")).collect();
+            let shown: Vec<String> = cands
+                .iter()
+                .take(12)
+                .map(|c| match c.char_indices().nth(40) {
+                    Some((cut, _)) => format!("`{}…`", &c[..cut]),
+                    None => format!("`{c}`"),
+                })
+                .collect();
             let more = if more_than_scanned {
                 " (and more)".to_string()
             } else if cands.len() > 12 {

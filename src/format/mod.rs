@@ -77,11 +77,46 @@ impl Default for Limits {
 }
 
 /// The limits every format shares, checked on the model a reader built:
-/// nodes or states, and nesting depth (BT levels below the root, HFSM
-/// containers). An error carries the span of the offending element when it
-/// has one (the caller attaches its file); walks use explicit stacks.
+/// nodes or states, nesting depth (BT levels below the root, HFSM
+/// containers) and name length (ids, names, labels). An error carries the
+/// span of the offending element when it has one (the caller attaches its
+/// file); walks use explicit stacks.
 pub fn check_shape(policy: &Policy, limits: &Limits) -> Option<Diagnostic> {
     use crate::model::PolicyBody;
+    let too_long = |what: &str, name: &str, span: Option<std::ops::Range<usize>>| {
+        let shown: String = name.chars().take(24).collect();
+        let mut d = Diagnostic::error(format!(
+            "{what} `{shown}…` is {} bytes long, more than the limit of {} bytes",
+            name.len(),
+            limits.max_name_bytes
+        ))
+        .hint("shorten it, or raise the limit with --max-name-bytes");
+        d.span = span;
+        d
+    };
+    let long = |s: &str| s.len() > limits.max_name_bytes;
+    match &policy.body {
+        PolicyBody::Bt(bt) => {
+            if let Some(n) = bt.nodes.iter().find(|n| long(&n.id) || long(&n.label)) {
+                let (what, name) = if long(&n.id) {
+                    ("node id", &n.id)
+                } else {
+                    ("name of a node", &n.label)
+                };
+                return Some(too_long(what, name, n.span.clone()));
+            }
+        }
+        PolicyBody::Machine(m) => {
+            if let Some(st) = m.states.iter().find(|s| long(&s.name) || long(&s.label)) {
+                let (what, name) = if long(&st.name) {
+                    ("state name", &st.name)
+                } else {
+                    ("label of a state", &st.label)
+                };
+                return Some(too_long(what, name, st.span.clone()));
+            }
+        }
+    }
     let too_many = |n: usize, what: &str| {
         Diagnostic::error(format!(
             "{n} {what}, more than the limit of {}",

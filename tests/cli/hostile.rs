@@ -159,12 +159,14 @@ fn hostile_binary_garbage_and_devices() {
     );
     // A device has no size: reading stops past the limit.
     if Path::new("/dev/zero").exists() {
-        let (code, _, stderr) = btfsm(&["analyze", "/dev/zero", "--max-file-bytes", "4096"]);
-        assert_eq!(code, 2, "{stderr}");
-        assert!(
-            stderr.contains("larger than the limit of 4096 bytes"),
-            "{stderr}"
-        );
+        for cmd in ["analyze", "sim"] {
+            let (code, _, stderr) = btfsm(&[cmd, "/dev/zero", "--max-file-bytes", "4096"]);
+            assert_eq!(code, 2, "{stderr}");
+            assert!(
+                stderr.contains("larger than the limit of 4096 bytes"),
+                "{stderr}"
+            );
+        }
         let f = dir.write(
             "dev.toml",
             "kind = \"bt\"\n[nodes]\nroot = { subtree = \"/dev/zero\" }\n",
@@ -335,4 +337,63 @@ fn interrupted_runs_leave_no_partial_output() {
         .filter(|f| f.ends_with(".tmp"))
         .collect();
     assert!(stray.is_empty(), "temporaries left: {stray:?}");
+}
+
+/// The importers: 100k levels of XML nesting and 10 MB names are refused by
+/// the same limits, whatever the format.
+#[test]
+fn hostile_xml_and_scxml_nesting_and_names() {
+    let dir = Scratch::new("xml");
+    let n = 100_000;
+    let deep_bt = format!(
+        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\">{}<AlwaysSuccess/>{}</BehaviorTree></root>",
+        "<Sequence>".repeat(n),
+        "</Sequence>".repeat(n)
+    );
+    let mut deep_sc = String::from(
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" initial=\"s0\">",
+    );
+    for i in 0..n {
+        deep_sc.push_str(&format!("<state id=\"s{i}\">"));
+    }
+    deep_sc.push_str(&"</state>".repeat(n));
+    deep_sc.push_str("</scxml>");
+    let long = "x".repeat(10 << 20);
+    let long_bt = format!(
+        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\"><Sequence name=\"{long}\"><AlwaysSuccess/></Sequence></BehaviorTree></root>"
+    );
+    let long_sc = format!(
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" initial=\"{long}\"><state id=\"{long}\"/></scxml>"
+    );
+    for (name, text, want) in [
+        ("deep.xml", deep_bt, "deeper than the limit of 1000 levels"),
+        (
+            "deep.scxml",
+            deep_sc,
+            "deeper than the limit of 1000 levels",
+        ),
+        (
+            "long.xml",
+            long_bt,
+            "is 10485760 bytes long, more than the limit of 4096 bytes",
+        ),
+        (
+            "long.scxml",
+            long_sc,
+            "is 10485760 bytes long, more than the limit of 4096 bytes",
+        ),
+    ] {
+        let f = dir.write(name, text);
+        let (code, _, stderr) = btfsm(&["analyze", &f]);
+        assert_eq!(code, 2, "{name}: {}", &stderr[..stderr.len().min(2000)]);
+        assert!(
+            stderr.contains(want),
+            "{name}: {}",
+            &stderr[..stderr.len().min(2000)]
+        );
+        assert!(
+            stderr.len() < 20_000,
+            "{name}: the message quotes names, not 10 MB"
+        );
+    }
 }
