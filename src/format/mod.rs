@@ -95,27 +95,21 @@ pub fn check_shape(policy: &Policy, limits: &Limits) -> Option<Diagnostic> {
         d
     };
     let long = |s: &str| s.len() > limits.max_name_bytes;
-    match &policy.body {
-        PolicyBody::Bt(bt) => {
-            if let Some(n) = bt.nodes.iter().find(|n| long(&n.id) || long(&n.label)) {
-                let (what, name) = if long(&n.id) {
-                    ("node id", &n.id)
-                } else {
-                    ("name of a node", &n.label)
-                };
-                return Some(too_long(what, name, n.span.clone()));
-            }
-        }
-        PolicyBody::Machine(m) => {
-            if let Some(st) = m.states.iter().find(|s| long(&s.name) || long(&s.label)) {
-                let (what, name) = if long(&st.name) {
-                    ("state name", &st.name)
-                } else {
-                    ("label of a state", &st.label)
-                };
-                return Some(too_long(what, name, st.span.clone()));
-            }
-        }
+    type Named<'p> = (&'p str, &'p str, &'p Option<std::ops::Range<usize>>);
+    let mut named: Box<dyn Iterator<Item = Named<'_>>> = match &policy.body {
+        PolicyBody::Bt(bt) => Box::new(bt.nodes.iter().map(|n| (&*n.id, &*n.label, &n.span))),
+        PolicyBody::Machine(m) => Box::new(m.states.iter().map(|s| (&*s.name, &*s.label, &s.span))),
+    };
+    let words = match &policy.body {
+        PolicyBody::Bt(_) => ["node id", "name of a node"],
+        PolicyBody::Machine(_) => ["state name", "label of a state"],
+    };
+    if let Some((id, label, span)) = named.find(|(id, label, _)| long(id) || long(label)) {
+        return Some(if long(id) {
+            too_long(words[0], id, span.clone())
+        } else {
+            too_long(words[1], label, span.clone())
+        });
     }
     let too_many = |n: usize, what: &str| {
         Diagnostic::error(format!(
