@@ -83,6 +83,7 @@ impl CompiledBt {
         }
     }
 
+    #[inline]
     fn kids(&self, n: &XNode) -> &[usize] {
         &self.kids[n.start..n.start + n.len]
     }
