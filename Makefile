@@ -1,7 +1,9 @@
-# btfsm: `make run` analyzes the bundled policies, `make test` is what CI runs.
+# btfsm: `make run` runs the main job on the bundled policies and scenarios,
+# `make test` is what CI runs.
 CARGO ?= cargo
 BIN := target/release/btfsm
 POLICIES := $(wildcard policies/paper/*.toml)
+SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
 .PHONY: build run test bench bench-ged clean paper-docs fuzz
 
@@ -18,8 +20,13 @@ run: build
 	  $(BIN) dot $$f -o out/$$b.dot || exit 2; \
 	  if command -v dot >/dev/null 2>&1; then $(BIN) dot $$f --render svg -o out/$$b.svg || exit 2; fi; \
 	done
-	@if command -v dot >/dev/null 2>&1; then echo "wrote out/analysis.json, out/*.dot and out/*.svg"; \
-	 else echo "wrote out/analysis.json and out/*.dot (install Graphviz for SVG)"; fi
+	@for s in $(SCENARIOS); do \
+	  b=$$(basename $$s .toml); \
+	  $(BIN) sim $$s --format json --plot out/sim-$$b.svg > out/sim-$$b.json || exit 2; \
+	done
+	$(BIN) sim policies/scenarios/exp1-pick-fails.toml
+	@if command -v dot >/dev/null 2>&1; then echo "wrote out/analysis.json, out/*.dot, out/*.svg and out/sim-*.json"; \
+	 else echo "wrote out/analysis.json, out/*.dot, out/sim-*.json and out/sim-*.svg (install Graphviz for the policy SVGs)"; fi
 
 test:
 	$(CARGO) fmt --check

@@ -21,6 +21,7 @@ use std::time::Instant;
 struct Frozen(World);
 
 impl Leaves for Frozen {
+    #[inline]
     fn condition(&mut self, call: &Call) -> bool {
         condition(call, &self.0)
     }

@@ -53,9 +53,24 @@ pub struct CompiledBt {
 pub struct XNode {
     pub kind: BtNodeKind,
     pub call: Option<Call>,
+    /// What ticking it needs, decided once: a leaf is evaluated in place.
+    leaf: Leaf,
     /// Its children are `kids[start..start + len]`.
     start: usize,
     len: usize,
+}
+
+/// How a node is ticked (precomputed from its kind and binding).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Leaf {
+    /// A control node or decorator: gets a frame.
+    No,
+    /// An action bound to a skill.
+    Action,
+    /// A condition bound to a skill.
+    Condition,
+    /// A leaf without a binding: fails.
+    Unbound,
 }
 
 impl CompiledBt {
@@ -68,9 +83,16 @@ impl CompiledBt {
             .map(|(n, call)| {
                 let start = kids.len();
                 kids.extend_from_slice(&n.children);
+                let leaf = match (n.kind, &call) {
+                    (BtNodeKind::Action, Some(_)) => Leaf::Action,
+                    (BtNodeKind::Condition, Some(_)) => Leaf::Condition,
+                    (BtNodeKind::Action | BtNodeKind::Condition, None) => Leaf::Unbound,
+                    _ => Leaf::No,
+                };
                 XNode {
                     kind: n.kind,
                     call,
+                    leaf,
                     start,
                     len: n.children.len(),
                 }
@@ -83,6 +105,7 @@ impl CompiledBt {
         }
     }
 
+    #[inline]
     fn kids(&self, n: &XNode) -> &[usize] {
         &self.kids[n.start..n.start + n.len]
     }
@@ -148,6 +171,21 @@ impl BtExec {
         }
     }
 
+    /// Evaluates a leaf in place; `None` for a node that needs a frame.
+    #[inline(always)]
+    fn leaf(cn: &XNode, c: usize, leaves: &mut impl Leaves) -> Option<Status> {
+        match (cn.leaf, &cn.call) {
+            (Leaf::Action, Some(call)) => Some(leaves.action(c, call)),
+            (Leaf::Condition, Some(call)) => Some(if leaves.condition(call) {
+                Status::Success
+            } else {
+                Status::Failure
+            }),
+            (Leaf::No, _) => None,
+            _ => Some(Status::Failure),
+        }
+    }
+
     /// Ticks the tree once from the root.
     pub fn tick(&mut self, leaves: &mut impl Leaves) -> Status {
         use BtNodeKind as K;
@@ -171,6 +209,7 @@ impl BtExec {
             let node = &bt.nodes[n];
             let kids = bt.kids(node);
             let mut push = None;
+            let mut composite = None;
             let out: Status = match node.kind {
                 K::Action => match &node.call {
                     Some(c) => leaves.action(n, c),
@@ -192,20 +231,9 @@ impl BtExec {
                             None if f.i < kids.len() => {
                                 let c = kids[f.i];
                                 let cn = &bt.nodes[c];
-                                let leaf = match (cn.kind, &cn.call) {
-                                    (K::Action, Some(call)) => leaves.action(c, call),
-                                    (K::Condition, Some(call)) => {
-                                        if leaves.condition(call) {
-                                            S
-                                        } else {
-                                            F
-                                        }
-                                    }
-                                    (K::Action | K::Condition, None) => F,
-                                    _ => {
-                                        push = Some(c);
-                                        break R;
-                                    }
+                                let Some(leaf) = Self::leaf(cn, c, leaves) else {
+                                    composite = Some(c);
+                                    break R;
                                 };
                                 if let Some(v) = &mut self.statuses {
                                     v.push((c, leaf));
@@ -300,16 +328,17 @@ impl BtExec {
                     },
                 },
             };
+            if let Some(c) = composite {
+                // A composite's child known not to be a leaf: straight to
+                // its frame.
+                let fr = Self::enter(st, bt.nodes[c].kind, step, c, now);
+                stack.push(fr);
+                continue;
+            }
             if let Some(c) = push {
                 // Leaves are evaluated in place (no frame): the hot path.
                 let cn = &bt.nodes[c];
-                let leaf = match (cn.kind, &cn.call) {
-                    (K::Action, Some(call)) => Some(leaves.action(c, call)),
-                    (K::Condition, Some(call)) => Some(if leaves.condition(call) { S } else { F }),
-                    (K::Action | K::Condition, None) => Some(F),
-                    _ => None,
-                };
-                match leaf {
+                match Self::leaf(cn, c, leaves) {
                     Some(r) => {
                         if let Some(v) = &mut self.statuses {
                             v.push((c, r));

@@ -202,6 +202,7 @@ fn round3(x: f64) -> f64 {
 }
 
 impl Leaves for Robot {
+    #[inline]
     fn condition(&mut self, call: &Call) -> bool {
         skills::condition(call, &self.world)
     }
