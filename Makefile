@@ -32,6 +32,7 @@ test:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets --locked -- -D warnings
 	$(CARGO) test --locked
+	$(CARGO) test --locked --bench scale --bench ged --bench sim -- --test
 	$(CARGO) run --quiet --locked -- paper --check
 
 # Regenerates docs/paper-results.md (a test fails when it is stale).

@@ -127,12 +127,16 @@ fn random_pairs() -> Vec<Pair> {
         .collect()
 }
 
-/// Median wall time of repeated runs (at least 5, for at least 50 ms).
-fn time(pair: &Pair, opts: &GedOptions) -> (u64, bool, Duration) {
+/// Median wall time of repeated runs (at least 5, for at least 50 ms; one
+/// run when `quick`).
+fn time(pair: &Pair, opts: &GedOptions, quick: bool) -> (u64, bool, Duration) {
     let mut times = Vec::new();
     let started = Instant::now();
     let mut last = None;
-    while times.len() < 5 || (started.elapsed() < Duration::from_millis(50) && times.len() < 1000) {
+    let enough = |n: usize| {
+        n >= 1 && quick || n >= 5 && (started.elapsed() >= Duration::from_millis(50) || n >= 1000)
+    };
+    while !enough(times.len()) {
         let t = Instant::now();
         let r = ged_graphs(&pair.a, &pair.b, GedMode::Structural, opts);
         times.push(t.elapsed());
@@ -154,6 +158,9 @@ fn arcs_json(g: &GedGraph) -> serde_json::Value {
 }
 
 fn main() {
+    // `cargo test --benches -- --test` (make test): one run per pair, the
+    // paper pairs only, nothing written — a smoke test of this file.
+    let quick = std::env::args().any(|a| a == "--test");
     let out = std::env::args()
         .skip(1)
         .find(|a| !a.starts_with('-'))
@@ -172,8 +179,10 @@ fn main() {
         "{:44} {:>9} {:>9} {:>5} {:>6} {:>12}",
         "pair", "V", "E", "GED", "exact", "btfsm"
     );
-    for p in paper_pairs().into_iter().chain(random_pairs()) {
-        let (ged, exact, t) = time(&p, &opts);
+    let random = if quick { Vec::new() } else { random_pairs() };
+    for p in paper_pairs().into_iter().chain(random) {
+        let (ged, exact, t) = time(&p, &opts, quick);
+        assert!(exact, "{}: not exact within 10 s", p.name);
         println!(
             "{:44} {:>4}/{:<4} {:>4}/{:<4} {:>5} {:>6} {:>9.3} ms",
             p.name,
@@ -193,6 +202,9 @@ fn main() {
             "self_loops": p.a.arcs().iter().chain(p.b.arcs()).any(|&(t, h, _)| t == h),
             "btfsm": { "ged": ged, "exact": exact, "seconds": t.as_secs_f64() },
         }));
+    }
+    if quick {
+        return;
     }
     let text = serde_json::to_string(&serde_json::json!({ "pairs": rows })).expect("json");
     if let Err(e) = std::fs::write(&out, text) {

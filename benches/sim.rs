@@ -63,10 +63,12 @@ fn main() {
     let mut ex = BtExec::new(compiled, false);
     let mut leaves = Frozen(w);
     // Best of 5 rounds (the machine is shared; py_trees gets the same rule).
+    // `cargo test --benches -- --test` (make test): a smoke test of this file.
+    let quick = std::env::args().any(|a| a == "--test");
     let n: u64 = std::env::var("BTFSM_BENCH_TICKS")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(1_000_000);
+        .unwrap_or(if quick { 1_000 } else { 1_000_000 });
     let mut dt = f64::INFINITY;
     for _ in 0..5 {
         let t0 = Instant::now();
@@ -86,7 +88,7 @@ fn main() {
 
     let t0 = Instant::now();
     let mut steps = 0u64;
-    for _ in 0..20 {
+    for _ in 0..if quick { 1 } else { 20 } {
         steps += run_scenario(&s, false).iter().map(|r| r.steps).sum::<u64>();
     }
     let dt = t0.elapsed().as_secs_f64();
@@ -94,10 +96,11 @@ fn main() {
 
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let t0 = Instant::now();
-    let stats = monte_carlo(&s, 1000, 7, threads);
+    let episodes = if quick { 10 } else { 1000 };
+    let stats = monte_carlo(&s, episodes, 7, threads);
     let dt = t0.elapsed().as_secs_f64();
     println!(
-        "btfsm_monte_carlo_1000_episodes_s {dt:.2} ({} policies, {threads} threads)",
+        "btfsm_monte_carlo_{episodes}_episodes_s {dt:.2} ({} policies, {threads} threads)",
         stats.len()
     );
     for st in stats {
