@@ -237,7 +237,29 @@ pub(crate) fn finish(
             d.span.as_ref().map_or(0, |s| s.start),
         )
     });
-    let (errors, warnings): (Vec<_>, Vec<_>) = diags.into_iter().partition(Diagnostic::is_error);
+    let (mut errors, mut warnings): (Vec<_>, Vec<_>) =
+        diags.into_iter().partition(Diagnostic::is_error);
+    // At most `MAX_DIAGNOSTICS` of each, the rest counted in one message (the
+    // TOML reader already stops keeping them there; the XML readers rely on
+    // this), so that a file with a million bad elements prints a bounded
+    // report.
+    let cap = self::toml::MAX_DIAGNOSTICS;
+    let end = file.text.len()..file.text.len();
+    if errors.len() > cap + 1 {
+        let more = errors.len() - cap;
+        errors.truncate(cap);
+        errors.push(
+            Diagnostic::error(format!(
+                "{more} more errors not shown (the first {cap} messages are)"
+            ))
+            .at(file, end.clone()),
+        );
+    }
+    if warnings.len() > cap + 1 {
+        let more = warnings.len() - cap;
+        warnings.truncate(cap);
+        warnings.push(Diagnostic::warning(format!("{more} more warnings not shown")).at(file, end));
+    }
     match policy {
         Some(policy) if errors.is_empty() => Ok(Loaded {
             path: file.path.clone(),
@@ -252,5 +274,43 @@ pub(crate) fn finish(
             all.extend(warnings);
             Err(all)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostic::SourceFile;
+
+    #[test]
+    fn finish_keeps_a_bounded_number_of_messages() {
+        let file = SourceFile::new("many.xml", "<root/>");
+        let cap = toml::MAX_DIAGNOSTICS;
+        let diags: Vec<Diagnostic> = (0..cap * 3)
+            .map(|i| Diagnostic::error(format!("problem {i}")).at(&file, 0..1))
+            .chain((0..cap * 2).map(|i| Diagnostic::warning(format!("odd {i}")).at(&file, 0..1)))
+            .collect();
+        let Err(all) = finish(&file, None, diags, "behavior tree") else {
+            panic!("errors make it fail");
+        };
+        let errors: Vec<_> = all.iter().filter(|d| d.is_error()).collect();
+        assert_eq!(errors.len(), cap + 1);
+        assert_eq!(
+            errors[cap].message,
+            format!(
+                "{} more errors not shown (the first {cap} messages are)",
+                cap * 2
+            )
+        );
+        let warnings = all.len() - errors.len();
+        assert_eq!(warnings, cap + 1);
+        // At the cap exactly, nothing is dropped.
+        let diags: Vec<Diagnostic> = (0..=cap)
+            .map(|i| Diagnostic::error(format!("problem {i}")).at(&file, 0..1))
+            .collect();
+        let Err(all) = finish(&file, None, diags, "behavior tree") else {
+            panic!("errors make it fail");
+        };
+        assert_eq!(all.len(), cap + 1);
     }
 }

@@ -186,11 +186,15 @@ type Published = BTreeMap<String, BTreeMap<String, BTreeMap<String, toml::Value>
 
 fn read_toml_file(path: &Path) -> Result<(std::sync::Arc<SourceFile>, toml::Table), Diagnostic> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        Diagnostic::error(format!("cannot read `{shown}`: {e}"))
-            .hint("give the directory of the paper's policies with --policies")
-    })?;
-    let file = SourceFile::new(shown, text);
+    // Read like a policy file: a device or a huge file stops at the size
+    // limit instead of filling memory.
+    let file = crate::format::toml::read_source(path, &shown, &crate::format::Limits::default())
+        .map_err(|e| {
+            e.into_iter()
+                .next()
+                .unwrap_or_else(|| Diagnostic::error(format!("cannot read `{shown}`")))
+                .hint("give the directory of the paper's policies with --policies")
+        })?;
     match file.text.parse::<toml::Table>() {
         Ok(t) => Ok((file, t)),
         Err(e) => {
