@@ -560,27 +560,21 @@ args = { object = "cube2" }
 on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
 "#;
 
-    const B: &str = r#"
-kind = "fsm"
-initial = "Go"
-outcomes = ["SUCCESS"]
-[states.Go]
-skill = "Move-To"
-args = { target = "cube2" }
-on = { SUCCESS = "Pick", FAILURE = "Safe", RUNNING = "Go" }
-[states.Safe]
-skill = "Safe-Move-To"
-args = { target = "cube2" }
-on = { SUCCESS = "Pick", FAILURE = "Go", RUNNING = "Safe" }
-[states.Pick]
-skill = "Pick"
-args = { object = "cube2" }
-on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
-"#;
+    /// A with `Safe-Move-To` as the alternative to `Go` (Fig. 8b's edit).
+    fn b() -> String {
+        A.replace(
+            "on = { SUCCESS = \"Pick\", FAILURE = \"Go\", RUNNING = \"Go\" }",
+            "on = { SUCCESS = \"Pick\", FAILURE = \"Safe\", RUNNING = \"Go\" }\n\
+             [states.Safe]\n\
+             skill = \"Safe-Move-To\"\n\
+             args = { target = \"cube2\" }\n\
+             on = { SUCCESS = \"Pick\", FAILURE = \"Go\", RUNNING = \"Safe\" }",
+        )
+    }
 
     #[test]
     fn named_script_tells_arcs_apart_by_label() {
-        let (pa, pb) = (policy(A), policy(B));
+        let (pa, pb) = (policy(A), policy(&b()));
         let pair = pair(&pa, &pb);
         let m = pair.run(GedMode::Named, &GedOptions::default());
         let s = &m.edit_script;
@@ -638,7 +632,7 @@ on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
     fn dot_options_never_reuse_a_key_of_b_for_a_ghost() {
         // Structurally, b's `Safe` may take a's place under another key; a
         // removed vertex whose key b also uses must be drawn apart.
-        let (pa, pb) = (policy(B), policy(A));
+        let (pa, pb) = (policy(&b()), policy(A));
         let pair = pair(&pa, &pb);
         for mode in [GedMode::Structural, GedMode::Named] {
             let m = pair.run(mode, &GedOptions::default());
