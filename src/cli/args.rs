@@ -20,7 +20,7 @@ pub struct Cli {
 pub enum Command {
     /// Counts, complexity and Table I estimates of each policy
     Analyze {
-        /// Policy files (TOML)
+        /// Policy files (TOML, BehaviorTree.CPP XML or SCXML)
         #[arg(required = true)]
         files: Vec<PathBuf>,
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
