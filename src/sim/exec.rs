@@ -23,6 +23,13 @@
 //!   and ends at SUCCESS.
 //!
 //! Both executors walk their structure with explicit stacks, never recursion.
+//! A BT's reactive skeleton (its Sequence and Fallback nodes from the root
+//! down to the first node with memory or a decorator) is compiled once into
+//! a table of successors ([`Plan`]): a tick then jumps from leaf to leaf as the
+//! short-circuit evaluation of an and/or expression does, and takes the stack
+//! walk only for the subtrees below the skeleton and when every node's status
+//! is recorded (`sim --trace`). A unit test checks both against a recursive
+//! reference on random trees of every node kind.
 
 use super::skills::{Call, Status};
 use crate::model::bt::Bt;
@@ -44,8 +51,101 @@ pub trait Leaves {
 #[derive(Debug)]
 pub struct CompiledBt {
     pub nodes: Vec<XNode>,
-    kids: Vec<usize>,
+    kids: Vec<u32>,
     pub root: usize,
+    plan: Plan,
+}
+
+/// The tree's reactive skeleton — the root and the reactive Sequence and
+/// Fallback nodes below it through reactive nodes only — compiled to a table
+/// of slots: every other node under the skeleton (a leaf, or a subtree whose
+/// root keeps memory or is not a reactive composite) is a slot, with the slot
+/// to tick next when it succeeds and when it fails. A reactive composite
+/// returns RUNNING as soon as a child does, so a RUNNING slot ends the tick.
+/// This is the short-circuit evaluation of an and/or tree; it visits the
+/// same leaves in the same order as the stack walk, without the frames.
+#[derive(Debug, Default)]
+struct Plan {
+    slots: Vec<Slot>,
+    /// The slot ticked first (or the tick's status, for an empty composite).
+    first: usize,
+}
+
+/// A slot's successors: a slot index, [`DONE_SUCCESS`] or [`DONE_FAILURE`].
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    node: usize,
+    on_success: usize,
+    on_failure: usize,
+}
+
+/// The root succeeds.
+const DONE_SUCCESS: usize = usize::MAX;
+/// The root fails.
+const DONE_FAILURE: usize = usize::MAX - 1;
+
+impl Plan {
+    /// Builds the table without recursion: children are visited last to
+    /// first, so that a child's successor (its next sibling's first slot) is
+    /// known when the child is visited.
+    fn new(nodes: &[XNode], kids: &[u32], root: usize) -> Plan {
+        enum Work {
+            /// Visit a node with its successors on success and on failure;
+            /// leaves its first slot on `firsts`.
+            Visit(usize, usize, usize),
+            /// Visit child `i` of the composite `p` (whose successors are
+            /// given); for all but the last child, the next child's first
+            /// slot is on top of `firsts`.
+            Child(usize, usize, usize, usize),
+        }
+        let reactive = |n: usize| matches!(nodes[n].op, Op::Sequence | Op::Fallback);
+        let kids_of = |n: usize| &kids[nodes[n].start as usize..nodes[n].end as usize];
+        let mut slots = Vec::new();
+        let mut firsts: Vec<usize> = Vec::new();
+        let mut work = vec![Work::Visit(root, DONE_SUCCESS, DONE_FAILURE)];
+        while let Some(w) = work.pop() {
+            match w {
+                Work::Visit(n, on_success, on_failure) => {
+                    if !reactive(n) {
+                        slots.push(Slot {
+                            node: n,
+                            on_success,
+                            on_failure,
+                        });
+                        firsts.push(slots.len() - 1);
+                    } else if kids_of(n).is_empty() {
+                        // Sequence() succeeds and Fallback() fails at once.
+                        let seq = nodes[n].op == Op::Sequence;
+                        firsts.push(if seq { on_success } else { on_failure });
+                    } else {
+                        let last = kids_of(n).len() - 1;
+                        work.push(Work::Child(n, last, on_success, on_failure));
+                    }
+                }
+                Work::Child(p, i, on_success, on_failure) => {
+                    let k = kids_of(p);
+                    let (s, f) = if i + 1 == k.len() {
+                        (on_success, on_failure)
+                    } else {
+                        let next = firsts.pop().unwrap_or(DONE_FAILURE);
+                        if nodes[p].op == Op::Sequence {
+                            (next, on_failure)
+                        } else {
+                            (on_success, next)
+                        }
+                    };
+                    if i > 0 {
+                        work.push(Work::Child(p, i - 1, on_success, on_failure));
+                    }
+                    work.push(Work::Visit(k[i] as usize, s, f));
+                }
+            }
+        }
+        Plan {
+            slots,
+            first: firsts.pop().unwrap_or(DONE_FAILURE),
+        }
+    }
 }
 
 /// A node of a [`CompiledBt`].
@@ -53,18 +153,34 @@ pub struct CompiledBt {
 pub struct XNode {
     pub kind: BtNodeKind,
     pub call: Option<Call>,
-    /// What ticking it needs, decided once: a leaf is evaluated in place.
-    leaf: Leaf,
-    /// Its children are `kids[start..start + len]`.
-    start: usize,
-    len: usize,
+    /// How it is ticked, decided once from its kind and binding.
+    op: Op,
+    /// A number the op needs: Parallel's success threshold, Repeat's and
+    /// Retry's count (`u32::MAX`: forever), Timeout's milliseconds.
+    arg: u64,
+    /// Its children are `kids[start..end]`.
+    start: u32,
+    end: u32,
 }
 
-/// How a node is ticked (precomputed from its kind and binding).
+/// How a node is ticked. Leaves are evaluated in place by their parent;
+/// every other op gets a frame on the stack.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Leaf {
-    /// A control node or decorator: gets a frame.
-    No,
+enum Op {
+    Sequence,
+    Fallback,
+    SequenceMemory,
+    FallbackMemory,
+    Parallel,
+    Inverter,
+    ForceSuccess,
+    ForceFailure,
+    Repeat,
+    Retry,
+    Timeout,
+    /// A kind the simulator does not model (scenarios reject it): passes
+    /// its first child's status through.
+    PassThrough,
     /// An action bound to a skill.
     Action,
     /// A condition bound to a skill.
@@ -75,40 +191,79 @@ enum Leaf {
 
 impl CompiledBt {
     pub fn new(bt: &Bt, call: Vec<Option<Call>>) -> Self {
-        let mut kids = Vec::new();
+        let mut kids = Vec::with_capacity(bt.nodes.len());
         let nodes = bt
             .nodes
             .iter()
             .zip(call)
             .map(|(n, call)| {
-                let start = kids.len();
-                kids.extend_from_slice(&n.children);
-                let leaf = match (n.kind, &call) {
-                    (BtNodeKind::Action, Some(_)) => Leaf::Action,
-                    (BtNodeKind::Condition, Some(_)) => Leaf::Condition,
-                    (BtNodeKind::Action | BtNodeKind::Condition, None) => Leaf::Unbound,
-                    _ => Leaf::No,
+                let start = kids.len() as u32;
+                kids.extend(n.children.iter().map(|&c| c as u32));
+                let (op, arg) = match (n.kind, &call) {
+                    (BtNodeKind::Sequence, _) => (Op::Sequence, 0),
+                    (BtNodeKind::Fallback, _) => (Op::Fallback, 0),
+                    (BtNodeKind::SequenceMemory, _) => (Op::SequenceMemory, 0),
+                    (BtNodeKind::FallbackMemory, _) => (Op::FallbackMemory, 0),
+                    (BtNodeKind::Parallel { success }, _) => (Op::Parallel, success as u64),
+                    (BtNodeKind::Inverter, _) => (Op::Inverter, 0),
+                    (BtNodeKind::ForceSuccess, _) => (Op::ForceSuccess, 0),
+                    (BtNodeKind::ForceFailure, _) => (Op::ForceFailure, 0),
+                    (BtNodeKind::Repeat { times }, _) => {
+                        (Op::Repeat, times.map_or(u64::MAX, u64::from))
+                    }
+                    (BtNodeKind::Retry { times }, _) => (Op::Retry, u64::from(times)),
+                    (BtNodeKind::Timeout { ms }, _) => (Op::Timeout, ms),
+                    (BtNodeKind::Control | BtNodeKind::Decorator, _) => (Op::PassThrough, 0),
+                    (BtNodeKind::Action, Some(_)) => (Op::Action, 0),
+                    (BtNodeKind::Condition, Some(_)) => (Op::Condition, 0),
+                    (BtNodeKind::Action | BtNodeKind::Condition, None) => (Op::Unbound, 0),
                 };
                 XNode {
                     kind: n.kind,
                     call,
-                    leaf,
+                    op,
+                    arg,
                     start,
-                    len: n.children.len(),
+                    end: kids.len() as u32,
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let plan = Plan::new(&nodes, &kids, bt.root);
         CompiledBt {
             nodes,
             kids,
             root: bt.root,
+            plan,
         }
     }
+}
 
-    #[inline]
-    fn kids(&self, n: &XNode) -> &[usize] {
-        &self.kids[n.start..n.start + n.len]
+/// Evaluates a leaf in place (noting it when `REC`); `None` for a node
+/// that needs a frame.
+#[inline(always)]
+fn leaf<const REC: bool>(
+    nodes: &[XNode],
+    c: usize,
+    leaves: &mut impl Leaves,
+    rec: &mut Vec<(usize, Status)>,
+) -> Option<Status> {
+    let cn = &nodes[c];
+    let s = match (cn.op, &cn.call) {
+        (Op::Condition, Some(call)) => {
+            if leaves.condition(call) {
+                Status::Success
+            } else {
+                Status::Failure
+            }
+        }
+        (Op::Action, Some(call)) => leaves.action(c, call),
+        (Op::Action | Op::Condition | Op::Unbound, _) => Status::Failure,
+        _ => return None,
+    };
+    if REC {
+        rec.push((c, s));
     }
+    Some(s)
 }
 
 /// The run-time state of a BT.
@@ -123,8 +278,9 @@ pub struct BtExec {
     stack: Vec<Frame>,
 }
 
-/// Per-node memory: the running child of a memory composite or a decorator's
-/// counter, the start of a Timeout, the step the node was last ticked.
+/// Per-node memory of the ops that have some (memory composites, Repeat,
+/// Retry, Timeout): the running child or the decorator's counter, the start
+/// of a Timeout, and the step the node was last ticked.
 #[derive(Debug, Clone, Copy, Default)]
 struct NodeState {
     mem: u32,
@@ -132,12 +288,21 @@ struct NodeState {
     t0: f64,
 }
 
-#[derive(Debug)]
+/// A node being ticked: the child it is at, and Parallel's counts.
+#[derive(Debug, Clone, Copy)]
 struct Frame {
-    node: usize,
-    i: usize,
-    ok: usize,
-    bad: usize,
+    node: u32,
+    i: u32,
+    ok: u32,
+    bad: u32,
+}
+
+/// What a node's visit ends with.
+enum Next {
+    /// Tick this child (not a leaf) in a frame of its own.
+    Descend(usize),
+    /// The node's status for this tick.
+    Done(Status),
 }
 
 impl BtExec {
@@ -152,215 +317,266 @@ impl BtExec {
         }
     }
 
-    fn enter(st: &mut [NodeState], kind: BtNodeKind, step: u64, n: usize, now: f64) -> Frame {
-        let ns = &mut st[n];
-        if ns.last + 1 != step {
-            ns.mem = 0;
-            ns.t0 = now;
-        }
-        ns.last = step;
-        let i = match kind {
-            BtNodeKind::SequenceMemory | BtNodeKind::FallbackMemory => ns.mem as usize,
-            _ => 0,
+    /// Ticks the tree once from the root.
+    pub fn tick(&mut self, leaves: &mut impl Leaves) -> Status {
+        self.step += 1;
+        let now = leaves.now();
+        let mut x = Ticking {
+            bt: &self.bt,
+            st: &mut self.node,
+            stack: &mut self.stack,
+            step: self.step,
+            now,
         };
+        match &mut self.statuses {
+            Some(v) => {
+                // Every node's status is wanted: the stack walk from the root.
+                v.clear();
+                x.run::<true>(x.bt.root, leaves, v)
+            }
+            None => x.run_plan(leaves),
+        }
+    }
+}
+
+/// One tick's view of a [`BtExec`].
+struct Ticking<'a> {
+    bt: &'a CompiledBt,
+    st: &'a mut [NodeState],
+    stack: &'a mut Vec<Frame>,
+    step: u64,
+    now: f64,
+}
+
+impl Ticking<'_> {
+    /// Ticks the tree through its plan: from slot to slot of the reactive
+    /// skeleton, a subtree with memory ticked by [`Ticking::run`].
+    fn run_plan(&mut self, leaves: &mut impl Leaves) -> Status {
+        let plan = &self.bt.plan;
+        let mut k = plan.first;
+        loop {
+            let Some(slot) = plan.slots.get(k) else {
+                return if k == DONE_SUCCESS {
+                    Status::Success
+                } else {
+                    Status::Failure
+                };
+            };
+            let s = match leaf::<false>(&self.bt.nodes, slot.node, leaves, &mut Vec::new()) {
+                Some(s) => s,
+                None => self.run::<false>(slot.node, leaves, &mut Vec::new()),
+            };
+            k = match s {
+                Status::Success => slot.on_success,
+                Status::Failure => slot.on_failure,
+                Status::Running => return Status::Running,
+            };
+        }
+    }
+
+    /// The frame of node `n` on entering it; a node with memory that was not
+    /// ticked on the previous step starts afresh.
+    #[inline(always)]
+    fn enter(nodes: &[XNode], st: &mut [NodeState], n: usize, step: u64, now: f64) -> Frame {
+        let mut i = 0;
+        if matches!(
+            nodes[n].op,
+            Op::SequenceMemory | Op::FallbackMemory | Op::Repeat | Op::Retry | Op::Timeout
+        ) {
+            let ns = &mut st[n];
+            if ns.last + 1 != step {
+                ns.mem = 0;
+                ns.t0 = now;
+            }
+            ns.last = step;
+            if matches!(nodes[n].op, Op::SequenceMemory | Op::FallbackMemory) {
+                i = ns.mem;
+            }
+        }
         Frame {
-            node: n,
+            node: n as u32,
             i,
             ok: 0,
             bad: 0,
         }
     }
 
-    /// Evaluates a leaf in place; `None` for a node that needs a frame.
-    #[inline(always)]
-    fn leaf(cn: &XNode, c: usize, leaves: &mut impl Leaves) -> Option<Status> {
-        match (cn.leaf, &cn.call) {
-            (Leaf::Action, Some(call)) => Some(leaves.action(c, call)),
-            (Leaf::Condition, Some(call)) => Some(if leaves.condition(call) {
-                Status::Success
-            } else {
-                Status::Failure
-            }),
-            (Leaf::No, _) => None,
-            _ => Some(Status::Failure),
+    /// Ticks the subtree of `from` with an explicit stack (noting every
+    /// node's status in `rec` when `REC`).
+    fn run<const REC: bool>(
+        &mut self,
+        from: usize,
+        leaves: &mut impl Leaves,
+        rec: &mut Vec<(usize, Status)>,
+    ) -> Status {
+        use Status::{Failure as F, Running as R, Success as S};
+        let bt = self.bt;
+        let nodes = &bt.nodes[..];
+        let st = &mut *self.st;
+        let (step, now) = (self.step, self.now);
+        if let Some(s) = leaf::<REC>(nodes, from, leaves, rec) {
+            return s;
+        }
+        let stack = &mut *self.stack;
+        stack.clear();
+        stack.push(Self::enter(nodes, st, from, step, now));
+        // The status of the child just popped, for its parent on top.
+        let mut ret: Option<Status> = None;
+        loop {
+            let Some(f) = stack.last_mut() else {
+                unreachable!("the loop returns when the root's frame is popped")
+            };
+            let n = f.node as usize;
+            let node = &nodes[n];
+            let kids = &bt.kids[node.start as usize..node.end as usize];
+            let next = match node.op {
+                op @ (Op::Sequence | Op::SequenceMemory | Op::Fallback | Op::FallbackMemory) => {
+                    let go_on = if matches!(op, Op::Sequence | Op::SequenceMemory) {
+                        S
+                    } else {
+                        F
+                    };
+                    // Leaf children are evaluated in place; the visit stops at
+                    // a child that needs a frame or at the node's status.
+                    let mut i = f.i as usize;
+                    let next = loop {
+                        let s = match ret.take() {
+                            Some(s) => s,
+                            None => {
+                                let Some(&c) = kids.get(i) else {
+                                    break Next::Done(go_on);
+                                };
+                                match leaf::<REC>(nodes, c as usize, leaves, rec) {
+                                    Some(s) => s,
+                                    None => break Next::Descend(c as usize),
+                                }
+                            }
+                        };
+                        if s != go_on {
+                            break Next::Done(s);
+                        }
+                        i += 1;
+                        if i == kids.len() {
+                            break Next::Done(go_on);
+                        }
+                    };
+                    f.i = i as u32;
+                    if let (Op::SequenceMemory | Op::FallbackMemory, Next::Done(s)) = (op, &next) {
+                        st[n].mem = if *s == R { i as u32 } else { 0 };
+                    }
+                    next
+                }
+                Op::Parallel => {
+                    if let Some(s) = ret.take() {
+                        f.ok += u32::from(s == S);
+                        f.bad += u32::from(s == F);
+                        f.i += 1;
+                    }
+                    let mut next = None;
+                    while let Some(&c) = kids.get(f.i as usize) {
+                        match leaf::<REC>(nodes, c as usize, leaves, rec) {
+                            Some(s) => {
+                                f.ok += u32::from(s == S);
+                                f.bad += u32::from(s == F);
+                                f.i += 1;
+                            }
+                            None => {
+                                next = Some(Next::Descend(c as usize));
+                                break;
+                            }
+                        }
+                    }
+                    next.unwrap_or_else(|| {
+                        let need = node.arg;
+                        Next::Done(if u64::from(f.ok) >= need {
+                            S
+                        } else if u64::from(f.bad) > (kids.len() as u64).saturating_sub(need) {
+                            F
+                        } else {
+                            R
+                        })
+                    })
+                }
+                op => {
+                    // A decorator: its child's status, evaluated in place for
+                    // a leaf, then mapped.
+                    let child = match ret.take() {
+                        Some(s) => Ok(s),
+                        None if op == Op::Timeout
+                            && (now - st[n].t0) * 1000.0 >= node.arg as f64 =>
+                        {
+                            st[n].last = 0;
+                            Err(Next::Done(F))
+                        }
+                        None => match kids.first() {
+                            None => Ok(F),
+                            Some(&c) => match leaf::<REC>(nodes, c as usize, leaves, rec) {
+                                Some(s) => Ok(s),
+                                None => Err(Next::Descend(c as usize)),
+                            },
+                        },
+                    };
+                    match child {
+                        Ok(s) => Next::Done(Self::decorate(op, node.arg, &mut st[n], s)),
+                        Err(next) => next,
+                    }
+                }
+            };
+            match next {
+                Next::Descend(c) => {
+                    let fr = Self::enter(nodes, st, c, step, now);
+                    stack.push(fr);
+                }
+                Next::Done(s) => {
+                    if REC {
+                        rec.push((n, s));
+                    }
+                    stack.pop();
+                    if stack.is_empty() {
+                        return s;
+                    }
+                    ret = Some(s);
+                }
+            }
         }
     }
 
-    /// Ticks the tree once from the root.
-    pub fn tick(&mut self, leaves: &mut impl Leaves) -> Status {
-        use BtNodeKind as K;
+    /// A decorator's status from its child's `s`.
+    fn decorate(op: Op, arg: u64, ns: &mut NodeState, s: Status) -> Status {
         use Status::{Failure as F, Running as R, Success as S};
-        self.step += 1;
-        if let Some(v) = &mut self.statuses {
-            v.clear();
-        }
-        let bt: &CompiledBt = &self.bt;
-        let st = &mut self.node;
-        let step = self.step;
-        let now = leaves.now();
-        let mut stack = std::mem::take(&mut self.stack);
-        stack.clear();
-        let root = Self::enter(st, bt.nodes[bt.root].kind, step, bt.root, now);
-        stack.push(root);
-        let mut ret: Option<Status> = None;
-        loop {
-            let top = stack.len() - 1;
-            let n = stack[top].node;
-            let node = &bt.nodes[n];
-            let kids = bt.kids(node);
-            let mut push = None;
-            let mut composite = None;
-            let out: Status = match node.kind {
-                K::Action => match &node.call {
-                    Some(c) => leaves.action(n, c),
-                    None => F,
-                },
-                K::Condition => match &node.call {
-                    Some(c) if leaves.condition(c) => S,
-                    _ => F,
-                },
-                k @ (K::Sequence | K::SequenceMemory | K::Fallback | K::FallbackMemory) => {
-                    let seq = matches!(k, K::Sequence | K::SequenceMemory);
-                    let (go_on, stop) = if seq { (S, F) } else { (F, S) };
-                    let f = &mut stack[top];
-                    // Runs through leaf children in place; stops at a
-                    // composite child (pushed) or at the node's result.
-                    let mut r = ret.take();
-                    loop {
-                        match r {
-                            None if f.i < kids.len() => {
-                                let c = kids[f.i];
-                                let cn = &bt.nodes[c];
-                                let Some(leaf) = Self::leaf(cn, c, leaves) else {
-                                    composite = Some(c);
-                                    break R;
-                                };
-                                if let Some(v) = &mut self.statuses {
-                                    v.push((c, leaf));
-                                }
-                                r = Some(leaf);
-                            }
-                            None => break go_on,
-                            Some(x) if x == go_on => {
-                                f.i += 1;
-                                if f.i < kids.len() {
-                                    r = None;
-                                } else {
-                                    st[n].mem = 0;
-                                    break go_on;
-                                }
-                            }
-                            Some(x) if x == stop => {
-                                st[n].mem = 0;
-                                break stop;
-                            }
-                            Some(_) => {
-                                st[n].mem = f.i as u32;
-                                break R;
-                            }
-                        }
-                    }
+        match (op, s) {
+            (_, R) => R,
+            (Op::Inverter, S) => F,
+            (Op::Inverter, F) => S,
+            (Op::ForceSuccess, _) => S,
+            (Op::ForceFailure, _) => F,
+            (Op::Repeat, S) => {
+                ns.mem = ns.mem.saturating_add(1);
+                if u64::from(ns.mem) >= arg {
+                    ns.mem = 0;
+                    S
+                } else {
+                    R
                 }
-                K::Parallel { success } => {
-                    let f = &mut stack[top];
-                    if let Some(r) = ret.take() {
-                        match r {
-                            S => f.ok += 1,
-                            F => f.bad += 1,
-                            R => {}
-                        }
-                        f.i += 1;
-                    }
-                    if f.i < kids.len() {
-                        push = Some(kids[f.i]);
-                        R
-                    } else if f.ok >= success {
-                        S
-                    } else if f.bad > kids.len().saturating_sub(success) {
-                        F
-                    } else {
-                        R
-                    }
-                }
-                K::Timeout { ms } if ret.is_none() && (now - st[n].t0) * 1000.0 >= ms as f64 => {
-                    st[n].last = 0;
+            }
+            (Op::Retry, F) => {
+                ns.mem = ns.mem.saturating_add(1);
+                if u64::from(ns.mem) > arg {
+                    ns.mem = 0;
                     F
+                } else {
+                    R
                 }
-                kind => match ret.take() {
-                    None => {
-                        push = Some(kids[0]);
-                        R
-                    }
-                    Some(r) => match (kind, r) {
-                        (K::Inverter, S) => F,
-                        (K::Inverter, F) => S,
-                        (K::ForceSuccess, S | F) => S,
-                        (K::ForceFailure, S | F) => F,
-                        (K::Repeat { times }, S) => {
-                            st[n].mem += 1;
-                            if times.is_some_and(|t| st[n].mem >= t) {
-                                st[n].mem = 0;
-                                S
-                            } else {
-                                R
-                            }
-                        }
-                        (K::Retry { times }, F) => {
-                            st[n].mem += 1;
-                            if st[n].mem > times {
-                                st[n].mem = 0;
-                                F
-                            } else {
-                                R
-                            }
-                        }
-                        (K::Repeat { .. } | K::Retry { .. }, r) => {
-                            st[n].mem = 0;
-                            r
-                        }
-                        (K::Timeout { .. }, r) => {
-                            if r != R {
-                                st[n].last = 0;
-                            }
-                            r
-                        }
-                        (_, r) => r,
-                    },
-                },
-            };
-            if let Some(c) = composite {
-                // A composite's child known not to be a leaf: straight to
-                // its frame.
-                let fr = Self::enter(st, bt.nodes[c].kind, step, c, now);
-                stack.push(fr);
-                continue;
             }
-            if let Some(c) = push {
-                // Leaves are evaluated in place (no frame): the hot path.
-                let cn = &bt.nodes[c];
-                match Self::leaf(cn, c, leaves) {
-                    Some(r) => {
-                        if let Some(v) = &mut self.statuses {
-                            v.push((c, r));
-                        }
-                        ret = Some(r);
-                    }
-                    None => {
-                        let fr = Self::enter(st, cn.kind, step, c, now);
-                        stack.push(fr);
-                    }
-                }
-                continue;
+            (Op::Repeat | Op::Retry, s) => {
+                ns.mem = 0;
+                s
             }
-            if let Some(v) = &mut self.statuses {
-                v.push((n, out));
+            (Op::Timeout, s) => {
+                ns.last = 0;
+                s
             }
-            stack.pop();
-            if stack.is_empty() {
-                self.stack = stack;
-                return out;
-            }
-            ret = Some(out);
+            (_, s) => s,
         }
     }
 }
@@ -789,5 +1005,326 @@ on = { SUCCESS = "A", RUNNING = "R" }
         assert_eq!(names, vec!["Recharge", "Recharge", "Tuck-Arm", "Tuck-Arm"]);
         assert_eq!(out[2], Status::Success);
         assert_eq!(ex.finished.as_ref().unwrap().0, "SUCCESS");
+    }
+
+    /// Random trees of every node kind, ticked by the plan (record off), the
+    /// stack walk (record on) and an independent recursive reference of the
+    /// semantics in this file's header: the same statuses, the same leaf
+    /// calls in the same order, and (stack walk) the same noted statuses.
+    #[test]
+    fn plan_stack_walk_and_recursive_reference_agree_on_random_trees() {
+        use crate::sim::rng::SimRng;
+        let mut rng = SimRng::named(11, "exec-differential");
+        for case in 0..400 {
+            let text = random_tree(&mut rng, 2 + case % 25);
+            let l = parse_str("r.toml", &text, Path::new("."), &Limits::default())
+                .unwrap_or_else(|e| panic!("{e:?}\n{text}"));
+            let PolicyBody::Bt(bt) = &l.policy.body else {
+                panic!()
+            };
+            // Leaf i answers as object i: conditions by In-Hand, actions by
+            // Pick; unbound leaves (label `U`) stay unbound.
+            let calls: Vec<Option<Call>> = bt
+                .nodes
+                .iter()
+                .enumerate()
+                .map(|(i, n)| match n.kind {
+                    BtNodeKind::Condition if n.label != "U" => Some(Call::InHand(i)),
+                    BtNodeKind::Action if n.label != "U" => Some(Call::Pick { object: i }),
+                    _ => None,
+                })
+                .collect();
+            let compiled = Arc::new(CompiledBt::new(bt, calls.clone()));
+            let mut plan = BtExec::new(compiled.clone(), false);
+            let mut walk = BtExec::new(compiled, true);
+            let mut reference = Reference::new(bt, calls);
+            let seed = rng.next_u64();
+            let (mut a, mut b, mut c) = (Oracle::new(seed), Oracle::new(seed), Oracle::new(seed));
+            for t in 0..30 {
+                for o in [&mut a, &mut b, &mut c] {
+                    o.step = t;
+                    o.log.clear();
+                }
+                let sa = plan.tick(&mut a);
+                let sb = walk.tick(&mut b);
+                let (sc, noted) = reference.tick(&mut c);
+                let ctx = format!("case {case}, tick {t}\n{text}");
+                assert_eq!((sa, &a.log), (sc, &c.log), "plan vs reference, {ctx}");
+                assert_eq!((sb, &b.log), (sc, &c.log), "walk vs reference, {ctx}");
+                assert_eq!(walk.statuses.as_ref(), Some(&noted), "noted, {ctx}");
+            }
+        }
+    }
+
+    /// Leaf answers drawn from (seed, step, leaf): the same for every
+    /// executor that asks the same question in the same step; every call is
+    /// logged.
+    struct Oracle {
+        seed: u64,
+        step: u64,
+        log: Vec<(usize, char)>,
+    }
+
+    impl Oracle {
+        fn new(seed: u64) -> Self {
+            Oracle {
+                seed,
+                step: 0,
+                log: vec![],
+            }
+        }
+        fn draw(&self, leaf: usize) -> u64 {
+            let mut x = self.seed ^ (self.step << 20) ^ (leaf as u64).wrapping_mul(0x9e37_79b9);
+            x ^= x >> 33;
+            x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
+            x ^ (x >> 29)
+        }
+    }
+
+    impl Leaves for Oracle {
+        fn condition(&mut self, call: &Call) -> bool {
+            let Call::InHand(i) = *call else { panic!() };
+            self.log.push((i, 'c'));
+            self.draw(i).is_multiple_of(2)
+        }
+        fn action(&mut self, key: usize, call: &Call) -> Status {
+            let Call::Pick { object } = *call else {
+                panic!()
+            };
+            assert_eq!(key, object);
+            self.log.push((key, 'a'));
+            [Status::Running, Status::Success, Status::Failure][(self.draw(key) % 3) as usize]
+        }
+        fn now(&self) -> f64 {
+            self.step as f64 * 0.1
+        }
+    }
+
+    /// A random BT of about `size` nodes as TOML, of every kind the executor
+    /// models.
+    fn random_tree(rng: &mut crate::sim::rng::SimRng, size: usize) -> String {
+        let mut lines = Vec::new();
+        let mut next = 1;
+        let mut open = vec![0usize];
+        let pick = |rng: &mut crate::sim::rng::SimRng, n: u64| (rng.next_u64() % n) as usize;
+        while let Some(n) = open.pop() {
+            let budget_left = next < size;
+            let kind = if n == 0 || (budget_left && pick(rng, 3) > 0) {
+                pick(rng, 11)
+            } else {
+                11 + pick(rng, 3)
+            };
+            let kids = |k: usize, next: &mut usize, open: &mut Vec<usize>| {
+                let ids: Vec<String> = (0..k).map(|j| format!("\"n{}\"", *next + j)).collect();
+                open.extend(*next..*next + k);
+                *next += k;
+                ids.join(", ")
+            };
+            let line = match kind {
+                0..=5 => {
+                    let k = 1 + pick(rng, 4);
+                    let list = kids(k, &mut next, &mut open);
+                    match kind {
+                        0 | 1 => format!("n{n} = {{ sequence = [{list}] }}"),
+                        2 => format!("n{n} = {{ fallback = [{list}] }}"),
+                        3 => format!("n{n} = {{ sequence_memory = [{list}] }}"),
+                        4 => format!("n{n} = {{ fallback_memory = [{list}] }}"),
+                        _ => format!(
+                            "n{n} = {{ parallel = [{list}], success = {} }}",
+                            1 + pick(rng, k as u64)
+                        ),
+                    }
+                }
+                6..=10 => {
+                    let c = kids(1, &mut next, &mut open);
+                    let c = c.trim_matches('"');
+                    match kind {
+                        6 => format!("n{n} = {{ inverter = \"{c}\" }}"),
+                        7 => format!("n{n} = {{ force_success = \"{c}\" }}"),
+                        8 if pick(rng, 2) == 0 => format!("n{n} = {{ repeat = \"{c}\" }}"),
+                        8 => format!(
+                            "n{n} = {{ repeat = \"{c}\", times = {} }}",
+                            1 + pick(rng, 3)
+                        ),
+                        9 => format!("n{n} = {{ retry = \"{c}\", times = {} }}", pick(rng, 3)),
+                        _ => format!(
+                            "n{n} = {{ timeout = \"{c}\", ms = {} }}",
+                            100 * pick(rng, 5)
+                        ),
+                    }
+                }
+                11 => format!("n{n} = {{ condition = \"C{n}?\" }}"),
+                12 => format!("n{n} = {{ action = \"A{n}!\" }}"),
+                _ if pick(rng, 2) == 0 => format!("n{n} = {{ condition = \"U\" }}"),
+                _ => format!("n{n} = {{ action = \"U\" }}"),
+            };
+            lines.push(line);
+        }
+        format!(
+            "kind = \"bt\"\nroot = \"n0\"\n[nodes]\n{}\n",
+            lines.join("\n")
+        )
+    }
+
+    /// The semantics of this file's header, written recursively over the
+    /// model (small trees only).
+    struct Reference<'a> {
+        bt: &'a Bt,
+        calls: Vec<Option<Call>>,
+        mem: Vec<u32>,
+        last: Vec<u64>,
+        t0: Vec<f64>,
+        step: u64,
+        now: f64,
+        noted: Vec<(usize, Status)>,
+    }
+
+    impl<'a> Reference<'a> {
+        fn new(bt: &'a Bt, calls: Vec<Option<Call>>) -> Self {
+            let n = bt.nodes.len();
+            Reference {
+                bt,
+                calls,
+                mem: vec![0; n],
+                last: vec![0; n],
+                t0: vec![0.0; n],
+                step: 0,
+                now: 0.0,
+                noted: vec![],
+            }
+        }
+
+        fn tick(&mut self, leaves: &mut impl Leaves) -> (Status, Vec<(usize, Status)>) {
+            self.step += 1;
+            self.now = leaves.now();
+            self.noted.clear();
+            let s = self.node(self.bt.root, leaves);
+            (s, std::mem::take(&mut self.noted))
+        }
+
+        fn node(&mut self, n: usize, leaves: &mut impl Leaves) -> Status {
+            use BtNodeKind as K;
+            use Status::{Failure as F, Running as R, Success as S};
+            let kind = self.bt.nodes[n].kind;
+            let kids = self.bt.nodes[n].children.clone();
+            if matches!(
+                kind,
+                K::SequenceMemory
+                    | K::FallbackMemory
+                    | K::Repeat { .. }
+                    | K::Retry { .. }
+                    | K::Timeout { .. }
+            ) {
+                if self.last[n] + 1 != self.step {
+                    self.mem[n] = 0;
+                    self.t0[n] = self.now;
+                }
+                self.last[n] = self.step;
+            }
+            let s = match kind {
+                K::Condition => match &self.calls[n] {
+                    Some(c) if leaves.condition(c) => S,
+                    _ => F,
+                },
+                K::Action => match &self.calls[n] {
+                    Some(c) => leaves.action(n, c),
+                    None => F,
+                },
+                K::Sequence | K::Fallback => {
+                    let go_on = if kind == K::Sequence { S } else { F };
+                    let mut out = go_on;
+                    for c in kids {
+                        let s = self.node(c, leaves);
+                        if s != go_on {
+                            out = s;
+                            break;
+                        }
+                    }
+                    out
+                }
+                K::SequenceMemory | K::FallbackMemory => {
+                    let go_on = if kind == K::SequenceMemory { S } else { F };
+                    let mut out = go_on;
+                    let start = self.mem[n] as usize;
+                    for (i, &c) in kids.iter().enumerate().skip(start) {
+                        let s = self.node(c, leaves);
+                        if s == R {
+                            self.mem[n] = i as u32;
+                            return self.note(n, R);
+                        }
+                        if s != go_on {
+                            out = s;
+                            break;
+                        }
+                    }
+                    self.mem[n] = 0;
+                    out
+                }
+                K::Parallel { success } => {
+                    let (mut ok, mut bad) = (0, 0);
+                    for &c in &kids {
+                        match self.node(c, leaves) {
+                            S => ok += 1,
+                            F => bad += 1,
+                            R => {}
+                        }
+                    }
+                    if ok >= success {
+                        S
+                    } else if bad > kids.len().saturating_sub(success) {
+                        F
+                    } else {
+                        R
+                    }
+                }
+                K::Timeout { ms } if (self.now - self.t0[n]) * 1000.0 >= ms as f64 => {
+                    self.last[n] = 0;
+                    F
+                }
+                _ => {
+                    let s = self.node(kids[0], leaves);
+                    match (kind, s) {
+                        (_, R) => R,
+                        (K::Inverter, S) => F,
+                        (K::Inverter, _) => S,
+                        (K::ForceSuccess, _) => S,
+                        (K::ForceFailure, _) => F,
+                        (K::Repeat { times }, S) => {
+                            self.mem[n] += 1;
+                            if times.is_some_and(|t| self.mem[n] >= t) {
+                                self.mem[n] = 0;
+                                S
+                            } else {
+                                R
+                            }
+                        }
+                        (K::Retry { times }, F) => {
+                            self.mem[n] += 1;
+                            if self.mem[n] > times {
+                                self.mem[n] = 0;
+                                F
+                            } else {
+                                R
+                            }
+                        }
+                        (K::Repeat { .. } | K::Retry { .. }, s) => {
+                            self.mem[n] = 0;
+                            s
+                        }
+                        (K::Timeout { .. }, s) => {
+                            self.last[n] = 0;
+                            s
+                        }
+                        (_, s) => s,
+                    }
+                }
+            };
+            self.note(n, s)
+        }
+
+        fn note(&mut self, n: usize, s: Status) -> Status {
+            self.noted.push((n, s));
+            s
+        }
     }
 }

@@ -8,7 +8,7 @@ use super::skills::{self, Call, Unresolved};
 use super::world::{Layout, Object, P2, Params, Place, Rect, World};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
 use crate::format::{self, Limits};
-use crate::model::{Policy, PolicyBody, SkillCall, StateBody, skill::SKILLS};
+use crate::model::{BtNodeKind, Policy, PolicyBody, SkillCall, StateBody, skill::SKILLS};
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -945,15 +945,27 @@ pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Dia
     match &p.body {
         PolicyBody::Bt(bt) => {
             for n in &bt.nodes {
-                if n.kind.arity() != crate::model::bt::Arity::Leaf {
-                    continue;
-                }
                 // Nodes of an included subtree (`include/...`) have spans in
                 // the included file: point at the include in this file.
-                let span = match n.id.split_once('/') {
+                let span = || match n.id.split_once('/') {
                     None => n.span.clone(),
                     Some((inc, _)) => src.as_ref().and_then(|f| key_span(&f.text, inc)),
                 };
+                if matches!(n.kind, BtNodeKind::Control | BtNodeKind::Decorator) {
+                    let t = n.type_name.as_deref().unwrap_or(n.kind.keyword());
+                    push(
+                        format!("node `{}`", n.id),
+                        span(),
+                        Unresolved {
+                            message: format!("the simulator does not model the node type `{t}`"),
+                            hint: "it executes sequence, fallback, sequence_memory, fallback_memory, parallel, inverter, force_success, force_failure, repeat, retry and timeout nodes".into(),
+                        },
+                    );
+                }
+                if n.kind.arity() != crate::model::bt::Arity::Leaf {
+                    continue;
+                }
+                let span = span();
                 match &n.skill {
                     Some(c) => {
                         if let Err(u) = skills::resolve(c, world) {
