@@ -7,7 +7,10 @@
 //! - Nodes in compact (`<Sequence>`) or explicit (`<Action ID="...">`) syntax.
 //!   `<SubTree ID>` (and format 3's `<SubTreePlus>`) is expanded in place: the
 //!   subtree's root takes the SubTree element's place, as TOML subtree includes
-//!   do, so counts are those of the expanded tree; recursion is rejected.
+//!   do, so counts are those of the expanded tree; recursion is rejected. Its
+//!   ports remap the subtree's blackboard entries, so inside the expansion a
+//!   port `{key}` becomes the value or outer entry the SubTree maps `key` to
+//!   (BehaviorTree.CPP 4 "Remapping ports between Trees and SubTrees").
 //! - Built-in types map onto the model (see [`BUILTINS`] and the README table);
 //!   other types are resolved through a `<TreeNodesModel>` (in the files read or
 //!   given with `--nodes-model`), or `--assume-leaf` decides for leaves.
@@ -638,8 +641,12 @@ impl Loader<'_> {
             /// `name` of the SubTree element this root replaces.
             name_override: Option<String>,
         }
-        // (tree ID, parent frame)
-        let mut frames: Vec<(String, Option<usize>)> = vec![(tree_id.to_string(), None)];
+        let mut frames: Vec<Frame> = vec![Frame {
+            id: tree_id.to_string(),
+            parent: None,
+            remap: BTreeMap::new(),
+            autoremap: false,
+        }];
         let root_el = self.docs[d0].elems[e0].children[0];
         let mut stack = vec![Item {
             d: d0,
@@ -678,11 +685,11 @@ impl Loader<'_> {
                 let mut f = Some(it.frame);
                 let mut recursive = false;
                 while let Some(fi) = f {
-                    chain.push(frames[fi].0.clone());
-                    if frames[fi].0 == id {
+                    chain.push(frames[fi].id.clone());
+                    if frames[fi].id == id {
                         recursive = true;
                     }
-                    f = frames[fi].1;
+                    f = frames[fi].parent;
                 }
                 if recursive {
                     chain.reverse();
@@ -692,7 +699,31 @@ impl Loader<'_> {
                     failed = true;
                     continue;
                 }
-                frames.push((id, Some(it.frame)));
+                // Its ports remap the subtree's blackboard entries: a
+                // reference is resolved in the enclosing expansion now, so
+                // that the subtree's nodes get the value or the outer entry.
+                let remap = el
+                    .attrs
+                    .iter()
+                    .filter(|a| a.ns.is_none() && !SUBTREE_ATTRS.contains(&a.name.as_str()))
+                    .map(|a| {
+                        let v = if a.value == "{=}" {
+                            format!("{{{}}}", a.name)
+                        } else {
+                            a.value.clone()
+                        };
+                        (a.name.clone(), resolve_port(&frames, it.frame, &v))
+                    })
+                    .collect();
+                let autoremap = ["_autoremap", "__autoremap", "__shared_blackboard"]
+                    .iter()
+                    .any(|k| el.attr(k) == Some("true") || el.attr(k) == Some("1"));
+                frames.push(Frame {
+                    id,
+                    parent: Some(it.frame),
+                    remap,
+                    autoremap,
+                });
                 let child = self.docs[sd].elems[se].children[0];
                 stack.push(Item {
                     d: sd,
@@ -713,7 +744,7 @@ impl Loader<'_> {
                 return None;
             }
             budget -= 1;
-            let Some(node) = self.node(it.d, &el) else {
+            let Some(node) = self.node(it.d, &el, |v| resolve_port(&frames, it.frame, v)) else {
                 failed = true;
                 continue;
             };
@@ -750,7 +781,7 @@ impl Loader<'_> {
 
     /// One node: its kind, label, type name and ports; arity is checked here
     /// on the element (a SubTree child counts as one).
-    fn node(&mut self, d: usize, el: &XElem) -> Option<BtNode> {
+    fn node(&mut self, d: usize, el: &XElem, resolve: impl Fn(&str) -> String) -> Option<BtNode> {
         let tag = el.name.as_str();
         let n = el.children.len();
         let (mut ty, explicit_cat): (String, Option<Category>) = match tag {
@@ -879,7 +910,7 @@ impl Loader<'_> {
                     && a.name != "ID"
                     && !consumed.contains(&a.name.as_str())
             })
-            .map(|a| (a.name.clone(), a.value.clone()))
+            .map(|a| (a.name.clone(), resolve(&a.value)))
             .collect();
         // A leaf whose type is a skill of the shared library, with arguments
         // that fit the skill, is bound to it.
@@ -920,6 +951,52 @@ impl Loader<'_> {
             ports,
             span: Some(el.span.clone()),
         })
+    }
+}
+
+/// Attributes of a `<SubTree>` element that are not port remappings.
+const SUBTREE_ATTRS: [&str; 5] = [
+    "ID",
+    "name",
+    "_autoremap",
+    "__autoremap",
+    "__shared_blackboard",
+];
+
+/// A SubTree expansion: the tree, the expansion it is in, and its port
+/// remapping (subtree entry -> value or outer `{entry}`, already resolved).
+struct Frame {
+    id: String,
+    parent: Option<usize>,
+    remap: BTreeMap<String, String>,
+    /// Entries not remapped are shared with the enclosing tree by name
+    /// (`_autoremap="true"`, format 3's `__shared_blackboard`).
+    autoremap: bool,
+}
+
+/// The value a port written as `value` inside expansion `frame` has in the
+/// expanded tree: a blackboard reference `{key}` remapped by the enclosing
+/// SubTree elements is replaced by what they map it to (a literal or an outer
+/// `{key}`); anything else is kept as written. BehaviorTree.CPP gives a
+/// subtree its own blackboard, so inlining it means renaming its entries.
+fn resolve_port(frames: &[Frame], frame: usize, value: &str) -> String {
+    let Some(key) = value
+        .strip_prefix('{')
+        .and_then(|v| v.strip_suffix('}'))
+        .filter(|k| !k.is_empty() && !k.contains(['{', '}']))
+    else {
+        return value.to_string();
+    };
+    let mut f = frame;
+    loop {
+        let fr = &frames[f];
+        if let Some(v) = fr.remap.get(key) {
+            return v.clone();
+        }
+        match fr.parent {
+            Some(p) if fr.autoremap => f = p,
+            _ => return value.to_string(),
+        }
     }
 }
 
@@ -1176,5 +1253,76 @@ mod tests {
         let names = vec![None, Some("x".to_string()), Some("x".to_string())];
         let (ids, _) = derive_ids(&children, 0, "T", &names, |_, _| None);
         assert_eq!(ids, ["T", "T/0", "T/1"]);
+    }
+
+    #[test]
+    fn subtree_ports_remap_the_subtree_blackboard() {
+        // Fetch is used twice with different cubes, Place through a nested
+        // subtree that remaps an outer entry, and Dock's target comes from
+        // an entry shared by _autoremap.
+        let l = parse(
+            r#"<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence>
+      <SubTree ID="Fetch" cube="cube1" where="{drop}"/>
+      <SubTree ID="Fetch" cube="cube2" where="delivery"/>
+      <SubTree ID="Park" _autoremap="true"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Fetch">
+    <Sequence>
+      <Action ID="Pick" object="{cube}"/>
+      <SubTree ID="Put" thing="{cube}" at="{where}"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Put">
+    <Action ID="Place" object="{thing}" at="{at}"/>
+  </BehaviorTree>
+  <BehaviorTree ID="Park">
+    <Sequence><Action ID="Move-To" target="{spot}"/><Wait secs="{private}"/></Sequence>
+  </BehaviorTree>
+  <TreeNodesModel><Action ID="Wait"/></TreeNodesModel>
+</root>"#,
+        )
+        .unwrap();
+        let b = bt(&l);
+        let calls: Vec<String> = b
+            .nodes
+            .iter()
+            .map(|n| match &n.skill {
+                Some(c) => format!("{}{:?}", c.skill, c.args),
+                None => format!("{}{:?}", n.label, n.ports),
+            })
+            .collect();
+        assert_eq!(
+            calls,
+            vec![
+                "Sequence{}",
+                "Sequence{}",
+                r#"Pick{"object": Str("cube1")}"#,
+                r#"Place{"at": Str("{drop}"), "object": Str("cube1")}"#,
+                "Sequence{}",
+                r#"Pick{"object": Str("cube2")}"#,
+                r#"Place{"at": Str("delivery"), "object": Str("cube2")}"#,
+                "Sequence{}",
+                r#"Move-To{"target": Str("{spot}")}"#,
+                r#"Wait{"secs": "{private}"}"#,
+            ]
+        );
+    }
+
+    #[test]
+    fn a_problem_in_a_subtree_used_twice_is_reported_once() {
+        let e = parse(
+            r#"<root main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence><SubTree ID="Sub"/><SubTree ID="Sub"/></Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Sub"><Mystery/></BehaviorTree>
+</root>"#,
+        )
+        .unwrap_err();
+        let msgs: Vec<&str> = e.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(msgs, vec!["unknown node type `Mystery` (0 children)"]);
     }
 }

@@ -237,6 +237,16 @@ pub(crate) fn finish(
             d.span.as_ref().map_or(0, |s| s.start),
         )
     });
+    // A problem inside a subtree used twice is found twice: say it once.
+    let mut seen = std::collections::BTreeSet::new();
+    diags.retain(|d| {
+        seen.insert((
+            d.file.as_ref().map(|f| f.path.clone()),
+            d.span.as_ref().map(|s| (s.start, s.end)),
+            d.is_error(),
+            d.message.clone(),
+        ))
+    });
     let (mut errors, mut warnings): (Vec<_>, Vec<_>) =
         diags.into_iter().partition(Diagnostic::is_error);
     // At most `MAX_DIAGNOSTICS` of each, the rest counted in one message (the
