@@ -25,6 +25,19 @@ pub enum Command {
         files: Vec<PathBuf>,
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
         format: OutputFormat,
+        /// Exit 1 when a policy's METRIC is above N, e.g. `--max cc=30`
+        /// (repeatable; metrics: vertices, edges, graphical_elements,
+        /// active_elements, cc, essential_cc)
+        #[arg(long = "max", value_name = "METRIC=N")]
+        max: Vec<crate::report::gate::Limit>,
+        /// A previous `analyze --format json` output: exit 1 when a policy's
+        /// metric grew over it by more than --max-increase allows
+        #[arg(long, value_name = "OLD.json")]
+        baseline: Option<PathBuf>,
+        /// How much METRIC may grow over the baseline (repeatable; default
+        /// `cc=0` and `essential_cc=0`)
+        #[arg(long = "max-increase", value_name = "METRIC=N", requires = "baseline")]
+        max_increase: Vec<crate::report::gate::Limit>,
         #[command(flatten)]
         limits: LimitArgs,
     },

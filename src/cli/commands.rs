@@ -1,9 +1,10 @@
 //! Runs each command: loads and validates inputs, calls the library, prints.
 
 use super::args::{Cli, Command, ConvertTarget};
-use super::{EXIT_BAD_INPUT, EXIT_OK};
+use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use crate::diagnostic::Diagnostic;
 use crate::format::{self, Limits, Loaded};
+use crate::report::gate::{Baseline, Gate, Limit};
 use crate::report::{self, analyze, render_analysis};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -13,13 +14,24 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Analyze {
             files,
             format,
+            max,
+            baseline,
+            max_increase,
             limits,
         } => {
-            let Some(loaded) = load_all(&files, &limits.limits()) else {
+            let limits = limits.limits();
+            let Some(gate) = gate(max, baseline.as_deref(), max_increase, &limits) else {
+                return EXIT_BAD_INPUT;
+            };
+            let Some(loaded) = load_all(&files, &limits) else {
                 return EXIT_BAD_INPUT;
             };
             let reports: Vec<_> = loaded.iter().map(analyze).collect();
-            emit(None, render_analysis(&reports, format).as_bytes())
+            let code = emit(None, render_analysis(&reports, format).as_bytes());
+            if code != EXIT_OK || gate.is_empty() {
+                return code;
+            }
+            check_gate(&gate, &reports)
         }
         Command::Validate { files, limits } => {
             let Some(loaded) = load_all(&files, &limits.limits()) else {
@@ -220,4 +232,78 @@ pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
             }
         }
     }
+}
+
+/// The complexity gate of `analyze`, with its baseline read (`None`: the
+/// baseline is unreadable, said on stderr).
+fn gate(
+    max: Vec<Limit>,
+    baseline: Option<&Path>,
+    max_increase: Vec<Limit>,
+    limits: &Limits,
+) -> Option<Gate> {
+    let baseline = match baseline {
+        None => None,
+        Some(p) => {
+            let shown = p.display().to_string();
+            let file = match format::toml::read_source(p, &shown, limits) {
+                Ok(f) => f,
+                Err(diags) => {
+                    for d in diags {
+                        eprint!("{d}");
+                    }
+                    return None;
+                }
+            };
+            match Baseline::parse(&shown, &file.text) {
+                Ok(b) => Some(b),
+                Err(d) => {
+                    eprint!("{d}");
+                    return None;
+                }
+            }
+        }
+    };
+    Some(Gate {
+        max,
+        baseline,
+        max_increase,
+    })
+}
+
+/// Prints the gate's verdict on stderr: exit 1 naming every metric over its
+/// limit.
+fn check_gate(gate: &Gate, reports: &[report::PolicyReport]) -> u8 {
+    let r = gate.check(reports);
+    let mut rules: Vec<String> = gate.max.iter().map(|l| format!("--max {l}")).collect();
+    if let Some(b) = &gate.baseline {
+        let grow: Vec<String> = gate
+            .increase_limits()
+            .iter()
+            .map(|l| format!("{} +{}", l.metric.key(), l.value))
+            .collect();
+        rules.push(format!("growth over `{}`: {}", b.path, grow.join(", ")));
+        for f in &r.new_policies {
+            eprintln!("note: `{f}` is not in the baseline; only its ceilings are checked");
+        }
+    }
+    let n = reports.len();
+    let policies = if n == 1 { "policy" } else { "policies" };
+    if r.violations.is_empty() {
+        eprintln!(
+            "complexity gate: {n} {policies} within limits ({})",
+            rules.join("; ")
+        );
+        return EXIT_OK;
+    }
+    for v in &r.violations {
+        eprintln!("error: complexity gate: {v}");
+    }
+    eprintln!(
+        "error: complexity gate: {} limit{} exceeded in {n} {policies} ({})",
+        r.violations.len(),
+        if r.violations.len() == 1 { "" } else { "s" },
+        rules.join("; ")
+    );
+    EXIT_CHECK_FAILED
 }

@@ -3,6 +3,7 @@
 
 pub mod compare;
 pub mod effort;
+pub mod gate;
 pub mod paper;
 pub mod table;
 

@@ -1,5 +1,6 @@
 //! Helpers shared by the modules of the integration-test binary.
 
+use std::path::PathBuf;
 use std::process::Command;
 
 /// Runs the built `btfsm` in the crate root: (exit code, stdout, stderr).
@@ -14,4 +15,11 @@ pub fn btfsm(args: &[&str]) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
+}
+
+/// A scratch directory of this test process.
+pub fn scratch(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("btfsm-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).expect("tmp");
+    d
 }

@@ -2,6 +2,7 @@
 //! files in ../shared/corpus, round trips at named GED 0, cross-format compare.
 
 use super::*;
+use common::scratch;
 
 const CORPUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/corpus");
 
@@ -286,13 +287,6 @@ fn lowercase_builtin_in_nav2_example_is_a_warning() {
         stderr.contains("docking_application_example.xml:22:13"),
         "{stderr}"
     );
-}
-
-/// A scratch directory for converted files.
-fn scratch(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("btfsm-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("tmp");
-    d
 }
 
 /// `btfsm convert FILE --to TARGET -o OUT` (with the Nav2 model).

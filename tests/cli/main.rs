@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 mod common;
 mod compare;
 mod formats;
+mod gate;
 mod hostile;
 mod paper;
 mod sim;
