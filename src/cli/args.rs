@@ -107,6 +107,10 @@ pub enum Command {
         files: Vec<PathBuf>,
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
         format: OutputFormat,
+        /// Time budget of the structural GED per policy; when it runs out the
+        /// result is a certified interval (the named GED has no budget)
+        #[arg(long, default_value_t = 2000, value_name = "MS")]
+        timeout_ms: u64,
         #[command(flatten)]
         limits: LimitArgs,
     },
@@ -213,6 +217,10 @@ impl LimitArgs {
 pub struct PaperArgs {
     #[arg(long, value_enum, default_value_t = crate::report::paper::PaperFormat::Table)]
     pub format: crate::report::paper::PaperFormat,
+    /// Time budget of each exact GED; when it runs out the cell shows the
+    /// certified interval
+    #[arg(long, default_value_t = 2000, value_name = "MS")]
+    pub timeout_ms: u64,
     /// Exit 1 naming every cell whose computed value departs from DIR/tables/expected.toml
     #[arg(long, conflicts_with = "record")]
     pub check: bool,

@@ -131,8 +131,9 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Effort {
             files,
             format,
+            timeout_ms,
             limits,
-        } => super::paper::effort(&files, format, &limits.limits()),
+        } => super::paper::effort(&files, format, timeout_ms, &limits.limits()),
         Command::Paper(args) => super::paper::paper(&args),
         Command::Edit(args) => super::edit::edit(&args),
         Command::Sim(args) => super::sim::execute(args),

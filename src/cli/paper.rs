@@ -11,12 +11,20 @@ use crate::report::effort::{EffortRow, render_effort};
 use crate::report::paper::{self, EXPECTED_FILE};
 use std::path::PathBuf;
 
+/// The GED budget given with `--timeout-ms`.
+fn ged_options(timeout_ms: u64) -> GedOptions {
+    GedOptions {
+        timeout: std::time::Duration::from_millis(timeout_ms),
+        ..GedOptions::default()
+    }
+}
+
 /// `btfsm effort FILE...`.
-pub fn effort(files: &[PathBuf], format: OutputFormat, limits: &Limits) -> u8 {
+pub fn effort(files: &[PathBuf], format: OutputFormat, timeout_ms: u64, limits: &Limits) -> u8 {
     let Some(loaded) = load_all(files, limits) else {
         return EXIT_BAD_INPUT;
     };
-    let opts = GedOptions::default();
+    let opts = ged_options(timeout_ms);
     let rows: Vec<EffortRow> = loaded
         .iter()
         .map(|l| EffortRow::new(&l.path, &l.policy.name, &compute_effort(&l.policy, &opts).0))
@@ -26,7 +34,7 @@ pub fn effort(files: &[PathBuf], format: OutputFormat, limits: &Limits) -> u8 {
 
 /// `btfsm paper`.
 pub fn paper(a: &PaperArgs) -> u8 {
-    let report = match paper::build(&a.policies, &a.limits.limits(), &GedOptions::default()) {
+    let report = match paper::build(&a.policies, &a.limits.limits(), &ged_options(a.timeout_ms)) {
         Ok(r) => r,
         Err(diags) => {
             for d in diags {

@@ -18,7 +18,10 @@ fn gate_ceilings_exit_1_naming_the_policy_and_metric() {
     ]);
     assert_eq!(code, 1, "{stderr}");
     // The report is printed all the same.
-    assert!(stdout.contains("policies/paper/fig01-bt.toml   bt"), "{stdout}");
+    assert!(
+        stdout.contains("policies/paper/fig01-bt.toml   bt"),
+        "{stdout}"
+    );
     assert_eq!(
         stderr,
         "error: complexity gate: `Fig. 4 FSM fault tolerant` (policies/paper/fig04-fsm.toml): cc is 14, above the limit 10 (--max cc=10)\n\
