@@ -118,6 +118,17 @@ fn sim_recharge_docking_arena_and_five_cubes_match() {
     }
 }
 
+/// The Fig. 1 BT written for BehaviorTree.CPP, its MoMa subtree
+/// parameterised by a SubTree port remapping (`cube="cube2"` over
+/// `object="{cube}"`), behaves as the TOML tree when a grasp fails.
+#[test]
+fn sim_a_btcpp_tree_with_a_parameterised_subtree_matches_the_toml_bt() {
+    let v = sim_json("tests/fixtures/sim/btcpp-subtree-pick-fails.toml");
+    assert!(sim_verdict(&v, BT1, "Main"), "{v}");
+    let skills = sim_policy(&v, "Main")["skills"].as_array().expect("skills").len();
+    assert_eq!(skills, 5, "{v}");
+}
+
 #[test]
 fn sim_reports_the_fig03_bt_as_chattering() {
     let v = sim_json("policies/scenarios/fig03-chattering.toml");
