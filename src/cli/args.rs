@@ -116,7 +116,7 @@ pub enum Command {
     },
     /// Reproduces the paper's Tables I-III and effort examples from policies/paper
     Paper(PaperArgs),
-    /// The paper's edit operations: insert a BT subtree, add an FSM state
+    /// The paper's edit operations: insert a BT subtree, add an (H)FSM state
     Edit(Box<EditArgs>),
     /// Runs policies in the planar robot simulator and compares their behavior
     Sim(super::sim::SimArgs),
@@ -286,9 +286,14 @@ pub enum EditOp {
         /// Name of the new state
         #[arg(long, value_name = "N")]
         name: String,
-        /// Preceding state (sequential, alternative); connected: file position only
+        /// Preceding state (sequential, alternative); connected: file position only.
+        /// A name unique in the machine, or a path `Container/State` (HFSM)
         #[arg(long, value_name = "P")]
         after: Option<String>,
+        /// HFSM: the container to add the state to when there is no --after
+        /// (default: the top level)
+        #[arg(long = "in", value_name = "CONTAINER")]
+        within: Option<String>,
         /// Skill the state runs, e.g. Tuck-Arm
         #[arg(long)]
         skill: String,

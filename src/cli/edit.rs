@@ -23,7 +23,7 @@ pub fn edit(a: &EditArgs) -> u8 {
     };
     let wrong_kind = |op: &str, want: &str| {
         eprintln!(
-            "error: {}: {op} edits {want}s, and this policy is a {kind}",
+            "error: {}: {op} edits {want}, and this policy is a {kind}",
             loaded.path
         );
         EXIT_BAD_INPUT
@@ -69,6 +69,7 @@ pub fn edit(a: &EditArgs) -> u8 {
                 kind,
                 name,
                 after,
+                within,
                 skill,
                 args,
                 guard,
@@ -112,6 +113,7 @@ pub fn edit(a: &EditArgs) -> u8 {
                 },
                 name: name.clone(),
                 after: after.clone(),
+                within: within.clone(),
                 skill: call,
                 guard,
                 selector_guard,
@@ -122,8 +124,8 @@ pub fn edit(a: &EditArgs) -> u8 {
                 Err(e) => return fail(e),
             }
         }
-        (EditOp::AddState { .. }, _) => return wrong_kind("add-state", "fsm"),
-        (_, _) => return wrong_kind("insert-subtree and wrap-root", "bt"),
+        (EditOp::AddState { .. }, _) => return wrong_kind("add-state", "FSMs and HFSMs"),
+        (_, _) => return wrong_kind("insert-subtree and wrap-root", "BTs"),
     };
     let text = crate::format::toml_write::write_policy(&policy);
     // The result must read back: an edit never writes an invalid file.

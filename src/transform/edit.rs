@@ -16,7 +16,11 @@
 //!   SELECTOR (SPEC §4 and the authors' code; Algorithm 1 as printed writes
 //!   `FAILURE`). A new sequential or alternative state copies its
 //!   predecessor's `RUNNING` and `FAILURE` pattern and its guards to the
-//!   connected states, so it joins their pattern (Fig. 8e).
+//!   connected states, so it joins their pattern (Fig. 8e). In an HFSM the
+//!   same happens inside the region of the predecessor (or of a named
+//!   container), whose decision state plays the SELECTOR; a new state never
+//!   shifts another state's identity (SPEC §3: names unique in the machine,
+//!   else positions).
 //!
 //! [`Touched::edits`] is the number of unit edits, which equals the named GED
 //! between the policy before and after (tested on the paper's figures).
@@ -225,8 +229,12 @@ pub struct AddState {
     pub kind: AddKind,
     pub name: String,
     /// The preceding state (sequential, alternative); for a connected state
-    /// only its place in the file (default: before the SELECTOR).
+    /// only its place in the file (default: before the SELECTOR). A name
+    /// unique in the machine or a path (`Container/State`).
     pub after: Option<String>,
+    /// HFSM: the container whose region gets the state when there is no
+    /// `after` (default: the top level).
+    pub within: Option<String>,
     pub skill: SkillCall,
     /// Connected: the guard every other action state gets to the new state
     /// (Algorithm 1's `condition`).
@@ -317,23 +325,91 @@ pub fn check_call(call: &SkillCall, kind: SkillKind) -> Result<(), EditError> {
     Ok(())
 }
 
-/// Adds a state to a flat FSM (see the module documentation).
-pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditError> {
-    if m.hierarchical {
-        return Err(err(
-            "add-state edits flat FSMs",
-            Some("an HFSM built from a BT is edited as the BT (insert-subtree)".into()),
-        ));
+/// A state by path (`Container/State`) or by a name unique in the machine.
+fn find_state(m: &StateMachine, s: &str) -> Result<usize, EditError> {
+    let n = m.states.len();
+    if let Some(i) = (0..n).find(|&i| m.path(i) == s) {
+        return Ok(i);
     }
+    let named: Vec<usize> = (0..n).filter(|&i| m.states[i].name == s).collect();
+    match named.as_slice() {
+        [i] => Ok(*i),
+        [] => Err(err(
+            format!("unknown state `{s}`"),
+            one_of(
+                "states",
+                (0..n)
+                    .filter(|&i| m.states[i].parent.is_none())
+                    .map(|i| m.states[i].name.as_str()),
+            ),
+        )),
+        many => Err(err(
+            format!("{} states are named `{s}`", many.len()),
+            Some(format!(
+                "give its path: {}",
+                many.iter()
+                    .map(|&i| format!("`{}`", m.path(i)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        )),
+    }
+}
+
+/// Adds a state to an FSM, or to a region of an HFSM (see the module
+/// documentation).
+pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditError> {
     check_call(&spec.skill, SkillKind::Action)?;
     for g in spec.guard.iter().chain(&spec.selector_guard) {
         for t in &g.all {
             check_call(&t.condition, SkillKind::Condition)?;
         }
     }
-    let top: Vec<usize> = m.top.states.clone();
-    let by_name = |n: &str| top.iter().copied().find(|&i| m.states[i].name == n);
-    if by_name(&spec.name).is_some() || m.top.outcomes.contains(&spec.name) {
+    let after = spec
+        .after
+        .as_deref()
+        .map(|a| find_state(m, a))
+        .transpose()?;
+    // The container whose region gets the state (`None`: the top level).
+    let container = match (&spec.within, after) {
+        (None, a) => a.and_then(|a| m.states[a].parent),
+        (Some(c), a) => {
+            let c = find_state(m, c)?;
+            if !matches!(m.states[c].body, StateBody::Container(_)) {
+                return Err(err(
+                    format!("`{}` is not a container", m.path(c)),
+                    Some("--in names a state that holds states".into()),
+                ));
+            }
+            if let Some(a) = a
+                && m.states[a].parent != Some(c)
+            {
+                return Err(err(
+                    format!("state `{}` is not in `{}`", m.path(a), m.path(c)),
+                    Some("drop --in: the new state goes beside its predecessor".into()),
+                ));
+            }
+            Some(c)
+        }
+    };
+    let (top, outcomes) = {
+        let r = match container {
+            None => &m.top,
+            Some(c) => match &m.states[c].body {
+                StateBody::Container(r) => r,
+                _ => unreachable!("checked above"),
+            },
+        };
+        (r.states.clone(), r.outcomes.clone())
+    };
+    // HFSM vertex identity is the name where it is unique in the machine, so
+    // a new name must be unique there (else other states' identities move).
+    let taken = if m.hierarchical {
+        m.states.iter().any(|s| s.name == spec.name)
+    } else {
+        top.iter().any(|&i| m.states[i].name == spec.name)
+    };
+    if taken || outcomes.contains(&spec.name) || m.top.outcomes.contains(&spec.name) {
         return Err(err(
             format!("a state or outcome `{}` already exists", spec.name),
             Some("choose an unused name".into()),
@@ -343,15 +419,6 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
         .iter()
         .copied()
         .find(|&i| matches!(m.states[i].body, StateBody::Decision));
-    let after = match &spec.after {
-        Some(a) => Some(by_name(a).ok_or_else(|| {
-            err(
-                format!("unknown state `{a}`"),
-                one_of("states", top.iter().map(|&i| m.states[i].name.as_str())),
-            )
-        })?),
-        None => None,
-    };
     let connected = crate::metrics::counts::fully_connected_states(m);
     let is_action = |m: &StateMachine, i: usize| {
         matches!(
@@ -360,10 +427,11 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
         )
     };
     let n = m.states.len();
+    let keys_before = m.hierarchical.then(|| m.keys());
     let mut new = State {
         name: spec.name.clone(),
         label: spec.name.clone(),
-        parent: None,
+        parent: container,
         body: StateBody::Task(Some(spec.skill.clone())),
         transitions: Vec::new(),
         pseudo: None,
@@ -511,8 +579,27 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
         }
     }
     m.states.push(new);
-    m.top.states.insert(pos, n);
+    region_mut(m, container).states.insert(pos, n);
+    // A state named by its position among siblings keeps its identity only
+    // if the new state does not come before it: else it goes last.
+    if let Some(before) = keys_before
+        && m.keys()[..n] != before[..]
+    {
+        let r = region_mut(m, container);
+        r.states.retain(|&i| i != n);
+        r.states.push(n);
+    }
     Ok(touched)
+}
+
+fn region_mut(m: &mut StateMachine, container: Option<usize>) -> &mut crate::model::Region {
+    match container {
+        None => &mut m.top,
+        Some(c) => match &mut m.states[c].body {
+            StateBody::Container(r) => r,
+            _ => unreachable!("a container holds a region"),
+        },
+    }
 }
 
 /// Parses a guard written `Skill(key=value, ...) & not Skill ...`: terms
@@ -673,6 +760,7 @@ mod tests {
             kind,
             name: name.into(),
             after: after.map(str::to_string),
+            within: None,
             skill: SkillCall {
                 skill: skill.into(),
                 args: BTreeMap::new(),
@@ -721,6 +809,59 @@ mod tests {
                 Some(parse_guard("not Battery-Level(min=20)", Some("battery < 20%")).unwrap());
             vec![add_state(fsm(p), &s).unwrap()]
         });
+    }
+
+    #[test]
+    fn hfsm_states_are_added_inside_containers() {
+        let orig = paper("fig06-hfsm");
+        let mut p = orig.clone();
+        let s = spec(AddKind::Sequential, "tuck", Some("pick"), "Tuck-Arm");
+        let t = add_state(fsm(&mut p), &s).unwrap();
+        assert_eq!(t.edits() as u64, named(&orig, &p));
+        let m = fsm(&mut p);
+        let tuck = m.states.iter().position(|s| s.name == "tuck").unwrap();
+        assert_eq!(m.path(tuck), "fetch/tuck");
+        // Pick's SUCCESS now goes to tuck, which ends the container.
+        let pick = m.states.iter().position(|s| s.name == "pick").unwrap();
+        assert_eq!(
+            outcome_target(&m.states[pick], "SUCCESS"),
+            Some(&Target::State(tuck))
+        );
+        assert_eq!(
+            outcome_target(&m.states[tuck], "SUCCESS"),
+            Some(&Target::Outcome("SUCCESS".into()))
+        );
+        // By path, and into a named container; clashes and wrong places are
+        // explained.
+        let mut q = orig.clone();
+        let mut s = spec(
+            AddKind::Alternative,
+            "retry-move",
+            Some("fetch/reached-cube/move-to-cube"),
+            "Move-To",
+        );
+        s.skill
+            .args
+            .insert("target".into(), ArgValue::Str("cube2".into()));
+        assert!(add_state(fsm(&mut q), &s).is_ok());
+        let e = add_state(
+            fsm(&mut q),
+            &spec(AddKind::Sequential, "pick", Some("at-cube"), "Dock"),
+        )
+        .unwrap_err();
+        assert!(e.message.contains("already exists"), "{}", e.message);
+        let mut s = spec(AddKind::Sequential, "x", Some("pick"), "Dock");
+        s.within = Some("reached-cube".into());
+        let e = add_state(fsm(&mut q), &s).unwrap_err();
+        assert!(
+            e.message.contains("is not in `fetch/reached-cube`"),
+            "{}",
+            e.message
+        );
+        let mut s = spec(AddKind::Sequential, "x", None, "Dock");
+        s.within = Some("pick".into());
+        let e = add_state(fsm(&mut q), &s).unwrap_err();
+        assert!(e.message.contains("not a container"), "{}", e.message);
     }
 
     #[test]
@@ -875,6 +1016,29 @@ mod tests {
             prop_assert!(edits as u64 >= named(&orig, &p));
             let text = crate::format::toml_write::write_policy(&p);
             prop_assert!(crate::format::toml::parse_str("e.toml", &text, Path::new("."), &Limits::default()).is_ok());
+        }
+        #[test]
+        fn hfsm_edit_counts_are_the_named_ged(ops in proptest::collection::vec((0usize..64, 0usize..2), 1..5)) {
+            let orig = crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&paper("fig01-bt")).unwrap();
+            let mut p = orig.clone();
+            for (k, (after, kind)) in ops.into_iter().enumerate() {
+                let m = fsm(&mut p);
+                let tasks: Vec<String> = (0..m.states.len())
+                    .filter(|&i| matches!(m.states[i].body, StateBody::Task(_)))
+                    .map(|i| m.path(i))
+                    .collect();
+                let kind = [AddKind::Sequential, AddKind::Alternative][kind];
+                let s = spec(kind, &format!("S{k}"), Some(&tasks[after % tasks.len()]), "Dock");
+                let before = p.clone();
+                match add_state(fsm(&mut p), &s) {
+                    Ok(t) => prop_assert_eq!(t.edits() as u64, named(&before, &p)),
+                    Err(_) => prop_assert_eq!(&before, &p),
+                }
+            }
+            let text = crate::format::toml_write::write_policy(&p);
+            let back = crate::format::toml::parse_str("e.toml", &text, Path::new("."), &Limits::default());
+            prop_assert!(back.is_ok(), "{}", text);
+            prop_assert_eq!(named(&back.unwrap().policy, &p), 0);
         }
     }
 }

@@ -396,7 +396,10 @@ fn edit_commands_rebuild_fig07c_and_fig08a() {
         &bad_s,
     ]);
     assert_eq!(code, 2);
-    assert!(stderr.contains("add-state edits fsms"), "{stderr}");
+    assert!(
+        stderr.contains("add-state edits FSMs and HFSMs"),
+        "{stderr}"
+    );
     let (code, _, stderr) = btfsm(&[
         "edit",
         "policies/paper/fig04-fsm.toml",

@@ -125,7 +125,10 @@ fn sim_recharge_docking_arena_and_five_cubes_match() {
 fn sim_a_btcpp_tree_with_a_parameterised_subtree_matches_the_toml_bt() {
     let v = sim_json("tests/fixtures/sim/btcpp-subtree-pick-fails.toml");
     assert!(sim_verdict(&v, BT1, "Main"), "{v}");
-    let skills = sim_policy(&v, "Main")["skills"].as_array().expect("skills").len();
+    let skills = sim_policy(&v, "Main")["skills"]
+        .as_array()
+        .expect("skills")
+        .len();
     assert_eq!(skills, 5, "{v}");
 }
 
