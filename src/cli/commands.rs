@@ -112,6 +112,17 @@ pub fn execute(cli: Cli) -> u8 {
                     }
                 }
                 ConvertTarget::Hfsm => {
+                    if let crate::model::PolicyBody::Bt(bt) = &l.policy.body {
+                        for n in crate::transform::bt_to_hfsm::memory_nodes(bt) {
+                            let node = &bt.nodes[n];
+                            eprintln!(
+                                "warning: {}: `{}` node `{}` becomes a container re-entered at its first state every tick: the HFSM counts as the paper's construction but does not keep the node's memory",
+                                l.path,
+                                node.kind.keyword(),
+                                node.id
+                            );
+                        }
+                    }
                     match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
                         Ok(p) => p,
                         Err(errs) => {

@@ -1016,7 +1016,7 @@ on = { SUCCESS = "A", RUNNING = "R" }
         use crate::sim::rng::SimRng;
         let mut rng = SimRng::named(11, "exec-differential");
         for case in 0..400 {
-            let text = random_tree(&mut rng, 2 + case % 25);
+            let text = random_tree(&mut rng, 2 + case % 25, &(0..12).collect::<Vec<_>>());
             let l = parse_str("r.toml", &text, Path::new("."), &Limits::default())
                 .unwrap_or_else(|e| panic!("{e:?}\n{text}"));
             let PolicyBody::Bt(bt) = &l.policy.body else {
@@ -1054,6 +1054,67 @@ on = { SUCCESS = "A", RUNNING = "R" }
                 assert_eq!(walk.statuses.as_ref(), Some(&noted), "noted, {ctx}");
             }
         }
+    }
+
+    /// The paper's sec. III claim, on random trees: the HFSM that
+    /// `bt_to_hfsm` builds (Fig. 5 -> Fig. 6) and the BT tick the same leaves
+    /// in the same order with the same statuses, step after step, until the
+    /// task first succeeds (then the machine has ended and the BT is ticked
+    /// on). Kinds: `kinds` (see `random_tree`).
+    fn hfsm_ticks_like_the_bt(kinds: &[usize], cases: usize) -> Result<(), String> {
+        use crate::sim::rng::SimRng;
+        use crate::transform::bt_to_hfsm::bt_to_hfsm;
+        let mut rng = SimRng::named(12, "bt-vs-hfsm");
+        for case in 0..cases {
+            let text = random_tree(&mut rng, 2 + case % 25, kinds);
+            let l = parse_str("r.toml", &text, Path::new("."), &Limits::default()).unwrap();
+            let PolicyBody::Bt(bt) = &l.policy.body else {
+                panic!()
+            };
+            let m = bt_to_hfsm(bt).map_err(|e| format!("{e:?}"))?;
+            let calls: Vec<Option<Call>> = bt
+                .nodes
+                .iter()
+                .enumerate()
+                .map(|(i, n)| match n.kind {
+                    BtNodeKind::Condition if n.label != "U" => Some(Call::InHand(i)),
+                    BtNodeKind::Action if n.label != "U" => Some(Call::Pick { object: i }),
+                    _ => None,
+                })
+                .collect();
+            let mut bx = BtExec::new(Arc::new(CompiledBt::new(bt, calls.clone())), false);
+            // The random leaves have no skill binding (nothing to resolve);
+            // state i is BT node i, so it gets node i's call.
+            let mut cm = CompiledMachine::new(&m, |_| Err::<Call, ()>(())).expect("no bindings");
+            cm.call = calls;
+            let mut mx = MachineExec::new(Arc::new(cm), false);
+            let seed = rng.next_u64();
+            let (mut a, mut b) = (Oracle::new(seed), Oracle::new(seed));
+            for t in 0..30 {
+                a.step = t;
+                b.step = t;
+                a.log.clear();
+                b.log.clear();
+                let sa = bx.tick(&mut a);
+                let sb = mx.step(&mut b);
+                if (sa, &a.log) != (sb, &b.log) {
+                    return Err(format!(
+                        "case {case}, tick {t}: BT {sa:?} {:?}, HFSM {sb:?} {:?}\n{text}",
+                        a.log, b.log
+                    ));
+                }
+                if sa == Status::Success {
+                    break;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn converted_hfsm_ticks_like_the_reactive_bt() {
+        // Sequence, Fallback, Inverter, ForceSuccess, ForceFailure.
+        hfsm_ticks_like_the_bt(&[0, 1, 2, 6, 7, 11], 400).unwrap();
     }
 
     /// Leaf answers drawn from (seed, step, leaf): the same for every
@@ -1102,7 +1163,7 @@ on = { SUCCESS = "A", RUNNING = "R" }
 
     /// A random BT of about `size` nodes as TOML, of every kind the executor
     /// models.
-    fn random_tree(rng: &mut crate::sim::rng::SimRng, size: usize) -> String {
+    fn random_tree(rng: &mut crate::sim::rng::SimRng, size: usize, kinds: &[usize]) -> String {
         let mut lines = Vec::new();
         let mut next = 1;
         let mut open = vec![0usize];
@@ -1110,9 +1171,9 @@ on = { SUCCESS = "A", RUNNING = "R" }
         while let Some(n) = open.pop() {
             let budget_left = next < size;
             let kind = if n == 0 || (budget_left && pick(rng, 3) > 0) {
-                pick(rng, 11)
+                kinds[pick(rng, kinds.len() as u64)]
             } else {
-                11 + pick(rng, 3)
+                12 + pick(rng, 3)
             };
             let kids = |k: usize, next: &mut usize, open: &mut Vec<usize>| {
                 let ids: Vec<String> = (0..k).map(|j| format!("\"n{}\"", *next + j)).collect();
@@ -1135,7 +1196,7 @@ on = { SUCCESS = "A", RUNNING = "R" }
                         ),
                     }
                 }
-                6..=10 => {
+                6..=11 => {
                     let c = kids(1, &mut next, &mut open);
                     let c = c.trim_matches('"');
                     match kind {
@@ -1147,14 +1208,15 @@ on = { SUCCESS = "A", RUNNING = "R" }
                             1 + pick(rng, 3)
                         ),
                         9 => format!("n{n} = {{ retry = \"{c}\", times = {} }}", pick(rng, 3)),
+                        11 => format!("n{n} = {{ force_failure = \"{c}\" }}"),
                         _ => format!(
                             "n{n} = {{ timeout = \"{c}\", ms = {} }}",
                             100 * pick(rng, 5)
                         ),
                     }
                 }
-                11 => format!("n{n} = {{ condition = \"C{n}?\" }}"),
-                12 => format!("n{n} = {{ action = \"A{n}!\" }}"),
+                12 => format!("n{n} = {{ condition = \"C{n}?\" }}"),
+                13 => format!("n{n} = {{ action = \"A{n}!\" }}"),
                 _ if pick(rng, 2) == 0 => format!("n{n} = {{ condition = \"U\" }}"),
                 _ => format!("n{n} = {{ action = \"U\" }}"),
             };

@@ -887,6 +887,21 @@ impl Reader {
                 );
                 return None;
             }
+            if let PolicyBody::Bt(bt) = &policy.body
+                && let Some(&n) = crate::transform::bt_to_hfsm::memory_nodes(bt).first()
+            {
+                let node = &bt.nodes[n];
+                self.err(
+                    f.span(),
+                    format!(
+                        "the HFSM of `{rel}` would not behave as the BT: its `{}` node `{}` keeps memory, and the construction re-enters containers at their first state every tick",
+                        node.kind.keyword(),
+                        node.id
+                    ),
+                    "run the BT itself, or make the node reactive (sequence / fallback); `btfsm convert --to hfsm` still gives the HFSM to count",
+                );
+                return None;
+            }
             match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
                 Ok(p) => policy = p,
                 Err(e) => {

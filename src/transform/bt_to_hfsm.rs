@@ -6,7 +6,9 @@
 //! parent's type dictates (Sequence: SUCCESS -> next; Fallback: FAILURE -> next).
 //! Conditions have no RUNNING transition. The graph of the result has, per node,
 //! action 1 vertex + 3 arcs, condition 1 + 2, control node 1 + 4, plus the three
-//! top-level outcomes (SPEC §2).
+//! top-level outcomes (SPEC §2). The HFSM ticks like the BT (a unit test in
+//! `sim/exec.rs` runs both on random reactive trees) except for memory
+//! composites: see [`memory_nodes`].
 
 use crate::model::{
     Bt, BtNodeKind, Policy, PolicyBody, Region, State, StateBody, StateMachine, Target, Transition,
@@ -23,6 +25,24 @@ const R: &str = "RUNNING";
 pub struct Unsupported {
     pub id: String,
     pub kind: &'static str,
+}
+
+/// The memory composites (Sequence*, Fallback*) of a BT, in pre-order. The
+/// construction turns them into containers like any other (the paper counts
+/// them so), but a container is re-entered at its initial state on every
+/// tick, so the HFSM does not resume at the running child: it counts as the
+/// BT, it does not behave as the BT. The simulator refuses to run such a
+/// conversion; `convert --to hfsm` warns.
+pub fn memory_nodes(bt: &Bt) -> Vec<usize> {
+    bt.preorder()
+        .into_iter()
+        .filter(|&i| {
+            matches!(
+                bt.nodes[i].kind,
+                BtNodeKind::SequenceMemory | BtNodeKind::FallbackMemory
+            )
+        })
+        .collect()
 }
 
 /// Converts a BT policy into the equivalent HFSM policy.
