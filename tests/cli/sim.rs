@@ -141,6 +141,30 @@ fn sim_reports_the_fig03_bt_as_chattering() {
     assert_eq!(sim_policy(&v, BT1)["outcome"], "success");
 }
 
+/// Recording a trace switches the BT executor from its compiled plan to the
+/// stack walk: every bundled scenario must report the same either way.
+#[test]
+fn sim_reports_the_same_with_and_without_a_trace() {
+    let dir = common::scratch("trace-same");
+    let trace = dir.join("t.json");
+    let trace = trace.to_str().expect("utf-8");
+    let mut scenarios: Vec<_> = std::fs::read_dir("policies/scenarios")
+        .expect("scenarios")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenarios.sort();
+    assert!(scenarios.len() >= 8);
+    for s in scenarios {
+        let s = s.to_str().expect("utf-8");
+        let plain = btfsm(&["sim", s, "--format", "json"]);
+        let traced = btfsm(&["sim", s, "--format", "json", "--trace", trace]);
+        assert_eq!(plain.0, 0, "{s}: {}", plain.2);
+        assert_eq!(plain, traced, "{s}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn sim_is_deterministic() {
     let a = btfsm(&[
