@@ -1000,6 +1000,17 @@ pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Dia
         }
         PolicyBody::Machine(m) => {
             for (i, s) in m.states.iter().enumerate() {
+                if s.pseudo.is_some() {
+                    push(
+                        format!("state `{}`", m.path(i)),
+                        s.span.clone(),
+                        Unresolved {
+                            message: "the simulator does not execute history pseudo-states".into(),
+                            hint: "re-entering a container at its last active state is not modelled; give the container an initial state instead".into(),
+                        },
+                    );
+                    continue;
+                }
                 let mut calls: Vec<&SkillCall> = Vec::new();
                 match &s.body {
                     StateBody::Task(Some(c)) => calls.push(c),
