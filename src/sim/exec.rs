@@ -1022,18 +1022,7 @@ on = { SUCCESS = "A", RUNNING = "R" }
             let PolicyBody::Bt(bt) = &l.policy.body else {
                 panic!()
             };
-            // Leaf i answers as object i: conditions by In-Hand, actions by
-            // Pick; unbound leaves (label `U`) stay unbound.
-            let calls: Vec<Option<Call>> = bt
-                .nodes
-                .iter()
-                .enumerate()
-                .map(|(i, n)| match n.kind {
-                    BtNodeKind::Condition if n.label != "U" => Some(Call::InHand(i)),
-                    BtNodeKind::Action if n.label != "U" => Some(Call::Pick { object: i }),
-                    _ => None,
-                })
-                .collect();
+            let calls = oracle_calls(bt);
             let compiled = Arc::new(CompiledBt::new(bt, calls.clone()));
             let mut plan = BtExec::new(compiled.clone(), false);
             let mut walk = BtExec::new(compiled, true);
@@ -1072,16 +1061,7 @@ on = { SUCCESS = "A", RUNNING = "R" }
                 panic!()
             };
             let m = bt_to_hfsm(bt).map_err(|e| format!("{e:?}"))?;
-            let calls: Vec<Option<Call>> = bt
-                .nodes
-                .iter()
-                .enumerate()
-                .map(|(i, n)| match n.kind {
-                    BtNodeKind::Condition if n.label != "U" => Some(Call::InHand(i)),
-                    BtNodeKind::Action if n.label != "U" => Some(Call::Pick { object: i }),
-                    _ => None,
-                })
-                .collect();
+            let calls = oracle_calls(bt);
             let mut bx = BtExec::new(Arc::new(CompiledBt::new(bt, calls.clone())), false);
             // The random leaves have no skill binding (nothing to resolve);
             // state i is BT node i, so it gets node i's call.
@@ -1115,6 +1095,20 @@ on = { SUCCESS = "A", RUNNING = "R" }
     fn converted_hfsm_ticks_like_the_reactive_bt() {
         // Sequence, Fallback, Inverter, ForceSuccess, ForceFailure.
         hfsm_ticks_like_the_bt(&[0, 1, 2, 6, 7, 11], 400).unwrap();
+    }
+
+    /// The bindings the [`Oracle`] answers: leaf i as object i, conditions
+    /// by In-Hand, actions by Pick; unbound leaves (label `U`) stay unbound.
+    fn oracle_calls(bt: &Bt) -> Vec<Option<Call>> {
+        bt.nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| match n.kind {
+                BtNodeKind::Condition if n.label != "U" => Some(Call::InHand(i)),
+                BtNodeKind::Action if n.label != "U" => Some(Call::Pick { object: i }),
+                _ => None,
+            })
+            .collect()
     }
 
     /// Leaf answers drawn from (seed, step, leaf): the same for every
