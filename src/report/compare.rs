@@ -12,10 +12,64 @@
 //! `FAILURE` arc removed and one added, not as an arbitrary pair.
 
 use crate::graph::{PolicyGraph, VertexType, policy_graph};
-use crate::metrics::ged::{GedMode, GedOptions, GedResult, ged};
+use crate::metrics::ged::{
+    GedMode, GedOptions, Shape, injective, keep_same_labels, mapping_cost, named_mapping_of_ids,
+    search_mapping,
+};
 use crate::model::{Policy, PolicyBody, PolicyKind};
 use crate::render::dot::{DotOptions, Highlight};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// An immutable shared string of an edit script (a key, a name, a label):
+/// cloning it copies a pointer, so that writing a script of 100k entries
+/// allocates no strings. Serialized as a plain string.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Text(Arc<str>);
+
+impl Text {
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+impl std::ops::Deref for Text {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.0
+    }
+}
+
+impl From<&str> for Text {
+    fn from(s: &str) -> Text {
+        Text(Arc::from(s))
+    }
+}
+
+impl PartialEq<str> for Text {
+    fn eq(&self, other: &str) -> bool {
+        &*self.0 == other
+    }
+}
+
+impl PartialEq<&str> for Text {
+    fn eq(&self, other: &&str) -> bool {
+        &*self.0 == *other
+    }
+}
+
+impl std::fmt::Display for Text {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl serde::Serialize for Text {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.0)
+    }
+}
 
 /// One policy being compared.
 #[derive(Debug, Clone, Copy)]
@@ -37,9 +91,9 @@ pub fn modes_of(selection: Option<GedMode>) -> Vec<GedMode> {
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct VertexRef {
     /// Identity (BT node id, state path, outcome name).
-    pub key: String,
+    pub key: Text,
     /// Display name.
-    pub name: String,
+    pub name: Text,
     #[serde(rename = "type")]
     pub vtype: VertexType,
 }
@@ -47,26 +101,26 @@ pub struct VertexRef {
 /// A vertex of a kept (substituted at cost 0) as the vertex of b it maps to.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct KeptVertex {
-    pub a: String,
-    pub b: String,
+    pub a: Text,
+    pub b: Text,
 }
 
 /// Arcs between two vertices with one label.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
 pub struct ArcRef {
     /// Tail key (of b for added and kept arcs, of a for removed ones).
-    pub from: String,
+    pub from: Text,
     /// Head key, likewise.
-    pub to: String,
+    pub to: Text,
     /// Outcome or guard label; `initial` for an HFSM container's arc to its
     /// initial state; empty for a BT edge.
-    pub label: String,
+    pub label: Text,
     /// How many such parallel arcs.
     pub count: u32,
     /// For a kept arc whose label differs in a: a's label (unit-cost GED does
     /// not charge for it, a reviewer wants to see it).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub label_in_a: Option<String>,
+    pub label_in_a: Option<Text>,
 }
 
 /// The edit script of one mode's mapping, a → b.
@@ -147,8 +201,134 @@ pub struct Pair<'a> {
     b: Side<'a>,
     ga: PolicyGraph,
     gb: PolicyGraph,
+    ia: ScriptIndex,
+    ib: ScriptIndex,
+    /// Each vertex's key as an id shared by both graphs (equal keys, equal
+    /// ids), so that the mapping by name costs no string work per mode.
+    ids_a: Vec<u32>,
+    ids_b: Vec<u32>,
     /// HFSM containment in a: state key -> its container's key.
     parent_a: BTreeMap<String, String>,
+}
+
+/// What writing edit scripts needs of one graph, computed once with the
+/// graph (it depends on that graph only): its keys, names and arc labels as
+/// shared strings, its vertices in key order, and its arcs grouped by
+/// ordered pair of vertices with their labels sorted. With it, an edit
+/// script costs O((n + m) log m) integer work and allocates no strings.
+struct ScriptIndex {
+    keys: Vec<Text>,
+    names: Vec<Text>,
+    /// Label of each arc (edge index), interned.
+    labels: Vec<Text>,
+    /// Vertices in key order (keys are unique within a graph).
+    by_key: Vec<u32>,
+    /// Position of each vertex in `by_key`.
+    rank: Vec<u32>,
+    /// `(tail, head, first, end)`: the arcs from tail to head are
+    /// `arcs[first..end]`; sorted by `(tail, head)`.
+    groups: Vec<(u32, u32, u32, u32)>,
+    /// Edge indices, grouped, by label within a group.
+    arcs: Vec<u32>,
+}
+
+impl ScriptIndex {
+    fn new(g: &PolicyGraph) -> ScriptIndex {
+        let nodes = g.g.raw_nodes();
+        let n = nodes.len();
+        let key = |i: u32| nodes[i as usize].weight.key.as_str();
+        let mut by_key: Vec<u32> = (0..n as u32).collect();
+        by_key.sort_unstable_by(|&x, &y| key(x).cmp(key(y)).then(x.cmp(&y)));
+        let mut rank = vec![0u32; n];
+        for (r, &v) in by_key.iter().enumerate() {
+            rank[v as usize] = r as u32;
+        }
+        let edges = g.g.raw_edges();
+        let mut interned: HashMap<&str, Text> = HashMap::new();
+        let labels: Vec<Text> = edges
+            .iter()
+            .map(|e| {
+                let l = e.weight.label();
+                interned.entry(l).or_insert_with(|| Text::from(l)).clone()
+            })
+            .collect();
+        let ends = |e: u32| {
+            let x = &edges[e as usize];
+            (x.source().index() as u32, x.target().index() as u32)
+        };
+        let mut arcs: Vec<u32> = (0..edges.len() as u32).collect();
+        arcs.sort_unstable_by(|&x, &y| {
+            ends(x)
+                .cmp(&ends(y))
+                .then_with(|| labels[x as usize].cmp(&labels[y as usize]))
+                .then(x.cmp(&y))
+        });
+        let mut groups: Vec<(u32, u32, u32, u32)> = Vec::new();
+        for (i, &e) in arcs.iter().enumerate() {
+            let (t, h) = ends(e);
+            match groups.last_mut() {
+                Some(last) if (last.0, last.1) == (t, h) => last.3 = i as u32 + 1,
+                _ => groups.push((t, h, i as u32, i as u32 + 1)),
+            }
+        }
+        ScriptIndex {
+            keys: nodes
+                .iter()
+                .map(|v| Text::from(v.weight.key.as_str()))
+                .collect(),
+            names: nodes
+                .iter()
+                .map(|v| Text::from(v.weight.label.as_str()))
+                .collect(),
+            labels,
+            by_key,
+            rank,
+            groups,
+            arcs,
+        }
+    }
+
+    /// The labels of group `k`, sorted.
+    fn group_labels(&self, k: usize) -> impl Iterator<Item = &Text> {
+        let (_, _, s, e) = self.groups[k];
+        self.arcs[s as usize..e as usize]
+            .iter()
+            .map(|&e| &self.labels[e as usize])
+    }
+
+    /// The group of arcs from `t` to `h`, if any.
+    fn group(&self, t: usize, h: usize) -> Option<usize> {
+        let key = (t as u32, h as u32);
+        self.groups
+            .binary_search_by(|&(x, y, _, _)| (x, y).cmp(&key))
+            .ok()
+    }
+
+    /// An end of an arc: its key and the key's rank.
+    fn end(&self, u: usize) -> (&Text, u32) {
+        (&self.keys[u], self.rank[u])
+    }
+}
+
+/// Ids for the keys of both graphs: equal keys get equal ids.
+fn key_ids<'g>(a: &'g PolicyGraph, b: &'g PolicyGraph) -> (Vec<u32>, Vec<u32>) {
+    let mut ids: HashMap<&'g str, u32> = HashMap::with_capacity(a.g.node_count());
+    let mut of = |g: &'g PolicyGraph| -> Vec<u32> {
+        keys(g)
+            .map(|k| {
+                let next = ids.len() as u32;
+                *ids.entry(k).or_insert(next)
+            })
+            .collect()
+    };
+    let ia = of(a);
+    let ib = of(b);
+    (ia, ib)
+}
+
+/// The vertex keys of a graph, in vertex order.
+fn keys(g: &PolicyGraph) -> impl Iterator<Item = &str> {
+    g.g.raw_nodes().iter().map(|v| v.weight.key.as_str())
 }
 
 /// State key -> container key, for every nested state of an HFSM.
@@ -166,33 +346,68 @@ fn containers(p: &Policy) -> BTreeMap<String, String> {
 
 impl<'a> Pair<'a> {
     pub fn new(a: Side<'a>, b: Side<'a>) -> Self {
+        let (ga, gb) = (policy_graph(a.policy), policy_graph(b.policy));
+        let (ids_a, ids_b) = key_ids(&ga, &gb);
         Pair {
-            ga: policy_graph(a.policy),
-            gb: policy_graph(b.policy),
+            ia: ScriptIndex::new(&ga),
+            ib: ScriptIndex::new(&gb),
+            ids_a,
+            ids_b,
+            ga,
+            gb,
             parent_a: containers(a.policy),
             a,
             b,
         }
     }
 
-    /// GED in one mode, with its labelled edit script.
+    /// GED in one mode, with its labelled edit script, within
+    /// `opts.timeout` for the whole of it: the clock starts before the
+    /// compact graphs are built, the mapping by name and its script come
+    /// next, and the search gets what remains minus the time that script
+    /// took (the script of the search's mapping, if better, costs as much).
+    /// `millis` is the time of all of it.
     pub fn run(&self, mode: GedMode, opts: &GedOptions) -> ModeReport {
-        let r: GedResult = ged(&self.ga, &self.gb, mode, opts);
-        let mapping: BTreeMap<&str, &str> = r
-            .edit_script
-            .vertices_kept
-            .iter()
-            .map(|(x, y)| (x.as_str(), y.as_str()))
-            .collect();
-        let edit_script = labelled_script(&self.ga, &self.gb, &mapping);
-        debug_assert_eq!(edit_script.cost(), r.edit_script.cost());
+        let start = Instant::now();
+        let (sa, sb) = (Shape::from(&self.ga), Shape::from(&self.gb));
+        let mut by_name = named_mapping_of_ids(&self.ids_a, &self.ids_b);
+        if mode == GedMode::Labeled {
+            keep_same_labels(&sa, &sb, &mut by_name);
+        }
+        let named_cost = mapping_cost(&sa, &sb, &by_name);
+        let before_script = Instant::now();
+        let named = self.script(&by_name);
+        let (lower, upper, edit_script) = if mode == GedMode::Named {
+            (named_cost, named_cost, named)
+        } else {
+            let reserve = before_script.elapsed();
+            let deadline = (start + opts.timeout)
+                .checked_sub(reserve)
+                .map_or(start, |d| d.max(start));
+            let found = search_mapping(
+                &sa,
+                &sb,
+                mode == GedMode::Labeled,
+                deadline,
+                opts.max_expansions,
+            );
+            // Among mappings of equal cost, prefer the one by name: its
+            // script reads as the engineer's own edits.
+            if named_cost <= found.upper_bound {
+                (found.lower_bound, named_cost, named)
+            } else {
+                let s = self.script(&found.map);
+                (found.lower_bound, found.upper_bound, s)
+            }
+        };
+        debug_assert_eq!(edit_script.cost(), upper);
         ModeReport {
             mode,
-            ged: r.ged,
-            exact: r.exact,
-            lower_bound: r.lower_bound,
-            upper_bound: r.upper_bound,
-            millis: r.millis,
+            ged: upper,
+            exact: lower >= upper,
+            lower_bound: lower.min(upper),
+            upper_bound: upper,
+            millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
             edit_script,
         }
     }
@@ -217,11 +432,15 @@ impl<'a> Pair<'a> {
     pub fn dot_options(&self, script: &Script) -> DotOptions {
         let mut opts = DotOptions::default();
         for v in &script.vertices_added {
-            opts.highlight.insert(v.key.clone(), Highlight::Added);
+            opts.highlight.insert(v.key.to_string(), Highlight::Added);
         }
         for arc in &script.arcs_added {
             opts.arc_label_highlight.insert(
-                (arc.from.clone(), arc.to.clone(), arc.label.clone()),
+                (
+                    arc.from.to_string(),
+                    arc.to.to_string(),
+                    arc.label.to_string(),
+                ),
                 Highlight::Added,
             );
         }
@@ -231,7 +450,7 @@ impl<'a> Pair<'a> {
         let mut drawn: BTreeMap<&str, String> = script
             .vertices_kept
             .iter()
-            .map(|k| (k.a.as_str(), k.b.clone()))
+            .map(|k| (k.a.as_str(), k.b.to_string()))
             .collect();
         // Containers before what they contain, so that a removed state is
         // drawn inside its container's cluster in b, or beside its ghost.
@@ -250,151 +469,220 @@ impl<'a> Pair<'a> {
             let leaf = v.key.rsplit('/').next().unwrap_or(&v.key);
             let mut ghost = match self
                 .parent_a
-                .get(&v.key)
+                .get(v.key.as_str())
                 .and_then(|p| drawn.get(p.as_str()))
             {
                 Some(parent) => format!("{parent}/{leaf}"),
-                None => v.key.clone(),
+                None => v.key.to_string(),
             };
             while taken.contains(&ghost) {
                 ghost.push_str(" (removed)");
             }
             taken.insert(ghost.clone());
-            opts.ghost_vertices.push((ghost.clone(), v.name.clone()));
+            opts.ghost_vertices
+                .push((ghost.clone(), v.name.to_string()));
             drawn.insert(v.key.as_str(), ghost);
         }
         for arc in &script.arcs_removed {
             let end = |k: &str| drawn.get(k).cloned().unwrap_or_else(|| k.to_string());
             for _ in 0..arc.count {
                 opts.ghost_arcs
-                    .push((end(&arc.from), end(&arc.to), arc.label.clone()));
+                    .push((end(&arc.from), end(&arc.to), arc.label.to_string()));
             }
         }
         opts
     }
 }
 
-/// Arcs of a graph grouped by ordered pair of vertex keys, each with its
-/// labels (sorted, one entry per parallel arc).
-fn arcs_by_pair(g: &PolicyGraph) -> BTreeMap<(&str, &str), Vec<&str>> {
-    let mut m: BTreeMap<(&str, &str), Vec<&str>> = BTreeMap::new();
-    for e in g.g.raw_edges() {
-        let t = g.g[e.source()].key.as_str();
-        let h = g.g[e.target()].key.as_str();
-        m.entry((t, h)).or_default().push(e.weight.label());
+/// Arcs between two vertices with one label each, being sorted into an
+/// edit script: `(tail rank, head rank, arc)`.
+type RankedArcs = Vec<(u32, u32, ArcRef)>;
+
+/// Groups equal labels into one `ArcRef` each, in `ArcRef` order.
+fn push_grouped(
+    out: &mut RankedArcs,
+    (from, rf): (&Text, u32),
+    (to, rt): (&Text, u32),
+    labels: &mut [(&Text, Option<&Text>)],
+) {
+    labels.sort_unstable();
+    let first = out.len();
+    let mut i = 0;
+    while i < labels.len() {
+        let l = labels[i];
+        let count = labels[i..].iter().take_while(|&&x| x == l).count();
+        out.push((
+            rf,
+            rt,
+            ArcRef {
+                from: from.clone(),
+                to: to.clone(),
+                label: l.0.clone(),
+                count: count as u32,
+                label_in_a: l.1.cloned(),
+            },
+        ));
+        i += count;
     }
-    for labels in m.values_mut() {
-        labels.sort_unstable();
+    if out.len() - first > 1 {
+        out[first..].sort_unstable_by(|x, y| x.2.cmp(&y.2));
     }
-    m
 }
 
-/// Groups equal labels into one `ArcRef` each.
-fn push_grouped(out: &mut Vec<ArcRef>, from: &str, to: &str, labels: &[(&str, Option<&str>)]) {
-    let mut counts: BTreeMap<(&str, Option<&str>), u32> = BTreeMap::new();
-    for &l in labels {
-        *counts.entry(l).or_default() += 1;
+/// The arcs in `ArcRef` order: by tail and head key (keys are unique in a
+/// graph, so their ranks order them as the keys do; one integer sort, then
+/// the arcs permuted in place), each pair's arcs already in order.
+fn sorted_arcs(l: RankedArcs) -> Vec<ArcRef> {
+    let mut order: Vec<(u64, u32)> = l
+        .iter()
+        .enumerate()
+        .map(|(i, x)| ((u64::from(x.0) << 32) | u64::from(x.1), i as u32))
+        .collect();
+    order.sort_unstable();
+    let mut arcs: Vec<ArcRef> = l.into_iter().map(|x| x.2).collect();
+    // Position i takes the arc at perm[i]: follow each cycle once.
+    let mut perm: Vec<u32> = order.into_iter().map(|(_, i)| i).collect();
+    for i in 0..perm.len() {
+        let mut j = i;
+        loop {
+            let k = perm[j] as usize;
+            perm[j] = j as u32;
+            if k == i {
+                break;
+            }
+            arcs.swap(j, k);
+            j = k;
+        }
     }
-    for ((label, was), count) in counts {
-        out.push(ArcRef {
-            from: from.to_string(),
-            to: to.to_string(),
-            label: label.to_string(),
-            count,
-            label_in_a: was.map(str::to_string),
-        });
-    }
+    arcs
 }
 
-/// The edit script of the vertex mapping `map` (a key → b key), with arcs
-/// told apart by label. Per ordered pair of mapped vertices, arcs with equal
-/// labels are kept first, then the remaining ones pairwise (relabelled);
-/// the surplus on either side is removed or added.
-fn labelled_script(a: &PolicyGraph, b: &PolicyGraph, map: &BTreeMap<&str, &str>) -> Script {
-    let vref = |g: &PolicyGraph, i: petgraph::graph::NodeIndex| {
-        let v = &g.g[i];
-        VertexRef {
-            key: v.key.clone(),
-            name: v.label.clone(),
-            vtype: v.vtype,
-        }
-    };
-    let image: BTreeSet<&str> = map.values().copied().collect();
-    let mut s = Script::default();
-    for i in a.g.node_indices() {
-        match map.get(a.g[i].key.as_str()) {
-            Some(&k) => s.vertices_kept.push(KeptVertex {
-                a: a.g[i].key.clone(),
-                b: k.to_string(),
-            }),
-            None => s.vertices_removed.push(vref(a, i)),
-        }
-    }
-    for i in b.g.node_indices() {
-        if !image.contains(b.g[i].key.as_str()) {
-            s.vertices_added.push(vref(b, i));
-        }
-    }
-    let arcs_a = arcs_by_pair(a);
-    let mut arcs_b = arcs_by_pair(b);
-    for ((t, h), la) in &arcs_a {
-        let (Some(&x), Some(&y)) = (map.get(t), map.get(h)) else {
-            let removed: Vec<_> = la.iter().map(|&l| (l, None)).collect();
-            push_grouped(&mut s.arcs_removed, t, h, &removed);
-            continue;
+impl Pair<'_> {
+    /// The edit script of the vertex mapping `map` (vertex of a → vertex of
+    /// b), with arcs told apart by label. Per ordered pair of mapped
+    /// vertices, arcs with equal labels are kept first, then the remaining
+    /// ones pairwise (relabelled); the surplus on either side is removed or
+    /// added. Entries that are out of range or not injective are unmapped.
+    fn script(&self, map: &[Option<usize>]) -> Script {
+        let (ia, ib) = (&self.ia, &self.ib);
+        let (fwd, inv) = injective(ia.keys.len(), ib.keys.len(), map);
+        let vref = |x: &ScriptIndex, u: usize| VertexRef {
+            key: x.keys[u].clone(),
+            name: x.names[u].clone(),
+            vtype: self.vtype(x, u),
         };
-        let lb = arcs_b.remove(&(x, y)).unwrap_or_default();
-        // Multiset intersection of two sorted lists, and the leftovers.
-        let (mut i, mut j) = (0, 0);
-        let (mut kept, mut only_a, mut only_b) = (Vec::new(), Vec::new(), Vec::new());
-        while i < la.len() || j < lb.len() {
-            match (la.get(i), lb.get(j)) {
-                (Some(p), Some(q)) if p == q => {
-                    kept.push((*q, None));
-                    i += 1;
-                    j += 1;
-                }
-                (Some(p), Some(q)) if p < q => {
-                    only_a.push(*p);
-                    i += 1;
-                }
-                (Some(p), None) => {
-                    only_a.push(*p);
-                    i += 1;
-                }
-                (_, Some(q)) => {
-                    only_b.push(*q);
-                    j += 1;
-                }
-                (None, None) => break,
+        let mut s = Script {
+            vertices_kept: Vec::with_capacity(ia.keys.len().min(ib.keys.len())),
+            vertices_removed: Vec::with_capacity(ia.keys.len()),
+            vertices_added: Vec::with_capacity(ib.keys.len()),
+            ..Script::default()
+        };
+        // In key order: the lists come out sorted.
+        for &u in &ia.by_key {
+            let u = u as usize;
+            match fwd[u] {
+                Some(v) => s.vertices_kept.push(KeptVertex {
+                    a: ia.keys[u].clone(),
+                    b: ib.keys[v].clone(),
+                }),
+                None => s.vertices_removed.push(vref(ia, u)),
             }
         }
-        let paired = only_a.len().min(only_b.len());
-        kept.extend(
-            only_b[..paired]
-                .iter()
-                .zip(&only_a[..paired])
-                .map(|(q, p)| (*q, Some(*p))),
-        );
-        push_grouped(&mut s.arcs_kept, x, y, &kept);
-        let removed: Vec<_> = only_a[paired..].iter().map(|&l| (l, None)).collect();
-        push_grouped(&mut s.arcs_removed, t, h, &removed);
-        let added: Vec<_> = only_b[paired..].iter().map(|&l| (l, None)).collect();
-        push_grouped(&mut s.arcs_added, x, y, &added);
+        for &v in &ib.by_key {
+            if inv[v as usize].is_none() {
+                s.vertices_added.push(vref(ib, v as usize));
+            }
+        }
+        let (na, nb) = (ia.groups.len(), ib.groups.len());
+        let mut kept_l = Vec::with_capacity(na.min(nb));
+        let mut removed_l = Vec::with_capacity(na);
+        let mut added_l = Vec::with_capacity(nb);
+        let mut used_b = vec![false; ib.groups.len()];
+        // Buffers reused across groups.
+        let (mut kept, mut only_a, mut only_b) = (Vec::new(), Vec::new(), Vec::new());
+        let mut rest: Vec<(&Text, Option<&Text>)> = Vec::new();
+        for (k, &(t, h, _, _)) in ia.groups.iter().enumerate() {
+            let (t, h) = (t as usize, h as usize);
+            let (Some(x), Some(y)) = (fwd[t], fwd[h]) else {
+                rest.clear();
+                rest.extend(ia.group_labels(k).map(|l| (l, None)));
+                push_grouped(&mut removed_l, ia.end(t), ia.end(h), &mut rest);
+                continue;
+            };
+            let j = ib.group(x, y);
+            if let Some(j) = j {
+                used_b[j] = true;
+            }
+            // Multiset intersection of two sorted lists, and the leftovers.
+            let mut la = ia.group_labels(k).peekable();
+            let mut lb = j.into_iter().flat_map(|j| ib.group_labels(j)).peekable();
+            kept.clear();
+            only_a.clear();
+            only_b.clear();
+            loop {
+                match (la.peek(), lb.peek()) {
+                    (Some(p), Some(q)) if p == q => {
+                        kept.push((*q, None));
+                        la.next();
+                        lb.next();
+                    }
+                    (Some(p), Some(q)) if p < q => {
+                        only_a.push(*p);
+                        la.next();
+                    }
+                    (Some(p), None) => {
+                        only_a.push(*p);
+                        la.next();
+                    }
+                    (_, Some(q)) => {
+                        only_b.push(*q);
+                        lb.next();
+                    }
+                    (None, None) => break,
+                }
+            }
+            let paired = only_a.len().min(only_b.len());
+            kept.extend(
+                only_b[..paired]
+                    .iter()
+                    .zip(&only_a[..paired])
+                    .map(|(q, p)| (*q, Some(*p))),
+            );
+            push_grouped(&mut kept_l, ib.end(x), ib.end(y), &mut kept);
+            rest.clear();
+            rest.extend(only_a[paired..].iter().map(|&l| (l, None)));
+            push_grouped(&mut removed_l, ia.end(t), ia.end(h), &mut rest);
+            rest.clear();
+            rest.extend(only_b[paired..].iter().map(|&l| (l, None)));
+            push_grouped(&mut added_l, ib.end(x), ib.end(y), &mut rest);
+        }
+        for (j, &(x, y, _, _)) in ib.groups.iter().enumerate() {
+            if !used_b[j] {
+                rest.clear();
+                rest.extend(ib.group_labels(j).map(|l| (l, None)));
+                push_grouped(
+                    &mut added_l,
+                    ib.end(x as usize),
+                    ib.end(y as usize),
+                    &mut rest,
+                );
+            }
+        }
+        s.arcs_added = sorted_arcs(added_l);
+        s.arcs_removed = sorted_arcs(removed_l);
+        s.arcs_kept = sorted_arcs(kept_l);
+        s
     }
-    for ((x, y), lb) in &arcs_b {
-        let added: Vec<_> = lb.iter().map(|&l| (l, None)).collect();
-        push_grouped(&mut s.arcs_added, x, y, &added);
+
+    /// The type of vertex `u` of the graph indexed by `x`.
+    fn vtype(&self, x: &ScriptIndex, u: usize) -> VertexType {
+        let g = if std::ptr::eq(x, &self.ia) {
+            &self.ga
+        } else {
+            &self.gb
+        };
+        g.g.raw_nodes()[u].weight.vtype
     }
-    let by_key = |v: &VertexRef| v.key.clone();
-    s.vertices_added.sort_by_key(by_key);
-    s.vertices_removed.sort_by_key(by_key);
-    s.vertices_kept
-        .sort_by(|p, q| (&p.a, &p.b).cmp(&(&q.a, &q.b)));
-    s.arcs_added.sort();
-    s.arcs_removed.sort();
-    s.arcs_kept.sort();
-    s
 }
 
 // ------------------------------------------------------------------ output
