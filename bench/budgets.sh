@@ -20,7 +20,7 @@ if [ "$what" = all ] || [ "$what" = compare ]; then
   for p in fsm500 fsm2000 bt5000 bt100000; do
     for T in 20 100 1000; do
       s=$(date +%s.%N)
-      $B compare "$DIR/$p-a.toml" "$DIR/$p-b.toml" --timeout-ms "$T" --format json > "$DIR/out.json"
+      $B compare "$DIR/$p-a.toml" "$DIR/$p-b.toml" --timeout-ms "$T" --format json > "$DIR/out.json" 2> "$DIR/err.txt"
       e=$(date +%s.%N)
       python3 - "$DIR/out.json" "$p" "$T" "$s" "$e" <<'PY'
 import json, sys

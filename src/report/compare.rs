@@ -23,51 +23,100 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// An immutable shared string of an edit script (a key, a name, a label):
-/// cloning it copies a pointer, so that writing a script of 100k entries
-/// allocates no strings. Serialized as a plain string.
-#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct Text(Arc<str>);
+/// an entry of a table of one graph's strings, built once per graph.
+/// Cloning it bumps the table's one reference count, so that writing a
+/// script of 100k entries allocates nothing and touches no string.
+/// Compared, ordered and serialized as the string it names.
+#[derive(Clone)]
+pub struct Text {
+    table: Arc<Vec<String>>,
+    index: u32,
+}
 
 impl Text {
+    /// Entry `index` of `table` (which must have it).
+    fn at(table: &Arc<Vec<String>>, index: usize) -> Text {
+        debug_assert!(index < table.len());
+        Text {
+            table: Arc::clone(table),
+            index: index as u32,
+        }
+    }
+
     pub fn as_str(&self) -> &str {
-        &self.0
+        self.table
+            .get(self.index as usize)
+            .map_or("", String::as_str)
+    }
+}
+
+impl PartialEq for Text {
+    fn eq(&self, other: &Text) -> bool {
+        (Arc::ptr_eq(&self.table, &other.table) && self.index == other.index)
+            || self.as_str() == other.as_str()
+    }
+}
+
+impl Eq for Text {}
+
+impl PartialOrd for Text {
+    fn partial_cmp(&self, other: &Text) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Text {
+    fn cmp(&self, other: &Text) -> std::cmp::Ordering {
+        self.as_str().cmp(other.as_str())
+    }
+}
+
+impl std::hash::Hash for Text {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.as_str().hash(h);
+    }
+}
+
+impl std::fmt::Debug for Text {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Debug::fmt(self.as_str(), f)
     }
 }
 
 impl std::ops::Deref for Text {
     type Target = str;
     fn deref(&self) -> &str {
-        &self.0
+        self.as_str()
     }
 }
 
 impl From<&str> for Text {
     fn from(s: &str) -> Text {
-        Text(Arc::from(s))
+        Text::at(&Arc::new(vec![s.to_string()]), 0)
     }
 }
 
 impl PartialEq<str> for Text {
     fn eq(&self, other: &str) -> bool {
-        &*self.0 == other
+        self.as_str() == other
     }
 }
 
 impl PartialEq<&str> for Text {
     fn eq(&self, other: &&str) -> bool {
-        &*self.0 == *other
+        self.as_str() == *other
     }
 }
 
 impl std::fmt::Display for Text {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
+        f.write_str(self.as_str())
     }
 }
 
 impl serde::Serialize for Text {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(&self.0)
+        s.serialize_str(self.as_str())
     }
 }
 
@@ -217,17 +266,20 @@ pub struct Pair<'a> {
 /// ordered pair of vertices with their labels sorted. With it, an edit
 /// script costs O((n + m) log m) integer work and allocates no strings.
 struct ScriptIndex {
-    keys: Vec<Text>,
-    names: Vec<Text>,
-    /// Label of each arc (edge index), interned.
+    keys: Arc<Vec<String>>,
+    names: Arc<Vec<String>>,
+    /// Label of each arc (edge index), an entry of one table of the
+    /// graph's distinct labels.
     labels: Vec<Text>,
     /// Vertices in key order (keys are unique within a graph).
     by_key: Vec<u32>,
-    /// Position of each vertex in `by_key`.
-    rank: Vec<u32>,
     /// `(tail, head, first, end)`: the arcs from tail to head are
     /// `arcs[first..end]`; sorted by `(tail, head)`.
     groups: Vec<(u32, u32, u32, u32)>,
+    /// The groups of tail `u` are `groups[by_tail[u]..by_tail[u + 1]]`.
+    by_tail: Vec<u32>,
+    /// Group indices in the order of their ends' keys (tail, then head).
+    groups_by_key: Vec<u32>,
     /// Edge indices, grouped, by label within a group.
     arcs: Vec<u32>,
 }
@@ -244,14 +296,20 @@ impl ScriptIndex {
             rank[v as usize] = r as u32;
         }
         let edges = g.g.raw_edges();
-        let mut interned: HashMap<&str, Text> = HashMap::new();
-        let labels: Vec<Text> = edges
+        let mut distinct: HashMap<&str, usize> = HashMap::new();
+        let ids: Vec<usize> = edges
             .iter()
             .map(|e| {
-                let l = e.weight.label();
-                interned.entry(l).or_insert_with(|| Text::from(l)).clone()
+                let next = distinct.len();
+                *distinct.entry(e.weight.label()).or_insert(next)
             })
             .collect();
+        let mut table = vec![String::new(); distinct.len()];
+        for (l, i) in distinct {
+            table[i] = l.to_string();
+        }
+        let table = Arc::new(table);
+        let labels: Vec<Text> = ids.into_iter().map(|i| Text::at(&table, i)).collect();
         let ends = |e: u32| {
             let x = &edges[e as usize];
             (x.source().index() as u32, x.target().index() as u32)
@@ -271,18 +329,25 @@ impl ScriptIndex {
                 _ => groups.push((t, h, i as u32, i as u32 + 1)),
             }
         }
+        let mut by_tail = vec![0u32; n + 1];
+        for &(t, _, _, _) in &groups {
+            by_tail[t as usize + 1] += 1;
+        }
+        for u in 0..n {
+            by_tail[u + 1] += by_tail[u];
+        }
+        let mut groups_by_key: Vec<u32> = (0..groups.len() as u32).collect();
+        groups_by_key.sort_unstable_by_key(|&k| {
+            let (t, h, _, _) = groups[k as usize];
+            (rank[t as usize], rank[h as usize])
+        });
         ScriptIndex {
-            keys: nodes
-                .iter()
-                .map(|v| Text::from(v.weight.key.as_str()))
-                .collect(),
-            names: nodes
-                .iter()
-                .map(|v| Text::from(v.weight.label.as_str()))
-                .collect(),
+            by_tail,
+            groups_by_key,
+            keys: Arc::new(nodes.iter().map(|v| v.weight.key.clone()).collect()),
+            names: Arc::new(nodes.iter().map(|v| v.weight.label.clone()).collect()),
             labels,
             by_key,
-            rank,
             groups,
             arcs,
         }
@@ -298,15 +363,19 @@ impl ScriptIndex {
 
     /// The group of arcs from `t` to `h`, if any.
     fn group(&self, t: usize, h: usize) -> Option<usize> {
-        let key = (t as u32, h as u32);
-        self.groups
-            .binary_search_by(|&(x, y, _, _)| (x, y).cmp(&key))
+        let (&s, &e) = (self.by_tail.get(t)?, self.by_tail.get(t + 1)?);
+        let mine = &self.groups[s as usize..e as usize];
+        mine.binary_search_by_key(&(h as u32), |&(_, y, _, _)| y)
             .ok()
+            .map(|i| s as usize + i)
     }
 
-    /// An end of an arc: its key and the key's rank.
-    fn end(&self, u: usize) -> (&Text, u32) {
-        (&self.keys[u], self.rank[u])
+    fn key(&self, u: usize) -> Text {
+        Text::at(&self.keys, u)
+    }
+
+    fn name(&self, u: usize) -> Text {
+        Text::at(&self.names, u)
     }
 }
 
@@ -364,9 +433,10 @@ impl<'a> Pair<'a> {
     /// GED in one mode, with its labelled edit script, within
     /// `opts.timeout` for the whole of it: the clock starts before the
     /// compact graphs are built, the mapping by name and its script come
-    /// next, and the search gets what remains minus the time that script
-    /// took (the script of the search's mapping, if better, costs as much).
-    /// `millis` is the time of all of it.
+    /// next, and the search gets what remains minus twice the time that
+    /// script took (the script of the search's mapping, if better, costs
+    /// about as much, and the unused one must be freed: 1.3 to 1.6 times
+    /// the first on 100k-vertex BTs). `millis` is the time of all of it.
     pub fn run(&self, mode: GedMode, opts: &GedOptions) -> ModeReport {
         let start = Instant::now();
         let (sa, sb) = (Shape::from(&self.ga), Shape::from(&self.gb));
@@ -380,7 +450,7 @@ impl<'a> Pair<'a> {
         let (lower, upper, edit_script) = if mode == GedMode::Named {
             (named_cost, named_cost, named)
         } else {
-            let reserve = before_script.elapsed();
+            let reserve = before_script.elapsed() * 2;
             let deadline = (start + opts.timeout)
                 .checked_sub(reserve)
                 .map_or(start, |d| d.max(start));
@@ -494,15 +564,11 @@ impl<'a> Pair<'a> {
     }
 }
 
-/// Arcs between two vertices with one label each, being sorted into an
-/// edit script: `(tail rank, head rank, arc)`.
-type RankedArcs = Vec<(u32, u32, ArcRef)>;
-
 /// Groups equal labels into one `ArcRef` each, in `ArcRef` order.
 fn push_grouped(
-    out: &mut RankedArcs,
-    (from, rf): (&Text, u32),
-    (to, rt): (&Text, u32),
+    out: &mut Vec<ArcRef>,
+    from: Text,
+    to: Text,
     labels: &mut [(&Text, Option<&Text>)],
 ) {
     labels.sort_unstable();
@@ -511,50 +577,66 @@ fn push_grouped(
     while i < labels.len() {
         let l = labels[i];
         let count = labels[i..].iter().take_while(|&&x| x == l).count();
-        out.push((
-            rf,
-            rt,
-            ArcRef {
-                from: from.clone(),
-                to: to.clone(),
-                label: l.0.clone(),
-                count: count as u32,
-                label_in_a: l.1.cloned(),
-            },
-        ));
+        out.push(ArcRef {
+            from: from.clone(),
+            to: to.clone(),
+            label: l.0.clone(),
+            count: count as u32,
+            label_in_a: l.1.cloned(),
+        });
         i += count;
     }
     if out.len() - first > 1 {
-        out[first..].sort_unstable_by(|x, y| x.2.cmp(&y.2));
+        out[first..].sort_unstable();
     }
 }
 
-/// The arcs in `ArcRef` order: by tail and head key (keys are unique in a
-/// graph, so their ranks order them as the keys do; one integer sort, then
-/// the arcs permuted in place), each pair's arcs already in order.
-fn sorted_arcs(l: RankedArcs) -> Vec<ArcRef> {
-    let mut order: Vec<(u64, u32)> = l
-        .iter()
-        .enumerate()
-        .map(|(i, x)| ((u64::from(x.0) << 32) | u64::from(x.1), i as u32))
-        .collect();
-    order.sort_unstable();
-    let mut arcs: Vec<ArcRef> = l.into_iter().map(|x| x.2).collect();
-    // Position i takes the arc at perm[i]: follow each cycle once.
-    let mut perm: Vec<u32> = order.into_iter().map(|(_, i)| i).collect();
-    for i in 0..perm.len() {
-        let mut j = i;
+/// How the arcs of a mapped pair of vertex pairs split: label by label,
+/// equal labels kept first, then the rest paired (relabelled), the surplus
+/// of either side left over. `la` and `lb` sorted.
+#[derive(Default)]
+struct Split<'t> {
+    /// (label in b, label in a when it differs).
+    kept: Vec<(&'t Text, Option<&'t Text>)>,
+    only_a: Vec<(&'t Text, Option<&'t Text>)>,
+    only_b: Vec<(&'t Text, Option<&'t Text>)>,
+}
+
+impl<'t> Split<'t> {
+    fn of(&mut self, la: impl Iterator<Item = &'t Text>, lb: impl Iterator<Item = &'t Text>) {
+        self.kept.clear();
+        self.only_a.clear();
+        self.only_b.clear();
+        let (mut la, mut lb) = (la.peekable(), lb.peekable());
         loop {
-            let k = perm[j] as usize;
-            perm[j] = j as u32;
-            if k == i {
-                break;
+            match (la.peek(), lb.peek()) {
+                (Some(p), Some(q)) if p == q => {
+                    self.kept.push((*q, None));
+                    la.next();
+                    lb.next();
+                }
+                (Some(p), Some(q)) if p < q => {
+                    self.only_a.push((*p, None));
+                    la.next();
+                }
+                (Some(p), None) => {
+                    self.only_a.push((*p, None));
+                    la.next();
+                }
+                (_, Some(q)) => {
+                    self.only_b.push((*q, None));
+                    lb.next();
+                }
+                (None, None) => break,
             }
-            arcs.swap(j, k);
-            j = k;
         }
+        let paired = self.only_a.len().min(self.only_b.len());
+        for i in 0..paired {
+            self.kept.push((self.only_b[i].0, Some(self.only_a[i].0)));
+        }
+        self.only_a.drain(..paired);
+        self.only_b.drain(..paired);
     }
-    arcs
 }
 
 impl Pair<'_> {
@@ -567,8 +649,8 @@ impl Pair<'_> {
         let (ia, ib) = (&self.ia, &self.ib);
         let (fwd, inv) = injective(ia.keys.len(), ib.keys.len(), map);
         let vref = |x: &ScriptIndex, u: usize| VertexRef {
-            key: x.keys[u].clone(),
-            name: x.names[u].clone(),
+            key: x.key(u),
+            name: x.name(u),
             vtype: self.vtype(x, u),
         };
         let mut s = Script {
@@ -582,8 +664,8 @@ impl Pair<'_> {
             let u = u as usize;
             match fwd[u] {
                 Some(v) => s.vertices_kept.push(KeptVertex {
-                    a: ia.keys[u].clone(),
-                    b: ib.keys[v].clone(),
+                    a: ia.key(u),
+                    b: ib.key(v),
                 }),
                 None => s.vertices_removed.push(vref(ia, u)),
             }
@@ -593,84 +675,28 @@ impl Pair<'_> {
                 s.vertices_added.push(vref(ib, v as usize));
             }
         }
-        let (na, nb) = (ia.groups.len(), ib.groups.len());
-        let mut kept_l = Vec::with_capacity(na.min(nb));
-        let mut removed_l = Vec::with_capacity(na);
-        let mut added_l = Vec::with_capacity(nb);
-        let mut used_b = vec![false; ib.groups.len()];
-        // Buffers reused across groups.
-        let (mut kept, mut only_a, mut only_b) = (Vec::new(), Vec::new(), Vec::new());
-        let mut rest: Vec<(&Text, Option<&Text>)> = Vec::new();
-        for (k, &(t, h, _, _)) in ia.groups.iter().enumerate() {
+        // Arcs in key order with no sort: b's groups in key order give the
+        // kept and added arcs (named by b's keys), a's the removed ones.
+        let mut split = Split::default();
+        for &j in &ib.groups_by_key {
+            let j = j as usize;
+            let (x, y, _, _) = ib.groups[j];
+            let (x, y) = (x as usize, y as usize);
+            let k = inv[x].zip(inv[y]).and_then(|(t, h)| ia.group(t, h));
+            let la = k.into_iter().flat_map(|k| ia.group_labels(k));
+            split.of(la, ib.group_labels(j));
+            push_grouped(&mut s.arcs_kept, ib.key(x), ib.key(y), &mut split.kept);
+            push_grouped(&mut s.arcs_added, ib.key(x), ib.key(y), &mut split.only_b);
+        }
+        for &k in &ia.groups_by_key {
+            let k = k as usize;
+            let (t, h, _, _) = ia.groups[k];
             let (t, h) = (t as usize, h as usize);
-            let (Some(x), Some(y)) = (fwd[t], fwd[h]) else {
-                rest.clear();
-                rest.extend(ia.group_labels(k).map(|l| (l, None)));
-                push_grouped(&mut removed_l, ia.end(t), ia.end(h), &mut rest);
-                continue;
-            };
-            let j = ib.group(x, y);
-            if let Some(j) = j {
-                used_b[j] = true;
-            }
-            // Multiset intersection of two sorted lists, and the leftovers.
-            let mut la = ia.group_labels(k).peekable();
-            let mut lb = j.into_iter().flat_map(|j| ib.group_labels(j)).peekable();
-            kept.clear();
-            only_a.clear();
-            only_b.clear();
-            loop {
-                match (la.peek(), lb.peek()) {
-                    (Some(p), Some(q)) if p == q => {
-                        kept.push((*q, None));
-                        la.next();
-                        lb.next();
-                    }
-                    (Some(p), Some(q)) if p < q => {
-                        only_a.push(*p);
-                        la.next();
-                    }
-                    (Some(p), None) => {
-                        only_a.push(*p);
-                        la.next();
-                    }
-                    (_, Some(q)) => {
-                        only_b.push(*q);
-                        lb.next();
-                    }
-                    (None, None) => break,
-                }
-            }
-            let paired = only_a.len().min(only_b.len());
-            kept.extend(
-                only_b[..paired]
-                    .iter()
-                    .zip(&only_a[..paired])
-                    .map(|(q, p)| (*q, Some(*p))),
-            );
-            push_grouped(&mut kept_l, ib.end(x), ib.end(y), &mut kept);
-            rest.clear();
-            rest.extend(only_a[paired..].iter().map(|&l| (l, None)));
-            push_grouped(&mut removed_l, ia.end(t), ia.end(h), &mut rest);
-            rest.clear();
-            rest.extend(only_b[paired..].iter().map(|&l| (l, None)));
-            push_grouped(&mut added_l, ib.end(x), ib.end(y), &mut rest);
+            let j = fwd[t].zip(fwd[h]).and_then(|(x, y)| ib.group(x, y));
+            let lb = j.into_iter().flat_map(|j| ib.group_labels(j));
+            split.of(ia.group_labels(k), lb);
+            push_grouped(&mut s.arcs_removed, ia.key(t), ia.key(h), &mut split.only_a);
         }
-        for (j, &(x, y, _, _)) in ib.groups.iter().enumerate() {
-            if !used_b[j] {
-                rest.clear();
-                rest.extend(ib.group_labels(j).map(|l| (l, None)));
-                push_grouped(
-                    &mut added_l,
-                    ib.end(x as usize),
-                    ib.end(y as usize),
-                    &mut rest,
-                );
-            }
-        }
-        s.arcs_added = sorted_arcs(added_l);
-        s.arcs_removed = sorted_arcs(removed_l);
-        s.arcs_kept = sorted_arcs(kept_l);
         s
     }
 

@@ -22,13 +22,16 @@ pub enum GedGraphError {
 
 /// The key-less part of a [`GedGraph`]: labels and the aggregated arc
 /// multiset, all the search needs. Built from a policy graph in linear time
-/// plus one sort of integer pairs (no strings), so that `compare` can build
-/// it inside each mode's time budget.
+/// (a counting sort by tail, then each tail's heads sorted; integers only),
+/// so that `compare` can build it inside each mode's time budget.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Shape {
     labels: Vec<u32>,
     /// `(tail, head, multiplicity)`, sorted by `(tail, head)`, multiplicity >= 1.
     arcs: Vec<(u32, u32, u32)>,
+    /// The arcs of tail `u` are `arcs[first[u]..first[u + 1]]` (n + 1
+    /// entries; empty for the default shape).
+    first: Vec<u32>,
 }
 
 impl Shape {
@@ -50,17 +53,44 @@ impl Shape {
             // Both fit in u32: n does.
             raw.push((tail as u32, head as u32));
         }
-        raw.sort_unstable();
+        if u32::try_from(raw.len()).is_err() {
+            return Err(GedGraphError::TooLarge);
+        }
+        // Counting sort by tail, then each tail's heads sorted.
+        let mut start = vec![0u32; n + 1];
+        for &(t, _) in &raw {
+            start[t as usize + 1] += 1;
+        }
+        for u in 0..n {
+            start[u + 1] += start[u];
+        }
+        let mut heads = vec![0u32; raw.len()];
+        let mut fill = start.clone();
+        for &(t, h) in &raw {
+            heads[fill[t as usize] as usize] = h;
+            fill[t as usize] += 1;
+        }
         let mut agg: Vec<(u32, u32, u32)> = Vec::with_capacity(raw.len());
-        for (t, h) in raw {
-            match agg.last_mut() {
-                Some(last) if last.0 == t && last.1 == h => {
-                    last.2 = last.2.checked_add(1).ok_or(GedGraphError::TooLarge)?;
+        let mut first = Vec::with_capacity(n + 1);
+        for u in 0..n {
+            first.push(agg.len() as u32);
+            let hs = &mut heads[start[u] as usize..start[u + 1] as usize];
+            hs.sort_unstable();
+            for &h in hs.iter() {
+                match agg.last_mut() {
+                    Some(last) if last.0 == u as u32 && last.1 == h => {
+                        last.2 = last.2.checked_add(1).ok_or(GedGraphError::TooLarge)?;
+                    }
+                    _ => agg.push((u as u32, h, 1)),
                 }
-                _ => agg.push((t, h, 1)),
             }
         }
-        Ok(Shape { labels, arcs: agg })
+        first.push(agg.len() as u32);
+        Ok(Shape {
+            labels,
+            arcs: agg,
+            first,
+        })
     }
 
     /// Number of vertices.
@@ -89,8 +119,14 @@ impl Shape {
         let (Ok(u), Ok(v)) = (u32::try_from(u), u32::try_from(v)) else {
             return 0;
         };
-        match self.arcs.binary_search_by(|&(t, h, _)| (t, h).cmp(&(u, v))) {
-            Ok(i) => self.arcs[i].2,
+        // Within u's arcs only: a short, cache-friendly search.
+        let (Some(&s), Some(&e)) = (self.first.get(u as usize), self.first.get(u as usize + 1))
+        else {
+            return 0;
+        };
+        let out = &self.arcs[s as usize..e as usize];
+        match out.binary_search_by_key(&v, |&(_, h, _)| h) {
+            Ok(i) => out[i].2,
             Err(_) => 0,
         }
     }
@@ -100,6 +136,7 @@ impl Shape {
         Shape {
             labels: vec![0; self.labels.len()],
             arcs: self.arcs.clone(),
+            first: self.first.clone(),
         }
     }
 }

@@ -247,13 +247,17 @@ pub fn search_mapping(
     let (lower, map) = if Instant::now() >= deadline {
         (count_bound(a, b, labeled), vec![None; a.n()])
     } else if labeled {
-        let o = Oriented::new(a, b);
-        let lim = search::Limits {
-            deadline,
-            max_expansions,
-        };
-        let out = search::solve(&o.p, &lim, None);
-        (out.lower, o.to_ab(&out.sigma))
+        match Oriented::within(a, b, deadline) {
+            Some(o) => {
+                let lim = search::Limits {
+                    deadline,
+                    max_expansions,
+                };
+                let out = search::solve(&o.p, &lim, None);
+                (out.lower, o.to_ab(&out.sigma))
+            }
+            None => (count_bound(a, b, true), vec![None; a.n()]),
+        }
     } else {
         structural(a, b, deadline, max_expansions)
     };
@@ -281,7 +285,9 @@ fn structural(
     let start = Instant::now();
     let total = deadline.saturating_duration_since(start);
     let (ua, ub) = (a.unlabeled(), b.unlabeled());
-    let st = Oriented::new(&ua, &ub);
+    let Some(st) = Oriented::within(&ua, &ub, deadline) else {
+        return (count_bound(a, b, false), vec![None; a.n()]);
+    };
     let built = start.elapsed();
     let first_label = a.labels().first().or(b.labels().first());
     let multi_class = a
@@ -311,7 +317,9 @@ fn structural(
     if first.lower >= first.upper || deadline.saturating_duration_since(Instant::now()) < stage {
         return (first.lower, st.to_ab(&first.sigma));
     }
-    let labeled = Oriented::new(a, b);
+    let Some(labeled) = Oriented::within(a, b, deadline) else {
+        return (first.lower, st.to_ab(&first.sigma));
+    };
     let lab = search::solve(&labeled.p, &lim(start + 2 * third), None);
     let hint = st.padded_from_ab(&labeled.to_ab(&lab.sigma));
     let second = search::solve(&st.p, &lim(deadline), Some(hint));
@@ -334,8 +342,26 @@ struct Oriented {
 }
 
 impl Oriented {
+    /// [`Oriented::new`], unless `deadline` passes before the padded
+    /// problem is built (its set-up, O((n + m) log n), reads the clock
+    /// between its steps: milliseconds each on 100k vertices).
+    fn within(a: &Shape, b: &Shape, deadline: Instant) -> Option<Oriented> {
+        let swap = Self::swap(a, b);
+        if Instant::now() >= deadline {
+            return None;
+        }
+        let o = Self::build(a, b, swap);
+        (Instant::now() < deadline).then_some(o)
+    }
+
+    #[cfg(test)]
     fn new(a: &Shape, b: &Shape) -> Oriented {
-        let swap = match (b.n(), b.arc_count()).cmp(&(a.n(), a.arc_count())) {
+        Self::build(a, b, Self::swap(a, b))
+    }
+
+    /// Whether b is searched from (see `orientation_key`).
+    fn swap(a: &Shape, b: &Shape) -> bool {
+        match (b.n(), b.arc_count()).cmp(&(a.n(), a.arc_count())) {
             std::cmp::Ordering::Less => true,
             std::cmp::Ordering::Greater => false,
             std::cmp::Ordering::Equal => {
@@ -344,7 +370,10 @@ impl Oriented {
                 let (ka, kb) = (orientation_key(a), orientation_key(b));
                 kb < ka || (kb == ka && (b.labels(), b.arcs()) < (a.labels(), a.arcs()))
             }
-        };
+        }
+    }
+
+    fn build(a: &Shape, b: &Shape, swap: bool) -> Oriented {
         let p = if swap {
             Problem::new(b, a)
         } else {
