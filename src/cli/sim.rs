@@ -106,12 +106,15 @@ pub fn execute(a: SimArgs) -> u8 {
         s.seed = seed;
     }
     let (runs, cut) = run::run_scenario_within(&s, a.trace.is_some(), deadline);
+    // The runs are the simulation work; the verdicts compared after them
+    // (trajectories thinned to 3000 points) are the report's.
+    let millis = t0.elapsed().as_millis();
     let rep = SimReport::new(&s.name, &file, s.seed, s.dt, runs);
     let budget = a.timeout_ms.map(|ms| Budget {
         timeout_ms: ms,
         exhausted: cut,
         requested_runs: None,
-        millis: Some(t0.elapsed().as_millis()),
+        millis: Some(millis),
     });
     if let Some(p) = &a.trace
         && emit(Some(p), rep.trace_json().as_bytes()) != EXIT_OK
@@ -151,7 +154,7 @@ struct Budget {
     #[serde(skip_serializing_if = "Option::is_none")]
     requested_runs: Option<u32>,
     /// Without `--runs` (whose report has its own `millis`): the wall time
-    /// of the simulation work, ms.
+    /// of the runs, ms (the verdicts are computed after them).
     #[serde(skip_serializing_if = "Option::is_none")]
     millis: Option<u128>,
 }

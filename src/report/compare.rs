@@ -657,7 +657,9 @@ impl Pair<'_> {
             vertices_kept: Vec::with_capacity(ia.keys.len().min(ib.keys.len())),
             vertices_removed: Vec::with_capacity(ia.keys.len()),
             vertices_added: Vec::with_capacity(ib.keys.len()),
-            ..Script::default()
+            arcs_kept: Vec::with_capacity(ia.groups.len().min(ib.groups.len())),
+            arcs_added: Vec::with_capacity(ib.groups.len()),
+            arcs_removed: Vec::with_capacity(ia.groups.len()),
         };
         // In key order: the lists come out sorted.
         for &u in &ia.by_key {
