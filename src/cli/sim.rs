@@ -85,21 +85,16 @@ pub fn execute(a: SimArgs) -> u8 {
             requested_runs: Some(n),
             millis: None,
         });
-        let text = match (a.format, &budget) {
-            (OutputFormat::Json, None) => rep.json(),
-            (OutputFormat::Json, Some(b)) => with_budget(&rep, b),
-            (_, None) => rep.table(),
-            (_, Some(b)) => {
-                let mut t = rep.table();
-                if b.exhausted {
-                    t.push_str(&format!(
-                        "note: the wall-clock budget of {} ms ran out: {done} of {n} episodes completed; the figures cover those (the first {done})\n",
-                        b.timeout_ms
-                    ));
-                }
-                t
-            }
-        };
+        let note =
+            format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
+        let text = render(
+            &rep,
+            a.format,
+            McReport::json,
+            McReport::table,
+            &budget,
+            &note,
+        );
         return emit(None, text.as_bytes());
     }
     if let Some(seed) = a.seed {
@@ -126,21 +121,15 @@ pub fn execute(a: SimArgs) -> u8 {
     {
         return EXIT_BAD_INPUT;
     }
-    let text = match (a.format, &budget) {
-        (OutputFormat::Json, None) => rep.json(),
-        (OutputFormat::Json, Some(b)) => with_budget(&rep, b),
-        (_, None) => rep.table(),
-        (_, Some(b)) => {
-            let mut t = rep.table();
-            if b.exhausted {
-                t.push_str(&format!(
-                    "note: the wall-clock budget of {} ms ran out: the runs with outcome `timeout` stopped at the step shown in their reason\n",
-                    b.timeout_ms
-                ));
-            }
-            t
-        }
-    };
+    let note = "the runs with outcome `timeout` stopped at the step shown in their reason";
+    let text = render(
+        &rep,
+        a.format,
+        SimReport::json,
+        SimReport::table,
+        &budget,
+        note,
+    );
     emit(None, text.as_bytes())
 }
 
@@ -157,6 +146,33 @@ struct Budget {
     /// of the runs, ms (the verdicts are computed after them).
     #[serde(skip_serializing_if = "Option::is_none")]
     millis: Option<u128>,
+}
+
+/// The report in `format`; with `--timeout-ms`, JSON gets the `budget`
+/// object, and the table `note` when the budget ran out.
+fn render<R: serde::Serialize>(
+    rep: &R,
+    format: OutputFormat,
+    json: fn(&R) -> String,
+    table: fn(&R) -> String,
+    budget: &Option<Budget>,
+    note: &str,
+) -> String {
+    match (format, budget) {
+        (OutputFormat::Json, None) => json(rep),
+        (OutputFormat::Json, Some(b)) => with_budget(rep, b),
+        (_, None) => table(rep),
+        (_, Some(b)) => {
+            let mut t = table(rep);
+            if b.exhausted {
+                t.push_str(&format!(
+                    "note: the wall-clock budget of {} ms ran out: {note}\n",
+                    b.timeout_ms
+                ));
+            }
+            t
+        }
+    }
 }
 
 /// The JSON report with a `budget` object after its own fields.

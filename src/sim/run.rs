@@ -321,19 +321,6 @@ pub fn run_policy(
     seed: u64,
     opts: RunOptions,
 ) -> Run {
-    run_policy_clocked(s, p, world, disturbances, rates, seed, opts).0
-}
-
-/// [`run_policy`], and whether the wall-clock budget cut the run short.
-fn run_policy_clocked(
-    s: &Scenario,
-    p: &Prepared,
-    world: World,
-    disturbances: &[Disturbance],
-    rates: BTreeMap<String, f64>,
-    seed: u64,
-    opts: RunOptions,
-) -> (Run, bool) {
     let n = p.keys.len();
     let mut robot = Robot {
         world,
@@ -375,13 +362,11 @@ fn run_policy_clocked(
     if opts.log {
         trajectory.push(robot.world.robot);
     }
-    let mut cut = false;
     while steps < s.max_steps {
         if let Some(d) = opts.deadline
             && steps % CLOCK_EVERY == 0
             && Instant::now() >= d
         {
-            cut = true;
             ended = Some((
                 Outcome::Timeout,
                 format!("wall-clock budget exhausted at step {steps}"),
@@ -503,7 +488,7 @@ fn run_policy_clocked(
         ),
     });
     let goal_met = s.goal.as_ref().map(|g| holds(g, &robot.world));
-    let run = Run {
+    Run {
         policy: p.name.clone(),
         file: p.file.clone(),
         kind: p.kind.clone(),
@@ -521,8 +506,13 @@ fn run_policy_clocked(
         recharge_latency_s: robot.latencies,
         trajectory,
         trace,
-    };
-    (run, cut)
+    }
+}
+
+/// Whether the wall-clock budget cut `r` short: a timeout before the step
+/// budget was used up (the clock is read only while steps remain).
+fn cut_short(s: &Scenario, r: &Run) -> bool {
+    r.outcome == Outcome::Timeout && r.steps < s.max_steps
 }
 
 /// Runs every policy of a scenario once (the scenario's own seed and
@@ -544,7 +534,7 @@ pub fn run_scenario_within(
     let runs = prepare(s)
         .iter()
         .map(|p| {
-            let (run, cut) = run_policy_clocked(
+            let run = run_policy(
                 s,
                 p,
                 s.world.clone(),
@@ -557,7 +547,7 @@ pub fn run_scenario_within(
                     deadline,
                 },
             );
-            any_cut |= cut;
+            any_cut |= cut_short(s, &run);
             run
         })
         .collect();
@@ -652,7 +642,7 @@ pub fn monte_carlo_within(
                         let (ep_seed, ds, rates) = episode(s, seed, i);
                         let first = out.len();
                         for (k, p) in prepared.iter().enumerate() {
-                            let (r, cut) = run_policy_clocked(
+                            let r = run_policy(
                                 s,
                                 p,
                                 s.world.clone(),
@@ -665,7 +655,7 @@ pub fn monte_carlo_within(
                                     deadline,
                                 },
                             );
-                            if cut {
+                            if cut_short(s, &r) {
                                 stop.store(true, Ordering::Relaxed);
                                 out.truncate(first);
                                 break 'episodes;
