@@ -922,6 +922,76 @@ on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
         assert_eq!(st.edit_script.cost(), st.ged);
     }
 
+    /// A random FSM: `n` states, each with three outcome arcs to random
+    /// states (parallel arcs and self-loops with different labels).
+    fn random_fsm(n: u64, seed: u64) -> String {
+        let mut x = seed;
+        let mut next = move |m: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % m
+        };
+        let mut s = String::from("kind = \"fsm\"\ninitial = \"s0\"\noutcomes = [\"SUCCESS\"]\n");
+        for i in 0..n {
+            let to = |t: u64| {
+                if t == n {
+                    "SUCCESS".to_string()
+                } else {
+                    format!("s{t}")
+                }
+            };
+            s.push_str(&format!(
+                "[states.s{i}]\nskill = \"Dock\"\non = {{ SUCCESS = \"{}\", FAILURE = \"{}\", RUNNING = \"{}\" }}\n",
+                to(next(n + 1)),
+                to(next(n + 1)),
+                to(next(n + 1)),
+            ));
+        }
+        s
+    }
+
+    /// The script of any partial mapping costs what `mapping_cost` says,
+    /// accounts for every arc of both graphs once, and comes out in the
+    /// order the old string sorts gave (vertices by key, arcs by `ArcRef`).
+    #[test]
+    fn scripts_of_random_mappings_are_complete_and_sorted() {
+        use crate::metrics::ged::{Shape, mapping_cost};
+        let (pa, pb) = (policy(&random_fsm(12, 3)), policy(&random_fsm(10, 8)));
+        let pair = pair(&pa, &pb);
+        let (sa, sb) = (Shape::from(&pair.ga), Shape::from(&pair.gb));
+        let (na, nb) = (sa.n(), sb.n());
+        let mut x = 99u64;
+        for round in 0..200 {
+            let map: Vec<Option<usize>> = (0..na)
+                .map(|_| {
+                    x = x
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    let r = (x >> 33) as usize;
+                    (!r.is_multiple_of(4)).then_some(r % (nb + 1))
+                })
+                .collect();
+            let s = pair.script(&map);
+            assert_eq!(s.cost(), mapping_cost(&sa, &sb, &map), "round {round}");
+            let count = |l: &[ArcRef]| l.iter().map(|a| u64::from(a.count)).sum::<u64>();
+            assert_eq!(count(&s.arcs_kept) + count(&s.arcs_removed), sa.arc_count());
+            assert_eq!(count(&s.arcs_kept) + count(&s.arcs_added), sb.arc_count());
+            assert_eq!(s.vertices_kept.len() + s.vertices_removed.len(), na);
+            assert_eq!(s.vertices_kept.len() + s.vertices_added.len(), nb);
+            for l in [&s.arcs_kept, &s.arcs_removed, &s.arcs_added] {
+                assert!(l.windows(2).all(|w| w[0] < w[1]), "round {round}: {l:?}");
+            }
+            let keys = |l: &[VertexRef]| l.windows(2).all(|w| w[0].key < w[1].key);
+            assert!(keys(&s.vertices_added) && keys(&s.vertices_removed));
+            assert!(
+                s.vertices_kept
+                    .windows(2)
+                    .all(|w| (&w[0].a, &w[0].b) < (&w[1].a, &w[1].b))
+            );
+        }
+    }
+
     #[test]
     fn relabelled_parallel_arc_is_kept_and_shown() {
         let b = A.replace(
