@@ -289,8 +289,7 @@ impl ScriptIndex {
         let nodes = g.g.raw_nodes();
         let n = nodes.len();
         let key = |i: u32| nodes[i as usize].weight.key.as_str();
-        let mut by_key: Vec<u32> = (0..n as u32).collect();
-        by_key.sort_unstable_by(|&x, &y| key(x).cmp(key(y)).then(x.cmp(&y)));
+        let by_key = key_order(n, key);
         let mut rank = vec![0u32; n];
         for (r, &v) in by_key.iter().enumerate() {
             rank[v as usize] = r as u32;
@@ -308,22 +307,29 @@ impl ScriptIndex {
         for (l, i) in distinct {
             table[i] = l.to_string();
         }
+        // Labels ordered as strings once (there are few), arcs then sorted
+        // on integers: (tail, head, label rank, edge).
+        let mut label_rank: Vec<u32> = vec![0; table.len()];
+        let mut by_label: Vec<usize> = (0..table.len()).collect();
+        by_label.sort_unstable_by(|&x, &y| table[x].cmp(&table[y]));
+        for (r, &l) in by_label.iter().enumerate() {
+            label_rank[l] = r as u32;
+        }
         let table = Arc::new(table);
+        let mut sorted: Vec<(u32, u32, u32, u32)> = edges
+            .iter()
+            .zip(&ids)
+            .enumerate()
+            .map(|(e, (x, &l))| {
+                let (t, h) = (x.source().index() as u32, x.target().index() as u32);
+                (t, h, label_rank[l], e as u32)
+            })
+            .collect();
+        sorted.sort_unstable();
         let labels: Vec<Text> = ids.into_iter().map(|i| Text::at(&table, i)).collect();
-        let ends = |e: u32| {
-            let x = &edges[e as usize];
-            (x.source().index() as u32, x.target().index() as u32)
-        };
-        let mut arcs: Vec<u32> = (0..edges.len() as u32).collect();
-        arcs.sort_unstable_by(|&x, &y| {
-            ends(x)
-                .cmp(&ends(y))
-                .then_with(|| labels[x as usize].cmp(&labels[y as usize]))
-                .then(x.cmp(&y))
-        });
+        let arcs: Vec<u32> = sorted.iter().map(|x| x.3).collect();
         let mut groups: Vec<(u32, u32, u32, u32)> = Vec::new();
-        for (i, &e) in arcs.iter().enumerate() {
-            let (t, h) = ends(e);
+        for (i, &(t, h, _, _)) in sorted.iter().enumerate() {
             match groups.last_mut() {
                 Some(last) if (last.0, last.1) == (t, h) => last.3 = i as u32 + 1,
                 _ => groups.push((t, h, i as u32, i as u32 + 1)),
@@ -379,25 +385,57 @@ impl ScriptIndex {
     }
 }
 
-/// Ids for the keys of both graphs: equal keys get equal ids.
-fn key_ids<'g>(a: &'g PolicyGraph, b: &'g PolicyGraph) -> (Vec<u32>, Vec<u32>) {
-    let mut ids: HashMap<&'g str, u32> = HashMap::with_capacity(a.g.node_count());
-    let mut of = |g: &'g PolicyGraph| -> Vec<u32> {
-        keys(g)
-            .map(|k| {
-                let next = ids.len() as u32;
-                *ids.entry(k).or_insert(next)
-            })
-            .collect()
+/// Vertices `0..n` in the order of their keys (then index): sorted on the
+/// keys' first 8 bytes as integers (big-endian, zero-padded, which orders
+/// as the bytes do), then each run of equal prefixes on the whole keys. On
+/// short keys (BT node ids) that is an integer sort, no string compared.
+fn key_order<'k>(n: usize, key: impl Fn(u32) -> &'k str) -> Vec<u32> {
+    let prefix = |i: u32| {
+        let mut b = [0u8; 8];
+        let k = key(i).as_bytes();
+        let m = k.len().min(8);
+        b[..m].copy_from_slice(&k[..m]);
+        u64::from_be_bytes(b)
     };
-    let ia = of(a);
-    let ib = of(b);
-    (ia, ib)
+    let mut order: Vec<(u64, u32)> = (0..n as u32).map(|i| (prefix(i), i)).collect();
+    order.sort_unstable();
+    let mut s = 0;
+    while s < order.len() {
+        let e = s + order[s..].iter().take_while(|x| x.0 == order[s].0).count();
+        if e - s > 1 {
+            order[s..e].sort_unstable_by(|x, y| key(x.1).cmp(key(y.1)).then(x.1.cmp(&y.1)));
+        }
+        s = e;
+    }
+    order.into_iter().map(|x| x.1).collect()
 }
 
-/// The vertex keys of a graph, in vertex order.
-fn keys(g: &PolicyGraph) -> impl Iterator<Item = &str> {
-    g.g.raw_nodes().iter().map(|v| v.weight.key.as_str())
+/// Ids for the keys of both graphs: equal keys get equal ids. One merge of
+/// the two graphs' vertices in key order.
+fn key_ids(ia: &ScriptIndex, ib: &ScriptIndex) -> (Vec<u32>, Vec<u32>) {
+    let (na, nb) = (ia.by_key.len(), ib.by_key.len());
+    let (mut ids_a, mut ids_b) = (vec![0u32; na], vec![0u32; nb]);
+    let key_a = |i: usize| ia.keys[ia.by_key[i] as usize].as_str();
+    let key_b = |j: usize| ib.keys[ib.by_key[j] as usize].as_str();
+    let (mut i, mut j) = (0, 0);
+    let mut last: Option<&str> = None;
+    let mut next = 0u32;
+    while i < na || j < nb {
+        let from_a = j >= nb || (i < na && key_a(i) <= key_b(j));
+        let k = if from_a { key_a(i) } else { key_b(j) };
+        if last != Some(k) {
+            last = Some(k);
+            next += 1;
+        }
+        if from_a {
+            ids_a[ia.by_key[i] as usize] = next - 1;
+            i += 1;
+        } else {
+            ids_b[ib.by_key[j] as usize] = next - 1;
+            j += 1;
+        }
+    }
+    (ids_a, ids_b)
 }
 
 /// State key -> container key, for every nested state of an HFSM.
@@ -416,10 +454,11 @@ fn containers(p: &Policy) -> BTreeMap<String, String> {
 impl<'a> Pair<'a> {
     pub fn new(a: Side<'a>, b: Side<'a>) -> Self {
         let (ga, gb) = (policy_graph(a.policy), policy_graph(b.policy));
-        let (ids_a, ids_b) = key_ids(&ga, &gb);
+        let (ia, ib) = (ScriptIndex::new(&ga), ScriptIndex::new(&gb));
+        let (ids_a, ids_b) = key_ids(&ia, &ib);
         Pair {
-            ia: ScriptIndex::new(&ga),
-            ib: ScriptIndex::new(&gb),
+            ia,
+            ib,
             ids_a,
             ids_b,
             ga,
@@ -990,6 +1029,32 @@ on = { SUCCESS = "SUCCESS", FAILURE = "Go", RUNNING = "Pick" }
                     .all(|w| (&w[0].a, &w[0].b) < (&w[1].a, &w[1].b))
             );
         }
+    }
+
+    #[test]
+    fn key_order_is_the_string_order() {
+        let keys = [
+            "n10",
+            "n9",
+            "",
+            "a",
+            "ab",
+            "ab\0",
+            "abcdefgh",
+            "abcdefghi",
+            "abcdefgh",
+            "é",
+            "Z",
+            "abcdefgha",
+            "n1",
+        ];
+        let got: Vec<&str> = key_order(keys.len(), |i| keys[i as usize])
+            .into_iter()
+            .map(|i| keys[i as usize])
+            .collect();
+        let mut want = keys.to_vec();
+        want.sort();
+        assert_eq!(got, want);
     }
 
     #[test]
