@@ -137,15 +137,27 @@ pub struct GedMapping {
     pub map: Vec<Option<usize>>,
 }
 
-/// GED between two policy graphs (see the module documentation).
+/// GED between two policy graphs (see the module documentation); the
+/// budget's clock starts before the compact graphs are built.
 pub fn ged(a: &PolicyGraph, b: &PolicyGraph, mode: GedMode, opts: &GedOptions) -> GedResult {
-    ged_graphs(&GedGraph::from(a), &GedGraph::from(b), mode, opts)
+    let start = Instant::now();
+    ged_since(start, &GedGraph::from(a), &GedGraph::from(b), mode, opts)
 }
 
 /// GED between two compact graphs; labels are used by `Labeled`, keys by
 /// `Named` and by the edit script.
 pub fn ged_graphs(a: &GedGraph, b: &GedGraph, mode: GedMode, opts: &GedOptions) -> GedResult {
-    let start = Instant::now();
+    ged_since(Instant::now(), a, b, mode, opts)
+}
+
+/// [`ged_graphs`] with the budget counted from `start`.
+fn ged_since(
+    start: Instant,
+    a: &GedGraph,
+    b: &GedGraph,
+    mode: GedMode,
+    opts: &GedOptions,
+) -> GedResult {
     let finish = |lower: u64, upper: u64, edit_script: EditScript| GedResult {
         ged: upper,
         exact: lower >= upper,
