@@ -73,8 +73,10 @@ pub enum Command {
         /// vertex type only), named (by node id / state name), or all three
         #[arg(long, value_enum, default_value_t = CompareMode::All)]
         mode: CompareMode,
-        /// Time budget per mode for the exact search; when it runs out the
-        /// result is a certified interval with `exact: false`
+        /// Time budget per mode, its whole computation (graphs, search, edit
+        /// script; docs/robustness.md gives the floor on large graphs); when
+        /// the search runs out the result is a certified interval with
+        /// `exact: false`
         #[arg(long, default_value_t = 2000, value_name = "MS")]
         timeout_ms: u64,
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]

@@ -32,6 +32,12 @@ pub struct SimArgs {
     /// Worker threads for --runs (default: the number of cores)
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Wall-clock budget for all the simulation work, in ms: when it runs
+    /// out, runs stop cleanly (outcome `timeout` at the step reached; with
+    /// --runs, the figures cover the episodes completed) and the report
+    /// says so; the exit code stays 0
+    #[arg(long, value_name = "MS")]
+    pub timeout_ms: Option<u64>,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
 }
@@ -49,6 +55,11 @@ pub fn execute(a: SimArgs) -> u8 {
         }
     };
     let file = a.scenario.display().to_string();
+    // The budget's clock starts once the scenario is read.
+    let t0 = std::time::Instant::now();
+    let deadline = a
+        .timeout_ms
+        .map(|ms| t0 + std::time::Duration::from_millis(ms));
     if let Some(n) = a.runs {
         if a.trace.is_some() || a.plot.is_some() {
             eprintln!("error: --trace and --plot record one run; leave them out with --runs");
@@ -58,27 +69,48 @@ pub fn execute(a: SimArgs) -> u8 {
         let threads = a
             .threads
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-        let t0 = std::time::Instant::now();
-        let stats = run::monte_carlo(&s, n, seed, threads);
+        let (stats, done) = run::monte_carlo_within(&s, n, seed, threads, deadline);
         let rep = McReport {
             scenario: s.name.clone(),
             seed,
-            runs: n,
+            // What the figures cover.
+            runs: done,
             threads: threads.max(1).min(n.max(1) as usize),
             millis: t0.elapsed().as_millis(),
             policies: stats,
         };
-        let text = match a.format {
-            OutputFormat::Json => rep.json(),
-            _ => rep.table(),
-        };
+        let budget = a.timeout_ms.map(|ms| Budget {
+            timeout_ms: ms,
+            exhausted: done < n,
+            requested_runs: Some(n),
+            millis: None,
+        });
+        let note =
+            format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
+        let text = render(
+            &rep,
+            a.format,
+            McReport::json,
+            McReport::table,
+            &budget,
+            &note,
+        );
         return emit(None, text.as_bytes());
     }
     if let Some(seed) = a.seed {
         s.seed = seed;
     }
-    let runs = run::run_scenario(&s, a.trace.is_some());
+    let (runs, cut) = run::run_scenario_within(&s, a.trace.is_some(), deadline);
+    // The runs are the simulation work; the verdicts compared after them
+    // (trajectories thinned to 3000 points) are the report's.
+    let millis = t0.elapsed().as_millis();
     let rep = SimReport::new(&s.name, &file, s.seed, s.dt, runs);
+    let budget = a.timeout_ms.map(|ms| Budget {
+        timeout_ms: ms,
+        exhausted: cut,
+        requested_runs: None,
+        millis: Some(millis),
+    });
     if let Some(p) = &a.trace
         && emit(Some(p), rep.trace_json().as_bytes()) != EXIT_OK
     {
@@ -89,11 +121,71 @@ pub fn execute(a: SimArgs) -> u8 {
     {
         return EXIT_BAD_INPUT;
     }
-    let text = match a.format {
-        OutputFormat::Json => rep.json(),
-        _ => rep.table(),
-    };
+    let note = "the runs with outcome `timeout` stopped at the step shown in their reason";
+    let text = render(
+        &rep,
+        a.format,
+        SimReport::json,
+        SimReport::table,
+        &budget,
+        note,
+    );
     emit(None, text.as_bytes())
+}
+
+/// What `--timeout-ms` adds to a JSON report.
+#[derive(Debug, serde::Serialize)]
+struct Budget {
+    timeout_ms: u64,
+    /// Whether the budget ran out (some run or episode was cut short).
+    exhausted: bool,
+    /// With `--runs`: the episodes asked for (`runs` is how many completed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    requested_runs: Option<u32>,
+    /// Without `--runs` (whose report has its own `millis`): the wall time
+    /// of the runs, ms (the verdicts are computed after them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    millis: Option<u128>,
+}
+
+/// The report in `format`; with `--timeout-ms`, JSON gets the `budget`
+/// object, and the table `note` when the budget ran out.
+fn render<R: serde::Serialize>(
+    rep: &R,
+    format: OutputFormat,
+    json: fn(&R) -> String,
+    table: fn(&R) -> String,
+    budget: &Option<Budget>,
+    note: &str,
+) -> String {
+    match (format, budget) {
+        (OutputFormat::Json, None) => json(rep),
+        (OutputFormat::Json, Some(b)) => with_budget(rep, b),
+        (_, None) => table(rep),
+        (_, Some(b)) => {
+            let mut t = table(rep);
+            if b.exhausted {
+                t.push_str(&format!(
+                    "note: the wall-clock budget of {} ms ran out: {note}\n",
+                    b.timeout_ms
+                ));
+            }
+            t
+        }
+    }
+}
+
+/// The JSON report with a `budget` object after its own fields.
+fn with_budget<T: serde::Serialize>(report: &T, budget: &Budget) -> String {
+    #[derive(serde::Serialize)]
+    struct Out<'a, T> {
+        #[serde(flatten)]
+        report: &'a T,
+        budget: &'a Budget,
+    }
+    let mut s = serde_json::to_string_pretty(&Out { report, budget }).expect("serializable");
+    s.push('\n');
+    s
 }
 
 /// `btfsm dot FILE --trace TRACE.json --step K [--policy NAME]`.

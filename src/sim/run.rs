@@ -3,7 +3,10 @@
 //! is pending, until it chatters or gives up, or until the step budget runs out.
 //! Also the `--runs N` Monte Carlo episodes, run in parallel over the cores
 //! (deterministic: episode i has its own seed and results are combined in
-//! episode order).
+//! episode order). Under a wall-clock budget (`sim --timeout-ms`), runs read
+//! the clock every 1024 steps and stop cleanly when it has passed: a single
+//! run ends with outcome `timeout` at the step reached; Monte Carlo keeps
+//! the first k whole episodes.
 
 use super::exec::{BtExec, CompiledBt, CompiledMachine, Leaves, MachineExec};
 use super::rng::SimRng;
@@ -14,6 +17,8 @@ use super::world::{P2, Place, World};
 use crate::model::PolicyBody;
 use std::collections::BTreeMap;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 /// A policy ready to run: bindings resolved against the scenario's world.
 #[derive(Debug, Clone)]
@@ -273,7 +278,15 @@ pub struct RunOptions {
     pub log: bool,
     /// Per-step statuses (for `--trace`).
     pub trace: bool,
+    /// Wall-clock budget: the run stops (outcome `timeout`) at the first
+    /// clock reading at or past it, read every [`CLOCK_EVERY`] steps.
+    pub deadline: Option<Instant>,
 }
+
+/// Steps between two readings of the clock under a wall-clock budget: a
+/// step costs microseconds, so the run stops within about a millisecond of
+/// its deadline, and the clock (tens of nanoseconds) costs nothing.
+pub const CLOCK_EVERY: u64 = 1024;
 
 /// Applies a disturbance's effect.
 fn apply(d: &Disturbance, r: &mut Robot) {
@@ -350,6 +363,16 @@ pub fn run_policy(
         trajectory.push(robot.world.robot);
     }
     while steps < s.max_steps {
+        if let Some(d) = opts.deadline
+            && steps % CLOCK_EVERY == 0
+            && Instant::now() >= d
+        {
+            ended = Some((
+                Outcome::Timeout,
+                format!("wall-clock budget exhausted at step {steps}"),
+            ));
+            break;
+        }
         steps += 1;
         let now = robot.world.time + 1e-9;
         for (i, d) in disturbances.iter().enumerate() {
@@ -486,23 +509,49 @@ pub fn run_policy(
     }
 }
 
+/// Whether the wall-clock budget cut `r` short: a timeout before the step
+/// budget was used up (the clock is read only while steps remain).
+fn cut_short(s: &Scenario, r: &Run) -> bool {
+    r.outcome == Outcome::Timeout && r.steps < s.max_steps
+}
+
 /// Runs every policy of a scenario once (the scenario's own seed and
 /// disturbances).
 pub fn run_scenario(s: &Scenario, trace: bool) -> Vec<Run> {
-    prepare(s)
+    run_scenario_within(s, trace, None).0
+}
+
+/// [`run_scenario`] under a wall-clock deadline for all of its runs: once
+/// it passes, the run in progress stops with outcome `timeout` at the step
+/// reached, and the later policies stop at step 0. Also says whether the
+/// deadline cut any run short.
+pub fn run_scenario_within(
+    s: &Scenario,
+    trace: bool,
+    deadline: Option<Instant>,
+) -> (Vec<Run>, bool) {
+    let mut any_cut = false;
+    let runs = prepare(s)
         .iter()
         .map(|p| {
-            run_policy(
+            let run = run_policy(
                 s,
                 p,
                 s.world.clone(),
                 &s.disturbances,
                 s.rates.clone(),
                 s.seed,
-                RunOptions { log: true, trace },
-            )
+                RunOptions {
+                    log: true,
+                    trace,
+                    deadline,
+                },
+            );
+            any_cut |= cut_short(s, &run);
+            run
         })
-        .collect()
+        .collect();
+    (runs, any_cut)
 }
 
 /// Per-policy figures of `--runs N`.
@@ -556,8 +605,25 @@ pub fn episode(s: &Scenario, seed: u64, i: u32) -> (u64, Vec<Disturbance>, BTree
 
 /// Runs `runs` seeded episodes of every policy on `threads` threads.
 pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<McStats> {
+    monte_carlo_within(s, runs, seed, threads, None).0
+}
+
+/// [`monte_carlo`] under a wall-clock deadline: once it passes, every
+/// thread stops (the episode in progress is cut within [`CLOCK_EVERY`]
+/// steps and dropped, no new one starts), and the figures cover the first
+/// k episodes, k the number returned (every episode before k completed for
+/// every policy; `runs` when the deadline never passed). The same k
+/// episodes give the same figures as `monte_carlo(s, k, seed, ..)`.
+pub fn monte_carlo_within(
+    s: &Scenario,
+    runs: u32,
+    seed: u64,
+    threads: usize,
+    deadline: Option<Instant>,
+) -> (Vec<McStats>, u32) {
     let prepared = prepare(s);
     let threads = threads.max(1).min(runs.max(1) as usize);
+    let stop = AtomicBool::new(false);
     // results[policy][episode] = (outcome, goal, completion, latencies)
     type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
     let mut per_thread: Vec<Vec<(u32, usize, Res)>> = Vec::new();
@@ -565,11 +631,16 @@ pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<Mc
         let handles: Vec<_> = (0..threads)
             .map(|t| {
                 let prepared = &prepared;
+                let stop = &stop;
                 sc.spawn(move || {
                     let mut out = Vec::new();
                     let mut i = t as u32;
-                    while i < runs {
+                    'episodes: while i < runs {
+                        if stop.load(Ordering::Relaxed) {
+                            break;
+                        }
                         let (ep_seed, ds, rates) = episode(s, seed, i);
+                        let first = out.len();
                         for (k, p) in prepared.iter().enumerate() {
                             let r = run_policy(
                                 s,
@@ -581,8 +652,14 @@ pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<Mc
                                 RunOptions {
                                     log: false,
                                     trace: false,
+                                    deadline,
                                 },
                             );
+                            if cut_short(s, &r) {
+                                stop.store(true, Ordering::Relaxed);
+                                out.truncate(first);
+                                break 'episodes;
+                            }
                             out.push((
                                 i,
                                 k,
@@ -600,8 +677,16 @@ pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<Mc
         }
     });
     let mut all: Vec<(u32, usize, Res)> = per_thread.into_iter().flatten().collect();
+    // Episodes come whole (all policies) or not at all: keep the prefix of
+    // consecutive completed ones.
+    let mut complete = vec![false; runs as usize];
+    for (i, _, _) in &all {
+        complete[*i as usize] = true;
+    }
+    let runs = complete.iter().position(|c| !c).unwrap_or(complete.len()) as u32;
+    all.retain(|(i, _, _)| *i < runs);
     all.sort_by_key(|(i, k, _)| (*k, *i));
-    prepared
+    let stats = prepared
         .iter()
         .enumerate()
         .map(|(k, p)| {
@@ -639,7 +724,8 @@ pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<Mc
                 recharges: lat.len() as u32,
             }
         })
-        .collect()
+        .collect();
+    (stats, runs)
 }
 
 #[cfg(test)]
@@ -703,6 +789,35 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
                 .all(|p| p.recharges == 0 || p.mean_recharge_latency_s.is_some())
         );
         assert!(one.iter().all(|p| p.success_rate > 0.0));
+    }
+
+    #[test]
+    fn a_spent_wall_clock_budget_stops_every_run_at_once() {
+        let s = scenario(FLAKY);
+        // No deadline: the same figures as without the budget.
+        let (stats, done) = monte_carlo_within(&s, 6, 3, 2, None);
+        assert_eq!((stats, done), (monte_carlo(&s, 6, 3, 2), 6));
+        // A deadline already past: no episode completes, no figure is made up.
+        let (stats, done) = monte_carlo_within(&s, 6, 3, 2, Some(Instant::now()));
+        assert_eq!(done, 0);
+        assert!(stats.iter().all(|p| p.runs == 0 && p.successes == 0));
+        let (runs, cut) = run_scenario_within(&s, false, Some(Instant::now()));
+        assert!(cut);
+        for r in &runs {
+            assert_eq!(r.outcome, Outcome::Timeout);
+            assert_eq!(
+                (r.steps, r.reason.as_str()),
+                (0, "wall-clock budget exhausted at step 0")
+            );
+        }
+        let (free, cut) = run_scenario_within(&s, false, None);
+        assert!(!cut);
+        let plain = run_scenario(&s, false);
+        let key = |r: &Run| (r.outcome, r.steps, r.reason.clone());
+        assert_eq!(
+            free.iter().map(key).collect::<Vec<_>>(),
+            plain.iter().map(key).collect::<Vec<_>>()
+        );
     }
 
     #[test]

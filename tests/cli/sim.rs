@@ -286,3 +286,100 @@ fn line_of(dot: &str, id: &str) -> String {
         .unwrap_or("")
         .to_string()
 }
+
+/// exp1-nominal with a step budget of 10^6 and a disturbance that never
+/// fires (so no run ends before its step budget): far more work than the
+/// wall-clock budgets below allow.
+fn endless_scenario(dir: &std::path::Path) -> String {
+    let paper = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper");
+    let text = std::fs::read_to_string("policies/scenarios/exp1-nominal.toml")
+        .expect("exp1-nominal")
+        .replace(
+            "file = \"../paper/",
+            &format!("file = \"{}/", paper.display()),
+        )
+        .replacen("seed = ", "max_steps = 1000000\nseed = ", 1)
+        + "\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
+    let path = dir.join("endless.toml");
+    std::fs::write(&path, text).expect("write scenario");
+    path.display().to_string()
+}
+
+#[test]
+fn sim_timeout_stops_runs_cleanly_and_says_so() {
+    let dir = std::env::temp_dir().join(format!("btfsm-sim-budget-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = endless_scenario(&dir);
+    // Monte Carlo: the episodes completed, out of those asked for.
+    let t = std::time::Instant::now();
+    let (code, stdout, stderr) = btfsm(&[
+        "sim",
+        &scenario,
+        "--runs",
+        "1000",
+        "--timeout-ms",
+        "200",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(t.elapsed().as_secs() < 10, "took {:?}", t.elapsed());
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    assert_eq!(v["budget"]["timeout_ms"], 200, "{v}");
+    assert_eq!(v["budget"]["exhausted"], true, "{v}");
+    assert_eq!(v["budget"]["requested_runs"], 1000, "{v}");
+    let done = v["runs"].as_u64().expect("runs");
+    assert!(done < 1000, "{v}");
+    for p in v["policies"].as_array().expect("policies") {
+        assert_eq!(p["runs"].as_u64(), Some(done), "{p}");
+    }
+    let (code, table, _) = btfsm(&["sim", &scenario, "--runs", "1000", "--timeout-ms", "50"]);
+    assert_eq!(code, 0);
+    assert!(
+        table.contains("note: the wall-clock budget of 50 ms ran out")
+            && table.contains("of 1000 episodes completed"),
+        "{table}"
+    );
+    // One run per policy: the first stops at the step reached, with outcome
+    // `timeout`; the trace is written whole.
+    let trace = dir.join("trace.json");
+    let (code, stdout, stderr) = btfsm(&[
+        "sim",
+        &scenario,
+        "--timeout-ms",
+        "50",
+        "--format",
+        "json",
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    assert_eq!(v["budget"]["exhausted"], true, "{v}");
+    let first = &v["policies"][0];
+    assert_eq!(first["outcome"], "timeout", "{first}");
+    let steps = first["steps"].as_u64().expect("steps");
+    assert!(steps < 1_000_000, "{first}");
+    assert_eq!(
+        first["reason"],
+        format!("wall-clock budget exhausted at step {steps}"),
+        "{first}"
+    );
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&trace).expect("trace")).expect("whole");
+    assert_eq!(t["policies"][0]["steps"], steps);
+    // A budget that is not exhausted is said so too.
+    let (code, stdout, _) = btfsm(&[
+        "sim",
+        "policies/scenarios/exp1-nominal.toml",
+        "--timeout-ms",
+        "600000",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    assert_eq!(v["budget"]["exhausted"], false, "{v}");
+    assert!(v["budget"].get("requested_runs").is_none(), "{v}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

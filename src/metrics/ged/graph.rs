@@ -20,29 +20,27 @@ pub enum GedGraphError {
     TooLarge,
 }
 
-/// A directed multigraph with labelled, keyed vertices `0..n`.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GedGraph {
+/// The key-less part of a [`GedGraph`]: labels and the aggregated arc
+/// multiset, all the search needs. Built from a policy graph in linear time
+/// (a counting sort by tail, then each tail's heads sorted; integers only),
+/// so that `compare` can build it inside each mode's time budget.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Shape {
     labels: Vec<u32>,
-    keys: Vec<String>,
     /// `(tail, head, multiplicity)`, sorted by `(tail, head)`, multiplicity >= 1.
     arcs: Vec<(u32, u32, u32)>,
+    /// The arcs of tail `u` are `arcs[first[u]..first[u + 1]]` (n + 1
+    /// entries; empty for the default shape).
+    first: Vec<u32>,
 }
 
-impl GedGraph {
-    /// Builds a graph from per-vertex labels and keys and a list of arcs, one
-    /// entry per arc (repeat a pair for parallel arcs; `(u, u)` is a self-loop).
+impl Shape {
+    /// Builds a shape from per-vertex labels and a list of arcs, one entry
+    /// per arc (repeat a pair for parallel arcs; `(u, u)` is a self-loop).
     pub fn new(
         labels: Vec<u32>,
-        keys: Vec<String>,
         arcs: impl IntoIterator<Item = (usize, usize)>,
     ) -> Result<Self, GedGraphError> {
-        if labels.len() != keys.len() {
-            return Err(GedGraphError::LengthMismatch {
-                labels: labels.len(),
-                keys: keys.len(),
-            });
-        }
         let n = labels.len();
         if u32::try_from(n).is_err() {
             return Err(GedGraphError::TooLarge);
@@ -55,20 +53,43 @@ impl GedGraph {
             // Both fit in u32: n does.
             raw.push((tail as u32, head as u32));
         }
-        raw.sort_unstable();
+        if u32::try_from(raw.len()).is_err() {
+            return Err(GedGraphError::TooLarge);
+        }
+        // Counting sort by tail, then each tail's heads sorted.
+        let mut start = vec![0u32; n + 1];
+        for &(t, _) in &raw {
+            start[t as usize + 1] += 1;
+        }
+        for u in 0..n {
+            start[u + 1] += start[u];
+        }
+        let mut heads = vec![0u32; raw.len()];
+        let mut fill = start.clone();
+        for &(t, h) in &raw {
+            heads[fill[t as usize] as usize] = h;
+            fill[t as usize] += 1;
+        }
         let mut agg: Vec<(u32, u32, u32)> = Vec::with_capacity(raw.len());
-        for (t, h) in raw {
-            match agg.last_mut() {
-                Some(last) if last.0 == t && last.1 == h => {
-                    last.2 = last.2.checked_add(1).ok_or(GedGraphError::TooLarge)?;
+        let mut first = Vec::with_capacity(n + 1);
+        for u in 0..n {
+            first.push(agg.len() as u32);
+            let hs = &mut heads[start[u] as usize..start[u + 1] as usize];
+            hs.sort_unstable();
+            for &h in hs.iter() {
+                match agg.last_mut() {
+                    Some(last) if last.0 == u as u32 && last.1 == h => {
+                        last.2 = last.2.checked_add(1).ok_or(GedGraphError::TooLarge)?;
+                    }
+                    _ => agg.push((u as u32, h, 1)),
                 }
-                _ => agg.push((t, h, 1)),
             }
         }
-        Ok(GedGraph {
+        first.push(agg.len() as u32);
+        Ok(Shape {
             labels,
-            keys,
             arcs: agg,
+            first,
         })
     }
 
@@ -80,11 +101,6 @@ impl GedGraph {
     /// The label (vertex type class) of each vertex.
     pub fn labels(&self) -> &[u32] {
         &self.labels
-    }
-
-    /// The key of each vertex.
-    pub fn keys(&self) -> &[String] {
-        &self.keys
     }
 
     /// The arc multiset, aggregated: `(tail, head, multiplicity)` sorted by
@@ -103,18 +119,96 @@ impl GedGraph {
         let (Ok(u), Ok(v)) = (u32::try_from(u), u32::try_from(v)) else {
             return 0;
         };
-        match self.arcs.binary_search_by(|&(t, h, _)| (t, h).cmp(&(u, v))) {
-            Ok(i) => self.arcs[i].2,
+        // Within u's arcs only: a short, cache-friendly search.
+        let (Some(&s), Some(&e)) = (self.first.get(u as usize), self.first.get(u as usize + 1))
+        else {
+            return 0;
+        };
+        let out = &self.arcs[s as usize..e as usize];
+        match out.binary_search_by_key(&v, |&(_, h, _)| h) {
+            Ok(i) => out[i].2,
             Err(_) => 0,
         }
     }
 
+    /// The same shape with every label replaced by 0 (for `structural` GED).
+    pub(crate) fn unlabeled(&self) -> Shape {
+        Shape {
+            labels: vec![0; self.labels.len()],
+            arcs: self.arcs.clone(),
+            first: self.first.clone(),
+        }
+    }
+}
+
+impl From<&PolicyGraph> for Shape {
+    /// Vertex `i` is petgraph's node index `i`; its label is the vertex
+    /// type's discriminant.
+    fn from(pg: &PolicyGraph) -> Self {
+        let labels: Vec<u32> = pg.g.node_weights().map(|v| v.vtype as u32).collect();
+        let arcs =
+            pg.g.raw_edges()
+                .iter()
+                .map(|e| (e.source().index(), e.target().index()));
+        // Indices come from the graph itself, so they are in range; a graph
+        // with more than u32::MAX elements cannot be built by petgraph's
+        // default u32 indices either. Fall back to an empty shape rather
+        // than panic if that ever changes.
+        Shape::new(labels, arcs).unwrap_or_default()
+    }
+}
+
+/// A directed multigraph with labelled, keyed vertices `0..n`: a [`Shape`]
+/// (which it dereferences to) plus one key per vertex.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GedGraph {
+    shape: Shape,
+    keys: Vec<String>,
+}
+
+impl std::ops::Deref for GedGraph {
+    type Target = Shape;
+    fn deref(&self) -> &Shape {
+        &self.shape
+    }
+}
+
+impl GedGraph {
+    /// Builds a graph from per-vertex labels and keys and a list of arcs, one
+    /// entry per arc (repeat a pair for parallel arcs; `(u, u)` is a self-loop).
+    pub fn new(
+        labels: Vec<u32>,
+        keys: Vec<String>,
+        arcs: impl IntoIterator<Item = (usize, usize)>,
+    ) -> Result<Self, GedGraphError> {
+        if labels.len() != keys.len() {
+            return Err(GedGraphError::LengthMismatch {
+                labels: labels.len(),
+                keys: keys.len(),
+            });
+        }
+        Ok(GedGraph {
+            shape: Shape::new(labels, arcs)?,
+            keys,
+        })
+    }
+
+    /// The key of each vertex.
+    pub fn keys(&self) -> &[String] {
+        &self.keys
+    }
+
+    /// The labels and arcs.
+    pub fn shape(&self) -> &Shape {
+        &self.shape
+    }
+
     /// The same graph with every label replaced by 0 (for `structural` GED).
+    #[cfg(test)]
     pub(crate) fn unlabeled(&self) -> GedGraph {
         GedGraph {
-            labels: vec![0; self.labels.len()],
+            shape: self.shape.unlabeled(),
             keys: self.keys.clone(),
-            arcs: self.arcs.clone(),
         }
     }
 }
@@ -123,21 +217,13 @@ impl From<&PolicyGraph> for GedGraph {
     /// Vertex `i` of the result is petgraph's node index `i`; its label is the
     /// vertex type's discriminant and its key the vertex's key.
     fn from(pg: &PolicyGraph) -> Self {
-        let labels: Vec<u32> = pg.g.node_weights().map(|v| v.vtype as u32).collect();
-        let keys: Vec<String> = pg.g.node_weights().map(|v| v.key.clone()).collect();
-        let arcs =
-            pg.g.raw_edges()
-                .iter()
-                .map(|e| (e.source().index(), e.target().index()));
-        // Indices come from the graph itself, so they are in range; a graph
-        // with more than u32::MAX elements cannot be built by petgraph's
-        // default u32 indices either. Fall back to an empty graph rather than
-        // panic if that ever changes.
-        GedGraph::new(labels, keys, arcs).unwrap_or(GedGraph {
-            labels: Vec::new(),
-            keys: Vec::new(),
-            arcs: Vec::new(),
-        })
+        let shape = Shape::from(pg);
+        let keys = if shape.n() == pg.g.node_count() {
+            pg.g.node_weights().map(|v| v.key.clone()).collect()
+        } else {
+            Vec::new()
+        };
+        GedGraph { shape, keys }
     }
 }
 

@@ -20,7 +20,11 @@
 //!   always exact.
 //!
 //! Every mode returns the edit script of the mapping it found (`script.rs`),
-//! whose cost is `upper_bound`. The search always starts from a canonical
+//! whose cost is `upper_bound`. [`search_mapping`] is the search alone, on
+//! key-less [`Shape`]s, with everything it builds (padded problems, fast
+//! path, local search) inside its deadline; `compare` calls it with the
+//! mapping by name and the edit scripts built around it, so that a mode's
+//! whole computation fits its budget. The search always starts from a canonical
 //! orientation of the pair (fewer vertices first, then a total order on the
 //! graphs), so `ged(a, b)` and `ged(b, a)` run the same search; the script
 //! is turned back to read a → b.
@@ -48,8 +52,8 @@ mod tests;
 
 use std::time::{Duration, Instant};
 
-pub use graph::{GedGraph, GedGraphError};
-pub use script::EditScript;
+pub use graph::{GedGraph, GedGraphError, Shape};
+pub use script::{EditScript, injective, named_mapping_of_ids, named_mapping_of_keys};
 
 use crate::graph::PolicyGraph;
 use problem::{NONE, Problem};
@@ -85,9 +89,9 @@ impl GedMode {
 /// (the count bound and a local-search mapping are returned).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GedOptions {
-    /// Wall-clock budget, checked at every search node and inside long
-    /// loops; overshoot is a few milliseconds on graphs of a few hundred
-    /// vertices.
+    /// Wall-clock budget of the whole computation of a mode (graphs,
+    /// problems, search, script), checked at every search node and inside
+    /// long loops (docs/robustness.md "Budgets" measures the overshoot).
     pub timeout: Duration,
     /// Bound on branch-and-bound nodes expanded. Structural GED on labeled
     /// graphs may run up to three searches (see `structural`), each with a
@@ -121,15 +125,39 @@ pub struct GedResult {
     pub edit_script: EditScript,
 }
 
-/// GED between two policy graphs (see the module documentation).
+/// A mapping found by [`search_mapping`], with its certificate, before any
+/// edit script is written.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GedMapping {
+    /// Certified: no mapping (of the mode searched) costs less.
+    pub lower_bound: u64,
+    /// The cost of `map` ([`mapping_cost`]), `>= lower_bound`.
+    pub upper_bound: u64,
+    /// Vertex of a -> vertex of b (a partial injection).
+    pub map: Vec<Option<usize>>,
+}
+
+/// GED between two policy graphs (see the module documentation); the
+/// budget's clock starts before the compact graphs are built.
 pub fn ged(a: &PolicyGraph, b: &PolicyGraph, mode: GedMode, opts: &GedOptions) -> GedResult {
-    ged_graphs(&GedGraph::from(a), &GedGraph::from(b), mode, opts)
+    let start = Instant::now();
+    ged_since(start, &GedGraph::from(a), &GedGraph::from(b), mode, opts)
 }
 
 /// GED between two compact graphs; labels are used by `Labeled`, keys by
 /// `Named` and by the edit script.
 pub fn ged_graphs(a: &GedGraph, b: &GedGraph, mode: GedMode, opts: &GedOptions) -> GedResult {
-    let start = Instant::now();
+    ged_since(Instant::now(), a, b, mode, opts)
+}
+
+/// [`ged_graphs`] with the budget counted from `start`.
+fn ged_since(
+    start: Instant,
+    a: &GedGraph,
+    b: &GedGraph,
+    mode: GedMode,
+    opts: &GedOptions,
+) -> GedResult {
     let finish = |lower: u64, upper: u64, edit_script: EditScript| GedResult {
         ged: upper,
         exact: lower >= upper,
@@ -138,51 +166,119 @@ pub fn ged_graphs(a: &GedGraph, b: &GedGraph, mode: GedMode, opts: &GedOptions) 
         millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
         edit_script,
     };
+    let mut by_name = script::named_mapping(a, b);
     if mode == GedMode::Named {
-        let map = script::named_mapping(a, b);
-        let s = script::build(a, b, &map);
+        let s = script::build(a, b, &by_name);
         let c = s.cost();
         return finish(c, c, s);
     }
     // The mapping by name, and its script, first: it competes with the
     // search's mapping below, and building it measures what the script of
     // the search's mapping will cost once the search stops, which is kept
-    // out of the search's budget (on a 100k-vertex BT, a quarter second).
-    let mut by_name = script::named_mapping(a, b);
+    // out of the search's budget.
     if mode == GedMode::Labeled {
-        for (u, m) in by_name.iter_mut().enumerate() {
-            if m.is_some_and(|v| a.labels()[u] != b.labels()[v]) {
-                *m = None;
-            }
-        }
+        keep_same_labels(a, b, &mut by_name);
     }
     let named = script::build(a, b, &by_name);
-    let opts = &GedOptions {
-        timeout: opts.timeout.saturating_sub(start.elapsed()),
-        ..*opts
-    };
-    let deadline = start + opts.timeout;
-    let labeled = Oriented::new(a, b);
-    let (lower, map_ab) = if mode == GedMode::Labeled {
-        let lim = search::Limits {
-            deadline,
-            max_expansions: opts.max_expansions,
-        };
-        let out = search::solve(&labeled.p, &lim, None);
-        (out.lower, labeled.to_ab(&out.sigma))
-    } else {
-        structural(a, b, &labeled, start, opts)
-    };
-    let mut s = script::build(a, b, &map_ab);
+    let deadline = start + opts.timeout.saturating_sub(start.elapsed());
+    let found = search_mapping(
+        a,
+        b,
+        mode == GedMode::Labeled,
+        deadline,
+        opts.max_expansions,
+    );
     // Among mappings of equal cost, prefer the one by name: its script reads
     // as the engineer's own edits rather than as an arbitrary rematching.
     // It also tightens the upper bound when the search ran out of budget.
-    if named.cost() <= s.cost() {
-        s = named;
-    }
+    let s = if named.cost() <= found.upper_bound {
+        named
+    } else {
+        script::build(a, b, &found.map)
+    };
     // The script scores the mapping kept, in the original graphs.
     let upper = s.cost();
-    finish(lower.min(upper), upper, s)
+    finish(found.lower_bound.min(upper), upper, s)
+}
+
+/// Unmaps the pairs of `map` whose labels differ (a mapping by name made
+/// fit for `labeled` GED).
+pub fn keep_same_labels(a: &Shape, b: &Shape, map: &mut [Option<usize>]) {
+    for (u, m) in map.iter_mut().enumerate() {
+        if m.is_some_and(|v| a.labels().get(u) != b.labels().get(v)) {
+            *m = None;
+        }
+    }
+}
+
+/// The cost of the partial injection `map` under the unit cost model (the
+/// cost of its edit script), in O((n + m) log m) integer work. Entries out
+/// of range or not injective count as unmapped, as in the edit script.
+pub fn mapping_cost(a: &Shape, b: &Shape, map: &[Option<usize>]) -> u64 {
+    let (fwd, _) = script::injective(a.n(), b.n(), map);
+    let mapped = fwd.iter().filter(|m| m.is_some()).count() as u64;
+    let mut kept = 0u64;
+    for &(t, h, m) in a.arcs() {
+        if let (Some(x), Some(y)) = (fwd[t as usize], fwd[h as usize]) {
+            kept += u64::from(m.min(b.mult(x, y)));
+        }
+    }
+    (a.n() as u64 - mapped) + (b.n() as u64 - mapped) + a.arc_count() + b.arc_count() - 2 * kept
+}
+
+/// The count bound: vertex insertions and deletions forced by the class
+/// sizes (one class when `labeled` is false), plus |m1 − m2|.
+fn count_bound(a: &Shape, b: &Shape, labeled: bool) -> u64 {
+    let arcs = a.arc_count().abs_diff(b.arc_count());
+    if !labeled {
+        return a.n().abs_diff(b.n()) as u64 + arcs;
+    }
+    let mut diff: std::collections::BTreeMap<u32, i64> = std::collections::BTreeMap::new();
+    for &l in a.labels() {
+        *diff.entry(l).or_default() += 1;
+    }
+    for &l in b.labels() {
+        *diff.entry(l).or_default() -= 1;
+    }
+    diff.values().map(|d| d.unsigned_abs()).sum::<u64>() + arcs
+}
+
+/// The search of `structural` (`labeled` false) or `labeled` GED on two
+/// shapes, everything included (padded problems, fast path, branch and
+/// bound, local search) within `deadline`: a certified lower bound and the
+/// best mapping found. Work after the search is O(n + m log m) (mapping the
+/// padded bijection back and scoring it). If the deadline has passed on
+/// entry, no problem is built: the count bound and the empty mapping.
+pub fn search_mapping(
+    a: &Shape,
+    b: &Shape,
+    labeled: bool,
+    deadline: Instant,
+    max_expansions: u64,
+) -> GedMapping {
+    let (lower, map) = if Instant::now() >= deadline {
+        (count_bound(a, b, labeled), vec![None; a.n()])
+    } else if labeled {
+        match Oriented::within(a, b, deadline) {
+            Some(o) => {
+                let lim = search::Limits {
+                    deadline,
+                    max_expansions,
+                };
+                let out = search::solve(&o.p, &lim, None);
+                (out.lower, o.to_ab(&out.sigma))
+            }
+            None => (count_bound(a, b, true), vec![None; a.n()]),
+        }
+    } else {
+        structural(a, b, deadline, max_expansions)
+    };
+    let upper = mapping_cost(a, b, &map);
+    GedMapping {
+        lower_bound: lower.min(upper),
+        upper_bound: upper,
+        map,
+    }
 }
 
 /// Structural GED. When the graphs carry more than one label, a labeled
@@ -193,36 +289,52 @@ pub fn ged_graphs(a: &GedGraph, b: &GedGraph, mode: GedMode, opts: &GedOptions) 
 /// structural search with its mapping. Both structural lower bounds are
 /// certified; the larger is kept.
 fn structural(
-    a: &GedGraph,
-    b: &GedGraph,
-    labeled: &Oriented,
-    start: Instant,
-    opts: &GedOptions,
+    a: &Shape,
+    b: &Shape,
+    deadline: Instant,
+    max_expansions: u64,
 ) -> (u64, Vec<Option<usize>>) {
+    let start = Instant::now();
+    let total = deadline.saturating_duration_since(start);
     let (ua, ub) = (a.unlabeled(), b.unlabeled());
-    let st = Oriented::new(&ua, &ub);
-    let multi_class = labeled.p.classes.len() > 1;
+    let Some(st) = Oriented::within(&ua, &ub, deadline) else {
+        return (count_bound(a, b, false), vec![None; a.n()]);
+    };
+    let built = start.elapsed();
+    let first_label = a.labels().first().or(b.labels().first());
+    let multi_class = a
+        .labels()
+        .iter()
+        .chain(b.labels())
+        .any(|l| Some(l) != first_label);
     if !multi_class {
         let lim = search::Limits {
-            deadline: start + opts.timeout,
-            max_expansions: opts.max_expansions,
+            deadline,
+            max_expansions,
         };
         let out = search::solve(&st.p, &lim, None);
         return (out.lower, st.to_ab(&out.sigma));
     }
-    let third = opts.timeout / 3;
-    let part = (opts.max_expansions / 3).max(1);
+    let third = total / 3;
+    let part = (max_expansions / 3).max(1);
     let lim = |deadline: Instant| search::Limits {
         deadline,
         max_expansions: part,
     };
     let first = search::solve(&st.p, &lim(start + third), None);
-    if first.lower >= first.upper || start.elapsed() >= opts.timeout {
+    // The labeled stage builds another padded problem and scores two more
+    // mappings before its searches read the clock: each about the cost of
+    // building `st`. Not when less time than that remains.
+    let stage = built.saturating_mul(4);
+    if first.lower >= first.upper || deadline.saturating_duration_since(Instant::now()) < stage {
         return (first.lower, st.to_ab(&first.sigma));
     }
+    let Some(labeled) = Oriented::within(a, b, deadline) else {
+        return (first.lower, st.to_ab(&first.sigma));
+    };
     let lab = search::solve(&labeled.p, &lim(start + 2 * third), None);
     let hint = st.padded_from_ab(&labeled.to_ab(&lab.sigma));
-    let second = search::solve(&st.p, &lim(start + opts.timeout), Some(hint));
+    let second = search::solve(&st.p, &lim(deadline), Some(hint));
     let lower = first.lower.max(second.lower);
     let best = if second.upper <= first.upper {
         second.sigma
@@ -242,11 +354,38 @@ struct Oriented {
 }
 
 impl Oriented {
-    fn new(a: &GedGraph, b: &GedGraph) -> Oriented {
-        let (ka, kb) = (orientation_key(a), orientation_key(b));
-        // Equal keys: fall back on the raw data, so that (a, b) and (b, a)
-        // always run the same search.
-        let swap = kb < ka || (kb == ka && (b.labels(), b.arcs()) < (a.labels(), a.arcs()));
+    /// [`Oriented::new`], unless `deadline` passes before the padded
+    /// problem is built (its set-up, O((n + m) log n), reads the clock
+    /// between its steps: milliseconds each on 100k vertices).
+    fn within(a: &Shape, b: &Shape, deadline: Instant) -> Option<Oriented> {
+        let swap = Self::swap(a, b);
+        if Instant::now() >= deadline {
+            return None;
+        }
+        let o = Self::build(a, b, swap);
+        (Instant::now() < deadline).then_some(o)
+    }
+
+    #[cfg(test)]
+    fn new(a: &Shape, b: &Shape) -> Oriented {
+        Self::build(a, b, Self::swap(a, b))
+    }
+
+    /// Whether b is searched from (see `orientation_key`).
+    fn swap(a: &Shape, b: &Shape) -> bool {
+        match (b.n(), b.arc_count()).cmp(&(a.n(), a.arc_count())) {
+            std::cmp::Ordering::Less => true,
+            std::cmp::Ordering::Greater => false,
+            std::cmp::Ordering::Equal => {
+                // Equal sizes: the degree signatures, then the raw data, so
+                // that (a, b) and (b, a) always run the same search.
+                let (ka, kb) = (orientation_key(a), orientation_key(b));
+                kb < ka || (kb == ka && (b.labels(), b.arcs()) < (a.labels(), a.arcs()))
+            }
+        }
+    }
+
+    fn build(a: &Shape, b: &Shape, swap: bool) -> Oriented {
         let p = if swap {
             Problem::new(b, a)
         } else {
@@ -325,13 +464,13 @@ impl Oriented {
     }
 }
 
-/// Vertex count, arc count, sorted (label, out, in, loops) per vertex.
-type OrientationKey = (usize, u64, Vec<(u32, u64, u64, u32)>);
+/// Sorted (label, out, in, loops) per vertex.
+type OrientationKey = Vec<(u32, u64, u64, u32)>;
 
 /// Canonical orientation: the graph with fewer vertices (then fewer arcs, then
-/// the smaller degree/label signature, then the smaller raw data) is searched
-/// from.
-fn orientation_key(g: &GedGraph) -> OrientationKey {
+/// the smaller degree/label signature (this key), then the smaller raw data)
+/// is searched from.
+fn orientation_key(g: &Shape) -> OrientationKey {
     let n = g.n();
     let mut out = vec![0u64; n];
     let mut inn = vec![0u64; n];
@@ -348,5 +487,5 @@ fn orientation_key(g: &GedGraph) -> OrientationKey {
         .map(|u| (g.labels()[u], out[u], inn[u], loops[u]))
         .collect();
     sig.sort_unstable();
-    (n, g.arc_count(), sig)
+    sig
 }

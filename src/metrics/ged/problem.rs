@@ -22,10 +22,56 @@
 //! Since Σ|a − b| = a + b − 2·min(a, b), this equals
 //! vertex cost + m1 + m2 − 2·Σ_{arcs (u,w) of G1} min(A(u,w), B(σ u, σ w)).
 
-use super::graph::GedGraph;
+use super::graph::Shape;
 
 /// Index value meaning "not mapped" / "no vertex".
 pub(crate) const NONE: u32 = u32::MAX;
+
+/// Adjacency lists of `n` vertices in one flat array (compressed rows):
+/// `adj[u]` is the slice of `(neighbour, multiplicity)` of `u`. One
+/// allocation instead of one per vertex, which on 100k-vertex graphs is
+/// most of the cost of building a [`Problem`].
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Adj {
+    start: Vec<usize>,
+    items: Vec<(u32, u32)>,
+}
+
+impl Adj {
+    /// From `(vertex, (neighbour, multiplicity))` entries; each list sorted.
+    fn build(n: usize, entries: &[(u32, (u32, u32))]) -> Adj {
+        let mut start = vec![0usize; n + 1];
+        for &(u, _) in entries {
+            start[u as usize + 1] += 1;
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![(0u32, 0u32); entries.len()];
+        for &(u, x) in entries {
+            items[fill[u as usize]] = x;
+            fill[u as usize] += 1;
+        }
+        for u in 0..n {
+            items[start[u]..start[u + 1]].sort_unstable();
+        }
+        Adj { start, items }
+    }
+
+    /// The lists, vertex by vertex.
+    pub fn iter(&self) -> impl Iterator<Item = &[(u32, u32)]> {
+        self.start.windows(2).map(|w| &self.items[w[0]..w[1]])
+    }
+}
+
+impl std::ops::Index<usize> for Adj {
+    type Output = [(u32, u32)];
+    #[inline]
+    fn index(&self, u: usize) -> &[(u32, u32)] {
+        &self.items[self.start[u]..self.start[u + 1]]
+    }
+}
 
 /// One side of the padded instance.
 #[derive(Debug, Clone)]
@@ -35,9 +81,9 @@ pub(crate) struct Side {
     /// Original vertex of each padded vertex, `NONE` for a dummy.
     pub orig: Vec<u32>,
     /// Out-arcs `(head, multiplicity)` sorted by head, self-loops excluded.
-    pub out: Vec<Vec<(u32, u32)>>,
+    pub out: Adj,
     /// In-arcs `(tail, multiplicity)` sorted by tail, self-loops excluded.
-    pub inn: Vec<Vec<(u32, u32)>>,
+    pub inn: Adj,
     /// Self-loop multiplicity.
     pub loops: Vec<u32>,
     /// Total number of arcs (with multiplicity).
@@ -137,10 +183,21 @@ pub(crate) struct Problem {
 
 impl Problem {
     /// Pads `g1` and `g2` class by class (classes are the distinct labels).
-    pub fn new(g1: &GedGraph, g2: &GedGraph) -> Problem {
+    /// O((n + m) log n), integers only.
+    pub fn new(g1: &Shape, g2: &Shape) -> Problem {
         let mut labels: Vec<u32> = g1.labels().iter().chain(g2.labels()).copied().collect();
         labels.sort_unstable();
         labels.dedup();
+        let class = |lab: u32| labels.binary_search(&lab).unwrap_or(0);
+        // Members of each class, in index order, on each side.
+        let members = |g: &Shape| -> Vec<Vec<u32>> {
+            let mut m = vec![Vec::new(); labels.len()];
+            for (i, &lab) in g.labels().iter().enumerate() {
+                m[class(lab)].push(i as u32);
+            }
+            m
+        };
+        let (m1, m2) = (members(g1), members(g2));
         let mut classes = Vec::with_capacity(labels.len());
         let mut class_of = Vec::new();
         let mut pos1 = vec![NONE; g1.n()];
@@ -148,19 +205,17 @@ impl Problem {
         let mut orig1 = Vec::new();
         let mut orig2 = Vec::new();
         let mut vertex_cost = 0u64;
-        for (k, &lab) in labels.iter().enumerate() {
+        for (k, (members1, members2)) in m1.iter().zip(&m2).enumerate() {
             let start = orig1.len();
-            let members1: Vec<usize> = (0..g1.n()).filter(|&i| g1.labels()[i] == lab).collect();
-            let members2: Vec<usize> = (0..g2.n()).filter(|&i| g2.labels()[i] == lab).collect();
             let size = members1.len().max(members2.len());
             vertex_cost += members1.len().abs_diff(members2.len()) as u64;
             for (orig, pos, members) in [
-                (&mut orig1, &mut pos1, &members1),
-                (&mut orig2, &mut pos2, &members2),
+                (&mut orig1, &mut pos1, members1),
+                (&mut orig2, &mut pos2, members2),
             ] {
                 for &i in members.iter() {
-                    pos[i] = orig.len() as u32;
-                    orig.push(i as u32);
+                    pos[i as usize] = orig.len() as u32;
+                    orig.push(i);
                 }
                 orig.resize(start + size, NONE);
             }
@@ -179,27 +234,24 @@ impl Problem {
         }
     }
 
-    fn side(g: &GedGraph, pos: &[u32], orig: Vec<u32>, n: usize) -> Side {
-        let mut out = vec![Vec::new(); n];
-        let mut inn = vec![Vec::new(); n];
+    fn side(g: &Shape, pos: &[u32], orig: Vec<u32>, n: usize) -> Side {
+        let mut out = Vec::with_capacity(g.arcs().len());
+        let mut inn = Vec::with_capacity(g.arcs().len());
         let mut loops = vec![0u32; n];
         for &(t, h, m) in g.arcs() {
             let (pt, ph) = (pos[t as usize], pos[h as usize]);
             if pt == ph {
                 loops[pt as usize] = m;
             } else {
-                out[pt as usize].push((ph, m));
-                inn[ph as usize].push((pt, m));
+                out.push((pt, (ph, m)));
+                inn.push((ph, (pt, m)));
             }
-        }
-        for l in out.iter_mut().chain(inn.iter_mut()) {
-            l.sort_unstable();
         }
         Side {
             n,
             orig,
-            out,
-            inn,
+            out: Adj::build(n, &out),
+            inn: Adj::build(n, &inn),
             loops,
             arcs: g.arc_count(),
         }
@@ -257,8 +309,8 @@ impl Problem {
         for &(s, e) in &self.classes {
             let mut a: Vec<usize> = (s..e).collect();
             let mut b: Vec<usize> = (s..e).collect();
-            a.sort_by_key(|&u| (std::cmp::Reverse(self.s1.degree(u)), u));
-            b.sort_by_key(|&v| (std::cmp::Reverse(self.s2.degree(v)), v));
+            a.sort_by_cached_key(|&u| (std::cmp::Reverse(self.s1.degree(u)), u));
+            b.sort_by_cached_key(|&v| (std::cmp::Reverse(self.s2.degree(v)), v));
             for (u, v) in a.into_iter().zip(b) {
                 sigma[u] = v as u32;
             }
@@ -281,6 +333,8 @@ pub(crate) fn invert(sigma: &[u32]) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use super::super::graph::GedGraph;
 
     fn g(labels: Vec<u32>, arcs: &[(usize, usize)]) -> GedGraph {
         let keys = (0..labels.len()).map(|i| format!("v{i}")).collect();

@@ -49,17 +49,7 @@ impl EditScript {
 /// Entries of `map` that are out of range or not injective are treated as
 /// unmapped.
 pub(crate) fn build(a: &GedGraph, b: &GedGraph, map: &[Option<usize>]) -> EditScript {
-    let mut fwd: Vec<Option<usize>> = vec![None; a.n()];
-    let mut inv: Vec<Option<usize>> = vec![None; b.n()];
-    for (u, m) in map.iter().enumerate().take(a.n()) {
-        if let Some(v) = *m
-            && v < b.n()
-            && inv[v].is_none()
-        {
-            fwd[u] = Some(v);
-            inv[v] = Some(u);
-        }
-    }
+    let (fwd, inv) = injective(a.n(), b.n(), map);
     let ka = a.keys();
     let kb = b.keys();
     let mut s = EditScript::default();
@@ -101,27 +91,96 @@ pub(crate) fn build(a: &GedGraph, b: &GedGraph, map: &[Option<usize>]) -> EditSc
             s.arcs_added.push((kb[x].clone(), kb[y].clone(), m - kept));
         }
     }
-    s.vertices_added.sort();
-    s.vertices_removed.sort();
-    s.vertices_kept.sort();
-    s.arcs_added.sort();
-    s.arcs_removed.sort();
-    s.arcs_kept.sort();
+    s.vertices_added.sort_unstable();
+    s.vertices_removed.sort_unstable();
+    s.vertices_kept.sort_unstable();
+    s.arcs_added.sort_unstable();
+    s.arcs_removed.sort_unstable();
+    s.arcs_kept.sort_unstable();
     s
+}
+
+/// `map` restricted to an injection of `0..na` into `0..nb` (entries out of
+/// range, or repeating an earlier image, dropped), and its inverse.
+pub fn injective(
+    na: usize,
+    nb: usize,
+    map: &[Option<usize>],
+) -> (Vec<Option<usize>>, Vec<Option<usize>>) {
+    let mut fwd: Vec<Option<usize>> = vec![None; na];
+    let mut inv: Vec<Option<usize>> = vec![None; nb];
+    for (u, m) in map.iter().enumerate().take(na) {
+        if let Some(v) = *m
+            && v < nb
+            && inv[v].is_none()
+        {
+            fwd[u] = Some(v);
+            inv[v] = Some(u);
+        }
+    }
+    (fwd, inv)
 }
 
 /// The `named` mapping: each vertex of a maps to the vertex of b with the
 /// same key. Keys are unique within a graph; should one repeat, its
 /// occurrences are paired in index order and the rest left unmapped.
 pub(crate) fn named_mapping(a: &GedGraph, b: &GedGraph) -> Vec<Option<usize>> {
-    let mut by_key: HashMap<&str, Vec<usize>> = HashMap::with_capacity(b.n());
-    for (v, k) in b.keys().iter().enumerate().rev() {
-        by_key.entry(k.as_str()).or_default().push(v);
+    named_mapping_of_keys(
+        a.keys().iter().map(String::as_str),
+        b.keys().iter().map(String::as_str),
+    )
+}
+
+/// [`named_mapping`] on key ids (equal keys, equal ids; ids are small
+/// integers, below about the number of keys): linear time, no hashing.
+pub fn named_mapping_of_ids(a: &[u32], b: &[u32]) -> Vec<Option<usize>> {
+    const END: usize = usize::MAX;
+    let top = a.iter().chain(b).max().map_or(0, |&m| m as usize + 1);
+    let mut first = vec![END; top];
+    let mut next = vec![END; b.len()];
+    for (v, &k) in b.iter().enumerate().rev() {
+        next[v] = first[k as usize];
+        first[k as usize] = v;
     }
-    a.keys()
-        .iter()
-        .map(|k| by_key.get_mut(k.as_str()).and_then(|vs| vs.pop()))
+    a.iter()
+        .map(|&k| {
+            let v = first[k as usize];
+            if v == END {
+                return None;
+            }
+            first[k as usize] = next[v];
+            Some(v)
+        })
         .collect()
+}
+
+/// [`named_mapping`] on the keys of a and of b, in vertex order: one hash
+/// map of b's keys, linear time.
+pub fn named_mapping_of_keys<'k>(
+    a: impl Iterator<Item = &'k str>,
+    b: impl Iterator<Item = &'k str>,
+) -> Vec<Option<usize>> {
+    const END: usize = usize::MAX;
+    let kb: Vec<&str> = b.collect();
+    // First unpaired vertex of b with each key, and the next one with the
+    // same key after each vertex (keys repeat only in hand-built graphs).
+    let mut first: HashMap<&str, usize> = HashMap::with_capacity(kb.len());
+    let mut next = vec![END; kb.len()];
+    for (v, k) in kb.iter().enumerate().rev() {
+        if let Some(w) = first.insert(k, v) {
+            next[v] = w;
+        }
+    }
+    a.map(|k| {
+        let slot = first.get_mut(k)?;
+        let v = *slot;
+        if v == END {
+            return None;
+        }
+        *slot = next[v];
+        Some(v)
+    })
+    .collect()
 }
 
 #[cfg(test)]

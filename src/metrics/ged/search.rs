@@ -211,7 +211,7 @@ struct Bnb<'a> {
 impl<'a> Bnb<'a> {
     fn new(p: &'a Problem, ub: u64, best: Vec<u32>, lim: Limits) -> Bnb<'a> {
         let n = p.n();
-        let layers = |lists: &Vec<Vec<(u32, u32)>>| -> Vec<Layers> {
+        let layers = |lists: &super::problem::Adj| -> Vec<Layers> {
             lists
                 .iter()
                 .map(|l| {

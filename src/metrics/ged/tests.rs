@@ -1085,3 +1085,68 @@ fn labels_separate_memory_sequences() {
     assert_eq!(exact(&star, &plain, GedMode::Labeled), 10);
     assert_eq!(brute_ged(&star, &plain, true), 10);
 }
+
+// ------------------------------------------------- integer-only pipeline
+
+/// The integer pieces `compare` builds a mode from agree with the keyed
+/// ones: `mapping_cost` is the cost of the edit script of any partial map
+/// (out-of-range and repeated images included), the mapping by key ids is
+/// the mapping by keys (repeated keys included), and `Shape` holds every
+/// arc with its multiplicity.
+#[test]
+fn integer_pipeline_agrees_with_the_keyed_one() {
+    let mut rng = Rng(0x5EED_B0D6E7);
+    for round in 0..300 {
+        let (na, nb) = (rng.below(9) as usize, rng.below(9) as usize);
+        let a = random_graph(&mut rng, na, 14, 3, "a");
+        let b = random_graph(&mut rng, nb, 14, 3, "b");
+        let map: Vec<Option<usize>> = (0..na)
+            .map(|_| (rng.below(3) > 0).then(|| rng.below(nb as u64 + 2) as usize))
+            .collect();
+        let want = script::build(&a, &b, &map).cost();
+        assert_eq!(mapping_cost(&a, &b, &map), want, "round {round}: {map:?}");
+        // Keys drawn from a small pool, so that they repeat and match.
+        let ka: Vec<u32> = (0..na).map(|_| rng.below(5) as u32).collect();
+        let kb: Vec<u32> = (0..nb).map(|_| rng.below(5) as u32).collect();
+        let s = |k: &[u32]| k.iter().map(|i| format!("k{i}")).collect::<Vec<_>>();
+        let (sa, sb) = (s(&ka), s(&kb));
+        assert_eq!(
+            named_mapping_of_ids(&ka, &kb),
+            named_mapping_of_keys(sa.iter().map(String::as_str), sb.iter().map(String::as_str)),
+            "round {round}: {ka:?} {kb:?}"
+        );
+        let mut naive: std::collections::BTreeMap<(u32, u32), u32> = Default::default();
+        for &(t, h, m) in a.arcs() {
+            *naive.entry((t, h)).or_default() += m;
+        }
+        for t in 0..na {
+            for h in 0..na {
+                let m = naive.get(&(t as u32, h as u32)).copied().unwrap_or(0);
+                assert_eq!(a.mult(t, h), m);
+            }
+        }
+        assert!(
+            a.arcs()
+                .windows(2)
+                .all(|w| (w[0].0, w[0].1) < (w[1].0, w[1].1))
+        );
+    }
+}
+
+/// A deadline already past: no problem is built, the count bound is the
+/// certified lower bound and the empty mapping's cost the upper one.
+#[test]
+fn search_with_a_spent_deadline_returns_the_count_bound() {
+    let mut rng = Rng(77);
+    for _ in 0..50 {
+        let a = random_graph(&mut rng, 6, 10, 2, "a");
+        let b = random_graph(&mut rng, 5, 10, 2, "b");
+        for labeled in [false, true] {
+            let m = search_mapping(&a, &b, labeled, Instant::now(), u64::MAX);
+            assert!(m.map.iter().all(Option::is_none));
+            assert_eq!(m.upper_bound, mapping_cost(&a, &b, &m.map));
+            assert!(m.lower_bound <= brute_ged(&a, &b, labeled));
+            assert_eq!(m.lower_bound, count_bound(&a, &b, labeled));
+        }
+    }
+}
