@@ -100,11 +100,22 @@ pub fn execute(a: SimArgs) -> u8 {
     if let Some(seed) = a.seed {
         s.seed = seed;
     }
-    let (runs, cut) = run::run_scenario_within(&s, a.trace.is_some(), deadline);
-    // The runs are the simulation work; the verdicts compared after them
-    // (trajectories thinned to 3000 points) are the report's.
+    // The runs stop 5% early, leaving the verdicts time to compare them.
+    let runs_deadline = a
+        .timeout_ms
+        .map(|ms| t0 + std::time::Duration::from_micros(ms * 950));
+    let (runs, cut) = run::run_scenario_within(&s, a.trace.is_some(), runs_deadline);
+    // The verdicts' trajectory distances get what is left of the budget:
+    // fewer points per trajectory when little is (300 at the least).
+    let pairs = runs.len() * runs.len().saturating_sub(1) / 2;
+    let points = deadline.map_or(crate::sim::trace::FRECHET_POINTS, |d| {
+        crate::sim::trace::frechet_points(
+            pairs,
+            d.saturating_duration_since(std::time::Instant::now()),
+        )
+    });
+    let rep = SimReport::with_points(&s.name, &file, s.seed, s.dt, runs, points);
     let millis = t0.elapsed().as_millis();
-    let rep = SimReport::new(&s.name, &file, s.seed, s.dt, runs);
     let budget = a.timeout_ms.map(|ms| Budget {
         timeout_ms: ms,
         exhausted: cut,
@@ -143,7 +154,7 @@ struct Budget {
     #[serde(skip_serializing_if = "Option::is_none")]
     requested_runs: Option<u32>,
     /// Without `--runs` (whose report has its own `millis`): the wall time
-    /// of the runs, ms (the verdicts are computed after them).
+    /// of the runs and their verdicts, ms.
     #[serde(skip_serializing_if = "Option::is_none")]
     millis: Option<u128>,
 }

@@ -4,7 +4,7 @@
 //! `--runs` summary and the `--trace` file.
 
 use super::run::McStats;
-use super::trace::{Run, Verdict, verdict};
+use super::trace::{FRECHET_POINTS, Run, Verdict, verdicts};
 use crate::report::table::Table;
 use serde::Serialize;
 
@@ -21,12 +21,20 @@ pub struct SimReport {
 
 impl SimReport {
     pub fn new(scenario: &str, file: &str, seed: u64, dt: f64, runs: Vec<Run>) -> Self {
-        let mut verdicts = Vec::new();
-        for i in 0..runs.len() {
-            for j in i + 1..runs.len() {
-                verdicts.push(verdict(&runs[i], &runs[j]));
-            }
-        }
+        Self::with_points(scenario, file, seed, dt, runs, FRECHET_POINTS)
+    }
+
+    /// The report, with trajectory distances on at most `points` points per
+    /// trajectory (fewer under a wall-clock budget).
+    pub fn with_points(
+        scenario: &str,
+        file: &str,
+        seed: u64,
+        dt: f64,
+        runs: Vec<Run>,
+        points: usize,
+    ) -> Self {
+        let verdicts = verdicts(&runs, points);
         SimReport {
             scenario: scenario.into(),
             file: file.into(),

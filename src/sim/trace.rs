@@ -222,7 +222,43 @@ pub struct Verdict {
     pub trajectory_distance_m: f64,
 }
 
+/// The verdict of every pair of runs, in pair order, their trajectories
+/// thinned once to at most `points` points each for the Fréchet distance.
+pub fn verdicts(runs: &[Run], points: usize) -> Vec<Verdict> {
+    let thinned: Vec<Vec<P2>> = runs.iter().map(|r| thin(&r.trajectory, points)).collect();
+    let mut out = Vec::new();
+    for i in 0..runs.len() {
+        for j in i + 1..runs.len() {
+            out.push(verdict_on(&runs[i], &runs[j], &thinned[i], &thinned[j]));
+        }
+    }
+    out
+}
+
+/// Trajectory points kept for the Fréchet distance when time allows.
+pub const FRECHET_POINTS: usize = 3000;
+/// The fewest kept under a wall-clock budget.
+pub const FRECHET_POINTS_MIN: usize = 300;
+
+/// Points per trajectory for `pairs` Fréchet distances to fit in
+/// `remaining` (about 5 ns per point pair on the machines measured), between
+/// [`FRECHET_POINTS_MIN`] and [`FRECHET_POINTS`].
+pub fn frechet_points(pairs: usize, remaining: std::time::Duration) -> usize {
+    let per_pair_ns = remaining.as_nanos() as f64 / pairs.max(1) as f64;
+    let p = (per_pair_ns / 5.0).sqrt() as usize;
+    p.clamp(FRECHET_POINTS_MIN, FRECHET_POINTS)
+}
+
 pub fn verdict(a: &Run, b: &Run) -> Verdict {
+    verdict_on(
+        a,
+        b,
+        &thin(&a.trajectory, FRECHET_POINTS),
+        &thin(&b.trajectory, FRECHET_POINTS),
+    )
+}
+
+fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
     let n = a.skills.len().max(b.skills.len());
     let first = (0..n).find(|&i| match (a.skills.get(i), b.skills.get(i)) {
         (Some(x), Some(y)) => !x.same(y),
@@ -240,7 +276,7 @@ pub fn verdict(a: &Run, b: &Run) -> Verdict {
             a: a.skills.get(i).map(SkillRecord::text),
             b: b.skills.get(i).map(SkillRecord::text),
         }),
-        trajectory_distance_m: (frechet(&a.trajectory, &b.trajectory) * 1000.0).round() / 1000.0,
+        trajectory_distance_m: (frechet_thinned(ta, tb) * 1000.0).round() / 1000.0,
     }
 }
 
@@ -261,9 +297,14 @@ fn thin(p: &[P2], max: usize) -> Vec<P2> {
     out
 }
 
-/// Discrete Fréchet distance (rolling rows, O(n m) time, O(m) memory).
+/// Discrete Fréchet distance (rolling rows, O(n m) time, O(m) memory), on
+/// trajectories thinned to [`FRECHET_POINTS`].
 pub fn frechet(a: &[P2], b: &[P2]) -> f64 {
-    let (a, b) = (thin(a, 3000), thin(b, 3000));
+    frechet_thinned(&thin(a, FRECHET_POINTS), &thin(b, FRECHET_POINTS))
+}
+
+/// Discrete Fréchet distance of two point sequences as given.
+fn frechet_thinned(a: &[P2], b: &[P2]) -> f64 {
     if a.is_empty() || b.is_empty() {
         return 0.0;
     }
@@ -287,6 +328,20 @@ pub fn frechet(a: &[P2], b: &[P2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn frechet_points_fit_the_time_left() {
+        use std::time::Duration;
+        // 6 pairs in 1 s: plenty, the full 3000; in 1 ms: sqrt(1e6 / 6 / 5)
+        // = 182, so the floor of 300; none left: the floor.
+        assert_eq!(frechet_points(6, Duration::from_secs(1)), FRECHET_POINTS);
+        assert_eq!(
+            frechet_points(6, Duration::from_millis(1)),
+            FRECHET_POINTS_MIN
+        );
+        assert_eq!(frechet_points(6, Duration::ZERO), FRECHET_POINTS_MIN);
+        assert_eq!(frechet_points(1, Duration::from_millis(2)), 632);
+    }
 
     #[test]
     fn frechet_of_shifted_paths() {
