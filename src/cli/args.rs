@@ -149,6 +149,8 @@ impl CompareMode {
 pub enum CompareFormat {
     Table,
     Json,
+    /// GitHub-flavoured markdown, for a pull-request comment
+    Markdown,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -66,6 +66,7 @@ pub fn execute(args: CompareArgs) -> u8 {
     let text = match args.format {
         CompareFormat::Json => compare::render_json(&report),
         CompareFormat::Table => compare::render_table(&report),
+        CompareFormat::Markdown => compare::render_markdown(&report),
     };
     emit(None, text.as_bytes())
 }

@@ -820,6 +820,57 @@ pub fn render_table(r: &CompareReport) -> String {
     out
 }
 
+/// The report as GitHub-flavoured markdown, for a pull-request comment: the
+/// two policies and the modes as tables, the primary edit script as a
+/// `diff` block (added lines green, removed red) in a collapsible section.
+pub fn render_markdown(r: &CompareReport) -> String {
+    let cell = |s: &str| s.replace('|', "\\|");
+    let mut out = format!(
+        "### btfsm compare: `{}` → `{}`\n\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
+        cell(&r.a.file),
+        cell(&r.b.file)
+    );
+    for (tag, s) in [("a", &r.a), ("b", &r.b)] {
+        out.push_str(&format!(
+            "| {tag} | `{}` | {} | {} | {} | {} |\n",
+            cell(&s.file),
+            s.kind,
+            cell(&s.name),
+            s.vertices,
+            s.arcs
+        ));
+    }
+    out.push_str("\n| mode | GED | exact | interval | ms |\n|---|---:|---|---|---:|\n");
+    for m in &r.modes {
+        out.push_str(&format!(
+            "| {} | {} | {} | [{}, {}] | {} |\n",
+            m.mode.as_str(),
+            m.ged,
+            if m.exact { "yes" } else { "no" },
+            m.lower_bound,
+            m.upper_bound,
+            m.millis
+        ));
+    }
+    if r.modes.iter().any(|m| !m.exact) {
+        out.push_str("\nThe search hit its budget: the distance lies in the certified interval.\n");
+    }
+    if let Some(p) = r.primary() {
+        let script = render_script(p);
+        let mut lines = script.lines();
+        let title = lines.next().unwrap_or_default().trim_end_matches(':');
+        out.push_str(&format!(
+            "\n<details><summary>{title}</summary>\n\n```diff\n"
+        ));
+        for l in lines {
+            out.push_str(l.strip_prefix("  ").unwrap_or(l));
+            out.push('\n');
+        }
+        out.push_str("```\n\n</details>\n");
+    }
+    out
+}
+
 /// One line per edit: `+` added, `-` removed, `~` rematched or relabelled.
 fn render_script(m: &ModeReport) -> String {
     let s = &m.edit_script;

@@ -251,3 +251,33 @@ fn compare_bad_input_exits_2() {
     ]);
     assert_eq!(code, 2, "--render needs --dot: {stderr}");
 }
+
+/// `--format markdown`: tables for the policies and modes, the named edit
+/// script as a `diff` block for a pull-request comment.
+#[test]
+fn compare_markdown_for_a_pull_request_comment() {
+    let (code, out, err) = btfsm(&[
+        "compare",
+        "policies/paper/fig04-fsm.toml",
+        "policies/paper/fig08b-fsm.toml",
+        "--format",
+        "markdown",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.starts_with(
+        "### btfsm compare: `policies/paper/fig04-fsm.toml` → `policies/paper/fig08b-fsm.toml`\n"
+    ));
+    assert!(out.contains("| named | 6 | yes | [6, 6] |"), "{out}");
+    let diff = out
+        .split("```diff\n")
+        .nth(1)
+        .and_then(|d| d.split("```").next())
+        .expect("a diff block");
+    // Every line of the block is an edit: + added, - removed, ~ rematched.
+    assert!(
+        diff.lines().all(|l| l.starts_with(['+', '-', '~'])),
+        "{diff}"
+    );
+    assert_eq!(diff.lines().filter(|l| !l.starts_with('~')).count(), 6);
+    assert!(out.trim_end().ends_with("</details>"));
+}
