@@ -1325,4 +1325,34 @@ mod tests {
         let msgs: Vec<&str> = e.iter().map(|d| d.message.as_str()).collect();
         assert_eq!(msgs, vec!["unknown node type `Mystery` (0 children)"]);
     }
+
+    #[test]
+    fn port_resolution_through_nested_expansions() {
+        let frame = |parent, remap: &[(&str, &str)], autoremap| Frame {
+            id: String::new(),
+            parent,
+            remap: remap
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
+            autoremap,
+        };
+        // Main <- Outer (goal={target}, autoremap) <- Inner (x={goal})
+        let frames = vec![
+            frame(None, &[], false),
+            frame(Some(0), &[("goal", "{target}")], true),
+            frame(Some(1), &[("x", "{goal}")], false),
+        ];
+        // Remap values are stored resolved, as `expand` does.
+        assert_eq!(resolve_port(&frames, 1, "{goal}"), "{target}");
+        // Not remapped in Inner and no autoremap: private, kept as written.
+        assert_eq!(resolve_port(&frames, 2, "{goal}"), "{goal}");
+        assert_eq!(resolve_port(&frames, 2, "{x}"), "{goal}");
+        // Outer shares unmapped entries with Main by name.
+        assert_eq!(resolve_port(&frames, 1, "{other}"), "{other}");
+        // Not a whole reference: kept.
+        for v in ["{}", "{a}{b}", "x{goal}", "{goal", "goal}", "literal"] {
+            assert_eq!(resolve_port(&frames, 1, v), v);
+        }
+    }
 }
