@@ -34,20 +34,56 @@ pub fn execute(cli: Cli) -> u8 {
             check_gate(&gate, &reports)
         }
         Command::Validate { files, limits } => {
-            let Some(loaded) = load_all(&files, &limits.limits()) else {
-                return EXIT_BAD_INPUT;
-            };
-            for l in &loaded {
-                eprintln!(
-                    "{}: ok ({} `{}`, {} warning{})",
-                    l.path,
-                    l.policy.kind(),
-                    l.policy.name,
-                    l.warnings.len(),
-                    if l.warnings.len() == 1 { "" } else { "s" },
-                );
+            let limits = limits.limits();
+            let stderr = std::io::stderr();
+            let mut err = stderr.lock();
+            let mut failed = false;
+            for f in &files {
+                // A scenario is validated as `sim` reads it (its policies
+                // included), without running it.
+                if format::detect(f) == format::FileFormat::Toml
+                    && crate::sim::scenario::looks_like_scenario(&format::read_head(f))
+                {
+                    match crate::sim::scenario::load(f, &limits) {
+                        Ok(s) => {
+                            let _ = writeln!(
+                                err,
+                                "{}: ok (scenario `{}`, {} polic{})",
+                                f.display(),
+                                s.name,
+                                s.policies.len(),
+                                if s.policies.len() == 1 { "y" } else { "ies" }
+                            );
+                        }
+                        Err(diags) => {
+                            failed = true;
+                            print_diagnostics(&mut err, &diags);
+                        }
+                    }
+                    continue;
+                }
+                match format::load(f, &limits) {
+                    Ok(l) => {
+                        for w in &l.warnings {
+                            let _ = write!(err, "{w}");
+                        }
+                        let _ = writeln!(
+                            err,
+                            "{}: ok ({} `{}`, {} warning{})",
+                            l.path,
+                            l.policy.kind(),
+                            l.policy.name,
+                            l.warnings.len(),
+                            if l.warnings.len() == 1 { "" } else { "s" },
+                        );
+                    }
+                    Err(diags) => {
+                        failed = true;
+                        print_diagnostics(&mut err, &diags);
+                    }
+                }
             }
-            EXIT_OK
+            if failed { EXIT_BAD_INPUT } else { EXIT_OK }
         }
         Command::Dot {
             file,

@@ -196,7 +196,7 @@ pub fn detect(path: &Path) -> FileFormat {
 }
 
 /// The first few kilobytes of a file (lossy), for sniffing.
-fn read_head(path: &Path) -> String {
+pub(crate) fn read_head(path: &Path) -> String {
     use std::io::Read;
     let mut buf = vec![0u8; 4096];
     let n = std::fs::File::open(path)

@@ -471,8 +471,13 @@ impl Loader {
 
     fn kind(&mut self, cx: &Ctx<'_>, t: &DeTable<'_>, whole: Range<usize>) -> Option<&'static str> {
         let Some((_, v)) = t.get_key_value("kind") else {
+            let scenario = t.contains_key("world") || t.contains_key("policies");
             self.err(cx, whole.start..whole.start, "missing `kind`")
-                .hint = Some("start the file with `kind = \"bt\"`, `\"fsm\"` or `\"hfsm\"`".into());
+                .hint = Some(if scenario {
+                "this looks like a simulator scenario (`[world]`, `[[policies]]`): run it with `btfsm sim FILE`; `btfsm validate` checks scenarios too".into()
+            } else {
+                "start the file with `kind = \"bt\"`, `\"fsm\"` or `\"hfsm\"`".into()
+            });
             return None;
         };
         match v.get_ref().as_str() {

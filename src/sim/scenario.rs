@@ -941,6 +941,31 @@ fn key_span(text: &str, key: &str) -> Option<Range<usize>> {
     None
 }
 
+/// Whether a TOML text is a scenario rather than a policy, from its head:
+/// TOML puts top-level keys before the first table, so a policy says `kind`
+/// before any header, and a scenario has `[world]` or `[[policies]]`.
+pub fn looks_like_scenario(head: &str) -> bool {
+    for line in head.lines() {
+        let l = line.trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        if let Some(h) = l.strip_prefix('[') {
+            let h = h.trim_start_matches('[').trim_start();
+            return ["world", "policies", "disturbances"]
+                .iter()
+                .any(|k| h.starts_with(k));
+        }
+        let key = l.split('=').next().unwrap_or("").trim().trim_matches('"');
+        match key {
+            "kind" => return false,
+            "world" | "policies" => return true,
+            _ => {}
+        }
+    }
+    false
+}
+
 /// Checks that every binding of a policy runs in the world: positioned in the
 /// policy file at the node or state.
 pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Diagnostic>) {
@@ -1127,5 +1152,20 @@ file = "../paper/fig16a-bt.toml"
                 Err(d) => proptest::prop_assert!(d.iter().any(|x| x.is_error())),
             }
         }
+    }
+
+    #[test]
+    fn scenarios_are_told_from_policies_by_their_head() {
+        assert!(looks_like_scenario(
+            "# c\nname = \"x\"\nseed = 1\n\n[world]\nrobot = \"start\"\n"
+        ));
+        assert!(looks_like_scenario(
+            "name = \"x\"\n[[policies]]\nfile = \"a.toml\"\n"
+        ));
+        assert!(!looks_like_scenario(
+            "kind = \"bt\"\nroot = \"r\"\n[nodes]\n"
+        ));
+        assert!(!looks_like_scenario("name = \"no kind\"\n[nodes]\n"));
+        assert!(!looks_like_scenario(""));
     }
 }

@@ -383,3 +383,26 @@ fn sim_timeout_stops_runs_cleanly_and_says_so() {
     assert!(v["budget"].get("requested_runs").is_none(), "{v}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `validate` reads a scenario as `sim` does (its policies included), without
+/// running it; `analyze` on a scenario points at `sim`.
+#[test]
+fn validate_checks_scenarios_without_running_them() {
+    let (code, out, err) = btfsm(&[
+        "validate",
+        "policies/scenarios/exp1-nominal.toml",
+        "policies/paper/fig01-bt.toml",
+    ]);
+    assert_eq!((code, out.as_str()), (0, ""), "{err}");
+    assert_eq!(
+        err,
+        "policies/scenarios/exp1-nominal.toml: ok (scenario `exp1-nominal`, 4 policies)\n\
+         policies/paper/fig01-bt.toml: ok (bt `Fig. 1 BT baseline`, 0 warnings)\n"
+    );
+    let (code, _, err) = btfsm(&["validate", "tests/fixtures/sim-invalid/unknown-skill.toml"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unknown-skill.toml:10:8"), "{err}");
+    let (code, _, err) = btfsm(&["analyze", "policies/scenarios/exp1-nominal.toml"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("run it with `btfsm sim FILE`"), "{err}");
+}
