@@ -15,4 +15,6 @@ py=$(echo "$PY" | awk '/py_trees_ticks_per_s/ {print $2}')
 rs=$(echo "$RS" | awk '/btfsm_bt_ticks_per_s/ {print $2}')
 tr=$(echo "$RS" | awk '/btfsm_bt_traced_ticks_per_s/ {print $2}')
 echo "ratio_btfsm_over_py_trees $(awk "BEGIN {printf \"%.0f\", $rs / $py}")"
+sw=$(echo "$RS" | awk '/btfsm_bt_stack_walk_ticks_per_s/ {print $2}')
 echo "ratio_btfsm_traced_over_py_trees $(awk "BEGIN {printf \"%.0f\", $tr / $py}")"
+echo "ratio_btfsm_stack_walk_over_py_trees $(awk "BEGIN {printf \"%.0f\", $sw / $py}")"

@@ -70,10 +70,18 @@ fn main() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(if quick { 1_000 } else { 1_000_000 });
-    // As the simulator ticks (through the compiled plan), and as it ticks
-    // when `--trace` wants every node's status (the stack walk).
-    for (name, record) in [("", false), ("_traced", true)] {
+    // As the simulator ticks (through the compiled plan), as it ticks when
+    // `--trace` wants every node's status, and with the stack walk alone
+    // (what the plan replaced; it still ticks subtrees with memory).
+    for (name, record, walk) in [
+        ("", false, false),
+        ("_traced", true, false),
+        ("_stack_walk", false, true),
+    ] {
         let mut ex = BtExec::new(compiled.clone(), record);
+        if walk {
+            ex = ex.with_stack_walk();
+        }
         let mut dt = f64::INFINITY;
         for _ in 0..5 {
             let t0 = Instant::now();

@@ -27,8 +27,10 @@
 //! down to the first node with memory or a decorator) is compiled once into
 //! a table of successors ([`Plan`]): a tick then jumps from leaf to leaf as the
 //! short-circuit evaluation of an and/or expression does, and takes the stack
-//! walk only for the subtrees below the skeleton and when every node's status
-//! is recorded (`sim --trace`). A unit test checks both against a recursive
+//! walk only for the subtrees below the skeleton. When every node's status is
+//! noted (`sim --trace`), the composites a status leaves are noted with it (a
+//! reactive composite returns the status of the child it stops at). A unit
+//! test checks plan and stack walk, noting or not, against a recursive
 //! reference on random trees of every node kind.
 
 use super::skills::{Call, Status};
@@ -54,6 +56,8 @@ pub struct CompiledBt {
     kids: Vec<u32>,
     pub root: usize,
     plan: Plan,
+    /// Each node's parent ([`NO_NODE`] for the root).
+    parent: Vec<usize>,
 }
 
 /// The tree's reactive skeleton — the root and the reactive Sequence and
@@ -69,15 +73,27 @@ struct Plan {
     slots: Vec<Slot>,
     /// The slot ticked first (or the tick's status, for an empty composite).
     first: usize,
+    /// Whether a recording tick can go through the plan: every skeleton
+    /// composite has children (an empty one is never visited, so it would
+    /// not be noted; valid files have none).
+    records: bool,
 }
 
-/// A slot's successors: a slot index, [`DONE_SUCCESS`] or [`DONE_FAILURE`].
+/// A slot's successors: a slot index, [`DONE_SUCCESS`] or [`DONE_FAILURE`];
+/// and for noting statuses, the skeleton composite where each successor
+/// continues (its ancestors below it are left with the slot's status;
+/// [`NO_NODE`]: every ancestor is left).
 #[derive(Debug, Clone, Copy)]
 struct Slot {
     node: usize,
     on_success: usize,
     on_failure: usize,
+    stop_success: usize,
+    stop_failure: usize,
 }
+
+/// No node (above the root).
+const NO_NODE: usize = usize::MAX;
 
 /// The root succeeds.
 const DONE_SUCCESS: usize = usize::MAX;
@@ -89,34 +105,45 @@ impl Plan {
     /// first, so that a child's successor (its next sibling's first slot) is
     /// known when the child is visited.
     fn new(nodes: &[XNode], kids: &[u32], root: usize) -> Plan {
+        /// Where a node's status sends the tick: (slot or DONE_*, the
+        /// composite where it continues or NO_NODE).
+        type Cont = (usize, usize);
         enum Work {
             /// Visit a node with its successors on success and on failure;
             /// leaves its first slot on `firsts`.
-            Visit(usize, usize, usize),
+            Visit(usize, Cont, Cont),
             /// Visit child `i` of the composite `p` (whose successors are
             /// given); for all but the last child, the next child's first
             /// slot is on top of `firsts`.
-            Child(usize, usize, usize, usize),
+            Child(usize, usize, Cont, Cont),
         }
         let reactive = |n: usize| matches!(nodes[n].op, Op::Sequence | Op::Fallback);
         let kids_of = |n: usize| &kids[nodes[n].start as usize..nodes[n].end as usize];
         let mut slots = Vec::new();
         let mut firsts: Vec<usize> = Vec::new();
-        let mut work = vec![Work::Visit(root, DONE_SUCCESS, DONE_FAILURE)];
+        let mut records = true;
+        let mut work = vec![Work::Visit(
+            root,
+            (DONE_SUCCESS, NO_NODE),
+            (DONE_FAILURE, NO_NODE),
+        )];
         while let Some(w) = work.pop() {
             match w {
                 Work::Visit(n, on_success, on_failure) => {
                     if !reactive(n) {
                         slots.push(Slot {
                             node: n,
-                            on_success,
-                            on_failure,
+                            on_success: on_success.0,
+                            on_failure: on_failure.0,
+                            stop_success: on_success.1,
+                            stop_failure: on_failure.1,
                         });
                         firsts.push(slots.len() - 1);
                     } else if kids_of(n).is_empty() {
                         // Sequence() succeeds and Fallback() fails at once.
                         let seq = nodes[n].op == Op::Sequence;
-                        firsts.push(if seq { on_success } else { on_failure });
+                        firsts.push(if seq { on_success.0 } else { on_failure.0 });
+                        records = false;
                     } else {
                         let last = kids_of(n).len() - 1;
                         work.push(Work::Child(n, last, on_success, on_failure));
@@ -127,7 +154,7 @@ impl Plan {
                     let (s, f) = if i + 1 == k.len() {
                         (on_success, on_failure)
                     } else {
-                        let next = firsts.pop().unwrap_or(DONE_FAILURE);
+                        let next = (firsts.pop().unwrap_or(DONE_FAILURE), p);
                         if nodes[p].op == Op::Sequence {
                             (next, on_failure)
                         } else {
@@ -144,6 +171,7 @@ impl Plan {
         Plan {
             slots,
             first: firsts.pop().unwrap_or(DONE_FAILURE),
+            records,
         }
     }
 }
@@ -229,11 +257,18 @@ impl CompiledBt {
             })
             .collect::<Vec<_>>();
         let plan = Plan::new(&nodes, &kids, bt.root);
+        let mut parent = vec![NO_NODE; nodes.len()];
+        for (p, n) in nodes.iter().enumerate() {
+            for &c in &kids[n.start as usize..n.end as usize] {
+                parent[c as usize] = p;
+            }
+        }
         CompiledBt {
             nodes,
             kids,
             root: bt.root,
             plan,
+            parent,
         }
     }
 }
@@ -276,6 +311,8 @@ pub struct BtExec {
     pub statuses: Option<Vec<(usize, Status)>>,
     /// The explicit stack, kept between ticks to avoid allocating.
     stack: Vec<Frame>,
+    /// Tick with the stack walk only (see [`BtExec::with_stack_walk`]).
+    stack_walk: bool,
 }
 
 /// Per-node memory of the ops that have some (memory composites, Repeat,
@@ -314,6 +351,7 @@ impl BtExec {
             step: 0,
             statuses: record.then(Vec::new),
             stack: Vec::new(),
+            stack_walk: false,
         }
     }
 
@@ -330,12 +368,24 @@ impl BtExec {
         };
         match &mut self.statuses {
             Some(v) => {
-                // Every node's status is wanted: the stack walk from the root.
+                // Every node's status is wanted.
                 v.clear();
-                x.run::<true>(x.bt.root, leaves, v)
+                if x.bt.plan.records && !self.stack_walk {
+                    x.run_plan::<true>(leaves, v)
+                } else {
+                    x.run::<true>(x.bt.root, leaves, v)
+                }
             }
-            None => x.run_plan(leaves),
+            None if self.stack_walk => x.run::<false>(x.bt.root, leaves, &mut Vec::new()),
+            None => x.run_plan::<false>(leaves, &mut Vec::new()),
         }
+    }
+
+    /// Ticks every node with the stack walk, never the plan (for the tests
+    /// and the benchmark that compare the two).
+    pub fn with_stack_walk(mut self) -> Self {
+        self.stack_walk = true;
+        self
     }
 }
 
@@ -351,7 +401,11 @@ struct Ticking<'a> {
 impl Ticking<'_> {
     /// Ticks the tree through its plan: from slot to slot of the reactive
     /// skeleton, a subtree with memory ticked by [`Ticking::run`].
-    fn run_plan(&mut self, leaves: &mut impl Leaves) -> Status {
+    fn run_plan<const REC: bool>(
+        &mut self,
+        leaves: &mut impl Leaves,
+        rec: &mut Vec<(usize, Status)>,
+    ) -> Status {
         let plan = &self.bt.plan;
         let mut k = plan.first;
         loop {
@@ -362,15 +416,28 @@ impl Ticking<'_> {
                     Status::Failure
                 };
             };
-            let s = match leaf::<false>(&self.bt.nodes, slot.node, leaves, &mut Vec::new()) {
+            let s = match leaf::<REC>(&self.bt.nodes, slot.node, leaves, rec) {
                 Some(s) => s,
-                None => self.run::<false>(slot.node, leaves, &mut Vec::new()),
+                None => self.run::<REC>(slot.node, leaves, rec),
             };
-            k = match s {
-                Status::Success => slot.on_success,
-                Status::Failure => slot.on_failure,
-                Status::Running => return Status::Running,
+            let (next, stop) = match s {
+                Status::Success => (slot.on_success, slot.stop_success),
+                Status::Failure => (slot.on_failure, slot.stop_failure),
+                Status::Running => (DONE_SUCCESS, NO_NODE),
             };
+            if REC {
+                // The composites the status leaves return it (a reactive
+                // composite's status is that of the child it stops at).
+                let mut a = self.bt.parent[slot.node];
+                while a != stop && a != NO_NODE {
+                    rec.push((a, s));
+                    a = self.bt.parent[a];
+                }
+            }
+            if s == Status::Running {
+                return s;
+            }
+            k = next;
         }
     }
 
@@ -1007,10 +1074,11 @@ on = { SUCCESS = "A", RUNNING = "R" }
         assert_eq!(ex.finished.as_ref().unwrap().0, "SUCCESS");
     }
 
-    /// Random trees of every node kind, ticked by the plan (record off), the
-    /// stack walk (record on) and an independent recursive reference of the
-    /// semantics in this file's header: the same statuses, the same leaf
-    /// calls in the same order, and (stack walk) the same noted statuses.
+    /// Random trees of every node kind, ticked through the plan and by the
+    /// stack walk, each noting statuses or not, and by an independent
+    /// recursive reference of the semantics in this file's header: the same
+    /// statuses, the same leaf calls in the same order, the same noted
+    /// statuses.
     #[test]
     fn plan_stack_walk_and_recursive_reference_agree_on_random_trees() {
         use crate::sim::rng::SimRng;
@@ -1024,23 +1092,38 @@ on = { SUCCESS = "A", RUNNING = "R" }
             };
             let calls = oracle_calls(bt);
             let compiled = Arc::new(CompiledBt::new(bt, calls.clone()));
-            let mut plan = BtExec::new(compiled.clone(), false);
-            let mut walk = BtExec::new(compiled, true);
+            // The four ways to tick: plan or stack walk, noting or not.
+            let mut execs = [
+                ("plan", BtExec::new(compiled.clone(), false)),
+                ("plan noting", BtExec::new(compiled.clone(), true)),
+                (
+                    "walk",
+                    BtExec::new(compiled.clone(), false).with_stack_walk(),
+                ),
+                ("walk noting", BtExec::new(compiled, true).with_stack_walk()),
+            ];
             let mut reference = Reference::new(bt, calls);
             let seed = rng.next_u64();
-            let (mut a, mut b, mut c) = (Oracle::new(seed), Oracle::new(seed), Oracle::new(seed));
+            let mut oracles: Vec<Oracle> = (0..5).map(|_| Oracle::new(seed)).collect();
             for t in 0..30 {
-                for o in [&mut a, &mut b, &mut c] {
+                for o in &mut oracles {
                     o.step = t;
                     o.log.clear();
                 }
-                let sa = plan.tick(&mut a);
-                let sb = walk.tick(&mut b);
-                let (sc, noted) = reference.tick(&mut c);
+                let (ref_oracle, others) = oracles.split_last_mut().expect("five");
+                let (sr, noted) = reference.tick(ref_oracle);
                 let ctx = format!("case {case}, tick {t}\n{text}");
-                assert_eq!((sa, &a.log), (sc, &c.log), "plan vs reference, {ctx}");
-                assert_eq!((sb, &b.log), (sc, &c.log), "walk vs reference, {ctx}");
-                assert_eq!(walk.statuses.as_ref(), Some(&noted), "noted, {ctx}");
+                for ((name, ex), o) in execs.iter_mut().zip(others) {
+                    let s = ex.tick(o);
+                    assert_eq!(
+                        (s, &o.log),
+                        (sr, &ref_oracle.log),
+                        "{name} vs reference, {ctx}"
+                    );
+                    if let Some(v) = &ex.statuses {
+                        assert_eq!(v, &noted, "{name}: noted statuses, {ctx}");
+                    }
+                }
             }
         }
     }

@@ -141,8 +141,8 @@ fn sim_reports_the_fig03_bt_as_chattering() {
     assert_eq!(sim_policy(&v, BT1)["outcome"], "success");
 }
 
-/// Recording a trace switches the BT executor from its compiled plan to the
-/// stack walk: every bundled scenario must report the same either way.
+/// Recording a trace makes the executors note every node's status: every
+/// bundled scenario must report the same either way.
 #[test]
 fn sim_reports_the_same_with_and_without_a_trace() {
     let dir = common::scratch("trace-same");
