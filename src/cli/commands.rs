@@ -62,11 +62,8 @@ pub fn execute(cli: Cli) -> u8 {
                     }
                     continue;
                 }
-                match format::load(f, &limits) {
-                    Ok(l) => {
-                        for w in &l.warnings {
-                            let _ = write!(err, "{w}");
-                        }
+                match load_reporting(f, &limits, &mut err) {
+                    Some(l) => {
                         let _ = writeln!(
                             err,
                             "{}: ok ({} `{}`, {} warning{})",
@@ -77,10 +74,7 @@ pub fn execute(cli: Cli) -> u8 {
                             if l.warnings.len() == 1 { "" } else { "s" },
                         );
                     }
-                    Err(diags) => {
-                        failed = true;
-                        print_diagnostics(&mut err, &diags);
-                    }
+                    None => failed = true,
                 }
             }
             if failed { EXIT_BAD_INPUT } else { EXIT_OK }
@@ -226,20 +220,28 @@ pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>
     let stderr = std::io::stderr();
     let mut err = stderr.lock();
     for f in files {
-        match format::load(f, limits) {
-            Ok(l) => {
-                for w in &l.warnings {
-                    let _ = write!(err, "{w}");
-                }
-                out.push(l);
-            }
-            Err(diags) => {
-                failed = true;
-                print_diagnostics(&mut err, &diags);
-            }
+        match load_reporting(f, limits, &mut err) {
+            Some(l) => out.push(l),
+            None => failed = true,
         }
     }
     (!failed).then_some(out)
+}
+
+/// Reads one policy, printing its warnings or its errors to `err`.
+fn load_reporting(f: &Path, limits: &Limits, err: &mut impl Write) -> Option<Loaded> {
+    match format::load(f, limits) {
+        Ok(l) => {
+            for w in &l.warnings {
+                let _ = write!(err, "{w}");
+            }
+            Some(l)
+        }
+        Err(diags) => {
+            print_diagnostics(err, &diags);
+            None
+        }
+    }
 }
 
 pub(super) fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
