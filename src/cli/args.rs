@@ -197,6 +197,19 @@ pub struct LimitArgs {
     /// (default: an error listing the known types)
     #[arg(long, value_enum, value_name = "KIND")]
     pub assume_leaf: Option<AssumeLeafArg>,
+    /// Most bytes the command reads in all its files (includes, node models,
+    /// baselines, traces and repeated arguments each count)
+    #[arg(long, default_value_t = crate::format::source::DEFAULT_MAX_TOTAL_BYTES, hide_short_help = true)]
+    pub max_total_bytes: u64,
+    /// Directory that files named by a policy or scenario (subtrees,
+    /// includes, scenario policies) must stay inside [default: the git work
+    /// tree of the file given, else its directory]
+    #[arg(long, value_name = "DIR", conflicts_with = "allow_outside_root")]
+    pub root: Option<PathBuf>,
+    /// Let policies and scenarios name files anywhere (absolute paths, `..`
+    /// out of the root): for trusted local files only
+    #[arg(long)]
+    pub allow_outside_root: bool,
 }
 
 impl LimitArgs {
@@ -211,6 +224,12 @@ impl LimitArgs {
                 AssumeLeafArg::Action => crate::format::AssumeLeaf::Action,
                 AssumeLeafArg::Condition => crate::format::AssumeLeaf::Condition,
             }),
+            confinement: match (&self.root, self.allow_outside_root) {
+                (_, true) => crate::format::source::Confinement::Off,
+                (Some(r), false) => crate::format::source::Confinement::Root(r.clone()),
+                (None, false) => crate::format::source::Confinement::Auto,
+            },
+            read_budget: crate::format::source::ReadBudget::new(self.max_total_bytes),
             ..Default::default()
         }
     }

@@ -6,6 +6,7 @@ use crate::diagnostic::Diagnostic;
 use crate::format::{self, Limits, Loaded};
 use crate::report::gate::{Baseline, Gate, Limit};
 use crate::report::{self, analyze, render_analysis};
+use crate::sanitize::shown;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -27,7 +28,7 @@ pub fn execute(cli: Cli) -> u8 {
                 return EXIT_BAD_INPUT;
             };
             let reports: Vec<_> = loaded.iter().map(analyze).collect();
-            let code = emit(None, render_analysis(&reports, format).as_bytes());
+            let code = emit_text(None, render_analysis(&reports, format));
             if code != EXIT_OK || gate.is_empty() {
                 return code;
             }
@@ -49,8 +50,8 @@ pub fn execute(cli: Cli) -> u8 {
                             let _ = writeln!(
                                 err,
                                 "{}: ok (scenario `{}`, {} polic{})",
-                                f.display(),
-                                s.name,
+                                shown(&f.display().to_string()),
+                                shown(&s.name),
                                 s.policies.len(),
                                 if s.policies.len() == 1 { "y" } else { "ies" }
                             );
@@ -67,9 +68,9 @@ pub fn execute(cli: Cli) -> u8 {
                         let _ = writeln!(
                             err,
                             "{}: ok ({} `{}`, {} warning{})",
-                            l.path,
+                            shown(&l.path),
                             l.policy.kind(),
-                            l.policy.name,
+                            shown(&l.policy.name),
                             l.warnings.len(),
                             if l.warnings.len() == 1 { "" } else { "s" },
                         );
@@ -133,8 +134,9 @@ pub fn execute(cli: Cli) -> u8 {
                         Err(errs) => {
                             for e in errs {
                                 eprintln!(
-                                    "error: {}: {e}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
-                                    l.path
+                                    "error: {}: {}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
+                                    shown(&l.path),
+                                    crate::sanitize::shown_max(&e.to_string(), 1000)
                                 );
                             }
                             return EXIT_BAD_INPUT;
@@ -147,9 +149,9 @@ pub fn execute(cli: Cli) -> u8 {
                             let node = &bt.nodes[n];
                             eprintln!(
                                 "warning: {}: `{}` node `{}` becomes a container re-entered at its first state every tick: the HFSM counts as the paper's construction but does not keep the node's memory",
-                                l.path,
+                                shown(&l.path),
                                 node.kind.keyword(),
-                                node.id
+                                shown(&node.id)
                             );
                         }
                     }
@@ -158,7 +160,8 @@ pub fn execute(cli: Cli) -> u8 {
                         Err(errs) => {
                             for e in errs {
                                 eprintln!(
-                                    "error: {e}\n  = hint: the construction covers sequence, fallback (with or without memory), inverter, force_success, force_failure and leaves"
+                                    "error: {}\n  = hint: the construction covers sequence, fallback (with or without memory), inverter, force_success, force_failure and leaves",
+                                    crate::sanitize::shown_max(&e.to_string(), 1000)
                                 );
                             }
                             return EXIT_BAD_INPUT;
@@ -167,7 +170,7 @@ pub fn execute(cli: Cli) -> u8 {
                 }
             };
             let text = crate::format::toml_write::write_policy(&policy);
-            emit(output.as_deref(), text.as_bytes())
+            emit_text(output.as_deref(), text)
         }
         Command::Effort {
             files,
@@ -192,7 +195,7 @@ pub(super) fn draw(
     use crate::render::dot::{self, RenderFormat};
     let text = dot::policy_dot(policy, opts);
     let Some(fmt) = render else {
-        return emit(output, text.as_bytes());
+        return emit_text(output, text);
     };
     if output.is_none() && fmt != RenderFormat::Svg {
         eprintln!("error: {fmt} output is binary; write it to a file with -o");
@@ -201,7 +204,7 @@ pub(super) fn draw(
     match dot::render(&text, fmt) {
         Ok(bytes) => emit(output, &bytes),
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", crate::sanitize::shown_max(&e.to_string(), 2000));
             EXIT_BAD_INPUT
         }
     }
@@ -254,8 +257,14 @@ pub(super) fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
             .iter()
             .find_map(|d| d.file.as_ref().map(|f| f.path.clone()))
             .unwrap_or_default();
-        let _ = writeln!(w, "error: {file}: {n} problems");
+        let _ = writeln!(w, "error: {}: {n} problems", shown(&file));
     }
+}
+
+/// Writes a text output (report, DOT, SVG, policy) through
+/// [`super::out::text`] to a file (atomically) or stdout.
+pub(super) fn emit_text(path: Option<&Path>, text: impl AsRef<str>) -> u8 {
+    emit(path, super::out::text(text.as_ref()).as_bytes())
 }
 
 /// Writes output to a file (atomically) or stdout.
@@ -264,7 +273,7 @@ pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
         Some(p) => match report::write_atomically(p, bytes) {
             Ok(()) => EXIT_OK,
             Err(e) => {
-                eprintln!("error: cannot write `{}`: {e}", p.display());
+                eprintln!("error: cannot write `{}`: {e}", shown(&p.display().to_string()));
                 EXIT_BAD_INPUT
             }
         },
@@ -334,7 +343,10 @@ fn check_gate(gate: &Gate, reports: &[report::PolicyReport]) -> u8 {
             .collect();
         rules.push(format!("growth over `{}`: {}", b.path, grow.join(", ")));
         for f in &r.new_policies {
-            eprintln!("note: `{f}` is not in the baseline; only its ceilings are checked");
+            eprintln!(
+                "note: `{}` is not in the baseline; only its ceilings are checked",
+                shown(f)
+            );
         }
     }
     let n = reports.len();
@@ -347,7 +359,10 @@ fn check_gate(gate: &Gate, reports: &[report::PolicyReport]) -> u8 {
         return EXIT_OK;
     }
     for v in &r.violations {
-        eprintln!("error: complexity gate: {v}");
+        eprintln!(
+            "error: complexity gate: {}",
+            crate::sanitize::shown_max(&v.to_string(), 1000)
+        );
     }
     eprintln!(
         "error: complexity gate: {} limit{} exceeded in {n} {policies} ({})",

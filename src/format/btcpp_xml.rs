@@ -241,6 +241,8 @@ struct Loader<'l> {
     /// Tree ID -> (document, `<BehaviorTree>` element).
     trees: BTreeMap<String, (usize, usize)>,
     models: BTreeMap<String, ModelEntry>,
+    /// The directory every included file must be in (`None`: anywhere).
+    root: Option<PathBuf>,
 }
 
 fn load(
@@ -250,7 +252,9 @@ fn load(
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let main = xml::parse(&file).map_err(|d| vec![d])?;
+    let root = super::source::root_for(limits, &base);
     let mut l = Loader {
+        root,
         limits,
         diags: Vec::new(),
         docs: vec![main],
@@ -349,7 +353,14 @@ impl Loader<'_> {
                 continue;
             };
             let (pval, pspan) = (p.value.clone(), p.span.clone());
-            let full = self.dirs[d].join(&pval);
+            let full = match super::source::resolve(self.root.as_deref(), &self.dirs[d], &pval) {
+                Ok(p) => p,
+                Err(r) => {
+                    self.err(d, pspan, format!("cannot include this file: {}", r.message))
+                        .hint = Some(r.hint);
+                    continue;
+                }
+            };
             let canon = super::toml::canonical(&full);
             if let Some(at) = chain.iter().position(|c| *c == canon) {
                 let mut names: Vec<String> = shown_chain[at..].to_vec();

@@ -5,6 +5,7 @@ pub mod btcpp_xml;
 pub mod btcpp_xml_write;
 pub mod scxml;
 pub mod scxml_write;
+pub mod source;
 pub mod toml;
 pub mod toml_write;
 pub mod xml;
@@ -44,6 +45,12 @@ pub struct Limits {
     /// How to read a BehaviorTree.CPP leaf of unknown type (`--assume-leaf`);
     /// `None`: such a leaf is an error.
     pub assume_leaf: Option<AssumeLeaf>,
+    /// Where files named by other files may be (`--root`,
+    /// `--allow-outside-root`; [`source::resolve`]).
+    pub confinement: source::Confinement,
+    /// The bytes the whole command may read (`--max-total-bytes`), shared
+    /// by every clone of these limits.
+    pub read_budget: Arc<source::ReadBudget>,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -72,6 +79,8 @@ impl Default for Limits {
             max_name_bytes: DEFAULT_MAX_NAME_BYTES,
             nodes_models: Vec::new(),
             assume_leaf: None,
+            confinement: source::Confinement::Auto,
+            read_budget: source::ReadBudget::new(source::DEFAULT_MAX_TOTAL_BYTES),
         }
     }
 }

@@ -63,7 +63,7 @@ pub fn render_effort(rows: &[EffortRow], format: OutputFormat) -> String {
                 policies: &'a [EffortRow],
             }
             let mut s =
-                serde_json::to_string_pretty(&Out { policies: rows }).expect("serializable");
+                crate::sanitize::json(serde_json::to_string_pretty(&Out { policies: rows }).expect("serializable"));
             s.push('\n');
             s
         }
