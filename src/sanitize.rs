@@ -136,12 +136,25 @@ pub fn markdown_cell(s: &str) -> String {
     out
 }
 
-/// The fence for a code block holding `body`: backticks, one more than the
-/// longest run of backticks in it (at least three), so the body cannot
-/// close it (CommonMark 0.31, 4.5).
-pub fn code_fence(body: &str) -> String {
+/// A user string as an inline code span in a markdown table: [`shown`],
+/// `|` escaped (GitHub reads `\|` inside a code span in a table as `|`),
+/// and delimited by one more backtick than its longest run (CommonMark
+/// 0.31, 6.1), so it can neither end the span nor the cell. A code span
+/// shows HTML as text.
+pub fn markdown_code(s: &str) -> String {
+    let s = shown(s).replace('|', "\\|");
+    let fence = "`".repeat(longest_backtick_run(&s) + 1);
+    let pad = if s.starts_with('`') || s.ends_with('`') {
+        " "
+    } else {
+        ""
+    };
+    format!("{fence}{pad}{s}{pad}{fence}")
+}
+
+fn longest_backtick_run(s: &str) -> usize {
     let (mut run, mut longest) = (0usize, 0usize);
-    for c in body.chars() {
+    for c in s.chars() {
         if c == '`' {
             run += 1;
             longest = longest.max(run);
@@ -149,7 +162,14 @@ pub fn code_fence(body: &str) -> String {
             run = 0;
         }
     }
-    "`".repeat((longest + 1).max(3))
+    longest
+}
+
+/// The fence for a code block holding `body`: backticks, one more than the
+/// longest run of backticks in it (at least three), so the body cannot
+/// close it (CommonMark 0.31, 4.5).
+pub fn code_fence(body: &str) -> String {
+    "`".repeat((longest_backtick_run(body) + 1).max(3))
 }
 
 /// A CSV cell: control characters escaped, quoted when it holds a comma, a
@@ -217,6 +237,9 @@ mod tests {
         assert!(cell.contains("\\|") && cell.contains("\\`"), "{cell}");
         assert_eq!(code_fence("a ``` b"), "````");
         assert_eq!(code_fence("plain"), "```");
+        assert_eq!(markdown_code("a|b"), "`a\\|b`");
+        assert_eq!(markdown_code("x``y"), "```x``y```");
+        assert_eq!(markdown_code("`x"), "`` `x ``");
     }
 
     #[test]

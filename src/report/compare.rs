@@ -825,15 +825,16 @@ pub fn render_table(r: &CompareReport) -> String {
 /// `diff` block (added lines green, removed red) in a collapsible section.
 pub fn render_markdown(r: &CompareReport) -> String {
     let cell = crate::sanitize::markdown_cell;
+    let code = crate::sanitize::markdown_code;
     let mut out = format!(
         "### btfsm compare: {} → {}\n\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
-        cell(&r.a.file),
-        cell(&r.b.file)
+        code(&r.a.file),
+        code(&r.b.file)
     );
     for (tag, s) in [("a", &r.a), ("b", &r.b)] {
         out.push_str(&format!(
             "| {tag} | {} | {} | {} | {} | {} |\n",
-            cell(&s.file),
+            code(&s.file),
             s.kind,
             cell(&s.name),
             s.vertices,

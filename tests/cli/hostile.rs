@@ -173,6 +173,10 @@ fn hostile_binary_garbage_and_devices() {
         );
         let (code, _, stderr) = btfsm(&["analyze", &f]);
         assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains("an absolute path is not allowed"), "{stderr}");
+        // Trusted local use lifts the root, never the regular-file rule.
+        let (code, _, stderr) = btfsm(&["analyze", &f, "--allow-outside-root"]);
+        assert_eq!(code, 2, "{stderr}");
         assert!(stderr.contains("not a regular file"), "{stderr}");
     }
 }
