@@ -180,7 +180,8 @@ pub struct LimitArgs {
     /// Largest input file, in bytes (also the total read through subtree includes)
     #[arg(long, default_value_t = crate::format::DEFAULT_MAX_FILE_BYTES, hide_short_help = true)]
     pub max_file_bytes: u64,
-    /// Most BT nodes or FSM states per policy, subtrees expanded
+    /// Most BT nodes or FSM states per policy, subtrees expanded (and most
+    /// nodes all policies of the command create by copying subtrees)
     #[arg(long, default_value_t = crate::format::DEFAULT_MAX_NODES, hide_short_help = true)]
     pub max_nodes: usize,
     /// Deepest BT or HFSM nesting (the root is at depth 0)
@@ -229,7 +230,8 @@ impl LimitArgs {
                 (Some(r), false) => crate::format::source::Confinement::Root(r.clone()),
                 (None, false) => crate::format::source::Confinement::Auto,
             },
-            read_budget: crate::format::source::ReadBudget::new(self.max_total_bytes),
+            read_budget: crate::format::source::Budget::new(self.max_total_bytes),
+            expansion_budget: crate::format::source::Budget::new(self.max_nodes as u64),
             ..Default::default()
         }
     }

@@ -50,7 +50,12 @@ pub struct Limits {
     pub confinement: source::Confinement,
     /// The bytes the whole command may read (`--max-total-bytes`), shared
     /// by every clone of these limits.
-    pub read_budget: Arc<source::ReadBudget>,
+    pub read_budget: Arc<source::Budget>,
+    /// The nodes the whole command may create by copying a subtree already
+    /// read (TOML subtrees used again, BehaviorTree.CPP `<SubTree>`s):
+    /// `max_nodes` in all, so that a few kilobytes of files including each
+    /// other twice per level cannot build millions of nodes per policy.
+    pub expansion_budget: Arc<source::Budget>,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -63,7 +68,7 @@ pub enum AssumeLeaf {
 /// Default of [`Limits::max_file_bytes`].
 pub const DEFAULT_MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 /// Default of [`Limits::max_nodes`].
-pub const DEFAULT_MAX_NODES: usize = 2_000_000;
+pub const DEFAULT_MAX_NODES: usize = 150_000;
 /// Default of [`Limits::max_depth`].
 pub const DEFAULT_MAX_DEPTH: usize = 1_000;
 /// Default of [`Limits::max_name_bytes`].
@@ -80,7 +85,8 @@ impl Default for Limits {
             nodes_models: Vec::new(),
             assume_leaf: None,
             confinement: source::Confinement::Auto,
-            read_budget: source::ReadBudget::new(source::DEFAULT_MAX_TOTAL_BYTES),
+            read_budget: source::Budget::new(source::DEFAULT_MAX_TOTAL_BYTES),
+            expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
         }
     }
 }

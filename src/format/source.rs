@@ -26,18 +26,19 @@ pub const DEFAULT_MAX_TOTAL_BYTES: u64 = 256 * 1024 * 1024;
 /// is an error (a writer that never writes nor closes).
 pub const PIPE_IDLE: Duration = Duration::from_secs(10);
 
-/// The bytes one command may still read, shared by every clone of its
-/// [`Limits`] (files on the command line, includes, node models, baselines,
-/// traces).
+/// A count one command may still spend, shared by every clone of its
+/// [`Limits`]: the bytes it reads (files on the command line, includes,
+/// node models, baselines, traces), the nodes it creates by copying
+/// subtrees.
 #[derive(Debug)]
-pub struct ReadBudget {
+pub struct Budget {
     limit: u64,
     used: AtomicU64,
 }
 
-impl ReadBudget {
-    pub fn new(limit: u64) -> Arc<ReadBudget> {
-        Arc::new(ReadBudget {
+impl Budget {
+    pub fn new(limit: u64) -> Arc<Budget> {
+        Arc::new(Budget {
             limit,
             used: AtomicU64::new(0),
         })
@@ -401,7 +402,7 @@ mod tests {
 
     #[test]
     fn budget_charges_until_the_limit() {
-        let b = ReadBudget::new(10);
+        let b = Budget::new(10);
         assert!(b.charge(6));
         assert!(!b.charge(5));
         assert_eq!(b.remaining(), 4);
@@ -476,7 +477,7 @@ mod tests {
         let p = d.0.join("a.toml");
         std::fs::write(&p, vec![b'#'; 600]).unwrap();
         let limits = Limits {
-            read_budget: ReadBudget::new(1000),
+            read_budget: Budget::new(1000),
             ..Limits::default()
         };
         assert!(read_bytes(&p, "a.toml", &limits, false).is_ok());

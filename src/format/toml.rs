@@ -991,10 +991,12 @@ impl Loader {
         }
 
         // Build the arena in pre-order from the root, splicing included subtrees.
+        // An included tree's ids are its own (`x`); the including node's
+        // id is put before them when it is spliced (`moma1/x`).
         let full_id = |id: &str| match prefix {
             Some(p) if id.is_empty() => p.to_string(),
-            Some(p) => format!("{p}/{id}"),
-            None => id.to_string(),
+            Some(p) if !p.is_empty() => format!("{p}/{id}"),
+            _ => id.to_string(),
         };
         let mut out: Vec<BtNode> = Vec::new();
         let mut new_index = vec![usize::MAX; ids.len()];
@@ -1016,6 +1018,22 @@ impl Loader {
             match raw.include.take() {
                 Some(sub) => {
                     // The included tree's root takes this node's place and id.
+                    // Ids grow by a prefix at each level: bounded here, before
+                    // millions of them are built.
+                    let longest = sub.nodes.iter().map(|n| n.id.len()).max().unwrap_or(0);
+                    if id.len() + 1 + longest > self.limits.max_name_bytes {
+                        self.err(
+                            cx,
+                            ids[i].1.clone(),
+                            format!(
+                                "the ids of subtree node `{}` would be longer than the limit of {} bytes",
+                                crate::sanitize::shown(ids[i].0),
+                                self.limits.max_name_bytes
+                            ),
+                        )
+                        .hint = Some("nest fewer subtrees, or raise the limit with --max-name-bytes".into());
+                        return None;
+                    }
                     let offset = out.len();
                     for (j, mut n) in sub.nodes.into_iter().enumerate() {
                         n.id = if j == sub.root {
@@ -1393,12 +1411,12 @@ impl Loader {
         if let Some(done) = self.includes.get(&key) {
             // Read before: its problems are reported already.
             let size = done.as_ref()?.nodes.len();
-            if size > self.node_budget {
+            if size > self.node_budget || !self.limits.expansion_budget.charge(size as u64) {
                 self.err(
                     cx,
                     tval.span(),
                     format!(
-                        "more than {} nodes with the subtrees expanded",
+                        "more than {} nodes with the subtrees expanded (in this policy, or copied by this command in all)",
                         self.limits.max_nodes
                     ),
                 )

@@ -229,7 +229,7 @@ fn hostile_exponential_subtree_include_hits_the_node_budget() {
     let e0 = dir.0.join("e0.toml").display().to_string();
     for (limit, flag) in [
         ("100000", vec!["--max-nodes", "100000"]),
-        ("2000000", vec![]),
+        ("150000", vec![]),
     ] {
         let mut args = vec!["analyze", e0.as_str()];
         args.extend(flag);
