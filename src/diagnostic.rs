@@ -303,7 +303,10 @@ mod tests {
 
     #[test]
     fn snippets_and_messages_are_escaped_and_cut() {
-        let f = SourceFile::new("p\u{1b}[2J.toml", "a = \"x\u{1b}]0;t\u{7}\" # \u{202e}\nb = 2\n");
+        let f = SourceFile::new(
+            "p\u{1b}[2J.toml",
+            "a = \"x\u{1b}]0;t\u{7}\" # \u{202e}\nb = 2\n",
+        );
         let d = Diagnostic::error("bad name `x\nerror: forged`")
             .at(&f, 4..12)
             .hint("h\r");
@@ -315,7 +318,10 @@ mod tests {
         assert!(s.contains("  |     ^"), "{s}");
         let long = SourceFile::new("l.toml", "x".repeat(100_000));
         let d = Diagnostic::error("m".repeat(100_000)).at(&long, 5..6);
-        assert!(d.to_string().len() < 3 * (MESSAGE_CHARS + SNIPPET_CHARS), "bounded");
+        assert!(
+            d.to_string().len() < 3 * (MESSAGE_CHARS + SNIPPET_CHARS),
+            "bounded"
+        );
     }
 
     #[test]

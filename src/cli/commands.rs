@@ -40,30 +40,40 @@ pub fn execute(cli: Cli) -> u8 {
             let mut err = stderr.lock();
             let mut failed = false;
             for f in &files {
-                // A scenario is validated as `sim` reads it (its policies
-                // included), without running it.
-                if format::detect(f) == format::FileFormat::Toml
-                    && crate::sim::scenario::looks_like_scenario(&format::read_head(f))
-                {
-                    match crate::sim::scenario::load(f, &limits) {
-                        Ok(s) => {
-                            let _ = writeln!(
-                                err,
-                                "{}: ok (scenario `{}`, {} polic{})",
-                                shown(&f.display().to_string()),
-                                shown(&s.name),
-                                s.policies.len(),
-                                if s.policies.len() == 1 { "y" } else { "ies" }
-                            );
-                        }
-                        Err(diags) => {
-                            failed = true;
-                            print_diagnostics(&mut err, &diags);
-                        }
+                // Read once; a scenario is validated as `sim` reads it (its
+                // policies included), without running it.
+                let (file, input) = match format::read_input(f, &limits) {
+                    Ok(r) => r,
+                    Err(diags) => {
+                        failed = true;
+                        print_diagnostics(&mut err, &diags);
+                        continue;
                     }
-                    continue;
-                }
-                match load_reporting(f, &limits, &mut err) {
+                };
+                let fmt = match input {
+                    format::Input::Policy(fmt) => fmt,
+                    format::Input::Scenario => {
+                        let base = f.parent().unwrap_or(Path::new(""));
+                        match crate::sim::scenario::parse(&file, base, &limits) {
+                            Ok(s) => {
+                                let _ = writeln!(
+                                    err,
+                                    "{}: ok (scenario `{}`, {} polic{})",
+                                    shown(&f.display().to_string()),
+                                    shown(&s.name),
+                                    s.policies.len(),
+                                    if s.policies.len() == 1 { "y" } else { "ies" }
+                                );
+                            }
+                            Err(diags) => {
+                                failed = true;
+                                print_diagnostics(&mut err, &diags);
+                            }
+                        }
+                        continue;
+                    }
+                };
+                match reported(format::load_read(file, f, fmt, &limits), &mut err) {
                     Some(l) => {
                         let _ = writeln!(
                             err,
@@ -204,7 +214,10 @@ pub(super) fn draw(
     match dot::render(&text, fmt) {
         Ok(bytes) => emit(output, &bytes),
         Err(e) => {
-            eprintln!("error: {}", crate::sanitize::shown_max(&e.to_string(), 2000));
+            eprintln!(
+                "error: {}",
+                crate::sanitize::shown_max(&e.to_string(), 2000)
+            );
             EXIT_BAD_INPUT
         }
     }
@@ -233,7 +246,12 @@ pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>
 
 /// Reads one policy, printing its warnings or its errors to `err`.
 fn load_reporting(f: &Path, limits: &Limits, err: &mut impl Write) -> Option<Loaded> {
-    match format::load(f, limits) {
+    reported(format::load(f, limits), err)
+}
+
+/// A policy read, its warnings printed to `err`; or its errors printed.
+fn reported(r: Result<Loaded, Vec<Diagnostic>>, err: &mut impl Write) -> Option<Loaded> {
+    match r {
         Ok(l) => {
             for w in &l.warnings {
                 let _ = write!(err, "{w}");
@@ -273,7 +291,10 @@ pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
         Some(p) => match report::write_atomically(p, bytes) {
             Ok(()) => EXIT_OK,
             Err(e) => {
-                eprintln!("error: cannot write `{}`: {e}", shown(&p.display().to_string()));
+                eprintln!(
+                    "error: cannot write `{}`: {e}",
+                    shown(&p.display().to_string())
+                );
                 EXIT_BAD_INPUT
             }
         },

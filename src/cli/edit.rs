@@ -5,9 +5,9 @@
 
 use super::args::{AddKind, EditArgs, EditOp, WrapKind};
 use super::commands::{emit_text, load_one};
-use crate::sanitize::{shown, shown_max};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use crate::model::{BtNodeKind, PolicyBody, SkillCall};
+use crate::sanitize::{shown, shown_max};
 use crate::transform::edit::{self, AddState, EditError, Touched};
 use std::collections::BTreeMap;
 

@@ -27,8 +27,8 @@ mod commands;
 mod compare;
 mod convert;
 mod edit;
-mod paper;
 pub mod out;
+mod paper;
 pub mod sim;
 
 use clap::Parser;

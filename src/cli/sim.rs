@@ -194,7 +194,9 @@ fn with_budget<T: serde::Serialize>(report: &T, budget: &Budget) -> String {
         report: &'a T,
         budget: &'a Budget,
     }
-    let mut s = crate::sanitize::json(serde_json::to_string_pretty(&Out { report, budget }).expect("serializable"));
+    let mut s = crate::sanitize::json(
+        serde_json::to_string_pretty(&Out { report, budget }).expect("serializable"),
+    );
     s.push('\n');
     s
 }

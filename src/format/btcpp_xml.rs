@@ -212,6 +212,16 @@ pub fn canonical_type(kind: BtNodeKind) -> Option<&'static str> {
 pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
     let file = super::toml::read_source(path, &shown, limits)?;
+    load_read(file, path, limits)
+}
+
+/// Reads BehaviorTree.CPP XML already read from `path` (includes resolve
+/// beside it).
+pub fn load_read(
+    file: Arc<SourceFile>,
+    path: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
     let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
     load(file, super::toml::canonical(path), base, limits)
 }

@@ -190,13 +190,17 @@ pub enum FileFormat {
 
 /// The format of a file: by extension (`.toml`, `.scxml`, `.xml`), else by its
 /// first bytes (`<scxml`, `<root`, ...); TOML otherwise.
-pub fn detect(path: &Path) -> FileFormat {
+pub fn detect(path: &Path, text: &str) -> FileFormat {
     match path.extension().and_then(|e| e.to_str()) {
         Some(e) if e.eq_ignore_ascii_case("toml") => return FileFormat::Toml,
         Some(e) if e.eq_ignore_ascii_case("scxml") => return FileFormat::Scxml,
         _ => {}
     }
-    let head = read_head(path);
+    let mut end = text.len().min(4096);
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    let head = &text[..end];
     let is_xml_ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -210,22 +214,58 @@ pub fn detect(path: &Path) -> FileFormat {
     }
 }
 
-/// The first few kilobytes of a file (lossy), for sniffing.
-pub(crate) fn read_head(path: &Path) -> String {
-    use std::io::Read;
-    let mut buf = vec![0u8; 4096];
-    let n = std::fs::File::open(path)
-        .and_then(|mut f| f.read(&mut buf))
-        .unwrap_or(0);
-    String::from_utf8_lossy(&buf[..n]).into_owned()
+/// What a command-line file holds, read once (so that a pipe or
+/// `/dev/stdin` works, and nothing is opened twice).
+pub enum Input {
+    Policy(FileFormat),
+    /// A simulator scenario (`sim`, `validate`).
+    Scenario,
+}
+
+/// Reads a command-line file once ([`source::read`]: bounded, charged,
+/// never blocking on a FIFO) and tells what it holds.
+pub fn read_input(
+    path: &Path,
+    limits: &Limits,
+) -> Result<(Arc<SourceFile>, Input), Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    let file = source::read(path, &shown, limits, false)?;
+    let input = match detect(path, &file.text) {
+        FileFormat::Toml if crate::sim::scenario::looks_like_scenario(head(&file.text)) => {
+            Input::Scenario
+        }
+        f => Input::Policy(f),
+    };
+    Ok((file, input))
+}
+
+fn head(text: &str) -> &str {
+    let mut end = text.len().min(4096);
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    &text[..end]
 }
 
 /// Reads a policy from any supported format (see [`detect`]).
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
-    let loaded = match detect(path) {
-        FileFormat::Toml => toml::load_file(path, limits),
-        FileFormat::BtcppXml => btcpp_xml::load_file(path, limits),
-        FileFormat::Scxml => scxml::load_file(path, limits),
+    let shown = path.display().to_string();
+    let file = source::read(path, &shown, limits, false)?;
+    let format = detect(path, &file.text);
+    load_read(file, path, format, limits)
+}
+
+/// A policy from a file already read from `path` (see [`read_input`]).
+pub fn load_read(
+    file: Arc<SourceFile>,
+    path: &Path,
+    format: FileFormat,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let loaded = match format {
+        FileFormat::Toml => toml::load_read(&file, path, limits),
+        FileFormat::BtcppXml => btcpp_xml::load_read(file, path, limits),
+        FileFormat::Scxml => scxml::load_read(file, limits),
     }?;
     // Every format: node count and nesting depth (the TOML reader has
     // already said where).

@@ -256,6 +256,12 @@ pub fn read_bytes(
             io_msg(&e)
         ))]
     };
+    // `-` is standard input (read once, like any pipe).
+    let path = if path == Path::new("-") && !named {
+        Path::new("/dev/stdin")
+    } else {
+        path
+    };
     let file = open_nonblocking(path).map_err(cannot)?;
     let meta = file.metadata().map_err(cannot)?;
     if meta.is_dir() {
@@ -422,9 +428,17 @@ mod tests {
         assert!(resolve(Some(&root), &sub, "a.toml").is_ok());
         assert!(resolve(Some(&root), &sub, "../b.toml").is_ok());
         // Outside: `..`, absolute, home, a symlink out, a device.
-        for rel in ["../../etc/passwd", "/etc/passwd", "~/x", "../../../../proc/self/environ"] {
+        for rel in [
+            "../../etc/passwd",
+            "/etc/passwd",
+            "~/x",
+            "../../../../proc/self/environ",
+        ] {
             let r = resolve(Some(&root), &sub, rel).unwrap_err();
-            assert!(r.message.contains("absolute") || r.message.contains("outside"), "{rel}: {r:?}");
+            assert!(
+                r.message.contains("absolute") || r.message.contains("outside"),
+                "{rel}: {r:?}"
+            );
             assert!(!r.message.contains("passwd") && !r.message.contains("environ"));
         }
         std::os::unix::fs::symlink("/etc/hostname", root.join("sub/link.toml")).unwrap();
@@ -438,7 +452,12 @@ mod tests {
         assert!(resolve(None, &sub, "/etc/hostname").is_ok());
         let r = resolve(None, &sub, "/dev/zero").unwrap_err();
         assert!(r.message.contains("not a regular file"), "{r:?}");
-        assert!(resolve(Some(&root), &sub, "missing.toml").unwrap_err().message == "no such file");
+        assert!(
+            resolve(Some(&root), &sub, "missing.toml")
+                .unwrap_err()
+                .message
+                == "no such file"
+        );
     }
 
     #[test]
@@ -482,8 +501,18 @@ mod tests {
         };
         assert!(read_bytes(&p, "a.toml", &limits, false).is_ok());
         let err = read_bytes(&p, "a.toml", &limits, false).unwrap_err();
-        assert!(err[0].message.contains("remains of the 1000 bytes"), "{}", err[0]);
-        assert!(err[0].hint.as_deref().unwrap().contains("--max-total-bytes"));
+        assert!(
+            err[0].message.contains("remains of the 1000 bytes"),
+            "{}",
+            err[0]
+        );
+        assert!(
+            err[0]
+                .hint
+                .as_deref()
+                .unwrap()
+                .contains("--max-total-bytes")
+        );
         // /dev/zero stops at the cap.
         let err = read_bytes(Path::new("/dev/zero"), "z", &limits, false).unwrap_err();
         assert!(err[0].message.contains("larger than"), "{}", err[0]);

@@ -16,9 +16,9 @@ use crate::model::{
 };
 use std::cell::Cell;
 use std::collections::{BTreeMap, HashMap};
-use std::rc::Rc;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 use std::sync::Arc;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
@@ -32,8 +32,17 @@ pub const TASK_OUTCOMES: &[&str] = &["SUCCESS", "FAILURE", "RUNNING"];
 pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
     let file = read_source(path, &shown, limits)?;
+    load_read(&file, path, limits)
+}
+
+/// Reads a TOML policy already read from `path` (includes resolve beside it).
+pub fn load_read(
+    file: &Arc<SourceFile>,
+    path: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
     let base = path.parent().unwrap_or(Path::new(""));
-    load_source(&file, canonical(path), base, limits)
+    load_source(file, canonical(path), base, limits)
 }
 
 /// Parses a policy from text (tests, stdin); includes resolve against `base`.
@@ -188,7 +197,9 @@ impl Ctx<'_> {
         }
         let b = &self.subst;
         // Built piece by piece, never longer than one byte past the limit.
-        let cap = b.max_one.min(usize::try_from(b.left.get()).unwrap_or(usize::MAX));
+        let cap = b
+            .max_one
+            .min(usize::try_from(b.left.get()).unwrap_or(usize::MAX));
         let mut out = String::new();
         let mut rest = s;
         while let Some(open) = rest.find('{') {

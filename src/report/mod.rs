@@ -73,8 +73,9 @@ pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String
             struct Out<'a> {
                 policies: &'a [PolicyReport],
             }
-            let mut s =
-                crate::sanitize::json(serde_json::to_string_pretty(&Out { policies: reports }).expect("serializable"));
+            let mut s = crate::sanitize::json(
+                serde_json::to_string_pretty(&Out { policies: reports }).expect("serializable"),
+            );
             s.push('\n');
             s
         }

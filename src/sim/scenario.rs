@@ -124,16 +124,18 @@ pub fn parse(
     // The first TOML error only: the recoverable parser keeps them all.
     let doc = match DeTable::parse(&file.text) {
         Ok(doc) => doc,
-        Err(e) => return Err(std::iter::once(e)
-            .map(|e| {
-                Diagnostic::error(format!(
-                    "invalid TOML: {}",
-                    e.message().trim().trim_end_matches('.')
-                ))
-                .at(file, e.span().unwrap_or(0..0))
-                .hint("see the scenario format in the README (Simulator)")
-            })
-            .collect()),
+        Err(e) => {
+            return Err(std::iter::once(e)
+                .map(|e| {
+                    Diagnostic::error(format!(
+                        "invalid TOML: {}",
+                        e.message().trim().trim_end_matches('.')
+                    ))
+                    .at(file, e.span().unwrap_or(0..0))
+                    .hint("see the scenario format in the README (Simulator)")
+                })
+                .collect());
+        }
     };
     let s = r.scenario(doc.get_ref(), base, limits);
     match s {
@@ -870,7 +872,11 @@ impl Reader {
                 return None;
             }
             Err(r) => {
-                self.err(f.span(), format!("policy file `{rel}`: {}", r.message), r.hint);
+                self.err(
+                    f.span(),
+                    format!("policy file `{rel}`: {}", r.message),
+                    r.hint,
+                );
                 return None;
             }
         };

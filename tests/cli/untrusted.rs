@@ -61,8 +61,8 @@ impl Drop for Dir {
 fn run_in(cwd: &Path, args: &[&str], stderr_to: Option<&str>) -> Run {
     // BTFSM_UNDER_TEST runs the suite against another build (e.g. the one
     // before issue 12, to see every case fail).
-    let bin = std::env::var_os("BTFSM_UNDER_TEST")
-        .unwrap_or_else(|| env!("CARGO_BIN_EXE_btfsm").into());
+    let bin =
+        std::env::var_os("BTFSM_UNDER_TEST").unwrap_or_else(|| env!("CARGO_BIN_EXE_btfsm").into());
     let mut cmd = Command::new(bin);
     cmd.args(args)
         .current_dir(cwd)
@@ -71,7 +71,12 @@ fn run_in(cwd: &Path, args: &[&str], stderr_to: Option<&str>) -> Run {
         .stdout(Stdio::piped());
     match stderr_to {
         Some(p) => {
-            cmd.stderr(std::fs::OpenOptions::new().write(true).open(p).expect("open"));
+            cmd.stderr(
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(p)
+                    .expect("open"),
+            );
         }
         None => {
             cmd.stderr(Stdio::piped());
@@ -181,14 +186,15 @@ fn check(r: &Run, dir: &Path, codes: &[i32], what: &str) {
     );
     for (name, s) in [("stdout", &r.stdout), ("stderr", &r.stderr)] {
         assert!(!s.contains(SECRET), "{what}: secret on {name}");
-        let raw = s
-            .chars()
-            .find(|&c| (c.is_control() && c != '\n' && c != '\t') || ('\u{202a}'..='\u{202e}').contains(&c));
+        let raw = s.chars().find(|&c| {
+            (c.is_control() && c != '\n' && c != '\t') || ('\u{202a}'..='\u{202e}').contains(&c)
+        });
         assert!(raw.is_none(), "{what}: raw {raw:?} on {name}: {s:?}");
     }
 }
 
-const LEAF: &str = "kind = \"bt\"\nroot = \"x\"\n[nodes]\nx = { action = \"Dock!\", skill = \"Dock\" }\n";
+const LEAF: &str =
+    "kind = \"bt\"\nroot = \"x\"\n[nodes]\nx = { action = \"Dock!\", skill = \"Dock\" }\n";
 
 /// A policy or scenario naming a file outside its root (absolute, `..`,
 /// a symlink out, `.git`) is refused before the file is opened, and
@@ -198,7 +204,10 @@ fn files_named_by_files_stay_inside_the_root() {
     let d = Dir::new("root");
     // A secret file outside the root (the root is `repo/`, a git work tree).
     d.write("secret.toml", format!("{SECRET} = 1\n"));
-    d.write("repo/.git/config", format!("[http]\nextraheader = {SECRET}\n"));
+    d.write(
+        "repo/.git/config",
+        format!("[http]\nextraheader = {SECRET}\n"),
+    );
     std::os::unix::fs::symlink(d.path("secret.toml"), d.0.join("repo/link.toml")).expect("symlink");
     let cases = [
         ("abs.toml", "/proc/self/environ", "absolute path"),
@@ -226,7 +235,11 @@ fn files_named_by_files_stay_inside_the_root() {
     );
     let r = run_in(&d.0, &["analyze", &x], None);
     check(&r, &d.0, &[2], "xml include");
-    assert!(r.stderr.contains("absolute path") && r.stderr.contains(":2:"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("absolute path") && r.stderr.contains(":2:"),
+        "{}",
+        r.stderr
+    );
     // A scenario's policies.
     let s = d.write(
         "repo/scen.toml",
@@ -274,7 +287,10 @@ fn control_characters_never_reach_an_output() {
         ),
     );
     // A file name with an escape sequence.
-    let c = d.write("c\u{1b}[31m.toml", "kind = \"bt\"\nroot = \"nope\"\n[nodes]\n");
+    let c = d.write(
+        "c\u{1b}[31m.toml",
+        "kind = \"bt\"\nroot = \"nope\"\n[nodes]\n",
+    );
     for args in [
         vec!["analyze", &a, &b],
         vec!["analyze", &a, &b, "--format", "csv"],
@@ -289,7 +305,11 @@ fn control_characters_never_reach_an_output() {
         let r = run_in(&d.0, &args, None);
         check(&r, &d.0, &[0, 2], &format!("{args:?}"));
         if args.contains(&"csv") {
-            assert!(r.stdout.contains("'=cmd"), "formula neutralised: {}", r.stdout);
+            assert!(
+                r.stdout.contains("'=cmd"),
+                "formula neutralised: {}",
+                r.stdout
+            );
         }
     }
     let r = run_in(&d.0, &["compare", &a, &b, "--format", "markdown"], None);
@@ -329,20 +349,31 @@ fn memory_stays_bounded_by_the_input() {
     );
     let r = run_in(&d.0, &["analyze", &top], None);
     check(&r, &d.0, &[2], "substitution");
-    assert!(r.stderr.contains("substituting the parameters"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("substituting the parameters"),
+        "{}",
+        r.stderr
+    );
     // A million bad lines.
     let bad = d.write("bad.toml", "= = =\n".repeat(1_000_000));
     let r = run_in(&d.0, &["analyze", &bad], None);
     check(&r, &d.0, &[2], "toml errors");
     assert!(r.stderr.lines().count() < 50, "{}", r.stderr.len());
     // One 3 MB file given 200 times: the command's read budget.
-    let big = d.write("big.toml", format!("{LEAF}{}", "# padding\n".repeat(300_000)));
+    let big = d.write(
+        "big.toml",
+        format!("{LEAF}{}", "# padding\n".repeat(300_000)),
+    );
     let mut args = vec!["analyze"];
     args.extend(std::iter::repeat_n(big.as_str(), 200));
     args.extend(["--max-total-bytes", "100000000"]);
     let r = run_in(&d.0, &args, None);
     check(&r, &d.0, &[2], "repeated file");
-    assert!(r.stderr.contains("--max-total-bytes"), "{}", &r.stderr[..r.stderr.len().min(2000)]);
+    assert!(
+        r.stderr.contains("--max-total-bytes"),
+        "{}",
+        &r.stderr[..r.stderr.len().min(2000)]
+    );
     // Subtrees copied 2^k times across two policies: one command-wide budget.
     for i in 0..30 {
         d.write(
@@ -382,7 +413,11 @@ fn a_fifo_never_blocks() {
     ] {
         let r = run_in(&d.0, &args, None);
         check(&r, &d.0, &[0, 2], &format!("{args:?}"));
-        assert!(r.elapsed < Duration::from_secs(20), "{args:?}: {:?}", r.elapsed);
+        assert!(
+            r.elapsed < Duration::from_secs(20),
+            "{args:?}: {:?}",
+            r.elapsed
+        );
     }
     // Named by a file: refused without opening.
     let f = d.write(
@@ -404,7 +439,11 @@ fn a_full_stderr_changes_no_exit_code() {
     let d = Dir::new("full");
     let leaf = d.write("leaf.toml", LEAF);
     let bad = d.write("bad.toml", "kind = \"bt\"\nroot = \"nope\"\n[nodes]\n");
-    let r = run_in(&d.0, &["analyze", &leaf, "--max", "cc=0"], Some("/dev/full"));
+    let r = run_in(
+        &d.0,
+        &["analyze", &leaf, "--max", "cc=0"],
+        Some("/dev/full"),
+    );
     assert_eq!(r.code, 1, "gate");
     let r = run_in(&d.0, &["analyze", &bad], Some("/dev/full"));
     assert_eq!(r.code, 2, "bad input");
