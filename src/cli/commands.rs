@@ -258,28 +258,54 @@ pub(super) fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
     }
 }
 
-/// Writes output to a file (atomically) or stdout.
+/// Writes output to a file (see `report::output`: atomically, through
+/// symlinks, into devices and FIFOs) or to stdout (no path, `-`, or a path
+/// that is stdout).
 pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
-    match path {
-        Some(p) => match report::write_atomically(p, bytes) {
+    use crate::report::output::Destination;
+    let dest = match path.map(Destination::resolve) {
+        None => Destination::Stdout,
+        Some(Ok(d)) => d,
+        Some(Err(e)) => return cannot_write(path, e),
+    };
+    if let Destination::Stdout = dest {
+        let stdout = std::io::stdout();
+        let mut out = stdout.lock();
+        return match out.write_all(bytes).and_then(|()| out.flush()) {
             Ok(()) => EXIT_OK,
+            // A closed pipe (`| head`) is not an error of ours.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => EXIT_OK,
             Err(e) => {
-                eprintln!("error: cannot write `{}`: {e}", p.display());
+                eprintln!("error: cannot write to stdout: {e}");
                 EXIT_BAD_INPUT
             }
-        },
-        None => {
-            let stdout = std::io::stdout();
-            let mut out = stdout.lock();
-            match out.write_all(bytes).and_then(|()| out.flush()) {
-                Ok(()) => EXIT_OK,
-                // A closed pipe (`| head`) is not an error of ours.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => EXIT_OK,
-                Err(e) => {
-                    eprintln!("error: cannot write to stdout: {e}");
-                    EXIT_BAD_INPUT
-                }
-            }
+        };
+    }
+    match dest.write(bytes) {
+        Ok(()) => EXIT_OK,
+        Err(e) => cannot_write(path, e),
+    }
+}
+
+fn cannot_write(path: Option<&Path>, e: std::io::Error) -> u8 {
+    let shown = path.map_or_else(|| "-".into(), |p| p.display().to_string());
+    eprintln!("error: cannot write `{shown}`: {e}");
+    EXIT_BAD_INPUT
+}
+
+/// Refuses, before anything is computed or written, outputs of one command
+/// that name one file (or the stdout where the report goes, when
+/// `report_on_stdout`); `false` after saying why.
+pub(super) fn outputs_distinct(outputs: &[(&str, Option<&Path>)], report_on_stdout: bool) -> bool {
+    let given: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|&(flag, p)| Some((flag, p?)))
+        .collect();
+    match crate::report::output::check_distinct(&given, report_on_stdout) {
+        Ok(()) => true,
+        Err(e) => {
+            eprintln!("error: {e}");
+            false
         }
     }
 }

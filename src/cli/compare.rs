@@ -29,6 +29,9 @@ pub struct CompareArgs {
 }
 
 pub fn execute(args: CompareArgs) -> u8 {
+    if !super::commands::outputs_distinct(&[("--dot", args.dot.as_deref())], true) {
+        return EXIT_BAD_INPUT;
+    }
     let Some(loaded) = load_all(&[args.a.clone(), args.b.clone()], &args.limits) else {
         return EXIT_BAD_INPUT;
     };
