@@ -83,6 +83,7 @@ pub fn execute(cli: Cli) -> u8 {
             file,
             output,
             render,
+            timeout_ms,
             trace,
             limits,
         } => {
@@ -92,7 +93,8 @@ pub fn execute(cli: Cli) -> u8 {
             let Some((policy, opts)) = super::sim::dot_trace(&trace, &file, l.policy) else {
                 return EXIT_BAD_INPUT;
             };
-            draw(&policy, &opts, output.as_deref(), render)
+            let timeout = std::time::Duration::from_millis(timeout_ms);
+            draw(&policy, &opts, output.as_deref(), render, timeout)
         }
         Command::Compare {
             a,
@@ -181,13 +183,14 @@ pub fn execute(cli: Cli) -> u8 {
     }
 }
 
-/// Draws a policy as DOT, or renders it through Graphviz, to `output` or
-/// stdout.
+/// Draws a policy as DOT, or renders it through Graphviz (killed past
+/// `timeout`), to `output` or stdout.
 pub(super) fn draw(
     policy: &crate::model::Policy,
     opts: &crate::render::dot::DotOptions,
     output: Option<&Path>,
     render: Option<crate::render::dot::RenderFormat>,
+    timeout: std::time::Duration,
 ) -> u8 {
     use crate::render::dot::{self, RenderFormat};
     let text = dot::policy_dot(policy, opts);
@@ -198,7 +201,7 @@ pub(super) fn draw(
         eprintln!("error: {fmt} output is binary; write it to a file with -o");
         return EXIT_BAD_INPUT;
     }
-    match dot::render(&text, fmt) {
+    match dot::render(&text, fmt, timeout) {
         Ok(bytes) => emit(output, &bytes),
         Err(e) => {
             eprintln!("error: {e}");

@@ -61,7 +61,9 @@ pub fn execute(args: CompareArgs) -> u8 {
     let report = pair.report(results);
     if let (Some(path), Some(primary)) = (&args.dot, report.primary()) {
         let opts = pair.dot_options(&primary.edit_script);
-        let code = draw(&lb.policy, &opts, Some(path), args.render);
+        // Graphviz gets the budget of one mode (--timeout-ms).
+        let timeout = Duration::from_millis(args.timeout_ms);
+        let code = draw(&lb.policy, &opts, Some(path), args.render, timeout);
         if code != EXIT_OK {
             return code;
         }

@@ -195,7 +195,12 @@ fn check_ranges(file: &Arc<SourceFile>, text: &str) -> Result<(), Diagnostic> {
     let end = offset(file, e.line(), e.column()).min(text.len());
     let bytes = text.as_bytes();
     let mut start = end;
-    while start > 0 && matches!(bytes[start - 1], b'0'..=b'9' | b'-' | b'+' | b'.' | b'e' | b'E') {
+    while start > 0
+        && matches!(
+            bytes[start - 1],
+            b'0'..=b'9' | b'-' | b'+' | b'.' | b'e' | b'E'
+        )
+    {
         start -= 1;
     }
     Err(Diagnostic::error(message)
@@ -526,7 +531,11 @@ mod tests {
             let text = policy_json(bad);
             let e = Baseline::parse("b.json", &text).unwrap_err();
             assert!(e.message.contains("out of range"), "{bad}: {}", e.message);
-            assert!(e.message.contains("`cc` of baseline policy 1"), "{}", e.message);
+            assert!(
+                e.message.contains("`cc` of baseline policy 1"),
+                "{}",
+                e.message
+            );
             let (_, line, col) = e.location().unwrap();
             assert_eq!(line, 4, "{bad}");
             let at = text.lines().nth(3).unwrap().find(bad).unwrap() + 1;
@@ -558,7 +567,11 @@ mod tests {
             baseline: Some(b),
             ..Gate::default()
         };
-        assert!(gate.check(&[report("a.toml", "A", 0, 5)]).violations.is_empty());
+        assert!(
+            gate.check(&[report("a.toml", "A", 0, 5)])
+                .violations
+                .is_empty()
+        );
     }
 
     #[test]

@@ -342,7 +342,6 @@ fn replace(dir: &Path, name: &OsStr, existing: Option<&Metadata>, bytes: &[u8]) 
     result
 }
 
-
 const TMP_INFIX: &[u8] = b".btfsm-";
 const TMP_SUFFIX: &[u8] = b".tmp";
 
@@ -403,10 +402,7 @@ fn remove_stale_temporaries(dir: &Path, name: &OsStr) {
         else {
             continue;
         };
-        if !Path::new("/proc")
-            .join(OsStr::from_bytes(pid))
-            .exists()
-        {
+        if !Path::new("/proc").join(OsStr::from_bytes(pid)).exists() {
             let _ = std::fs::remove_file(e.path());
         }
     }
@@ -573,7 +569,11 @@ mod tests {
         // SAFETY: a valid NUL-terminated path.
         let made =
             unsafe { libc::mknod(c.as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) } == 0;
-        let target = if made { node } else { PathBuf::from("/dev/null") };
+        let target = if made {
+            node
+        } else {
+            PathBuf::from("/dev/null")
+        };
         symlink(&target, d.0.join("link")).unwrap();
         for p in [target.clone(), d.0.join("link")] {
             write_atomically(&p, b"gone").unwrap();
@@ -618,7 +618,10 @@ mod tests {
         assert_eq!(twice.is_ok(), shared, "{twice:?}");
         // Character devices may take several outputs.
         let null = Path::new("/dev/null");
-        assert_eq!(check_distinct(&[("--a", null), ("--b", null)], true), Ok(()));
+        assert_eq!(
+            check_distinct(&[("--a", null), ("--b", null)], true),
+            Ok(())
+        );
         // A missing directory is said before anything is written.
         let e = check_distinct(&[("--a", &d.0.join("no/such"))], false).unwrap_err();
         assert!(matches!(e, OutputClash::Unwritable { .. }), "{e}");

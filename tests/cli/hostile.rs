@@ -503,7 +503,10 @@ fn hostile_output_through_a_symlink_writes_its_target_and_keeps_the_link() {
     // dangling.dot -> other/new.dot, which does not exist yet.
     symlink("other/new.dot", dir.0.join("dangling.dot")).expect("symlink");
     let want = fig01_dot();
-    for (link, written) in [("link.dot", &target), ("dangling.dot", &other.join("new.dot"))] {
+    for (link, written) in [
+        ("link.dot", &target),
+        ("dangling.dot", &other.join("new.dot")),
+    ] {
         let r = run_in(&dir.0, &["dot", &fig01(), "-o", link], None, 60);
         assert_eq!(r.code, 0, "{}", r.stderr);
         let meta = std::fs::symlink_metadata(dir.0.join(link)).expect("link");
@@ -555,7 +558,10 @@ fn hostile_output_onto_devices_writes_into_them() {
         let r = run_in(&dir.0, &["dot", &fig01(), "-o", "null"], None, 60);
         assert_eq!(r.code, 0, "{}", r.stderr);
         let meta = std::fs::symlink_metadata(&node).expect("node");
-        assert!(meta.file_type().is_char_device(), "the device node was replaced");
+        assert!(
+            meta.file_type().is_char_device(),
+            "the device node was replaced"
+        );
     }
     // A private link to this process's stdout: the bytes go to the pipe.
     symlink("/proc/self/fd/1", dir.0.join("stdout")).expect("symlink");
@@ -604,9 +610,7 @@ fn hostile_output_onto_a_fifo_never_blocks() {
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("no process is reading"), "{}", r.stderr);
     assert!(r.secs < 10.0, "took {} s", r.secs);
-    let is_fifo = |p: &Path| {
-        std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_fifo())
-    };
+    let is_fifo = |p: &Path| std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_fifo());
     assert!(is_fifo(&fifo), "the FIFO was replaced");
     // With a reader (the DOT text fits in the pipe's buffer).
     let mut reader = open_fifo_reader(&fifo);
@@ -644,7 +648,11 @@ fn hostile_output_keeps_an_existing_files_permissions() {
     assert_eq!(r.code, 0, "{}", r.stderr);
     let mode = |p: &Path| std::fs::metadata(p).expect("meta").permissions().mode() & 0o7777;
     assert_eq!(mode(&secret), 0o600);
-    assert!(std::fs::read_to_string(&secret).expect("read").contains("kind = \"bt\""));
+    assert!(
+        std::fs::read_to_string(&secret)
+            .expect("read")
+            .contains("kind = \"bt\"")
+    );
     // A new file gets the default mode (0666 less the umask).
     let reference = dir.0.join("reference");
     std::fs::write(&reference, "").expect("write");
@@ -725,13 +733,89 @@ fn hostile_one_output_path_used_twice_is_refused() {
         .join("policies/paper/fig05-bt.toml")
         .display()
         .to_string();
-    let r = run_in(&dir.0, &["compare", &a, &b, "--mode", "named", "--dot", "-"], None, 60);
+    let r = run_in(
+        &dir.0,
+        &["compare", &a, &b, "--mode", "named", "--dot", "-"],
+        None,
+        60,
+    );
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("used twice"), "{}", r.stderr);
     assert!(r.stdout.is_empty());
     // Distinct paths are fine.
-    let r = run_in(&dir.0, &["sim", s, "--trace", "x.out", "--plot", "y.out"], None, 60);
+    let r = run_in(
+        &dir.0,
+        &["sim", s, "--trace", "x.out", "--plot", "y.out"],
+        None,
+        60,
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
+/// Graphviz is a child under a deadline: a `dot` that never answers (a
+/// script whose `sleep` child holds the pipes, first on the child's PATH)
+/// is killed at `--timeout-ms` and the run exits 2, writing nothing.
+#[cfg(unix)]
+#[test]
+fn hostile_graphviz_past_its_deadline_is_killed() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = Scratch::new("out-graphviz");
+    let bin = dir.0.join("bin");
+    std::fs::create_dir_all(&bin).expect("dir");
+    let fake = bin.join("dot");
+    std::fs::write(&fake, "#!/bin/sh\nsleep 30\n").expect("write");
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+    let f = fig01();
+    let b = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("policies/paper/fig05-bt.toml")
+        .display()
+        .to_string();
+    let cases: Vec<(Vec<&str>, u64)> = vec![
+        (
+            vec![
+                "dot",
+                &f,
+                "--render",
+                "svg",
+                "--timeout-ms",
+                "1000",
+                "-o",
+                "out.svg",
+            ],
+            1000,
+        ),
+        (
+            vec![
+                "compare",
+                &f,
+                &b,
+                "--mode",
+                "named",
+                "--timeout-ms",
+                "1000",
+                "--dot",
+                "out.svg",
+                "--render",
+                "svg",
+            ],
+            1000,
+        ),
+    ];
+    for (args, ms) in cases {
+        let r = run_in(&dir.0, &args, Some(&bin), 25);
+        assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
+        assert!(
+            r.stderr.contains(&format!("did not finish within {ms} ms")),
+            "{args:?}: {}",
+            r.stderr
+        );
+        assert!(
+            r.secs < ms as f64 / 1000.0 + 5.0,
+            "{args:?}: took {} s",
+            r.secs
+        );
+        assert!(!dir.0.join("out.svg").exists(), "{args:?} wrote a file");
+    }
 }
 
 /// A baseline whose numbers would wrap the gate's subtraction (cc =
@@ -763,8 +847,12 @@ fn hostile_baseline_numbers_out_of_range_are_refused() {
     }
     // Extreme growth limits do not wrap either.
     let base = dir.write("base.json", &json);
-    for (limit, want) in [("cc=-9223372036854775808", 1), ("cc=9223372036854775807", 0)] {
-        let (code, _, stderr) = btfsm(&["analyze", f, "--baseline", &base, "--max-increase", limit]);
+    for (limit, want) in [
+        ("cc=-9223372036854775808", 1),
+        ("cc=9223372036854775807", 0),
+    ] {
+        let (code, _, stderr) =
+            btfsm(&["analyze", f, "--baseline", &base, "--max-increase", limit]);
         assert_eq!(code, want, "{limit}: {stderr}");
     }
 }
