@@ -97,6 +97,7 @@ impl Destination {
                 }
                 Err(e) => return Err(e),
                 Ok(m) if m.file_type().is_symlink() => {
+                    refuse_planted_link(&dir, &full, &m)?;
                     let to = std::fs::read_link(&full)?;
                     p = if to.is_absolute() { to } else { dir.join(to) };
                 }
@@ -248,6 +249,29 @@ pub fn check_distinct(
             });
         }
         seen.push((id, flag, path));
+    }
+    Ok(())
+}
+
+/// Linux's `protected_symlinks` rule, which following a link by hand would
+/// bypass: a symlink in a sticky world-writable directory (`/tmp`) is
+/// followed only when it belongs to the follower or to the directory's
+/// owner; otherwise another user planted it (`/tmp/out.svg` ->
+/// `/etc/shadow`, waiting for root to write `-o /tmp/out.svg`).
+fn refuse_planted_link(dir: &Path, link: &Path, m: &Metadata) -> io::Result<()> {
+    let Ok(d) = std::fs::metadata(dir) else {
+        return Ok(());
+    };
+    // SAFETY: geteuid has no failure mode.
+    let me = unsafe { libc::geteuid() };
+    if d.mode() & 0o1002 == 0o1002 && m.uid() != d.uid() && m.uid() != me {
+        return Err(io::Error::new(
+            io::ErrorKind::PermissionDenied,
+            format!(
+                "`{}` is a symlink of another user in a shared sticky directory: not followed",
+                link.display()
+            ),
+        ));
     }
     Ok(())
 }
@@ -467,6 +491,29 @@ mod tests {
         let e = write_atomically(&d.0.join("loop"), b"x").unwrap_err();
         assert!(e.to_string().contains("symbolic links"), "{e}");
         assert_eq!(d.temporaries(), 0);
+    }
+
+    #[test]
+    fn a_symlink_planted_by_another_user_in_a_sticky_directory_is_refused() {
+        let d = Dir::new("sticky");
+        std::fs::set_permissions(&d.0, std::fs::Permissions::from_mode(0o1777)).unwrap();
+        let victim = d.0.join("victim");
+        std::fs::write(&victim, "keep").unwrap();
+        let link = d.0.join("out");
+        symlink(&victim, &link).unwrap();
+        // Only root can give the link to another user.
+        if std::os::unix::fs::lchown(&link, Some(54321), None).is_err() {
+            return;
+        }
+        let e = write_atomically(&link, b"data").unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::PermissionDenied, "{e}");
+        assert!(e.to_string().contains("not followed"), "{e}");
+        assert_eq!(std::fs::read(&victim).unwrap(), b"keep");
+        // The directory's owner's (or one's own) links are followed.
+        std::os::unix::fs::lchown(&link, Some(std::fs::metadata(&d.0).unwrap().uid()), None)
+            .unwrap();
+        write_atomically(&link, b"data").unwrap();
+        assert_eq!(std::fs::read(&victim).unwrap(), b"data");
     }
 
     #[test]
