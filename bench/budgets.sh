@@ -40,8 +40,9 @@ if [ "$what" = all ] || [ "$what" = sim ]; then
   # fires, so that no run ends before 10^6 steps (about 4 x 10^6 steps an
   # episode): far more work than any of the budgets allows (as in
   # tests/cli/sim.rs).
-  P=$(pwd)/policies/paper
-  sed -e "s#file = \"../paper/#file = \"$P/#" -e 's/^seed = /max_steps = 1000000\nseed = /' \
+  # The policies go beside it: files a scenario names stay inside its root.
+  cp policies/paper/fig01-bt.toml policies/paper/fig02-fsm.toml policies/paper/fig04-fsm.toml "$DIR/"
+  sed -e "s#file = \"../paper/#file = \"#" -e 's/^seed = /max_steps = 1000000\nseed = /' \
     policies/scenarios/exp1-nominal.toml > "$DIR/sim-huge.toml"
   printf '\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n' >> "$DIR/sim-huge.toml"
   echo "T_ms sim_millis wall_ms episodes_completed exit    (--runs 1000)"

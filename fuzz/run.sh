@@ -5,7 +5,7 @@
 # in fuzz/artifacts/TARGET/ (keep each as a regression test:
 # tests/fixtures/fuzz-regressions/, see docs/robustness.md).
 # Usage: fuzz/run.sh [TARGET...]   (default: every target in fuzz/Cargo.toml:
-# toml_policy, compare, btcpp_xml, scxml, scenario)
+# toml_policy, compare, btcpp_xml, scxml, scenario, project)
 set -eu
 cd "$(dirname "$0")"
 SECONDS_EACH=${FUZZ_SECONDS:-600}
@@ -29,16 +29,26 @@ for t in $TARGETS; do
         [ -f "$f" ] && cp "$f" "corpus/$t/seed-$(basename "$f")"
       done ;;
     btcpp_xml)
-      for f in $(find ../../shared/corpus/bt-xml ../tests/fixtures -name '*.xml' 2>/dev/null); do
+      for f in $(find ../tests/fixtures -name '*.xml' 2>/dev/null); do
         cp "$f" "corpus/$t/seed-$(echo "$f" | tr '/.' '__')"
       done ;;
     scxml)
-      for f in $(find ../../shared/corpus/scxml ../tests/fixtures -name '*.scxml' 2>/dev/null); do
+      for f in $(find ../tests/fixtures -name '*.scxml' 2>/dev/null); do
         cp "$f" "corpus/$t/seed-$(echo "$f" | tr '/.' '__')"
       done ;;
     scenario)
       for f in ../policies/scenarios/*.toml ../tests/fixtures/sim-invalid/*.toml; do
         [ -f "$f" ] && cp "$f" "corpus/$t/seed-$(basename "$f")"
+      done ;;
+    project)
+      # A BT including a parameterised subtree, a scenario with two
+      # policies, BehaviorTree.CPP files including each other.
+      { sed 's#lib/moma.toml#f1.toml#' ../policies/paper/fig16a-bt.toml; printf '\n%%%%\n'; cat ../policies/paper/lib/moma.toml; } > "corpus/$t/seed-fig16a"
+      { sed -e 's#\.\./paper/fig01-bt.toml#f1.toml#' -e 's#\.\./paper/fig04-fsm.toml#f2.toml#' -e 's#\.\./paper/fig02-fsm.toml#sub/f.toml#' ../policies/scenarios/exp1-pick-fails.toml
+        printf '\n%%%%\n'; cat ../policies/paper/fig01-bt.toml; printf '\n%%%%\n'; cat ../policies/paper/fig04-fsm.toml; printf '\n%%%%\n'; cat ../policies/paper/fig02-fsm.toml; } > "corpus/$t/seed-exp1"
+      printf '<root BTCPP_format="4" main_tree_to_execute="M">\n<include path="f1.xml"/>\n<BehaviorTree ID="M"><Sequence><SubTree ID="S"/><AlwaysSuccess/></Sequence></BehaviorTree>\n</root>\n%%%%\n<root BTCPP_format="4">\n<BehaviorTree ID="S"><Fallback><AlwaysFailure/><AlwaysSuccess/></Fallback></BehaviorTree>\n</root>\n' > "corpus/$t/seed-xml"
+      for f in ../tests/fixtures/fuzz-regressions/project-*; do
+        [ -f "$f" ] && cp "$f" "corpus/$t/"
       done ;;
     *)
       for f in ../tests/fixtures/fuzz-regressions/*; do
@@ -47,7 +57,7 @@ for t in $TARGETS; do
   esac
   dict=""
   [ -f "$t.dict" ] && dict="-dict=$t.dict"
-  case $t in toml_policy|compare|scenario) dict="-dict=toml.dict" ;; esac
+  case $t in toml_policy|compare|scenario|project) dict="-dict=toml.dict" ;; esac
   echo "== fuzzing $t for ${SECONDS_EACH}s"
   nice cargo +nightly fuzz run "$t" "corpus/$t" -- \
     -max_total_time="$SECONDS_EACH" -timeout="$TIMEOUT" -rss_limit_mb="$RSS" \

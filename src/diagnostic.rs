@@ -131,20 +131,31 @@ impl Diagnostic {
     }
 }
 
+/// Longest message or hint shown, in characters (a message quotes names
+/// from the input; readers cut those, this is the last bound).
+pub const MESSAGE_CHARS: usize = 1000;
+/// Characters of a source line shown in a snippet.
+pub const SNIPPET_CHARS: usize = 160;
+
 impl fmt::Display for Diagnostic {
+    /// Every part that comes from input (message, path, source line, hint)
+    /// goes through [`crate::sanitize`]: one line each, control characters
+    /// escaped, cut with a count.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use crate::sanitize::{shown, shown_max};
         let sev = match self.severity {
             Severity::Error => "error",
             Severity::Warning => "warning",
         };
-        writeln!(f, "{sev}: {}", self.message)?;
+        writeln!(f, "{sev}: {}", shown_max(&self.message, MESSAGE_CHARS))?;
         if let Some(file) = &self.file {
+            let path = shown_max(&file.path, 400);
             match &self.span {
                 Some(span) => {
                     let (line, col) = file.line_col(span.start);
                     let num = line.to_string();
                     let pad = " ".repeat(num.len());
-                    writeln!(f, "{pad}--> {}:{line}:{col}", file.path)?;
+                    writeln!(f, "{pad}--> {path}:{line}:{col}")?;
                     let text = file.line_text(line);
                     // Underline the span, clipped to this line.
                     let line_chars = text.chars().count();
@@ -155,21 +166,40 @@ impl fmt::Display for Diagnostic {
                             .take_while(|&c| c != '\n')
                             .count();
                     let width = span_chars.clamp(1, (line_chars + 1).saturating_sub(col).max(1));
-                    let shown: String = text.chars().take(200).collect();
+                    // The line as shown (escaped, cut), and where the caret
+                    // falls in it: each character takes the width of its
+                    // escaped form.
+                    let mut shown_line = String::new();
+                    let (mut caret_at, mut caret_len) = (None, 0usize);
+                    for (i, c) in text.chars().enumerate().take(SNIPPET_CHARS) {
+                        let mut buf = [0u8; 4];
+                        let piece = shown(c.encode_utf8(&mut buf));
+                        if i + 1 == col {
+                            caret_at = Some(shown_line.chars().count());
+                        }
+                        if i + 1 >= col && i + 1 < col + width {
+                            caret_len += piece.chars().count();
+                        }
+                        shown_line.push_str(&piece);
+                    }
+                    if line_chars > SNIPPET_CHARS {
+                        shown_line.push('…');
+                    }
+                    let caret_at = caret_at.unwrap_or(shown_line.chars().count());
                     writeln!(f, "{pad} |")?;
-                    writeln!(f, "{num} | {shown}")?;
+                    writeln!(f, "{num} | {shown_line}")?;
                     writeln!(
                         f,
                         "{pad} | {}{}",
-                        " ".repeat(col.saturating_sub(1).min(200)),
-                        "^".repeat(width.min(200))
+                        " ".repeat(caret_at),
+                        "^".repeat(caret_len.clamp(1, 200))
                     )?;
                 }
-                None => writeln!(f, " --> {}", file.path)?,
+                None => writeln!(f, " --> {path}")?,
             }
         }
         if let Some(hint) = &self.hint {
-            writeln!(f, "  = hint: {hint}")?;
+            writeln!(f, "  = hint: {}", shown_max(hint, MESSAGE_CHARS))?;
         }
         Ok(())
     }
@@ -269,6 +299,29 @@ mod tests {
         assert!(s.contains("2 | root = \"nope\""), "{s}");
         assert!(s.contains("  |        ^^^^^^"), "{s}");
         assert!(s.contains("= hint: did you mean `none`?"), "{s}");
+    }
+
+    #[test]
+    fn snippets_and_messages_are_escaped_and_cut() {
+        let f = SourceFile::new(
+            "p\u{1b}[2J.toml",
+            "a = \"x\u{1b}]0;t\u{7}\" # \u{202e}\nb = 2\n",
+        );
+        let d = Diagnostic::error("bad name `x\nerror: forged`")
+            .at(&f, 4..12)
+            .hint("h\r");
+        let s = d.to_string();
+        assert!(!crate::sanitize::has_raw_control(&s), "{s}");
+        assert_eq!(s.lines().count(), 6, "{s}");
+        assert!(s.contains("1 | a = \"x\\u{1b}]0;t\\u{7}\""), "{s}");
+        // The caret still starts under the opening quote.
+        assert!(s.contains("  |     ^"), "{s}");
+        let long = SourceFile::new("l.toml", "x".repeat(100_000));
+        let d = Diagnostic::error("m".repeat(100_000)).at(&long, 5..6);
+        assert!(
+            d.to_string().len() < 3 * (MESSAGE_CHARS + SNIPPET_CHARS),
+            "bounded"
+        );
     }
 
     #[test]

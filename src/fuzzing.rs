@@ -114,6 +114,77 @@ pub fn scenario(data: &[u8]) {
     }
 }
 
+/// Fuzz target `project`: several files that name each other (TOML
+/// subtrees with `with` parameters, BehaviorTree.CPP includes, a scenario
+/// and its policies). The bytes split at `\n%%\n` into at most six files,
+/// written to a scratch folder of this process: the first as `top.toml`
+/// (`top.xml` when it starts with `<`), the others as `f1.toml`, ...
+/// (`fN.xml` likewise) and the last also as `sub/f.toml`, so that paths
+/// with `..`, into `sub/` and out of the folder are all reachable. The
+/// first file is read as `btfsm` would (a scenario when it looks like one)
+/// under the confinement rule; an accepted policy goes through
+/// [`exercise`], a scenario runs 2000 steps.
+pub fn project(data: &[u8]) {
+    let dir = std::env::temp_dir().join(format!("btfsm-fuzz-project-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    if std::fs::create_dir_all(dir.join("sub")).is_err() {
+        return;
+    }
+    let mut parts: Vec<&[u8]> = Vec::new();
+    let mut rest = data;
+    loop {
+        let (a, b) = split_pair(rest);
+        parts.push(a);
+        if b.is_empty() || parts.len() == 6 {
+            break;
+        }
+        rest = b;
+    }
+    let ext = |p: &[u8]| {
+        if p.trim_ascii_start().starts_with(b"<") {
+            "xml"
+        } else {
+            "toml"
+        }
+    };
+    let mut top = None;
+    for (i, p) in parts.iter().enumerate() {
+        let name = if i == 0 {
+            format!("top.{}", ext(p))
+        } else {
+            format!("f{i}.{}", ext(p))
+        };
+        let path = dir.join(&name);
+        if std::fs::write(&path, p).is_err() {
+            return;
+        }
+        if i == 0 {
+            top = Some(path);
+        }
+    }
+    if let Some(last) = parts.last() {
+        let _ = std::fs::write(dir.join("sub/f.toml"), last);
+    }
+    let Some(top) = top else { return };
+    let limits = limits();
+    match crate::format::read_input(&top, &limits) {
+        Ok((file, crate::format::Input::Scenario)) => {
+            match crate::sim::scenario::parse(&file, &dir, &limits) {
+                Ok(mut s) => {
+                    s.max_steps = s.max_steps.min(2000);
+                    let _ = crate::sim::run::run_scenario(&s, true);
+                }
+                Err(diags) => check_diagnostics(&diags),
+            }
+        }
+        Ok((file, crate::format::Input::Policy(f))) => {
+            accepted(crate::format::load_read(file, &top, f, &limits));
+        }
+        Err(diags) => check_diagnostics(&diags),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// An importer's result: checked diagnostics, or [`exercise`] when the
 /// policy is within the shape limits `format::load` enforces for every
 /// format.
@@ -277,6 +348,7 @@ mod tests {
                 Some("btcpp_xml") => btcpp_xml(&data),
                 Some("scxml") => scxml(&data),
                 Some("scenario") => scenario(&data),
+                Some("project") => project(&data),
                 other => panic!("{}: no fuzz target `{other:?}`", f.display()),
             }
         }
@@ -298,5 +370,16 @@ mod tests {
         pair.extend_from_slice(&b);
         compare(&pair);
         toml_policy(&a);
+    }
+
+    #[test]
+    fn project_files_name_each_other() {
+        // A top file including f1 with a parameter, f1 including sub/f.toml
+        // through `..`-free and `..` paths; then a scenario with a policy.
+        project(
+            b"kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"f1.toml\", with = { v = \"x\" } }\n%%\nkind = \"bt\"\nroot = \"a\"\n[params]\nv = \"\"\n[nodes]\na = { action = \"{v}\", skill = \"Dock\" }\n",
+        );
+        project(b"kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"../../etc/passwd\" }\n");
+        project(b"name = \"s\"\n[world]\n[[policies]]\nfile = \"f1.toml\"\n%%\nkind = \"bt\"\nroot = \"a\"\n[nodes]\na = { action = \"D\", skill = \"Dock\" }\n");
     }
 }

@@ -16,6 +16,7 @@ pub mod metrics;
 pub mod model;
 pub mod render;
 pub mod report;
+pub mod sanitize;
 pub mod sim;
 pub mod transform;
 

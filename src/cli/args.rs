@@ -185,7 +185,8 @@ pub struct LimitArgs {
     /// Largest input file, in bytes (also the total read through subtree includes)
     #[arg(long, default_value_t = crate::format::DEFAULT_MAX_FILE_BYTES, hide_short_help = true)]
     pub max_file_bytes: u64,
-    /// Most BT nodes or FSM states per policy, subtrees expanded
+    /// Most BT nodes or FSM states per policy, subtrees expanded (and most
+    /// nodes all policies of the command create by copying subtrees)
     #[arg(long, default_value_t = crate::format::DEFAULT_MAX_NODES, hide_short_help = true)]
     pub max_nodes: usize,
     /// Deepest BT or HFSM nesting (the root is at depth 0)
@@ -202,6 +203,19 @@ pub struct LimitArgs {
     /// (default: an error listing the known types)
     #[arg(long, value_enum, value_name = "KIND")]
     pub assume_leaf: Option<AssumeLeafArg>,
+    /// Most bytes the command reads in all its files (includes, node models,
+    /// baselines, traces and repeated arguments each count)
+    #[arg(long, default_value_t = crate::format::source::DEFAULT_MAX_TOTAL_BYTES, hide_short_help = true)]
+    pub max_total_bytes: u64,
+    /// Directory that files named by a policy or scenario (subtrees,
+    /// includes, scenario policies) must stay inside [default: the git work
+    /// tree of the file given, else its directory]
+    #[arg(long, value_name = "DIR", conflicts_with = "allow_outside_root")]
+    pub root: Option<PathBuf>,
+    /// Let policies and scenarios name files anywhere (absolute paths, `..`
+    /// out of the root): for trusted local files only
+    #[arg(long)]
+    pub allow_outside_root: bool,
 }
 
 impl LimitArgs {
@@ -216,6 +230,13 @@ impl LimitArgs {
                 AssumeLeafArg::Action => crate::format::AssumeLeaf::Action,
                 AssumeLeafArg::Condition => crate::format::AssumeLeaf::Condition,
             }),
+            confinement: match (&self.root, self.allow_outside_root) {
+                (_, true) => crate::format::source::Confinement::Off,
+                (Some(r), false) => crate::format::source::Confinement::Root(r.clone()),
+                (None, false) => crate::format::source::Confinement::Auto,
+            },
+            read_budget: crate::format::source::Budget::new(self.max_total_bytes),
+            expansion_budget: crate::format::source::Budget::new(self.max_nodes as u64),
             ..Default::default()
         }
     }

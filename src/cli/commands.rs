@@ -6,6 +6,7 @@ use crate::diagnostic::Diagnostic;
 use crate::format::{self, Limits, Loaded};
 use crate::report::gate::{Baseline, Gate, Limit};
 use crate::report::{self, analyze, render_analysis};
+use crate::sanitize::shown;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -27,7 +28,7 @@ pub fn execute(cli: Cli) -> u8 {
                 return EXIT_BAD_INPUT;
             };
             let reports: Vec<_> = loaded.iter().map(analyze).collect();
-            let code = emit(None, render_analysis(&reports, format).as_bytes());
+            let code = emit_text(None, render_analysis(&reports, format));
             if code != EXIT_OK || gate.is_empty() {
                 return code;
             }
@@ -39,37 +40,47 @@ pub fn execute(cli: Cli) -> u8 {
             let mut err = stderr.lock();
             let mut failed = false;
             for f in &files {
-                // A scenario is validated as `sim` reads it (its policies
-                // included), without running it.
-                if format::detect(f) == format::FileFormat::Toml
-                    && crate::sim::scenario::looks_like_scenario(&format::read_head(f))
-                {
-                    match crate::sim::scenario::load(f, &limits) {
-                        Ok(s) => {
-                            let _ = writeln!(
-                                err,
-                                "{}: ok (scenario `{}`, {} polic{})",
-                                f.display(),
-                                s.name,
-                                s.policies.len(),
-                                if s.policies.len() == 1 { "y" } else { "ies" }
-                            );
-                        }
-                        Err(diags) => {
-                            failed = true;
-                            print_diagnostics(&mut err, &diags);
-                        }
+                // Read once; a scenario is validated as `sim` reads it (its
+                // policies included), without running it.
+                let (file, input) = match format::read_input(f, &limits) {
+                    Ok(r) => r,
+                    Err(diags) => {
+                        failed = true;
+                        print_diagnostics(&mut err, &diags);
+                        continue;
                     }
-                    continue;
-                }
-                match load_reporting(f, &limits, &mut err) {
+                };
+                let fmt = match input {
+                    format::Input::Policy(fmt) => fmt,
+                    format::Input::Scenario => {
+                        let base = f.parent().unwrap_or(Path::new(""));
+                        match crate::sim::scenario::parse(&file, base, &limits) {
+                            Ok(s) => {
+                                let _ = writeln!(
+                                    err,
+                                    "{}: ok (scenario `{}`, {} polic{})",
+                                    shown(&f.display().to_string()),
+                                    shown(&s.name),
+                                    s.policies.len(),
+                                    if s.policies.len() == 1 { "y" } else { "ies" }
+                                );
+                            }
+                            Err(diags) => {
+                                failed = true;
+                                print_diagnostics(&mut err, &diags);
+                            }
+                        }
+                        continue;
+                    }
+                };
+                match reported(format::load_read(file, f, fmt, &limits), &mut err) {
                     Some(l) => {
                         let _ = writeln!(
                             err,
                             "{}: ok ({} `{}`, {} warning{})",
-                            l.path,
+                            shown(&l.path),
                             l.policy.kind(),
-                            l.policy.name,
+                            shown(&l.policy.name),
                             l.warnings.len(),
                             if l.warnings.len() == 1 { "" } else { "s" },
                         );
@@ -135,8 +146,9 @@ pub fn execute(cli: Cli) -> u8 {
                         Err(errs) => {
                             for e in errs {
                                 eprintln!(
-                                    "error: {}: {e}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
-                                    l.path
+                                    "error: {}: {}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
+                                    shown(&l.path),
+                                    crate::sanitize::shown_max(&e.to_string(), 1000)
                                 );
                             }
                             return EXIT_BAD_INPUT;
@@ -149,9 +161,9 @@ pub fn execute(cli: Cli) -> u8 {
                             let node = &bt.nodes[n];
                             eprintln!(
                                 "warning: {}: `{}` node `{}` becomes a container re-entered at its first state every tick: the HFSM counts as the paper's construction but does not keep the node's memory",
-                                l.path,
+                                shown(&l.path),
                                 node.kind.keyword(),
-                                node.id
+                                shown(&node.id)
                             );
                         }
                     }
@@ -160,7 +172,8 @@ pub fn execute(cli: Cli) -> u8 {
                         Err(errs) => {
                             for e in errs {
                                 eprintln!(
-                                    "error: {e}\n  = hint: the construction covers sequence, fallback (with or without memory), inverter, force_success, force_failure and leaves"
+                                    "error: {}\n  = hint: the construction covers sequence, fallback (with or without memory), inverter, force_success, force_failure and leaves",
+                                    crate::sanitize::shown_max(&e.to_string(), 1000)
                                 );
                             }
                             return EXIT_BAD_INPUT;
@@ -169,7 +182,7 @@ pub fn execute(cli: Cli) -> u8 {
                 }
             };
             let text = crate::format::toml_write::write_policy(&policy);
-            emit(output.as_deref(), text.as_bytes())
+            emit_text(output.as_deref(), text)
         }
         Command::Effort {
             files,
@@ -195,7 +208,7 @@ pub(super) fn draw(
     use crate::render::dot::{self, RenderFormat};
     let text = dot::policy_dot(policy, opts);
     let Some(fmt) = render else {
-        return emit(output, text.as_bytes());
+        return emit_text(output, text);
     };
     if output.is_none() && fmt != RenderFormat::Svg {
         eprintln!("error: {fmt} output is binary; write it to a file with -o");
@@ -204,7 +217,10 @@ pub(super) fn draw(
     match dot::render(&text, fmt, timeout) {
         Ok(bytes) => emit(output, &bytes),
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!(
+                "error: {}",
+                crate::sanitize::shown_max(&e.to_string(), 2000)
+            );
             EXIT_BAD_INPUT
         }
     }
@@ -233,7 +249,12 @@ pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>
 
 /// Reads one policy, printing its warnings or its errors to `err`.
 fn load_reporting(f: &Path, limits: &Limits, err: &mut impl Write) -> Option<Loaded> {
-    match format::load(f, limits) {
+    reported(format::load(f, limits), err)
+}
+
+/// A policy read, its warnings printed to `err`; or its errors printed.
+fn reported(r: Result<Loaded, Vec<Diagnostic>>, err: &mut impl Write) -> Option<Loaded> {
+    match r {
         Ok(l) => {
             for w in &l.warnings {
                 let _ = write!(err, "{w}");
@@ -257,8 +278,14 @@ pub(super) fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
             .iter()
             .find_map(|d| d.file.as_ref().map(|f| f.path.clone()))
             .unwrap_or_default();
-        let _ = writeln!(w, "error: {file}: {n} problems");
+        let _ = writeln!(w, "error: {}: {n} problems", shown(&file));
     }
+}
+
+/// Writes a text output (report, DOT, SVG, policy) through
+/// [`super::out::text`] to a file (atomically) or stdout.
+pub(super) fn emit_text(path: Option<&Path>, text: impl AsRef<str>) -> u8 {
+    emit(path, super::out::text(text.as_ref()).as_bytes())
 }
 
 /// Writes output to a file (see `report::output`: atomically, through
@@ -291,8 +318,12 @@ pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
 }
 
 fn cannot_write(path: Option<&Path>, e: std::io::Error) -> u8 {
-    let shown = path.map_or_else(|| "-".into(), |p| p.display().to_string());
-    eprintln!("error: cannot write `{shown}`: {e}");
+    let path = path.map_or_else(|| "-".into(), |p| p.display().to_string());
+    eprintln!(
+        "error: cannot write `{}`: {}",
+        shown(&path),
+        crate::sanitize::shown_max(&e.to_string(), 2000)
+    );
     EXIT_BAD_INPUT
 }
 
@@ -307,7 +338,10 @@ pub(super) fn outputs_distinct(outputs: &[(&str, Option<&Path>)], report_on_stdo
     match crate::report::output::check_distinct(&given, report_on_stdout) {
         Ok(()) => true,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!(
+                "error: {}",
+                crate::sanitize::shown_max(&e.to_string(), 2000)
+            );
             false
         }
     }
@@ -363,7 +397,10 @@ fn check_gate(gate: &Gate, reports: &[report::PolicyReport]) -> u8 {
             .collect();
         rules.push(format!("growth over `{}`: {}", b.path, grow.join(", ")));
         for f in &r.new_policies {
-            eprintln!("note: `{f}` is not in the baseline; only its ceilings are checked");
+            eprintln!(
+                "note: `{}` is not in the baseline; only its ceilings are checked",
+                shown(f)
+            );
         }
     }
     let n = reports.len();
@@ -376,7 +413,10 @@ fn check_gate(gate: &Gate, reports: &[report::PolicyReport]) -> u8 {
         return EXIT_OK;
     }
     for v in &r.violations {
-        eprintln!("error: complexity gate: {v}");
+        eprintln!(
+            "error: complexity gate: {}",
+            crate::sanitize::shown_max(&v.to_string(), 1000)
+        );
     }
     eprintln!(
         "error: complexity gate: {} limit{} exceeded in {n} {policies} ({})",

@@ -5,7 +5,7 @@
 //! computed and how much of its budget is spent.
 
 use super::args::{CompareFormat, CompareMode};
-use super::commands::{draw, emit, load_all};
+use super::commands::{draw, emit_text, load_all};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use crate::format::Limits;
 use crate::metrics::ged::{GedMode, GedOptions};
@@ -73,7 +73,7 @@ pub fn execute(args: CompareArgs) -> u8 {
         CompareFormat::Table => compare::render_table(&report),
         CompareFormat::Markdown => compare::render_markdown(&report),
     };
-    emit(None, text.as_bytes())
+    emit_text(None, text)
 }
 
 /// A progress line on stderr, shown after a short delay while a search runs

@@ -19,9 +19,12 @@ pub fn to_xml(p: &Policy, to: ConvertTarget, output: Option<&Path>) -> u8 {
             .map_err(|e| (e.to_string(), "convert a behavior tree with --to btcpp-xml")),
     };
     match text {
-        Ok(t) => super::commands::emit(output, t.as_bytes()),
+        Ok(t) => super::commands::emit_text(output, t),
         Err((msg, hint)) => {
-            eprintln!("error: {msg}\n  = hint: {hint}");
+            eprintln!(
+                "error: {}\n  = hint: {hint}",
+                crate::sanitize::shown_max(&msg.to_string(), 1000)
+            );
             EXIT_BAD_INPUT
         }
     }

@@ -4,9 +4,10 @@
 //! to stderr.
 
 use super::args::{AddKind, EditArgs, EditOp, WrapKind};
-use super::commands::{emit, load_one};
+use super::commands::{emit_text, load_one};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use crate::model::{BtNodeKind, PolicyBody, SkillCall};
+use crate::sanitize::{shown, shown_max};
 use crate::transform::edit::{self, AddState, EditError, Touched};
 use std::collections::BTreeMap;
 
@@ -18,13 +19,17 @@ pub fn edit(a: &EditArgs) -> u8 {
     let mut policy = loaded.policy;
     let kind = policy.kind();
     let fail = |e: EditError| {
-        eprintln!("error: {}: {e}", loaded.path);
+        eprintln!(
+            "error: {}: {}",
+            shown(&loaded.path),
+            shown_max(&e.to_string(), 1000)
+        );
         EXIT_BAD_INPUT
     };
     let wrong_kind = |op: &str, want: &str| {
         eprintln!(
             "error: {}: {op} edits {want}, and this policy is a {kind}",
-            loaded.path
+            shown(&loaded.path)
         );
         EXIT_BAD_INPUT
     };
@@ -44,7 +49,7 @@ pub fn edit(a: &EditArgs) -> u8 {
             let PolicyBody::Bt(sub_bt) = &sub.policy.body else {
                 eprintln!(
                     "error: {}: the subtree must be a BT, and this is a {}",
-                    sub.path,
+                    shown(&sub.path),
                     sub.policy.kind()
                 );
                 return EXIT_BAD_INPUT;
@@ -137,7 +142,7 @@ pub fn edit(a: &EditArgs) -> u8 {
         }
         return EXIT_BAD_INPUT;
     }
-    let code = emit(a.output.as_deref(), text.as_bytes());
+    let code = emit_text(a.output.as_deref(), text);
     if code == EXIT_OK {
         eprintln!(
             "edit: {} added, {} modified, transitions +{} -{} ({} unit edits)",

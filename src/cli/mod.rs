@@ -2,11 +2,32 @@
 //! flags into [`args::Cli`], then each command validates what it was given and
 //! runs against the library. Only this module prints.
 
+// `eprintln!` and `eprint!` inside `cli` are these, not std's: std's panic
+// when stderr cannot be written (a full device turned a failed gate's exit 1
+// into 101), and print what they are given raw. These escape every control
+// character but newline and tab (`sanitize::stream`) and ignore write
+// errors, so that the exit code keeps its documented meaning. Defined before
+// the submodules so that their textual scope covers them.
+macro_rules! eprintln {
+    () => {
+        $crate::cli::out::stderr("\n")
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::out::stderr(&format!("{}\n", format_args!($($arg)*)))
+    };
+}
+macro_rules! eprint {
+    ($($arg:tt)*) => {
+        $crate::cli::out::stderr(&format!($($arg)*))
+    };
+}
+
 pub mod args;
 mod commands;
 mod compare;
 mod convert;
 mod edit;
+pub mod out;
 mod paper;
 pub mod sim;
 

@@ -1,7 +1,7 @@
 //! `btfsm paper` and `btfsm effort`: load, compute through the library, print.
 
 use super::args::PaperArgs;
-use super::commands::{emit, load_all};
+use super::commands::{emit_text, load_all};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use crate::format::Limits;
 use crate::metrics::effort::effort as compute_effort;
@@ -29,7 +29,7 @@ pub fn effort(files: &[PathBuf], format: OutputFormat, timeout_ms: u64, limits: 
         .iter()
         .map(|l| EffortRow::new(&l.path, &l.policy.name, &compute_effort(&l.policy, &opts).0))
         .collect();
-    emit(None, render_effort(&rows, format).as_bytes())
+    emit_text(None, render_effort(&rows, format))
 }
 
 /// `btfsm paper`.
@@ -46,7 +46,7 @@ pub fn paper(a: &PaperArgs) -> u8 {
     let expected_path = a.policies.join(EXPECTED_FILE);
     if a.record {
         let text = paper::expected_toml(&report);
-        let code = emit(Some(&expected_path), text.as_bytes());
+        let code = emit_text(Some(&expected_path), text);
         if code == EXIT_OK {
             eprintln!(
                 "recorded {} cells in `{}`",
@@ -86,8 +86,5 @@ pub fn paper(a: &PaperArgs) -> u8 {
         );
         return EXIT_CHECK_FAILED;
     }
-    emit(
-        a.output.as_deref(),
-        paper::render(&report, a.format).as_bytes(),
-    )
+    emit_text(a.output.as_deref(), paper::render(&report, a.format))
 }

@@ -2,7 +2,7 @@
 //! prints outcomes, executed skills, final worlds and behavior-match verdicts
 //! (SPEC §6, §7); `--runs N` runs seeded Monte Carlo episodes instead.
 
-use super::commands::{emit, print_diagnostics};
+use super::commands::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use crate::report::OutputFormat;
 use crate::sim::report::{McReport, SimReport};
@@ -102,7 +102,7 @@ pub fn execute(a: SimArgs) -> u8 {
             &budget,
             &note,
         );
-        return emit(None, text.as_bytes());
+        return emit_text(None, text);
     }
     if let Some(seed) = a.seed {
         s.seed = seed;
@@ -130,12 +130,12 @@ pub fn execute(a: SimArgs) -> u8 {
         millis: Some(millis),
     });
     if let Some(p) = &a.trace
-        && emit(Some(p), rep.trace_json().as_bytes()) != EXIT_OK
+        && emit_text(Some(p), rep.trace_json()) != EXIT_OK
     {
         return EXIT_BAD_INPUT;
     }
     if let Some(p) = &a.plot
-        && emit(Some(p), plot::svg(&s, &rep.policies).as_bytes()) != EXIT_OK
+        && emit_text(Some(p), plot::svg(&s, &rep.policies)) != EXIT_OK
     {
         return EXIT_BAD_INPUT;
     }
@@ -148,7 +148,7 @@ pub fn execute(a: SimArgs) -> u8 {
         &budget,
         note,
     );
-    emit(None, text.as_bytes())
+    emit_text(None, text)
 }
 
 /// What `--timeout-ms` adds to a JSON report.
@@ -201,7 +201,9 @@ fn with_budget<T: serde::Serialize>(report: &T, budget: &Budget) -> String {
         report: &'a T,
         budget: &'a Budget,
     }
-    let mut s = serde_json::to_string_pretty(&Out { report, budget }).expect("serializable");
+    let mut s = crate::sanitize::json(
+        serde_json::to_string_pretty(&Out { report, budget }).expect("serializable"),
+    );
     s.push('\n');
     s
 }

@@ -212,6 +212,16 @@ pub fn canonical_type(kind: BtNodeKind) -> Option<&'static str> {
 pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
     let file = super::toml::read_source(path, &shown, limits)?;
+    load_read(file, path, limits)
+}
+
+/// Reads BehaviorTree.CPP XML already read from `path` (includes resolve
+/// beside it).
+pub fn load_read(
+    file: Arc<SourceFile>,
+    path: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
     let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
     load(file, super::toml::canonical(path), base, limits)
 }
@@ -241,6 +251,8 @@ struct Loader<'l> {
     /// Tree ID -> (document, `<BehaviorTree>` element).
     trees: BTreeMap<String, (usize, usize)>,
     models: BTreeMap<String, ModelEntry>,
+    /// The directory every included file must be in (`None`: anywhere).
+    root: Option<PathBuf>,
 }
 
 fn load(
@@ -250,7 +262,9 @@ fn load(
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let main = xml::parse(&file).map_err(|d| vec![d])?;
+    let root = super::source::root_for(limits, &base);
     let mut l = Loader {
+        root,
         limits,
         diags: Vec::new(),
         docs: vec![main],
@@ -349,7 +363,14 @@ impl Loader<'_> {
                 continue;
             };
             let (pval, pspan) = (p.value.clone(), p.span.clone());
-            let full = self.dirs[d].join(&pval);
+            let full = match super::source::resolve(self.root.as_deref(), &self.dirs[d], &pval) {
+                Ok(p) => p,
+                Err(r) => {
+                    self.err(d, pspan, format!("cannot include this file: {}", r.message))
+                        .hint = Some(r.hint);
+                    continue;
+                }
+            };
             let canon = super::toml::canonical(&full);
             if let Some(at) = chain.iter().position(|c| *c == canon) {
                 let mut names: Vec<String> = shown_chain[at..].to_vec();

@@ -5,6 +5,7 @@ pub mod btcpp_xml;
 pub mod btcpp_xml_write;
 pub mod scxml;
 pub mod scxml_write;
+pub mod source;
 pub mod toml;
 pub mod toml_write;
 pub mod xml;
@@ -44,6 +45,17 @@ pub struct Limits {
     /// How to read a BehaviorTree.CPP leaf of unknown type (`--assume-leaf`);
     /// `None`: such a leaf is an error.
     pub assume_leaf: Option<AssumeLeaf>,
+    /// Where files named by other files may be (`--root`,
+    /// `--allow-outside-root`; [`source::resolve`]).
+    pub confinement: source::Confinement,
+    /// The bytes the whole command may read (`--max-total-bytes`), shared
+    /// by every clone of these limits.
+    pub read_budget: Arc<source::Budget>,
+    /// The nodes the whole command may create by copying a subtree already
+    /// read (TOML subtrees used again, BehaviorTree.CPP `<SubTree>`s):
+    /// `max_nodes` in all, so that a few kilobytes of files including each
+    /// other twice per level cannot build millions of nodes per policy.
+    pub expansion_budget: Arc<source::Budget>,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -56,7 +68,7 @@ pub enum AssumeLeaf {
 /// Default of [`Limits::max_file_bytes`].
 pub const DEFAULT_MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 /// Default of [`Limits::max_nodes`].
-pub const DEFAULT_MAX_NODES: usize = 2_000_000;
+pub const DEFAULT_MAX_NODES: usize = 150_000;
 /// Default of [`Limits::max_depth`].
 pub const DEFAULT_MAX_DEPTH: usize = 1_000;
 /// Default of [`Limits::max_name_bytes`].
@@ -72,6 +84,9 @@ impl Default for Limits {
             max_name_bytes: DEFAULT_MAX_NAME_BYTES,
             nodes_models: Vec::new(),
             assume_leaf: None,
+            confinement: source::Confinement::Auto,
+            read_budget: source::Budget::new(source::DEFAULT_MAX_TOTAL_BYTES),
+            expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
         }
     }
 }
@@ -175,13 +190,17 @@ pub enum FileFormat {
 
 /// The format of a file: by extension (`.toml`, `.scxml`, `.xml`), else by its
 /// first bytes (`<scxml`, `<root`, ...); TOML otherwise.
-pub fn detect(path: &Path) -> FileFormat {
+pub fn detect(path: &Path, text: &str) -> FileFormat {
     match path.extension().and_then(|e| e.to_str()) {
         Some(e) if e.eq_ignore_ascii_case("toml") => return FileFormat::Toml,
         Some(e) if e.eq_ignore_ascii_case("scxml") => return FileFormat::Scxml,
         _ => {}
     }
-    let head = read_head(path);
+    let mut end = text.len().min(4096);
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    let head = &text[..end];
     let is_xml_ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -195,22 +214,58 @@ pub fn detect(path: &Path) -> FileFormat {
     }
 }
 
-/// The first few kilobytes of a file (lossy), for sniffing.
-pub(crate) fn read_head(path: &Path) -> String {
-    use std::io::Read;
-    let mut buf = vec![0u8; 4096];
-    let n = std::fs::File::open(path)
-        .and_then(|mut f| f.read(&mut buf))
-        .unwrap_or(0);
-    String::from_utf8_lossy(&buf[..n]).into_owned()
+/// What a command-line file holds, read once (so that a pipe or
+/// `/dev/stdin` works, and nothing is opened twice).
+pub enum Input {
+    Policy(FileFormat),
+    /// A simulator scenario (`sim`, `validate`).
+    Scenario,
+}
+
+/// Reads a command-line file once ([`source::read`]: bounded, charged,
+/// never blocking on a FIFO) and tells what it holds.
+pub fn read_input(
+    path: &Path,
+    limits: &Limits,
+) -> Result<(Arc<SourceFile>, Input), Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    let file = source::read(path, &shown, limits, false)?;
+    let input = match detect(path, &file.text) {
+        FileFormat::Toml if crate::sim::scenario::looks_like_scenario(head(&file.text)) => {
+            Input::Scenario
+        }
+        f => Input::Policy(f),
+    };
+    Ok((file, input))
+}
+
+fn head(text: &str) -> &str {
+    let mut end = text.len().min(4096);
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    &text[..end]
 }
 
 /// Reads a policy from any supported format (see [`detect`]).
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
-    let loaded = match detect(path) {
-        FileFormat::Toml => toml::load_file(path, limits),
-        FileFormat::BtcppXml => btcpp_xml::load_file(path, limits),
-        FileFormat::Scxml => scxml::load_file(path, limits),
+    let shown = path.display().to_string();
+    let file = source::read(path, &shown, limits, false)?;
+    let format = detect(path, &file.text);
+    load_read(file, path, format, limits)
+}
+
+/// A policy from a file already read from `path` (see [`read_input`]).
+pub fn load_read(
+    file: Arc<SourceFile>,
+    path: &Path,
+    format: FileFormat,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let loaded = match format {
+        FileFormat::Toml => toml::load_read(&file, path, limits),
+        FileFormat::BtcppXml => btcpp_xml::load_read(file, path, limits),
+        FileFormat::Scxml => scxml::load_read(file, limits),
     }?;
     // Every format: node count and nesting depth (the TOML reader has
     // already said where).

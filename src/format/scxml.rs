@@ -50,6 +50,11 @@ pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>
     load(file, limits)
 }
 
+/// Reads SCXML already read from a file.
+pub fn load_read(file: Arc<SourceFile>, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    load(file, limits)
+}
+
 /// Reads SCXML from text.
 pub fn parse_str(name: &str, text: &str, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     load(SourceFile::new(name, text), limits)

@@ -14,9 +14,11 @@ use crate::model::skill::{self, ArgValue, Guard, GuardTerm, SkillCall, SkillKind
 use crate::model::{
     Bt, Policy, PolicyBody, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
+use std::cell::Cell;
 use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 use std::sync::Arc;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
@@ -30,8 +32,17 @@ pub const TASK_OUTCOMES: &[&str] = &["SUCCESS", "FAILURE", "RUNNING"];
 pub fn load_file(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
     let file = read_source(path, &shown, limits)?;
+    load_read(&file, path, limits)
+}
+
+/// Reads a TOML policy already read from `path` (includes resolve beside it).
+pub fn load_read(
+    file: &Arc<SourceFile>,
+    path: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
     let base = path.parent().unwrap_or(Path::new(""));
-    load_source(&file, canonical(path), base, limits)
+    load_source(file, canonical(path), base, limits)
 }
 
 /// Parses a policy from text (tests, stdin); includes resolve against `base`.
@@ -63,6 +74,12 @@ fn load_source(
         dropped_errors: 0,
         dropped_warnings: 0,
         scratch: Diagnostic::error(""),
+        root: super::source::root_for(limits, base),
+        subst: Rc::new(SubstBudget {
+            max_one: limits.max_name_bytes,
+            left: Cell::new(limits.max_file_bytes),
+            overflow: Cell::new(false),
+        }),
     };
     let mut policy = loader.policy(file, base);
     if let Some(mut d) = policy.as_ref().and_then(|p| super::check_shape(p, limits)) {
@@ -97,99 +114,27 @@ fn load_source(
 }
 
 pub(crate) fn canonical(p: &Path) -> PathBuf {
-    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
+    super::source::canonical(p)
 }
 
 /// Reads a policy file named on the command line (a pipe or device is read
-/// up to the size limit).
+/// up to the size limit, never blocking on a FIFO with no writer).
 pub(crate) fn read_source(
     path: &Path,
     shown: &str,
     limits: &Limits,
 ) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
-    read_file(path, shown, limits, false)
+    super::source::read(path, shown, limits, false)
 }
 
-/// Reads a file another file includes: it must be a regular file.
+/// Reads a file another file names, once [`super::source::resolve`] has
+/// placed it inside the root: it must be a regular file.
 pub(crate) fn read_included(
     path: &Path,
     shown: &str,
     limits: &Limits,
 ) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
-    read_file(path, shown, limits, true)
-}
-
-fn read_file(
-    path: &Path,
-    shown: &str,
-    limits: &Limits,
-    include: bool,
-) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
-    use std::io::Read;
-    let cannot = |e: std::io::Error| {
-        vec![Diagnostic::error(format!(
-            "cannot read `{shown}`: {}",
-            io_msg(&e)
-        ))]
-    };
-    let meta = std::fs::metadata(path).map_err(cannot)?;
-    if meta.is_dir() {
-        return Err(vec![Diagnostic::error(format!(
-            "cannot read `{shown}`: it is a directory"
-        ))]);
-    }
-    // A subtree is a file; a device or pipe could block or never end.
-    if include && !meta.is_file() {
-        return Err(vec![
-            Diagnostic::error(format!("cannot read `{shown}`: not a regular file"))
-                .hint("a subtree is a policy file"),
-        ]);
-    }
-    let too_big = |len: Option<u64>| {
-        let size = len.map_or_else(|| "larger than".into(), |n| format!("{n} bytes, more than"));
-        vec![
-            Diagnostic::error(format!(
-                "`{shown}` is {size} the limit of {} bytes",
-                limits.max_file_bytes
-            ))
-            .hint("raise the limit with --max-file-bytes"),
-        ]
-    };
-    if meta.len() > limits.max_file_bytes {
-        return Err(too_big(Some(meta.len())));
-    }
-    // Read at most one byte past the limit: pipes and devices report no size.
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| {
-            f.take(limits.max_file_bytes.saturating_add(1))
-                .read_to_end(&mut bytes)
-        })
-        .map_err(cannot)?;
-    if bytes.len() as u64 > limits.max_file_bytes {
-        return Err(too_big(None));
-    }
-    match String::from_utf8(bytes) {
-        Ok(text) => Ok(SourceFile::new(shown, text)),
-        Err(e) => {
-            let off = e.utf8_error().valid_up_to();
-            let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
-            let f = SourceFile::new(shown, text);
-            Err(vec![
-                Diagnostic::error("file is not valid UTF-8")
-                    .at(&f, off..off + 1)
-                    .hint("policy files are UTF-8 text"),
-            ])
-        }
-    }
-}
-
-fn io_msg(e: &std::io::Error) -> String {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".into(),
-        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
-        _ => e.to_string().to_lowercase(),
-    }
+    super::source::read(path, shown, limits, true)
 }
 
 /// An included file (canonical path) with its `with` values.
@@ -212,6 +157,9 @@ struct Loader {
     dropped_errors: usize,
     dropped_warnings: usize,
     scratch: Diagnostic,
+    /// The directory every included file must be in (`None`: anywhere).
+    root: Option<PathBuf>,
+    subst: Rc<SubstBudget>,
 }
 
 /// Most messages kept per policy file (with its includes); the rest are
@@ -225,6 +173,21 @@ struct Ctx<'a> {
     base: &'a Path,
     /// Subtree parameters substituted into strings as `{name}`.
     params: BTreeMap<String, String>,
+    /// What substitution may still produce (shared by every file of a
+    /// policy).
+    subst: Rc<SubstBudget>,
+}
+
+/// Bounds on parameter substitution: each result at most `max_name_bytes`
+/// (it becomes an id, label or argument, all bounded so), and all results
+/// of a policy together at most `--max-file-bytes`, so that parameters
+/// doubled level by level cannot multiply a few kilobytes into gigabytes.
+#[derive(Debug)]
+struct SubstBudget {
+    max_one: usize,
+    left: Cell<u64>,
+    /// Set when a result was cut (reported once, at the include).
+    overflow: Cell<bool>,
 }
 
 impl Ctx<'_> {
@@ -232,12 +195,84 @@ impl Ctx<'_> {
         if self.params.is_empty() || !s.contains('{') {
             return s.to_string();
         }
-        let mut out = s.to_string();
-        for (k, v) in &self.params {
-            out = out.replace(&format!("{{{k}}}"), v);
+        let b = &self.subst;
+        // Built piece by piece, never longer than one byte past the limit.
+        let cap = b
+            .max_one
+            .min(usize::try_from(b.left.get()).unwrap_or(usize::MAX));
+        let mut out = String::new();
+        let mut rest = s;
+        while let Some(open) = rest.find('{') {
+            out.push_str(&rest[..open]);
+            let after = &rest[open + 1..];
+            match after
+                .find('}')
+                .and_then(|close| self.params.get(&after[..close]).map(|v| (close, v)))
+            {
+                Some((close, v)) => {
+                    out.push_str(v);
+                    rest = &after[close + 1..];
+                }
+                None => {
+                    out.push('{');
+                    rest = after;
+                }
+            }
+            if out.len() > cap {
+                break;
+            }
         }
+        if out.len() <= cap {
+            out.push_str(rest);
+        }
+        if out.len() > cap {
+            let mut end = cap.saturating_add(1).min(out.len());
+            while !out.is_char_boundary(end) {
+                end -= 1;
+            }
+            out.truncate(end);
+            b.overflow.set(true);
+        }
+        b.left.set(b.left.get().saturating_sub(out.len() as u64));
         out
     }
+}
+
+/// Where brackets and braces (outside strings and comments) first nest
+/// more than 80 deep: the place to point at when the TOML parser refuses
+/// deep nesting without a position.
+fn deep_nesting_at(text: &str) -> Range<usize> {
+    let b = text.as_bytes();
+    let (mut depth, mut i) = (0usize, 0usize);
+    while i < b.len() {
+        match b[i] {
+            b'#' => {
+                while i < b.len() && b[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            q @ (b'"' | b'\'') => {
+                i += 1;
+                while i < b.len() && b[i] != q && b[i] != b'\n' {
+                    if q == b'"' && b[i] == b'\\' {
+                        i += 1;
+                    }
+                    i += 1;
+                }
+            }
+            b'[' | b'{' => {
+                depth += 1;
+                if depth > 80 {
+                    return i..i + 1;
+                }
+            }
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            b'\n' => {}
+            _ => {}
+        }
+        i += 1;
+    }
+    0..0
 }
 
 fn type_name(v: &DeValue<'_>) -> &'static str {
@@ -333,15 +368,21 @@ impl Loader {
 
     /// Parses the TOML syntax of a file, reporting every syntax error.
     fn parse_doc<'i>(&mut self, file: &'i Arc<SourceFile>) -> Option<Spanned<DeTable<'i>>> {
-        let (doc, errors) = DeTable::parse_recoverable(&file.text);
-        if errors.is_empty() {
-            return self.names_within_limit(file, &doc).then_some(doc);
-        }
+        // The parser keeps the first error only (the recoverable parser
+        // keeps every one: millions for a large bad file).
+        let errors = match DeTable::parse(&file.text) {
+            Ok(doc) => return self.names_within_limit(file, &doc).then_some(doc),
+            Err(e) => vec![e],
+        };
         let mut last_dup_line = None;
         let mut seen = std::collections::HashSet::new();
         for e in errors.iter().take(20) {
-            let span = e.span().unwrap_or(0..0);
             let msg = e.message().trim().trim_end_matches('.').to_string();
+            let span = match e.span() {
+                Some(span) => span,
+                None if msg.contains("recursion") => deep_nesting_at(&file.text),
+                None => 0..0,
+            };
             if !seen.insert((span.start, msg.clone())) {
                 continue;
             }
@@ -431,6 +472,7 @@ impl Loader {
             file,
             base,
             params: BTreeMap::new(),
+            subst: self.subst.clone(),
         };
         let table = doc.get_ref();
         let kind = self.kind(&cx, table, doc.span())?;
@@ -960,10 +1002,12 @@ impl Loader {
         }
 
         // Build the arena in pre-order from the root, splicing included subtrees.
+        // An included tree's ids are its own (`x`); the including node's
+        // id is put before them when it is spliced (`moma1/x`).
         let full_id = |id: &str| match prefix {
             Some(p) if id.is_empty() => p.to_string(),
-            Some(p) => format!("{p}/{id}"),
-            None => id.to_string(),
+            Some(p) if !p.is_empty() => format!("{p}/{id}"),
+            _ => id.to_string(),
         };
         let mut out: Vec<BtNode> = Vec::new();
         let mut new_index = vec![usize::MAX; ids.len()];
@@ -985,6 +1029,22 @@ impl Loader {
             match raw.include.take() {
                 Some(sub) => {
                     // The included tree's root takes this node's place and id.
+                    // Ids grow by a prefix at each level: bounded here, before
+                    // millions of them are built.
+                    let longest = sub.nodes.iter().map(|n| n.id.len()).max().unwrap_or(0);
+                    if id.len() + 1 + longest > self.limits.max_name_bytes {
+                        self.err(
+                            cx,
+                            ids[i].1.clone(),
+                            format!(
+                                "the ids of subtree node `{}` would be longer than the limit of {} bytes",
+                                crate::sanitize::shown(ids[i].0),
+                                self.limits.max_name_bytes
+                            ),
+                        )
+                        .hint = Some("nest fewer subtrees, or raise the limit with --max-name-bytes".into());
+                        return None;
+                    }
                     let offset = out.len();
                     for (j, mut n) in sub.nodes.into_iter().enumerate() {
                         n.id = if j == sub.root {
@@ -1309,7 +1369,18 @@ impl Loader {
             );
             return None;
         };
-        let path = cx.base.join(rel);
+        let path = match super::source::resolve(self.root.as_deref(), cx.base, rel) {
+            Ok(p) => p,
+            Err(r) => {
+                self.err(
+                    cx,
+                    tval.span(),
+                    format!("subtree of node `{id}`: {}", r.message),
+                )
+                .hint = Some(r.hint);
+                return None;
+            }
+        };
         let canon = canonical(&path);
         if let Some(pos) = self.stack.iter().position(|p| *p == canon) {
             let chain: Vec<String> = self.stack[pos..]
@@ -1351,12 +1422,12 @@ impl Loader {
         if let Some(done) = self.includes.get(&key) {
             // Read before: its problems are reported already.
             let size = done.as_ref()?.nodes.len();
-            if size > self.node_budget {
+            if size > self.node_budget || !self.limits.expansion_budget.charge(size as u64) {
                 self.err(
                     cx,
                     tval.span(),
                     format!(
-                        "more than {} nodes with the subtrees expanded",
+                        "more than {} nodes with the subtrees expanded (in this policy, or copied by this command in all)",
                         self.limits.max_nodes
                     ),
                 )
@@ -1367,6 +1438,19 @@ impl Loader {
             return done.clone();
         }
         let bt = self.read_include(cx, id, t, rel, &path, canon);
+        if self.subst.overflow.replace(false) {
+            self.err(
+                cx,
+                tval.span(),
+                format!(
+                    "substituting the parameters of subtree `{rel}` makes a string longer than {} bytes, or more than {} bytes in all",
+                    self.limits.max_name_bytes, self.limits.max_file_bytes
+                ),
+            )
+            .hint = Some("shorten the `with` values, or raise --max-name-bytes / --max-file-bytes".into());
+            self.includes.insert(key, None);
+            return None;
+        }
         self.includes.insert(key, bt.clone());
         bt
     }
@@ -1411,6 +1495,7 @@ impl Loader {
             file: &file,
             base: path.parent().unwrap_or(Path::new("")),
             params: BTreeMap::new(),
+            subst: self.subst.clone(),
         };
         match self.kind(&sub_cx0, sub_table, doc.span()) {
             Some("bt") => {}
@@ -1486,6 +1571,7 @@ impl Loader {
             file: &file,
             base: sub_cx0.base,
             params,
+            subst: self.subst.clone(),
         };
         self.stack.push(canon);
         let bt = self.bt(&sub_cx, sub_table, doc.span(), Some(""));

@@ -406,7 +406,8 @@ fn run_graphviz(
 // DOT syntax helpers
 
 /// `s` as a DOT double-quoted string: `"` and `\` escaped, line breaks as `\n`
-/// (a centred line break in labels), other control characters as spaces.
+/// (a centred line break in labels), other control characters and
+/// bidirectional controls as spaces.
 fn quote(s: &str) -> String {
     let mut out = String::with_capacity(s.len() + 2);
     out.push('"');
@@ -416,7 +417,7 @@ fn quote(s: &str) -> String {
             '\\' => out.push_str("\\\\"),
             '\n' => out.push_str("\\n"),
             '\r' => {}
-            c if c.is_control() => out.push(' '),
+            c if c.is_control() || crate::sanitize::is_unsafe(c, false) => out.push(' '),
             c => out.push(c),
         }
     }

@@ -778,7 +778,7 @@ pub fn render_json(r: &CompareReport) -> String {
         labeled: r.mode(GedMode::Labeled),
         named: r.mode(GedMode::Named),
     };
-    let mut s = serde_json::to_string_pretty(&out).expect("serializable");
+    let mut s = crate::sanitize::json(serde_json::to_string_pretty(&out).expect("serializable"));
     s.push('\n');
     s
 }
@@ -827,16 +827,17 @@ pub fn render_table(r: &CompareReport) -> String {
 /// two policies and the modes as tables, the primary edit script as a
 /// `diff` block (added lines green, removed red) in a collapsible section.
 pub fn render_markdown(r: &CompareReport) -> String {
-    let cell = |s: &str| s.replace('|', "\\|");
+    let cell = crate::sanitize::markdown_cell;
+    let code = crate::sanitize::markdown_code;
     let mut out = format!(
-        "### btfsm compare: `{}` → `{}`\n\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
-        cell(&r.a.file),
-        cell(&r.b.file)
+        "### btfsm compare: {} → {}\n\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
+        code(&r.a.file),
+        code(&r.b.file)
     );
     for (tag, s) in [("a", &r.a), ("b", &r.b)] {
         out.push_str(&format!(
-            "| {tag} | `{}` | {} | {} | {} | {} |\n",
-            cell(&s.file),
+            "| {tag} | {} | {} | {} | {} | {} |\n",
+            code(&s.file),
             s.kind,
             cell(&s.name),
             s.vertices,
@@ -862,20 +863,23 @@ pub fn render_markdown(r: &CompareReport) -> String {
         let script = render_script(p);
         let mut lines = script.lines();
         let title = lines.next().unwrap_or_default().trim_end_matches(':');
+        let body: String = lines
+            .map(|l| format!("{}\n", l.strip_prefix("  ").unwrap_or(l)))
+            .collect();
+        // Names are escaped onto one line each and every line starts with
+        // its sign; the fence is longer than any run of backticks anyway.
+        let fence = crate::sanitize::code_fence(&body);
         out.push_str(&format!(
-            "\n<details><summary>{title}</summary>\n\n```diff\n"
+            "\n<details><summary>{}</summary>\n\n{fence}diff\n{body}{fence}\n\n</details>\n",
+            cell(title)
         ));
-        for l in lines {
-            out.push_str(l.strip_prefix("  ").unwrap_or(l));
-            out.push('\n');
-        }
-        out.push_str("```\n\n</details>\n");
     }
     out
 }
 
 /// One line per edit: `+` added, `-` removed, `~` rematched or relabelled.
 fn render_script(m: &ModeReport) -> String {
+    use crate::sanitize::shown;
     let s = &m.edit_script;
     let cost = s.cost();
     let mut out = format!(
@@ -888,22 +892,26 @@ fn render_script(m: &ModeReport) -> String {
         let name = if v.name == v.key {
             String::new()
         } else {
-            format!(" \"{}\"", v.name)
+            format!(" \"{}\"", shown(&v.name))
         };
-        format!("  {sign} {} `{}`{name}\n", v.vtype.as_str(), v.key)
+        format!("  {sign} {} `{}`{name}\n", v.vtype.as_str(), shown(&v.key))
     };
     let arc = |sign: char, a: &ArcRef| {
         let label = if a.label.is_empty() {
             String::new()
         } else {
-            format!(" [{}]", a.label)
+            format!(" [{}]", shown(&a.label))
         };
         let times = if a.count > 1 {
             format!(" ×{}", a.count)
         } else {
             String::new()
         };
-        format!("  {sign} arc `{}` -> `{}`{label}{times}\n", a.from, a.to)
+        format!(
+            "  {sign} arc `{}` -> `{}`{label}{times}\n",
+            shown(&a.from),
+            shown(&a.to)
+        )
     };
     for v in &s.vertices_removed {
         out.push_str(&vertex('-', v));
@@ -918,15 +926,19 @@ fn render_script(m: &ModeReport) -> String {
         out.push_str(&arc('+', a));
     }
     for k in s.rematched() {
-        out.push_str(&format!("  ~ `{}` matched to `{}`\n", k.a, k.b));
+        out.push_str(&format!(
+            "  ~ `{}` matched to `{}`\n",
+            shown(&k.a),
+            shown(&k.b)
+        ));
     }
     for a in s.arcs_kept.iter().filter(|a| a.label_in_a.is_some()) {
         out.push_str(&format!(
             "  ~ arc `{}` -> `{}` relabelled [{}] -> [{}]\n",
-            a.from,
-            a.to,
-            a.label_in_a.as_deref().unwrap_or_default(),
-            a.label
+            shown(&a.from),
+            shown(&a.to),
+            shown(a.label_in_a.as_deref().unwrap_or_default()),
+            shown(&a.label)
         ));
     }
     if cost == 0 && s.rematched().next().is_none() {

@@ -62,8 +62,9 @@ pub fn render_effort(rows: &[EffortRow], format: OutputFormat) -> String {
             struct Out<'a> {
                 policies: &'a [EffortRow],
             }
-            let mut s =
-                serde_json::to_string_pretty(&Out { policies: rows }).expect("serializable");
+            let mut s = crate::sanitize::json(
+                serde_json::to_string_pretty(&Out { policies: rows }).expect("serializable"),
+            );
             s.push('\n');
             s
         }

@@ -74,8 +74,9 @@ pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String
             struct Out<'a> {
                 policies: &'a [PolicyReport],
             }
-            let mut s =
-                serde_json::to_string_pretty(&Out { policies: reports }).expect("serializable");
+            let mut s = crate::sanitize::json(
+                serde_json::to_string_pretty(&Out { policies: reports }).expect("serializable"),
+            );
             s.push('\n');
             s
         }
@@ -147,13 +148,10 @@ fn fmt_num(x: f64) -> String {
     }
 }
 
-/// Quotes a CSV field when needed (RFC 4180).
+/// A CSV field from input: quoted when needed (RFC 4180), control characters
+/// escaped, formulas neutralised ([`crate::sanitize::csv_cell`]).
 pub fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
+    crate::sanitize::csv_cell(s)
 }
 
 #[cfg(test)]

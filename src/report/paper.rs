@@ -740,7 +740,8 @@ pub fn build(
 pub fn render(r: &PaperReport, format: PaperFormat) -> String {
     match format {
         PaperFormat::Json => {
-            let mut s = serde_json::to_string_pretty(r).expect("serializable");
+            let mut s =
+                crate::sanitize::json(serde_json::to_string_pretty(r).expect("serializable"));
             s.push('\n');
             s
         }

@@ -13,8 +13,19 @@ impl Table {
         }
     }
 
+    /// Adds a row; each cell is shown on one line with its control
+    /// characters escaped and cut at [`crate::sanitize::SHOWN_CHARS`]
+    /// characters (names come from input files).
     pub fn row(&mut self, cells: Vec<String>) {
-        self.rows.push(cells);
+        self.rows.push(
+            cells
+                .into_iter()
+                .map(|c| match crate::sanitize::shown(&c) {
+                    std::borrow::Cow::Borrowed(_) => c,
+                    std::borrow::Cow::Owned(o) => o,
+                })
+                .collect(),
+        );
     }
 
     pub fn render(&self) -> String {
@@ -69,5 +80,14 @@ mod tests {
         t.row(vec!["a".into(), "10".into()]);
         t.row(vec!["long".into(), "2".into()]);
         assert_eq!(t.render(), "name   n\na     10\nlong   2\n");
+    }
+
+    #[test]
+    fn cells_stay_on_one_line_without_control_characters() {
+        let mut t = Table::new(&["name"]);
+        t.row(vec!["x\nerror: forged\u{1b}[31m".into()]);
+        let out = t.render();
+        assert_eq!(out.lines().count(), 2, "{out}");
+        assert!(!crate::sanitize::has_raw_control(&out), "{out}");
     }
 }

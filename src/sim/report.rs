@@ -46,7 +46,8 @@ impl SimReport {
     }
 
     pub fn json(&self) -> String {
-        let mut s = serde_json::to_string_pretty(self).expect("serializable");
+        let mut s =
+            crate::sanitize::json(serde_json::to_string_pretty(self).expect("serializable"));
         s.push('\n');
         s
     }
@@ -85,7 +86,7 @@ impl SimReport {
                 .collect(),
             verdicts: &self.verdicts,
         };
-        let mut s = serde_json::to_string(&t).expect("serializable");
+        let mut s = crate::sanitize::json(serde_json::to_string(&t).expect("serializable"));
         s.push('\n');
         s
     }
@@ -211,7 +212,8 @@ pub struct McReport {
 
 impl McReport {
     pub fn json(&self) -> String {
-        let mut s = serde_json::to_string_pretty(self).expect("serializable");
+        let mut s =
+            crate::sanitize::json(serde_json::to_string_pretty(self).expect("serializable"));
         s.push('\n');
         s
     }

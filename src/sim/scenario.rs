@@ -113,21 +113,30 @@ pub fn parse(
         file: file.clone(),
         diags: Vec::new(),
     };
-    let (doc, errors) = DeTable::parse_recoverable(&file.text);
-    if !errors.is_empty() {
-        return Err(errors
-            .iter()
-            .take(20)
-            .map(|e| {
-                Diagnostic::error(format!(
-                    "invalid TOML: {}",
-                    e.message().trim().trim_end_matches('.')
-                ))
-                .at(file, e.span().unwrap_or(0..0))
-                .hint("see the scenario format in the README (Simulator)")
-            })
-            .collect());
-    }
+    // The policies and their includes stay inside the scenario's root.
+    let root = format::source::root_for(limits, base);
+    let limits = &Limits {
+        confinement: root.map_or(format::source::Confinement::Off, |r| {
+            format::source::Confinement::Root(r)
+        }),
+        ..limits.clone()
+    };
+    // The first TOML error only: the recoverable parser keeps them all.
+    let doc = match DeTable::parse(&file.text) {
+        Ok(doc) => doc,
+        Err(e) => {
+            return Err(std::iter::once(e)
+                .map(|e| {
+                    Diagnostic::error(format!(
+                        "invalid TOML: {}",
+                        e.message().trim().trim_end_matches('.')
+                    ))
+                    .at(file, e.span().unwrap_or(0..0))
+                    .hint("see the scenario format in the README (Simulator)")
+                })
+                .collect());
+        }
+    };
     let s = r.scenario(doc.get_ref(), base, limits);
     match s {
         Some(s) if r.diags.iter().all(|d| !d.is_error()) => Ok(s),
@@ -848,7 +857,29 @@ impl Reader {
             return None;
         };
         let rel = self.string(f, "`file`")?;
-        let path = base.join(&rel);
+        let root = format::source::root_for(limits, base);
+        let path = match format::source::resolve(root.as_deref(), base, &rel) {
+            Ok(p) => p,
+            Err(r) if r.message == "no such file" => {
+                self.err(
+                    f.span(),
+                    format!("policy file `{rel}` not found"),
+                    format!(
+                        "paths are relative to the scenario's folder (`{}`)",
+                        base.display()
+                    ),
+                );
+                return None;
+            }
+            Err(r) => {
+                self.err(
+                    f.span(),
+                    format!("policy file `{rel}`: {}", r.message),
+                    r.hint,
+                );
+                return None;
+            }
+        };
         let convert = match t.get("convert") {
             None => None,
             Some(c) => match c.get_ref().as_str() {
@@ -859,17 +890,6 @@ impl Reader {
                 }
             },
         };
-        if !path.is_file() {
-            self.err(
-                f.span(),
-                format!("policy file `{rel}` not found"),
-                format!(
-                    "paths are relative to the scenario's folder (`{}`)",
-                    base.display()
-                ),
-            );
-            return None;
-        }
         let loaded = match format::load(&path, limits) {
             Ok(l) => l,
             Err(d) => {

@@ -1,10 +1,10 @@
 //! BehaviorTree.CPP XML and SCXML through the binary: the corpus of real
-//! files in ../shared/corpus, round trips at named GED 0, cross-format compare.
+//! files in tests/fixtures/corpus, round trips at named GED 0, cross-format compare.
 
 use super::*;
 use common::scratch;
 
-const CORPUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/corpus");
+const CORPUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/corpus");
 
 fn nav2_model() -> String {
     format!("{CORPUS}/bt-xml/nav2/nav2_tree_nodes.xml")
@@ -15,7 +15,7 @@ fn corpus_files(ext: &str) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut dirs = vec![PathBuf::from(CORPUS)];
     while let Some(d) = dirs.pop() {
-        for e in std::fs::read_dir(&d).expect("corpus dir (../shared/corpus)") {
+        for e in std::fs::read_dir(&d).expect("corpus dir (tests/fixtures/corpus)") {
             let p = e.expect("entry").path();
             if p.is_dir() {
                 dirs.push(p);

@@ -291,13 +291,14 @@ fn line_of(dot: &str, id: &str) -> String {
 /// fires (so no run ends before its step budget): far more work than the
 /// wall-clock budgets below allow.
 fn endless_scenario(dir: &std::path::Path) -> String {
+    // The policies beside the scenario: files it names stay inside its root.
     let paper = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper");
+    for f in ["fig01-bt.toml", "fig04-fsm.toml", "fig02-fsm.toml"] {
+        std::fs::copy(paper.join(f), dir.join(f)).expect("copy policy");
+    }
     let text = std::fs::read_to_string("policies/scenarios/exp1-nominal.toml")
         .expect("exp1-nominal")
-        .replace(
-            "file = \"../paper/",
-            &format!("file = \"{}/", paper.display()),
-        )
+        .replace("file = \"../paper/", "file = \"")
         .replacen("seed = ", "max_steps = 1000000\nseed = ", 1)
         + "\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
     let path = dir.join("endless.toml");

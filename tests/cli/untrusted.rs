@@ -1,0 +1,452 @@
+//! Issue 12: btfsm run on a stranger's pull request. Every input here is
+//! generated at test time; each case runs the binary under an address-space
+//! cap (1 GiB) and a wall-clock limit (60 s, killed past it), measures its
+//! peak memory (`wait4`'s `ru_maxrss`) against 64 x (bytes of the inputs) +
+//! 200 MB, and checks that no raw control character and no planted secret
+//! reaches stdout or stderr.
+
+use std::io::Read;
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The secret planted in the environment of every run: it must never be
+/// printed.
+const SECRET: &str = "ghp_SECRETSECRETSECRET0123456789";
+/// The address-space cap of every run.
+const AS_LIMIT: u64 = 1 << 30;
+/// The wall-clock limit of every run.
+const WALL: Duration = Duration::from_secs(60);
+
+struct Run {
+    code: i32,
+    stdout: String,
+    stderr: String,
+    peak_kb: u64,
+    elapsed: Duration,
+}
+
+/// A scratch directory removed on drop.
+struct Dir(PathBuf);
+
+impl Dir {
+    fn new(tag: &str) -> Dir {
+        let d = std::env::temp_dir().join(format!("btfsm-untrusted-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("tmp");
+        Dir(d)
+    }
+    fn write(&self, name: &str, text: impl AsRef<[u8]>) -> String {
+        let p = self.0.join(name);
+        if let Some(parent) = p.parent() {
+            std::fs::create_dir_all(parent).expect("mkdir");
+        }
+        std::fs::write(&p, text).expect("write");
+        p.display().to_string()
+    }
+    fn path(&self, name: &str) -> String {
+        self.0.join(name).display().to_string()
+    }
+}
+
+impl Drop for Dir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Runs btfsm with `args` in `cwd`, the secret in its environment, under
+/// the caps; stderr goes to `stderr_to` when given (e.g. `/dev/full`).
+fn run_in(cwd: &Path, args: &[&str], stderr_to: Option<&str>) -> Run {
+    // BTFSM_UNDER_TEST runs the suite against another build (e.g. the one
+    // before issue 12, to see every case fail).
+    let bin =
+        std::env::var_os("BTFSM_UNDER_TEST").unwrap_or_else(|| env!("CARGO_BIN_EXE_btfsm").into());
+    let mut cmd = Command::new(bin);
+    cmd.args(args)
+        .current_dir(cwd)
+        .env("BTFSM_TEST_TOKEN", SECRET)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped());
+    match stderr_to {
+        Some(p) => {
+            cmd.stderr(
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(p)
+                    .expect("open"),
+            );
+        }
+        None => {
+            cmd.stderr(Stdio::piped());
+        }
+    }
+    // SAFETY: setrlimit is async-signal-safe; nothing else runs in the child.
+    unsafe {
+        cmd.pre_exec(|| {
+            let lim = libc::rlimit {
+                rlim_cur: AS_LIMIT,
+                rlim_max: AS_LIMIT,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let t = Instant::now();
+    let mut child = cmd.spawn().expect("spawn btfsm");
+    let pid = child.id() as libc::pid_t;
+    let mut out = child.stdout.take().expect("stdout");
+    let err = child.stderr.take();
+    let out_t = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let _ = out.read_to_end(&mut v);
+        v
+    });
+    let err_t = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        if let Some(mut e) = err {
+            let _ = e.read_to_end(&mut v);
+        }
+        v
+    });
+    // Kill past the wall-clock limit.
+    let killer = std::thread::spawn(move || {
+        let end = Instant::now() + WALL;
+        while Instant::now() < end {
+            std::thread::sleep(Duration::from_millis(50));
+            // SAFETY: signal 0 only checks that the process exists.
+            if unsafe { libc::kill(pid, 0) } != 0 {
+                return false;
+            }
+        }
+        // SAFETY: our own child.
+        unsafe { libc::kill(pid, libc::SIGKILL) };
+        true
+    });
+    let mut status = 0;
+    // SAFETY: zeroed rusage is a valid out-parameter.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: waits for our own child, writing into the two locals.
+    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    assert_eq!(r, pid, "wait4");
+    let elapsed = t.elapsed();
+    std::mem::forget(child); // reaped by wait4
+    let killed = killer.join().expect("killer");
+    assert!(!killed, "btfsm {args:?} ran past {WALL:?}");
+    let code = if libc::WIFEXITED(status) {
+        libc::WEXITSTATUS(status)
+    } else {
+        -libc::WTERMSIG(status)
+    };
+    let stdout = out_t.join().expect("stdout");
+    let stderr = err_t.join().expect("stderr");
+    Run {
+        code,
+        stdout: String::from_utf8_lossy(&stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&stderr).into_owned(),
+        peak_kb: usage.ru_maxrss as u64,
+        elapsed,
+    }
+}
+
+/// Bytes of the files under `dir` (the inputs of a case).
+fn input_bytes(dir: &Path) -> u64 {
+    let mut total = 0;
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            match e.file_type() {
+                Ok(t) if t.is_dir() => stack.push(e.path()),
+                Ok(t) if t.is_file() => total += e.metadata().map_or(0, |m| m.len()),
+                _ => {}
+            }
+        }
+    }
+    total
+}
+
+/// The checks every case shares: a documented exit code, no panic, memory
+/// within 64 x input + 200 MB, no raw control byte, no secret.
+fn check(r: &Run, dir: &Path, codes: &[i32], what: &str) {
+    assert!(
+        codes.contains(&r.code),
+        "{what}: exit {} (want {codes:?})\n{}",
+        r.code,
+        r.stderr
+    );
+    assert!(!r.stderr.contains("panicked"), "{what}: {}", r.stderr);
+    let allowed_kb = (64 * input_bytes(dir) + 200 * 1024 * 1024) / 1024;
+    assert!(
+        r.peak_kb < allowed_kb,
+        "{what}: peak {} KB, allowed {allowed_kb} KB",
+        r.peak_kb
+    );
+    for (name, s) in [("stdout", &r.stdout), ("stderr", &r.stderr)] {
+        assert!(!s.contains(SECRET), "{what}: secret on {name}");
+        let raw = s.chars().find(|&c| {
+            (c.is_control() && c != '\n' && c != '\t') || ('\u{202a}'..='\u{202e}').contains(&c)
+        });
+        assert!(raw.is_none(), "{what}: raw {raw:?} on {name}: {s:?}");
+    }
+}
+
+const LEAF: &str =
+    "kind = \"bt\"\nroot = \"x\"\n[nodes]\nx = { action = \"Dock!\", skill = \"Dock\" }\n";
+
+/// A policy or scenario naming a file outside its root (absolute, `..`,
+/// a symlink out, `.git`) is refused before the file is opened, and
+/// nothing of that file is printed.
+#[test]
+fn files_named_by_files_stay_inside_the_root() {
+    let d = Dir::new("root");
+    // A secret file outside the root (the root is `repo/`, a git work tree).
+    d.write("secret.toml", format!("{SECRET} = 1\n"));
+    d.write(
+        "repo/.git/config",
+        format!("[http]\nextraheader = {SECRET}\n"),
+    );
+    std::os::unix::fs::symlink(d.path("secret.toml"), d.0.join("repo/link.toml")).expect("symlink");
+    let cases = [
+        ("abs.toml", "/proc/self/environ", "absolute path"),
+        ("dotdot.toml", "../secret.toml", "outside the root"),
+        ("deep/dotdot.toml", "../../secret.toml", "outside the root"),
+        ("link.toml-user.toml", "link.toml", "symbolic link"),
+        ("git.toml", ".git/config", "`.git`"),
+        ("dev.toml", "../../../../../../dev/zero", "outside the root"),
+    ];
+    for (name, target, want) in cases {
+        let f = d.write(
+            &format!("repo/{name}"),
+            format!("kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = {{ subtree = \"{target}\" }}\n"),
+        );
+        let r = run_in(&d.0, &["analyze", &f], None);
+        check(&r, &d.0, &[2], name);
+        assert!(r.stderr.contains(want), "{name}: {}", r.stderr);
+        assert!(r.stderr.contains(":4:"), "{name}: positioned: {}", r.stderr);
+        assert!(r.stderr.contains("--allow-outside-root"), "{}", r.stderr);
+    }
+    // BehaviorTree.CPP includes, the same rule.
+    let x = d.write(
+        "repo/inc.xml",
+        "<root BTCPP_format=\"4\" main_tree_to_execute=\"M\">\n<include path=\"/proc/self/environ\"/>\n<BehaviorTree ID=\"M\"><AlwaysSuccess/></BehaviorTree></root>\n",
+    );
+    let r = run_in(&d.0, &["analyze", &x], None);
+    check(&r, &d.0, &[2], "xml include");
+    assert!(
+        r.stderr.contains("absolute path") && r.stderr.contains(":2:"),
+        "{}",
+        r.stderr
+    );
+    // A scenario's policies.
+    let s = d.write(
+        "repo/scen.toml",
+        "name = \"s\"\n[world]\n[[policies]]\nfile = \"../secret.toml\"\n",
+    );
+    let r = run_in(&d.0, &["sim", &s], None);
+    check(&r, &d.0, &[2], "scenario policy");
+    assert!(r.stderr.contains("outside the root"), "{}", r.stderr);
+    // Inside the root, through `..` that stays inside: read.
+    d.write("repo/lib/leaf.toml", LEAF);
+    let ok = d.write(
+        "repo/sub/ok.toml",
+        "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"../lib/leaf.toml\" }\n",
+    );
+    let r = run_in(&d.0, &["analyze", &ok], None);
+    check(&r, &d.0, &[0], "inside the root");
+    // --root narrows it; --allow-outside-root lifts it for trusted files.
+    let r = run_in(&d.0, &["analyze", &ok, "--root", &d.path("repo/sub")], None);
+    check(&r, &d.0, &[2], "--root");
+    let up = d.write(
+        "repo/up.toml",
+        "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"../outside/leaf.toml\" }\n",
+    );
+    d.write("outside/leaf.toml", LEAF);
+    let r = run_in(&d.0, &["analyze", &up, "--allow-outside-root"], None);
+    check(&r, &d.0, &[0], "--allow-outside-root");
+}
+
+/// Names with escape sequences, newlines and bidi overrides reach no
+/// output raw, in any format; markdown cannot leave its code block.
+#[test]
+fn control_characters_never_reach_an_output() {
+    let d = Dir::new("ctl");
+    let evil = "x\\u001b]0;pwned\\u0007\\n```\\n<img src=x onerror=alert(1)>\\u202e\\u009b";
+    let a = d.write(
+        "a.toml",
+        format!(
+            "kind = \"bt\"\nname = \"{evil}\"\nroot = \"r\"\n[nodes]\nr = {{ sequence = [\"x\"], name = \"{evil}\" }}\nx = {{ action = \"{evil}\", skill = \"Dock\" }}\n"
+        ),
+    );
+    let b = d.write(
+        "b.toml",
+        format!(
+            "kind = \"bt\"\nname = \"=cmd|' /C calc'!A0\"\nroot = \"r\"\n[nodes]\nr = {{ sequence = [\"x\", \"y\\u001b[2J\\n\"] }}\nx = {{ action = \"{evil}\", skill = \"Dock\" }}\n\"y\\u001b[2J\\n\" = {{ action = \"Tuck\", skill = \"Tuck-Arm\" }}\n"
+        ),
+    );
+    // A file name with an escape sequence.
+    let c = d.write(
+        "c\u{1b}[31m.toml",
+        "kind = \"bt\"\nroot = \"nope\"\n[nodes]\n",
+    );
+    for args in [
+        vec!["analyze", &a, &b],
+        vec!["analyze", &a, &b, "--format", "csv"],
+        vec!["analyze", &a, &b, "--format", "json"],
+        vec!["validate", &a, &b],
+        vec!["dot", &b],
+        vec!["compare", &a, &b],
+        vec!["compare", &a, &b, "--format", "json"],
+        vec!["convert", &b, "--to", "btcpp-xml"],
+        vec!["validate", &c],
+    ] {
+        let r = run_in(&d.0, &args, None);
+        check(&r, &d.0, &[0, 2], &format!("{args:?}"));
+        if args.contains(&"csv") {
+            assert!(
+                r.stdout.contains("'=cmd"),
+                "formula neutralised: {}",
+                r.stdout
+            );
+        }
+    }
+    let r = run_in(&d.0, &["compare", &a, &b, "--format", "markdown"], None);
+    check(&r, &d.0, &[0], "markdown");
+    assert!(!r.stdout.contains("<img"), "{}", r.stdout);
+    // The diff block is closed only by its own fence, on the last lines.
+    let fence_lines: Vec<&str> = r
+        .stdout
+        .lines()
+        .filter(|l| l.trim_start().starts_with("```"))
+        .collect();
+    assert_eq!(fence_lines.len(), 2, "{}", r.stdout);
+}
+
+/// Parameters doubled level by level, a file of a million TOML errors, the
+/// same big file given many times, a big include: bounded memory, exit 2.
+#[test]
+fn memory_stays_bounded_by_the_input() {
+    let d = Dir::new("mem");
+    // `with` values doubled at each of 20 levels: 2^20 x 8 bytes.
+    for i in 0..20 {
+        d.write(
+            &format!("p{i}.toml"),
+            format!(
+                "kind = \"bt\"\nroot = \"s\"\n[params]\nv = \"\"\n[nodes]\ns = {{ subtree = \"p{}.toml\", with = {{ v = \"{{v}}{{v}}\" }} }}\n",
+                i + 1
+            ),
+        );
+    }
+    d.write(
+        "p20.toml",
+        "kind = \"bt\"\nroot = \"x\"\n[params]\nv = \"\"\n[nodes]\nx = { action = \"{v}\", skill = \"Dock\" }\n",
+    );
+    let top = d.write(
+        "top.toml",
+        "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"p0.toml\", with = { v = \"abcdefgh\" } }\n",
+    );
+    let r = run_in(&d.0, &["analyze", &top], None);
+    check(&r, &d.0, &[2], "substitution");
+    assert!(
+        r.stderr.contains("substituting the parameters"),
+        "{}",
+        r.stderr
+    );
+    // A million bad lines.
+    let bad = d.write("bad.toml", "= = =\n".repeat(1_000_000));
+    let r = run_in(&d.0, &["analyze", &bad], None);
+    check(&r, &d.0, &[2], "toml errors");
+    assert!(r.stderr.lines().count() < 50, "{}", r.stderr.len());
+    // One 3 MB file given 200 times: the command's read budget.
+    let big = d.write(
+        "big.toml",
+        format!("{LEAF}{}", "# padding\n".repeat(300_000)),
+    );
+    let mut args = vec!["analyze"];
+    args.extend(std::iter::repeat_n(big.as_str(), 200));
+    args.extend(["--max-total-bytes", "100000000"]);
+    let r = run_in(&d.0, &args, None);
+    check(&r, &d.0, &[2], "repeated file");
+    assert!(
+        r.stderr.contains("--max-total-bytes"),
+        "{}",
+        &r.stderr[..r.stderr.len().min(2000)]
+    );
+    // Subtrees copied 2^k times across two policies: one command-wide budget.
+    for i in 0..30 {
+        d.write(
+            &format!("e{i}.toml"),
+            format!(
+                "kind = \"bt\"\nroot = \"r\"\n[nodes]\nr = {{ sequence = [\"a\", \"b\"] }}\na = {{ subtree = \"e{0}.toml\" }}\nb = {{ subtree = \"e{0}.toml\" }}\n",
+                i + 1
+            ),
+        );
+    }
+    d.write("e30.toml", LEAF);
+    let e0 = d.path("e0.toml");
+    let e14 = d.path("e14.toml");
+    let r = run_in(&d.0, &["compare", &e0, &e0], None);
+    check(&r, &d.0, &[2], "expansion");
+    // 2^16 leaves each, 2^17 copies in all: over the command's budget
+    // of 150,000 copied nodes though each policy alone is within it.
+    let r = run_in(&d.0, &["compare", &e14, &e14, "--mode", "named"], None);
+    check(&r, &d.0, &[2], "expansion across policies");
+    assert!(r.stderr.contains("copied by this command"), "{}", r.stderr);
+}
+
+/// A FIFO with no writer, as a policy, node model or baseline: an answer
+/// at once, not a hang.
+#[test]
+fn a_fifo_never_blocks() {
+    let d = Dir::new("fifo");
+    let fifo = d.path("f.toml");
+    let c = std::ffi::CString::new(fifo.clone()).expect("path");
+    // SAFETY: a NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let leaf = d.write("leaf.toml", LEAF);
+    for args in [
+        vec!["analyze", fifo.as_str()],
+        vec!["analyze", leaf.as_str(), "--baseline", fifo.as_str()],
+        vec!["analyze", leaf.as_str(), "--nodes-model", fifo.as_str()],
+    ] {
+        let r = run_in(&d.0, &args, None);
+        check(&r, &d.0, &[0, 2], &format!("{args:?}"));
+        assert!(
+            r.elapsed < Duration::from_secs(20),
+            "{args:?}: {:?}",
+            r.elapsed
+        );
+    }
+    // Named by a file: refused without opening.
+    let f = d.write(
+        "named.toml",
+        "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"f.toml\" }\n",
+    );
+    let r = run_in(&d.0, &["analyze", &f], None);
+    check(&r, &d.0, &[2], "named fifo");
+    assert!(r.stderr.contains("not a regular file"), "{}", r.stderr);
+}
+
+/// stderr on a full device: the exit code keeps its meaning (1 for a
+/// failed gate, 2 for bad input), never 101.
+#[test]
+fn a_full_stderr_changes_no_exit_code() {
+    if !Path::new("/dev/full").exists() {
+        return;
+    }
+    let d = Dir::new("full");
+    let leaf = d.write("leaf.toml", LEAF);
+    let bad = d.write("bad.toml", "kind = \"bt\"\nroot = \"nope\"\n[nodes]\n");
+    let r = run_in(
+        &d.0,
+        &["analyze", &leaf, "--max", "cc=0"],
+        Some("/dev/full"),
+    );
+    assert_eq!(r.code, 1, "gate");
+    let r = run_in(&d.0, &["analyze", &bad], Some("/dev/full"));
+    assert_eq!(r.code, 2, "bad input");
+    let r = run_in(&d.0, &["validate", &leaf], Some("/dev/full"));
+    assert_eq!(r.code, 0, "validate");
+}
