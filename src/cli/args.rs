@@ -57,6 +57,10 @@ pub enum Command {
         /// Render with Graphviz's `dot` instead of printing DOT
         #[arg(long, value_enum)]
         render: Option<crate::render::dot::RenderFormat>,
+        /// With --render: Graphviz's time budget; past it `dot` is killed
+        /// and the run exits 2
+        #[arg(long, default_value_t = crate::render::dot::DEFAULT_RENDER_TIMEOUT_MS, value_name = "MS")]
+        timeout_ms: u64,
         /// Colour nodes by their status at --step in a `sim --trace` file
         #[command(flatten)]
         trace: super::sim::DotTraceArgs,
@@ -85,7 +89,8 @@ pub enum Command {
         /// (the edit script of --mode; named when all modes run)
         #[arg(long, value_name = "OUT")]
         dot: Option<PathBuf>,
-        /// With --dot: render through Graphviz instead of writing DOT
+        /// With --dot: render through Graphviz instead of writing DOT (under
+        /// the --timeout-ms budget of one mode: past it `dot` is killed)
         #[arg(long, value_enum, requires = "dot")]
         render: Option<crate::render::dot::RenderFormat>,
         #[command(flatten)]

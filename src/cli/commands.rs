@@ -94,6 +94,7 @@ pub fn execute(cli: Cli) -> u8 {
             file,
             output,
             render,
+            timeout_ms,
             trace,
             limits,
         } => {
@@ -103,7 +104,8 @@ pub fn execute(cli: Cli) -> u8 {
             let Some((policy, opts)) = super::sim::dot_trace(&trace, &file, l.policy) else {
                 return EXIT_BAD_INPUT;
             };
-            draw(&policy, &opts, output.as_deref(), render)
+            let timeout = std::time::Duration::from_millis(timeout_ms);
+            draw(&policy, &opts, output.as_deref(), render, timeout)
         }
         Command::Compare {
             a,
@@ -194,13 +196,14 @@ pub fn execute(cli: Cli) -> u8 {
     }
 }
 
-/// Draws a policy as DOT, or renders it through Graphviz, to `output` or
-/// stdout.
+/// Draws a policy as DOT, or renders it through Graphviz (killed past
+/// `timeout`), to `output` or stdout.
 pub(super) fn draw(
     policy: &crate::model::Policy,
     opts: &crate::render::dot::DotOptions,
     output: Option<&Path>,
     render: Option<crate::render::dot::RenderFormat>,
+    timeout: std::time::Duration,
 ) -> u8 {
     use crate::render::dot::{self, RenderFormat};
     let text = dot::policy_dot(policy, opts);
@@ -211,7 +214,7 @@ pub(super) fn draw(
         eprintln!("error: {fmt} output is binary; write it to a file with -o");
         return EXIT_BAD_INPUT;
     }
-    match dot::render(&text, fmt) {
+    match dot::render(&text, fmt, timeout) {
         Ok(bytes) => emit(output, &bytes),
         Err(e) => {
             eprintln!(
@@ -285,31 +288,61 @@ pub(super) fn emit_text(path: Option<&Path>, text: impl AsRef<str>) -> u8 {
     emit(path, super::out::text(text.as_ref()).as_bytes())
 }
 
-/// Writes output to a file (atomically) or stdout.
+/// Writes output to a file (see `report::output`: atomically, through
+/// symlinks, into devices and FIFOs) or to stdout (no path, `-`, or a path
+/// that is stdout).
 pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
-    match path {
-        Some(p) => match report::write_atomically(p, bytes) {
+    use crate::report::output::Destination;
+    let dest = match path.map(Destination::resolve) {
+        None => Destination::Stdout,
+        Some(Ok(d)) => d,
+        Some(Err(e)) => return cannot_write(path, e),
+    };
+    if let Destination::Stdout = dest {
+        let stdout = std::io::stdout();
+        let mut out = stdout.lock();
+        return match out.write_all(bytes).and_then(|()| out.flush()) {
             Ok(()) => EXIT_OK,
+            // A closed pipe (`| head`) is not an error of ours.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => EXIT_OK,
             Err(e) => {
-                eprintln!(
-                    "error: cannot write `{}`: {e}",
-                    shown(&p.display().to_string())
-                );
+                eprintln!("error: cannot write to stdout: {e}");
                 EXIT_BAD_INPUT
             }
-        },
-        None => {
-            let stdout = std::io::stdout();
-            let mut out = stdout.lock();
-            match out.write_all(bytes).and_then(|()| out.flush()) {
-                Ok(()) => EXIT_OK,
-                // A closed pipe (`| head`) is not an error of ours.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => EXIT_OK,
-                Err(e) => {
-                    eprintln!("error: cannot write to stdout: {e}");
-                    EXIT_BAD_INPUT
-                }
-            }
+        };
+    }
+    match dest.write(bytes) {
+        Ok(()) => EXIT_OK,
+        Err(e) => cannot_write(path, e),
+    }
+}
+
+fn cannot_write(path: Option<&Path>, e: std::io::Error) -> u8 {
+    let path = path.map_or_else(|| "-".into(), |p| p.display().to_string());
+    eprintln!(
+        "error: cannot write `{}`: {}",
+        shown(&path),
+        crate::sanitize::shown_max(&e.to_string(), 2000)
+    );
+    EXIT_BAD_INPUT
+}
+
+/// Refuses, before anything is computed or written, outputs of one command
+/// that name one file (or the stdout where the report goes, when
+/// `report_on_stdout`); `false` after saying why.
+pub(super) fn outputs_distinct(outputs: &[(&str, Option<&Path>)], report_on_stdout: bool) -> bool {
+    let given: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|&(flag, p)| Some((flag, p?)))
+        .collect();
+    match crate::report::output::check_distinct(&given, report_on_stdout) {
+        Ok(()) => true,
+        Err(e) => {
+            eprintln!(
+                "error: {}",
+                crate::sanitize::shown_max(&e.to_string(), 2000)
+            );
+            false
         }
     }
 }

@@ -29,6 +29,9 @@ pub struct CompareArgs {
 }
 
 pub fn execute(args: CompareArgs) -> u8 {
+    if !super::commands::outputs_distinct(&[("--dot", args.dot.as_deref())], true) {
+        return EXIT_BAD_INPUT;
+    }
     let Some(loaded) = load_all(&[args.a.clone(), args.b.clone()], &args.limits) else {
         return EXIT_BAD_INPUT;
     };
@@ -58,7 +61,9 @@ pub fn execute(args: CompareArgs) -> u8 {
     let report = pair.report(results);
     if let (Some(path), Some(primary)) = (&args.dot, report.primary()) {
         let opts = pair.dot_options(&primary.edit_script);
-        let code = draw(&lb.policy, &opts, Some(path), args.render);
+        // Graphviz gets the budget of one mode (--timeout-ms).
+        let timeout = Duration::from_millis(args.timeout_ms);
+        let code = draw(&lb.policy, &opts, Some(path), args.render, timeout);
         if code != EXIT_OK {
             return code;
         }

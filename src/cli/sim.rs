@@ -47,6 +47,13 @@ pub fn execute(a: SimArgs) -> u8 {
         eprintln!("error: `sim` prints `table` or `json`, not `csv`");
         return EXIT_BAD_INPUT;
     }
+    let outputs = [
+        ("--trace", a.trace.as_deref()),
+        ("--plot", a.plot.as_deref()),
+    ];
+    if !super::commands::outputs_distinct(&outputs, true) {
+        return EXIT_BAD_INPUT;
+    }
     let mut s = match scenario::load(&a.scenario, &a.limits.limits()) {
         Ok(s) => s,
         Err(d) => {

@@ -39,6 +39,7 @@ use graphviz_rust::printer::{DotPrinter, PrinterContext};
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::io::Write;
 use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
 
 /// A return status, as the paper colours it (Fig. 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -215,6 +216,12 @@ pub enum RenderError {
         status: String,
         stderr: String,
     },
+    #[error(
+        "graphviz `{program}` did not finish within {ms} ms and was stopped (give it more time with --timeout-ms)"
+    )]
+    Timeout { program: String, ms: u128 },
+    #[error("graphviz `{program}` wrote more than {limit} bytes and was stopped")]
+    TooLarge { program: String, limit: u64 },
     #[error("cannot run graphviz `{program}`: {source}")]
     Io {
         program: String,
@@ -223,27 +230,82 @@ pub enum RenderError {
     },
 }
 
-/// Renders DOT to svg/png/pdf by running Graphviz's `dot`; a clear error when
+/// Graphviz's time budget where the command has no `--timeout-ms` of its
+/// own meaning (`dot --render`'s default).
+pub const DEFAULT_RENDER_TIMEOUT_MS: u64 = 60_000;
+
+/// Most bytes of a rendered diagram read from Graphviz: past them the child
+/// is killed and the run fails.
+pub const MAX_RENDER_BYTES: u64 = 256 << 20;
+
+/// Most bytes of Graphviz's stderr kept for the message (the rest is read
+/// and dropped, so that the child never blocks on it).
+pub const MAX_RENDER_STDERR_BYTES: u64 = 64 << 10;
+
+/// What a Graphviz run may take.
+#[derive(Debug, Clone, Copy)]
+struct Budget {
+    timeout: Duration,
+    max_output: u64,
+    max_stderr: u64,
+}
+
+impl Budget {
+    fn new(timeout: Duration) -> Budget {
+        Budget {
+            timeout,
+            max_output: MAX_RENDER_BYTES,
+            max_stderr: MAX_RENDER_STDERR_BYTES,
+        }
+    }
+}
+
+/// Renders DOT to svg/png/pdf by running Graphviz's `dot` as a child killed
+/// after `timeout` or [`MAX_RENDER_BYTES`] of output; a clear error when
 /// `dot` is not installed.
-pub fn render(dot: &str, format: RenderFormat) -> Result<Vec<u8>, RenderError> {
-    render_with("dot", dot, format)
+pub fn render(dot: &str, format: RenderFormat, timeout: Duration) -> Result<Vec<u8>, RenderError> {
+    render_with("dot", dot, format, timeout)
 }
 
 /// [`render`] with another Graphviz program (a full path, or `neato`, ...).
-pub fn render_with(program: &str, dot: &str, format: RenderFormat) -> Result<Vec<u8>, RenderError> {
-    run_graphviz(program, dot, format).map(|(out, _warnings)| out)
+pub fn render_with(
+    program: &str,
+    dot: &str,
+    format: RenderFormat,
+    timeout: Duration,
+) -> Result<Vec<u8>, RenderError> {
+    run_graphviz(program, dot, format, Budget::new(timeout)).map(|(out, _warnings)| out)
+}
+
+/// What the threads around a Graphviz child report.
+enum Piped {
+    /// Its input written (or not).
+    Stdin(std::io::Result<()>),
+    /// Its output, at most `max_output + 1` bytes.
+    Stdout(std::io::Result<Vec<u8>>),
+    /// Its first `max_stderr` bytes of stderr.
+    Stderr(std::io::Result<Vec<u8>>),
 }
 
 /// Runs a Graphviz program on `dot`: its output and its warnings (stderr).
+/// Input is fed and output read by threads, so that a child that does not
+/// read, or writes a lot, cannot dead-lock us; the child is killed past the
+/// budget's deadline or output size, without waiting for its pipes.
 fn run_graphviz(
     program: &str,
     dot: &str,
     format: RenderFormat,
+    budget: Budget,
 ) -> Result<(Vec<u8>, String), RenderError> {
+    use std::io::Read;
+    use std::sync::mpsc;
     let io = |source: std::io::Error| RenderError::Io {
         program: program.to_string(),
         source,
     };
+    let start = Instant::now();
+    // No deadline when the budget passes the clock's range.
+    let deadline = start.checked_add(budget.timeout);
     let mut child = Command::new(program)
         .arg(format!("-T{}", format.extension()))
         .stdin(Stdio::piped())
@@ -256,27 +318,88 @@ fn run_graphviz(
             },
             _ => io(e),
         })?;
-    let mut stdin = child.stdin.take().expect("stdin is piped");
-    // Write from another thread so that a large output cannot dead-lock us.
-    let (written, output) = std::thread::scope(|s| {
-        let writer = s.spawn(move || stdin.write_all(dot.as_bytes()));
-        let output = child.wait_with_output();
-        (writer.join(), output)
+    let (tx, rx) = mpsc::channel();
+    let (mut stdin, stdout, stderr) = (
+        child.stdin.take().expect("stdin is piped"),
+        child.stdout.take().expect("stdout is piped"),
+        child.stderr.take().expect("stderr is piped"),
+    );
+    let input = dot.as_bytes().to_vec();
+    let t = tx.clone();
+    std::thread::spawn(move || {
+        let r = stdin.write_all(&input);
+        drop(stdin);
+        let _ = t.send(Piped::Stdin(r));
     });
-    let output = output.map_err(io)?;
-    if !output.status.success() {
+    let t = tx.clone();
+    std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let r = stdout
+            .take(budget.max_output.saturating_add(1))
+            .read_to_end(&mut v);
+        let _ = t.send(Piped::Stdout(r.map(|_| v)));
+    });
+    std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let mut err = stderr;
+        let r = (&mut err).take(budget.max_stderr).read_to_end(&mut v);
+        // Drained, not kept.
+        let _ = std::io::copy(&mut err, &mut std::io::sink());
+        let _ = tx.send(Piped::Stderr(r.map(|_| v)));
+    });
+    let stop = |child: &mut std::process::Child| {
+        let _ = child.kill();
+        let _ = child.wait();
+    };
+    let (mut written, mut out, mut err, mut status) = (None, None, None, None);
+    while written.is_none() || out.is_none() || err.is_none() || status.is_none() {
+        let now = Instant::now();
+        if deadline.is_some_and(|d| now >= d) {
+            stop(&mut child);
+            return Err(RenderError::Timeout {
+                program: program.to_string(),
+                ms: budget.timeout.as_millis(),
+            });
+        }
+        let wait = deadline.map_or(Duration::from_millis(20), |d| {
+            (d - now).min(Duration::from_millis(20))
+        });
+        match rx.recv_timeout(wait) {
+            Ok(Piped::Stdin(r)) => written = Some(r),
+            Ok(Piped::Stdout(r)) => {
+                if r.as_ref().is_ok_and(|v| v.len() as u64 > budget.max_output) {
+                    stop(&mut child);
+                    return Err(RenderError::TooLarge {
+                        program: program.to_string(),
+                        limit: budget.max_output,
+                    });
+                }
+                out = Some(r);
+            }
+            Ok(Piped::Stderr(r)) => err = Some(r),
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            // Every thread has reported: only the exit is awaited.
+            Err(mpsc::RecvTimeoutError::Disconnected) => std::thread::sleep(wait),
+        }
+        if status.is_none() {
+            status = child.try_wait().map_err(io)?;
+        }
+    }
+    let (Some(status), Some(written), Some(out), Some(err)) = (status, written, out, err) else {
+        unreachable!("the loop ends when all are known");
+    };
+    let stderr = String::from_utf8_lossy(&err.map_err(io)?)
+        .trim()
+        .to_string();
+    if !status.success() {
         return Err(RenderError::Failed {
             program: program.to_string(),
-            status: output.status.to_string(),
-            stderr: String::from_utf8_lossy(&output.stderr).trim().to_string(),
+            status: status.to_string(),
+            stderr,
         });
     }
-    let warnings = String::from_utf8_lossy(&output.stderr).trim().to_string();
-    match written {
-        Ok(Ok(())) => Ok((output.stdout, warnings)),
-        Ok(Err(e)) => Err(io(e)),
-        Err(_) => Err(io(std::io::Error::other("writer thread panicked"))),
-    }
+    written.map_err(io)?;
+    Ok((out.map_err(io)?, stderr))
 }
 
 // ---------------------------------------------------------------------------
@@ -1182,7 +1305,7 @@ root = 'go "home" now'
         assert_eq!(ids.len(), 4);
         assert_eq!(edges, 3);
         // Graphviz itself accepts it, where installed.
-        match render(&dot, RenderFormat::Svg) {
+        match render(&dot, RenderFormat::Svg, T) {
             Ok(svg) => {
                 let svg = String::from_utf8(svg).unwrap();
                 assert!(svg.contains("Say &quot;hi&quot;!"), "{svg}");
@@ -1211,6 +1334,7 @@ root = 'go "home" now'
             "btfsm-test-no-such-graphviz",
             "digraph { a }",
             RenderFormat::Svg,
+            T,
         )
         .unwrap_err();
         assert!(matches!(err, RenderError::NotInstalled { .. }), "{err:?}");
@@ -1221,10 +1345,93 @@ root = 'go "home" now'
 
     #[test]
     fn graphviz_errors_are_reported() {
-        match render("digraph { a -> }", RenderFormat::Svg) {
+        match render("digraph { a -> }", RenderFormat::Svg, T) {
             Err(RenderError::Failed { stderr, .. }) => assert!(!stderr.is_empty()),
             Err(RenderError::NotInstalled { .. }) => {}
             other => panic!("expected a syntax error, got {other:?}"),
+        }
+    }
+
+    /// The budget of the tests that run Graphviz.
+    const T: Duration = Duration::from_secs(60);
+
+    /// A fake Graphviz: a shell script in a scratch directory.
+    fn fake_graphviz(tag: &str, script: &str) -> std::path::PathBuf {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = std::env::temp_dir().join(format!("btfsm-gv-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("dot");
+        std::fs::write(&p, format!("#!/bin/sh\n{script}\n")).unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+        p
+    }
+
+    /// Runs a fake Graphviz, retrying while the script is "busy" (another
+    /// test thread forked while it was open for writing).
+    fn run_fake(
+        program: &std::path::Path,
+        dot: &str,
+        budget: Budget,
+    ) -> (Result<(Vec<u8>, String), RenderError>, Duration) {
+        for _ in 0..100 {
+            let t0 = Instant::now();
+            match run_graphviz(program.to_str().unwrap(), dot, RenderFormat::Svg, budget) {
+                Err(RenderError::Io { source, .. }) if source.raw_os_error() == Some(26) => {
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+                r => return (r, t0.elapsed()),
+            }
+        }
+        panic!("{} stayed busy", program.display());
+    }
+
+    #[test]
+    fn graphviz_runs_under_a_deadline_and_an_output_cap() {
+        let short = Budget::new(Duration::from_millis(300));
+        // Answers: the output is what it wrote (here, its input).
+        let cat = fake_graphviz("cat", "exec cat");
+        let (r, _) = run_fake(&cat, "digraph { a }", short);
+        assert_eq!(r.unwrap().0, b"digraph { a }");
+        // Never answers; its `sleep` child holds the pipes: killed at the
+        // deadline without waiting for them.
+        let sleeper = fake_graphviz("sleep", "sleep 30");
+        let (r, took) = run_fake(&sleeper, "digraph { a }", short);
+        assert!(
+            matches!(r, Err(RenderError::Timeout { ms: 300, .. })),
+            "{r:?}"
+        );
+        assert!(took < Duration::from_secs(5), "{took:?}");
+        let msg = r.unwrap_err().to_string();
+        assert!(msg.contains("did not finish within 300 ms") && msg.contains("--timeout-ms"));
+        // Does not read 8 MiB of input: no dead-lock either.
+        let big = "x".repeat(8 << 20);
+        let (r, took) = run_fake(&sleeper, &big, short);
+        assert!(matches!(r, Err(RenderError::Timeout { .. })), "{r:?}");
+        assert!(took < Duration::from_secs(5), "{took:?}");
+        // Writes without end: stopped past the output cap.
+        let flood = fake_graphviz("flood", "exec cat /dev/zero");
+        let capped = Budget {
+            max_output: 1 << 20,
+            ..Budget::new(T)
+        };
+        let (r, took) = run_fake(&flood, "digraph { a }", capped);
+        assert!(
+            matches!(r, Err(RenderError::TooLarge { limit: 1048576, .. })),
+            "{r:?}"
+        );
+        assert!(took < Duration::from_secs(10), "{took:?}");
+        // Floods its stderr and fails: the message keeps the first bytes.
+        let noisy = fake_graphviz("noisy", "yes e | head -c 4000000 >&2; exit 3");
+        let (r, _) = run_fake(&noisy, "digraph { a }", Budget::new(T));
+        match r {
+            Err(RenderError::Failed { stderr, .. }) => {
+                // 64 KiB of `e\n`, trimmed.
+                assert_eq!(stderr.len() as u64, MAX_RENDER_STDERR_BYTES - 1);
+            }
+            r => panic!("{r:?}"),
+        }
+        for p in [cat, sleeper, flood, noisy] {
+            let _ = std::fs::remove_dir_all(p.parent().unwrap());
         }
     }
 
@@ -1414,7 +1621,7 @@ root = 'go "home" now'
             } else {
                 RenderFormat::Svg
             };
-            match run_graphviz("dot", &dot, format) {
+            match run_graphviz("dot", &dot, format, Budget::new(T)) {
                 Ok((bytes, warnings)) => {
                     assert!(warnings.is_empty(), "{}: {warnings}", f.display());
                     if let Some(out) = &out {

@@ -20,7 +20,7 @@ use crate::model::{Policy, PolicyBody, PolicyKind};
 use crate::render::dot::{DotOptions, Highlight};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// An immutable shared string of an edit script (a key, a name, a label):
 /// an entry of a table of one graph's strings, built once per graph.
@@ -490,7 +490,10 @@ impl<'a> Pair<'a> {
             (named_cost, named_cost, named)
         } else {
             let reserve = before_script.elapsed() * 2;
-            let deadline = (start + opts.timeout)
+            // Checked: a budget past the clock's range means no deadline.
+            let deadline = start
+                .checked_add(opts.timeout)
+                .unwrap_or_else(|| start + Duration::from_secs(1 << 32))
                 .checked_sub(reserve)
                 .map_or(start, |d| d.max(start));
             let found = search_mapping(

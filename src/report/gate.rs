@@ -47,16 +47,26 @@ impl Metric {
 
     /// Its value in a report.
     pub fn of(self, r: &PolicyReport) -> i64 {
+        let count = |n: usize| i64::try_from(n).unwrap_or(i64::MAX);
         match self {
-            Metric::Vertices => r.vertices as i64,
-            Metric::Edges => r.edges as i64,
-            Metric::GraphicalElements => r.graphical_elements as i64,
-            Metric::ActiveElements => r.active_elements as i64,
+            Metric::Vertices => count(r.vertices),
+            Metric::Edges => count(r.edges),
+            Metric::GraphicalElements => count(r.graphical_elements),
+            Metric::ActiveElements => count(r.active_elements),
             Metric::Cc => r.cc,
             Metric::EssentialCc => r.essential_cc,
         }
     }
+
+    fn from_key(key: &str) -> Option<Metric> {
+        Metric::ALL.into_iter().find(|m| m.key() == key)
+    }
 }
+
+/// The largest metric a baseline may hold: 2^53, the largest integer every
+/// JSON reader keeps exactly (no policy within the input limits comes near).
+/// Every metric counts something, so none is negative.
+pub const MAX_BASELINE_METRIC: i64 = 1 << 53;
 
 /// `METRIC=N`, as given to `--max` and `--max-increase`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -118,6 +128,7 @@ impl Baseline {
                 .at(&file, at..at + 1)
                 .hint(hint)
         })?;
+        check_ranges(&file, text)?;
         let not_analysis = |what: &str| {
             Diagnostic::error(format!(
                 "the baseline is not an `analyze --format json` output: {what}"
@@ -163,6 +174,140 @@ impl Baseline {
                 Some(v) if v.len() == 1 => v.first(),
                 _ => None,
             })
+    }
+}
+
+/// Refuses, at its position, a metric of a policy that is not a whole
+/// number from 0 to [`MAX_BASELINE_METRIC`] (a hostile `cc = i64::MIN` would
+/// otherwise wrap the growth computed from it). `text` is valid JSON; other
+/// shapes are left to [`Baseline::parse`]'s own messages.
+fn check_ranges(file: &Arc<SourceFile>, text: &str) -> Result<(), Diagnostic> {
+    use serde::de::DeserializeSeed;
+    let mut de = serde_json::Deserializer::from_str(text);
+    let Err(e) = Walk(Level::Top).deserialize(&mut de) else {
+        return Ok(());
+    };
+    // serde_json appends the position to the message; it is shown apart.
+    let full = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    let message = full.strip_suffix(&suffix).unwrap_or(&full).to_string();
+    // The position is just past the number: the span is the number.
+    let end = offset(file, e.line(), e.column()).min(text.len());
+    let bytes = text.as_bytes();
+    let mut start = end;
+    while start > 0
+        && matches!(
+            bytes[start - 1],
+            b'0'..=b'9' | b'-' | b'+' | b'.' | b'e' | b'E'
+        )
+    {
+        start -= 1;
+    }
+    Err(Diagnostic::error(message)
+        .at(file, start..end.max(start + 1).min(text.len()))
+        .hint(format!(
+            "a baseline is an `analyze --format json` output: its metrics are counts from 0 to {MAX_BASELINE_METRIC}"
+        )))
+}
+
+/// Where [`Walk`] is in the baseline JSON.
+#[derive(Debug, Clone, Copy)]
+enum Level {
+    Top,
+    /// The `policies` list.
+    List,
+    /// One policy; its index (from 1).
+    Policy(usize),
+    /// A metric of a policy.
+    Metric(Metric, usize),
+    Other,
+}
+
+/// A serde visitor over the whole baseline that fails, at serde_json's
+/// position, on the first metric out of range.
+struct Walk(Level);
+
+impl Walk {
+    fn check<E: serde::de::Error>(self, n: i128, shown: &dyn fmt::Display) -> Result<(), E> {
+        match self.0 {
+            Level::Metric(m, i) if !(0..=MAX_BASELINE_METRIC as i128).contains(&n) => {
+                Err(E::custom(format!(
+                    "`{}` of baseline policy {i} is {shown}, out of range (0 to {MAX_BASELINE_METRIC})",
+                    m.key()
+                )))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+impl<'de> serde::de::DeserializeSeed<'de> for Walk {
+    type Value = ();
+
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for Walk {
+    type Value = ();
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a JSON value")
+    }
+
+    fn visit_bool<E>(self, _: bool) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<(), E> {
+        self.check(v.into(), &v)
+    }
+
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<(), E> {
+        self.check(v.into(), &v)
+    }
+
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<(), E> {
+        match self.0 {
+            // Fractions, and integers too large for 64 bits.
+            Level::Metric(..) => self.check(i128::MAX, &v),
+            _ => Ok(()),
+        }
+    }
+
+    fn visit_str<E>(self, _: &str) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_unit<E>(self) -> Result<(), E> {
+        Ok(())
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        let mut i = 0;
+        loop {
+            i += 1;
+            let next = match self.0 {
+                Level::List => Level::Policy(i),
+                _ => Level::Other,
+            };
+            if seq.next_element_seed(Walk(next))?.is_none() {
+                return Ok(());
+            }
+        }
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
+        while let Some(key) = map.next_key::<std::borrow::Cow<'de, str>>()? {
+            let next = match (self.0, Metric::from_key(&key)) {
+                (Level::Top, _) if key == "policies" => Level::List,
+                (Level::Policy(i), Some(m)) => Level::Metric(m, i),
+                _ => Level::Other,
+            };
+            map.next_value_seed(Walk(next))?;
+        }
+        Ok(())
     }
 }
 
@@ -212,7 +357,7 @@ impl fmt::Display for Violation {
                 f,
                 "`{name}` ({file}): {m} grew from {b} to {} (+{}), more than the allowed +{} (--max-increase {m}={})",
                 self.value,
-                self.value - b,
+                i128::from(self.value) - i128::from(b),
                 self.limit,
                 self.limit
             ),
@@ -276,7 +421,8 @@ impl Gate {
             };
             for l in &grow {
                 let before = old[&l.metric];
-                if l.metric.of(r) - before > l.value {
+                // In i128: no limit or value given can wrap it.
+                if i128::from(l.metric.of(r)) - i128::from(before) > i128::from(l.value) {
                     out.violations.push(violation(l, Some(before)));
                 }
             }
@@ -363,6 +509,69 @@ mod tests {
             ..gate
         };
         assert_eq!(lenient.check(&now).violations.len(), 1);
+    }
+
+    fn policy_json(cc: &str) -> String {
+        format!(
+            "{{\"policies\": [\n  {{\"file\": \"a.toml\", \"name\": \"A\", \"vertices\": 5, \"edges\": 4,\n   \"graphical_elements\": 9, \"active_elements\": 5,\n   \"cc\": {cc}, \"essential_cc\": 1}}]}}"
+        )
+    }
+
+    #[test]
+    fn baseline_numbers_out_of_range_are_positioned_errors() {
+        for bad in [
+            "-9223372036854775808",
+            "9223372036854775807",
+            "18446744073709551615",
+            "9007199254740993",
+            "1e300",
+            "2.5",
+            "-1",
+        ] {
+            let text = policy_json(bad);
+            let e = Baseline::parse("b.json", &text).unwrap_err();
+            assert!(e.message.contains("out of range"), "{bad}: {}", e.message);
+            assert!(
+                e.message.contains("`cc` of baseline policy 1"),
+                "{}",
+                e.message
+            );
+            let (_, line, col) = e.location().unwrap();
+            assert_eq!(line, 4, "{bad}");
+            let at = text.lines().nth(3).unwrap().find(bad).unwrap() + 1;
+            assert_eq!(col, at, "{bad}: the caret is on the number");
+        }
+        // The largest count allowed, and the gate's arithmetic on extremes.
+        let b = Baseline::parse("b.json", &policy_json("9007199254740992")).unwrap();
+        let now = [report("a.toml", "A", i64::MAX, 5)];
+        for (limit, violations) in [(i64::MIN, 1), (i64::MAX, 0), (0, 1)] {
+            let gate = Gate {
+                max: vec![Limit {
+                    metric: Metric::Cc,
+                    value: limit,
+                }],
+                baseline: Some(Baseline::parse("b.json", &policy_json("0")).unwrap()),
+                max_increase: vec![Limit {
+                    metric: Metric::Cc,
+                    value: limit,
+                }],
+            };
+            let r = gate.check(&now);
+            let grew = r.violations.iter().filter(|v| v.before.is_some()).count();
+            assert_eq!(grew, violations, "--max-increase cc={limit}");
+            for v in &r.violations {
+                assert!(!v.to_string().is_empty());
+            }
+        }
+        let gate = Gate {
+            baseline: Some(b),
+            ..Gate::default()
+        };
+        assert!(
+            gate.check(&[report("a.toml", "A", 0, 5)])
+                .violations
+                .is_empty()
+        );
     }
 
     #[test]

@@ -1,9 +1,10 @@
 //! Reports: what `analyze` prints per policy, in table, JSON (the stable contract
-//! of SPEC §7) or CSV form, and the safe writing of output files.
+//! of SPEC §7) or CSV form, and the safe writing of output files (`output`).
 
 pub mod compare;
 pub mod effort;
 pub mod gate;
+pub mod output;
 pub mod paper;
 pub mod table;
 
@@ -13,8 +14,8 @@ use crate::metrics::complexity::{cyclomatic, essential};
 use crate::metrics::counts::{TableOne, counts, fully_connected_states, table_one};
 use crate::model::{PolicyBody, PolicyKind};
 use std::collections::BTreeMap;
-use std::io::Write;
-use std::path::Path;
+
+pub use output::write_atomically;
 
 /// Output format for figures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -153,60 +154,6 @@ pub fn csv_field(s: &str) -> String {
     crate::sanitize::csv_cell(s)
 }
 
-/// Writes `bytes` to `path` whole or not at all: a temporary file in the same
-/// directory, renamed over the target when complete.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.btfsm-{}.tmp", std::process::id()));
-    remove_stale_temporaries(&dir, &name);
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// Removes `.NAME.btfsm-PID.tmp` files beside the target left by runs that
-/// were killed between writing and renaming (the target itself is never
-/// half-written: the rename is atomic). Only temporaries of processes that
-/// no longer run are removed; where that cannot be told (no `/proc`), none.
-fn remove_stale_temporaries(dir: &Path, name: &str) {
-    let proc = Path::new("/proc/self");
-    if !proc.exists() {
-        return;
-    }
-    let prefix = format!(".{name}.btfsm-");
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for e in entries.flatten() {
-        let file = e.file_name();
-        let Some(pid) = file
-            .to_str()
-            .and_then(|f| f.strip_prefix(&prefix))
-            .and_then(|r| r.strip_suffix(".tmp"))
-            .filter(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
-        else {
-            continue;
-        };
-        if !Path::new("/proc").join(pid).exists() {
-            let _ = std::fs::remove_file(e.path());
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -222,7 +169,7 @@ mod tests {
             std::fs::write(f, b"partial").unwrap();
         }
         write_atomically(&dir.join("x.txt"), b"whole").unwrap();
-        if Path::new("/proc/self").exists() {
+        if std::path::Path::new("/proc/self").exists() {
             assert!(!dead.exists());
         }
         assert!(mine.exists(), "another target's temporary is kept");

@@ -405,3 +405,462 @@ fn hostile_xml_and_scxml_nesting_and_names() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------
+// Output files (issue 12): symlinks, devices, FIFOs, `-`, permissions, long
+// names, one path given twice; Graphviz under a deadline; a baseline whose
+// numbers would wrap the gate's arithmetic.
+
+/// What a run of the binary gave, and how long it took.
+struct Run {
+    code: i32,
+    stdout: Vec<u8>,
+    stderr: String,
+    secs: f64,
+}
+
+/// Runs the built `btfsm` in `dir` with `path_prefix` put first on the
+/// child's PATH (only the child's), killed after `limit_secs`.
+#[cfg(unix)]
+fn run_in(dir: &Path, args: &[&str], path_prefix: Option<&Path>, limit_secs: u64) -> Run {
+    use std::io::Read;
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_btfsm"));
+    cmd.args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    if let Some(pre) = path_prefix {
+        let old = std::env::var_os("PATH").unwrap_or_default();
+        let mut paths = vec![pre.to_path_buf()];
+        paths.extend(std::env::split_paths(&old));
+        cmd.env("PATH", std::env::join_paths(paths).expect("PATH"));
+    }
+    let t0 = Instant::now();
+    let mut child = cmd.spawn().expect("spawn btfsm");
+    let mut out = child.stdout.take().expect("stdout");
+    let mut err = child.stderr.take().expect("stderr");
+    let o = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let _ = out.read_to_end(&mut v);
+        v
+    });
+    let e = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let _ = err.read_to_end(&mut v);
+        v
+    });
+    let status = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break s;
+        }
+        if t0.elapsed() > Duration::from_secs(limit_secs) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("btfsm {args:?} still running after {limit_secs} s");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let secs = t0.elapsed().as_secs_f64();
+    Run {
+        code: status.code().unwrap_or(-1),
+        stdout: o.join().expect("stdout thread"),
+        stderr: String::from_utf8_lossy(&e.join().expect("stderr thread")).into_owned(),
+        secs,
+    }
+}
+
+/// The DOT drawing of `policies/paper/fig01-bt.toml`, as printed on stdout.
+fn fig01_dot() -> Vec<u8> {
+    let (code, stdout, stderr) = btfsm(&["dot", "policies/paper/fig01-bt.toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    stdout.into_bytes()
+}
+
+fn fig01() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("policies/paper/fig01-bt.toml")
+        .display()
+        .to_string()
+}
+
+/// Names of the temporaries (`*.tmp`) left in `dir`.
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .expect("dir")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|f| f.ends_with(".tmp"))
+        .collect()
+}
+
+#[cfg(unix)]
+#[test]
+fn hostile_output_through_a_symlink_writes_its_target_and_keeps_the_link() {
+    use std::os::unix::fs::symlink;
+    let dir = Scratch::new("out-symlink");
+    let other = dir.0.join("other");
+    std::fs::create_dir_all(&other).expect("dir");
+    let target = other.join("target.dot");
+    std::fs::write(&target, "old").expect("write");
+    // link.dot -> hop.dot -> other/target.dot (relative links, two hops).
+    symlink("hop.dot", dir.0.join("link.dot")).expect("symlink");
+    symlink("other/target.dot", dir.0.join("hop.dot")).expect("symlink");
+    // dangling.dot -> other/new.dot, which does not exist yet.
+    symlink("other/new.dot", dir.0.join("dangling.dot")).expect("symlink");
+    let want = fig01_dot();
+    for (link, written) in [
+        ("link.dot", &target),
+        ("dangling.dot", &other.join("new.dot")),
+    ] {
+        let r = run_in(&dir.0, &["dot", &fig01(), "-o", link], None, 60);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let meta = std::fs::symlink_metadata(dir.0.join(link)).expect("link");
+        assert!(meta.file_type().is_symlink(), "{link} was replaced");
+        assert_eq!(std::fs::read(written).expect("target"), want);
+    }
+    assert_eq!(
+        std::fs::read_link(dir.0.join("hop.dot")).expect("hop"),
+        Path::new("other/target.dot")
+    );
+    assert!(temporaries(&dir.0).is_empty() && temporaries(&other).is_empty());
+}
+
+/// Opens the read end of a FIFO without waiting for a writer.
+#[cfg(unix)]
+fn open_fifo_reader(path: &Path) -> std::fs::File {
+    use std::os::unix::fs::OpenOptionsExt;
+    std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .expect("open the FIFO for reading")
+}
+
+#[cfg(unix)]
+fn mkfifo(path: &Path) {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(path.as_os_str().as_bytes()).expect("path");
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo");
+}
+
+/// `-o` onto a device writes into it: `/dev/null` (and a private copy of it,
+/// checked first) stays a character device, `/dev/stdout` (and a private
+/// link to `/proc/self/fd/1`) stays a link and the bytes reach stdout.
+#[cfg(target_os = "linux")]
+#[test]
+fn hostile_output_onto_devices_writes_into_them() {
+    use std::os::unix::ffi::OsStrExt;
+    use std::os::unix::fs::{FileTypeExt, MetadataExt, symlink};
+    let dir = Scratch::new("out-dev");
+    let want = fig01_dot();
+    // A private character device (1, 3), where allowed (root, no seccomp).
+    let node = dir.0.join("null");
+    let c = std::ffi::CString::new(node.as_os_str().as_bytes()).expect("path");
+    // SAFETY: a valid NUL-terminated path.
+    let made = unsafe { libc::mknod(c.as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) } == 0;
+    if made {
+        let r = run_in(&dir.0, &["dot", &fig01(), "-o", "null"], None, 60);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let meta = std::fs::symlink_metadata(&node).expect("node");
+        assert!(
+            meta.file_type().is_char_device(),
+            "the device node was replaced"
+        );
+    }
+    // A private link to this process's stdout: the bytes go to the pipe.
+    symlink("/proc/self/fd/1", dir.0.join("stdout")).expect("symlink");
+    let r = run_in(&dir.0, &["dot", &fig01(), "-o", "stdout"], None, 60);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        std::fs::symlink_metadata(dir.0.join("stdout"))
+            .expect("link")
+            .file_type()
+            .is_symlink(),
+        "the link to stdout was replaced"
+    );
+    assert_eq!(r.stdout, want);
+    // The system's own entries.
+    let before = std::fs::metadata("/dev/null").expect("/dev/null");
+    let r = run_in(&dir.0, &["dot", &fig01(), "-o", "/dev/null"], None, 60);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let after = std::fs::symlink_metadata("/dev/null").expect("/dev/null");
+    assert!(after.file_type().is_char_device(), "/dev/null was replaced");
+    assert_eq!((after.ino(), after.rdev()), (before.ino(), before.rdev()));
+    if std::fs::symlink_metadata("/dev/stdout").is_ok_and(|m| m.file_type().is_symlink()) {
+        let r = run_in(&dir.0, &["dot", &fig01(), "-o", "/dev/stdout"], None, 60);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        assert_eq!(r.stdout, want);
+        assert!(
+            std::fs::symlink_metadata("/dev/stdout")
+                .expect("/dev/stdout")
+                .file_type()
+                .is_symlink()
+        );
+    }
+    assert!(temporaries(&dir.0).is_empty());
+}
+
+/// A FIFO is written into, not replaced; with no reader the run fails at
+/// once (exit 2) instead of blocking.
+#[cfg(unix)]
+#[test]
+fn hostile_output_onto_a_fifo_never_blocks() {
+    use std::io::Read;
+    use std::os::unix::fs::FileTypeExt;
+    let dir = Scratch::new("out-fifo");
+    let fifo = dir.0.join("pipe");
+    mkfifo(&fifo);
+    let r = run_in(&dir.0, &["dot", &fig01(), "-o", "pipe"], None, 20);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("no process is reading"), "{}", r.stderr);
+    assert!(r.secs < 10.0, "took {} s", r.secs);
+    let is_fifo = |p: &Path| std::fs::symlink_metadata(p).is_ok_and(|m| m.file_type().is_fifo());
+    assert!(is_fifo(&fifo), "the FIFO was replaced");
+    // With a reader (the DOT text fits in the pipe's buffer).
+    let mut reader = open_fifo_reader(&fifo);
+    let r = run_in(&dir.0, &["dot", &fig01(), "-o", "pipe"], None, 20);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let mut got = Vec::new();
+    let mut buf = [0u8; 8192];
+    loop {
+        match reader.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => got.extend_from_slice(&buf[..n]),
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => break,
+            Err(e) => panic!("{e}"),
+        }
+    }
+    assert_eq!(got, fig01_dot());
+    assert!(is_fifo(&fifo), "the FIFO was replaced");
+    assert!(temporaries(&dir.0).is_empty());
+}
+
+#[cfg(unix)]
+#[test]
+fn hostile_output_keeps_an_existing_files_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = Scratch::new("out-perm");
+    let secret = dir.0.join("secret.toml");
+    std::fs::write(&secret, "old").expect("write");
+    std::fs::set_permissions(&secret, std::fs::Permissions::from_mode(0o600)).expect("chmod");
+    let r = run_in(
+        &dir.0,
+        &["convert", &fig01(), "--to", "toml", "-o", "secret.toml"],
+        None,
+        60,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let mode = |p: &Path| std::fs::metadata(p).expect("meta").permissions().mode() & 0o7777;
+    assert_eq!(mode(&secret), 0o600);
+    assert!(
+        std::fs::read_to_string(&secret)
+            .expect("read")
+            .contains("kind = \"bt\"")
+    );
+    // A new file gets the default mode (0666 less the umask).
+    let reference = dir.0.join("reference");
+    std::fs::write(&reference, "").expect("write");
+    let r = run_in(&dir.0, &["dot", &fig01(), "-o", "new.dot"], None, 60);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(mode(&dir.0.join("new.dot")), mode(&reference));
+}
+
+/// A legal 254-byte file name: the temporary beside it must stay within
+/// NAME_MAX (255 bytes) too.
+#[cfg(unix)]
+#[test]
+fn hostile_output_with_a_254_byte_name() {
+    let dir = Scratch::new("out-long");
+    let name = format!("{}.dot", "n".repeat(250));
+    assert_eq!(name.len(), 254);
+    for _ in 0..2 {
+        let r = run_in(&dir.0, &["dot", &fig01(), "-o", &name], None, 60);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+    }
+    assert_eq!(std::fs::read(dir.0.join(&name)).expect("read"), fig01_dot());
+    assert!(temporaries(&dir.0).is_empty());
+}
+
+/// `-o -` is stdout, for every command with `-o`; no file named `-`.
+#[cfg(unix)]
+#[test]
+fn hostile_output_dash_means_stdout() {
+    let dir = Scratch::new("out-dash");
+    let f = fig01();
+    let (_, toml, _) = btfsm(&["convert", &f, "--to", "toml"]);
+    for (args, want) in [
+        (vec!["dot", f.as_str(), "-o", "-"], fig01_dot()),
+        (
+            vec!["convert", f.as_str(), "--to", "toml", "-o", "-"],
+            toml.into_bytes(),
+        ),
+    ] {
+        let r = run_in(&dir.0, &args, None, 60);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        assert_eq!(r.stdout, want, "{args:?}");
+        assert!(!dir.0.join("-").exists(), "{args:?} created a file `-`");
+    }
+}
+
+/// One output path given twice (the same spelling, another spelling, a
+/// symlink, or stdout where the report goes) is refused before anything is
+/// written.
+#[cfg(unix)]
+#[test]
+fn hostile_one_output_path_used_twice_is_refused() {
+    let dir = Scratch::new("out-twice");
+    std::fs::create_dir_all(dir.0.join("sub")).expect("dir");
+    std::os::unix::fs::symlink("x.out", dir.0.join("link.out")).expect("symlink");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("policies/scenarios/exp1-nominal.toml")
+        .display()
+        .to_string();
+    let s = scenario.as_str();
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["sim", s, "--trace", "x.out", "--plot", "x.out"],
+        vec!["sim", s, "--trace", "x.out", "--plot", "./sub/../x.out"],
+        vec!["sim", s, "--trace", "link.out", "--plot", "x.out"],
+        vec!["sim", s, "--trace", "-", "--plot", "y.out"],
+    ];
+    for args in &cases {
+        let r = run_in(&dir.0, args, None, 60);
+        assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
+        assert!(r.stderr.contains("used twice"), "{args:?}: {}", r.stderr);
+        assert!(r.stdout.is_empty(), "{args:?}");
+        for f in ["x.out", "y.out", "-"] {
+            assert!(!dir.0.join(f).exists(), "{args:?} wrote {f}");
+        }
+    }
+    // compare: --dot on stdout, where the report goes.
+    let a = fig01();
+    let b = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("policies/paper/fig05-bt.toml")
+        .display()
+        .to_string();
+    let r = run_in(
+        &dir.0,
+        &["compare", &a, &b, "--mode", "named", "--dot", "-"],
+        None,
+        60,
+    );
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("used twice"), "{}", r.stderr);
+    assert!(r.stdout.is_empty());
+    // Distinct paths are fine.
+    let r = run_in(
+        &dir.0,
+        &["sim", s, "--trace", "x.out", "--plot", "y.out"],
+        None,
+        60,
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
+/// Graphviz is a child under a deadline: a `dot` that never answers (a
+/// script whose `sleep` child holds the pipes, first on the child's PATH)
+/// is killed at `--timeout-ms` and the run exits 2, writing nothing.
+#[cfg(unix)]
+#[test]
+fn hostile_graphviz_past_its_deadline_is_killed() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = Scratch::new("out-graphviz");
+    let bin = dir.0.join("bin");
+    std::fs::create_dir_all(&bin).expect("dir");
+    let fake = bin.join("dot");
+    std::fs::write(&fake, "#!/bin/sh\nsleep 30\n").expect("write");
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+    let f = fig01();
+    let b = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("policies/paper/fig05-bt.toml")
+        .display()
+        .to_string();
+    let cases: Vec<(Vec<&str>, u64)> = vec![
+        (
+            vec![
+                "dot",
+                &f,
+                "--render",
+                "svg",
+                "--timeout-ms",
+                "1000",
+                "-o",
+                "out.svg",
+            ],
+            1000,
+        ),
+        (
+            vec![
+                "compare",
+                &f,
+                &b,
+                "--mode",
+                "named",
+                "--timeout-ms",
+                "1000",
+                "--dot",
+                "out.svg",
+                "--render",
+                "svg",
+            ],
+            1000,
+        ),
+    ];
+    for (args, ms) in cases {
+        let r = run_in(&dir.0, &args, Some(&bin), 25);
+        assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
+        assert!(
+            r.stderr.contains(&format!("did not finish within {ms} ms")),
+            "{args:?}: {}",
+            r.stderr
+        );
+        assert!(
+            r.secs < ms as f64 / 1000.0 + 5.0,
+            "{args:?}: took {} s",
+            r.secs
+        );
+        assert!(!dir.0.join("out.svg").exists(), "{args:?} wrote a file");
+    }
+}
+
+/// A baseline whose numbers would wrap the gate's subtraction (cc =
+/// i64::MIN passed the gate) or are no count at all: exit 2, positioned.
+#[test]
+fn hostile_baseline_numbers_out_of_range_are_refused() {
+    let dir = Scratch::new("out-baseline");
+    let f = "policies/paper/fig04-fsm.toml";
+    let (code, json, _) = btfsm(&["analyze", f, "--format", "json"]);
+    assert_eq!(code, 0);
+    for bad in [
+        "-9223372036854775808",
+        "9223372036854775807",
+        "18446744073709551615",
+        "1e300",
+        "-1",
+    ] {
+        let text = json.replacen("\"cc\": 14", &format!("\"cc\": {bad}"), 1);
+        assert_ne!(text, json);
+        let base = dir.write("base.json", &text);
+        let (code, _, stderr) = btfsm(&["analyze", f, "--baseline", &base]);
+        assert_eq!(code, 2, "cc = {bad}: {stderr}");
+        assert!(stderr.contains("out of range"), "cc = {bad}: {stderr}");
+        let line = text.lines().position(|l| l.contains(bad)).expect("line") + 1;
+        assert!(
+            stderr.contains(&format!("base.json:{line}:")),
+            "cc = {bad}: {stderr}"
+        );
+    }
+    // Extreme growth limits do not wrap either.
+    let base = dir.write("base.json", &json);
+    for (limit, want) in [
+        ("cc=-9223372036854775808", 1),
+        ("cc=9223372036854775807", 0),
+    ] {
+        let (code, _, stderr) =
+            btfsm(&["analyze", f, "--baseline", &base, "--max-increase", limit]);
+        assert_eq!(code, want, "{limit}: {stderr}");
+    }
+}
