@@ -125,11 +125,10 @@ impl Destination {
     /// Writes `bytes` whole: stdout, in place, or by atomic replacement.
     pub fn write(&self, bytes: &[u8]) -> io::Result<()> {
         match self {
-            Destination::Stdout => {
-                let mut out = io::stdout().lock();
-                out.write_all(bytes)?;
-                out.flush()
-            }
+            // The library never prints: the command line writes stdout.
+            Destination::Stdout => Err(io::Error::other(
+                "standard output is written by the command line, not here",
+            )),
             Destination::Direct { path } => write_in_place(path, bytes),
             Destination::File {
                 dir,
