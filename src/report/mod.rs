@@ -180,6 +180,71 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// A file written as it is made (`sim --trace`), whole or not at all like
+/// [`write_atomically`]'s: the bytes go to the same temporary
+/// `.NAME.btfsm-PID.tmp` beside the target, which [`AtomicFile::commit`]
+/// syncs and renames over it. Dropped without a commit (an error, a panic),
+/// the temporary is removed and the target left as it was.
+pub struct AtomicFile {
+    path: std::path::PathBuf,
+    tmp: std::path::PathBuf,
+    file: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+/// Starts an [`AtomicFile`] for `path`.
+pub fn create_atomically(path: &Path) -> std::io::Result<AtomicFile> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.btfsm-{}.tmp", std::process::id()));
+    remove_stale_temporaries(&dir, &name);
+    let file = std::fs::File::create(&tmp)?;
+    Ok(AtomicFile {
+        path: path.to_path_buf(),
+        tmp,
+        file: Some(std::io::BufWriter::with_capacity(1 << 16, file)),
+    })
+}
+
+impl AtomicFile {
+    /// Flushes and syncs the temporary, then renames it over the target.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let w = self.file.take().expect("not committed yet");
+        let result = (|| {
+            let f = w.into_inner().map_err(|e| e.into_error())?;
+            f.sync_all()?;
+            std::fs::rename(&self.tmp, &self.path)
+        })();
+        if result.is_err() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+        result
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.file.as_mut().expect("not committed").write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.as_mut().expect("not committed").flush()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.file.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
 /// Removes `.NAME.btfsm-PID.tmp` files beside the target left by runs that
 /// were killed between writing and renaming (the target itself is never
 /// half-written: the rename is atomic). Only temporaries of processes that

@@ -12,7 +12,7 @@ use super::exec::{BtExec, CompiledBt, CompiledMachine, Leaves, MachineExec};
 use super::rng::SimRng;
 use super::scenario::{Disturbance, Effect, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Running, Status, Target};
-use super::trace::{Event, FinalWorld, Outcome, Run, SkillRecord, Step};
+use super::trace::{Event, FinalWorld, Outcome, Run, SkillRecord, Step, compact_trajectory};
 use super::world::{P2, Place, World};
 use crate::model::PolicyBody;
 use std::collections::BTreeMap;
@@ -311,6 +311,22 @@ fn holds(terms: &[(Call, bool)], w: &World) -> bool {
     terms.iter().all(|(c, neg)| skills::condition(c, w) != *neg)
 }
 
+/// Steps between two clock readings for a policy and disturbances: at most
+/// [`CLOCK_EVERY`], fewer as the work of a step grows (a BT of a million
+/// nodes, a thousand disturbances with conditions), so that the clock is
+/// read about every 64k units of work (node ticks, conditions) whatever
+/// the input.
+pub fn clock_every(p: &Prepared, disturbances: &[Disturbance], w: &World) -> u64 {
+    let terms: usize = (disturbances.iter())
+        .map(|d| match &d.when {
+            When::Holds(t) => t.len(),
+            _ => 1,
+        })
+        .sum();
+    let work = (p.keys.len() + terms + w.objects.len()).max(1) as u64;
+    (65_536 / work).clamp(1, CLOCK_EVERY)
+}
+
 /// Runs one policy in a scenario.
 pub fn run_policy(
     s: &Scenario,
@@ -321,6 +337,27 @@ pub fn run_policy(
     seed: u64,
     opts: RunOptions,
 ) -> Run {
+    run_policy_into(s, p, world, disturbances, rates, seed, opts, None)
+}
+
+/// Where the steps of a traced run go as they are made (instead of
+/// [`Run::trace`]), so that a trace never has to fit in memory.
+pub type StepSink<'a> = &'a mut dyn FnMut(&Step);
+
+/// [`run_policy`], handing each step of the trace (`opts.trace`) to `sink`
+/// when there is one.
+#[allow(clippy::too_many_arguments)]
+pub fn run_policy_into(
+    s: &Scenario,
+    p: &Prepared,
+    world: World,
+    disturbances: &[Disturbance],
+    rates: BTreeMap<String, f64>,
+    seed: u64,
+    opts: RunOptions,
+    mut sink: Option<StepSink<'_>>,
+) -> Run {
+    let every = clock_every(p, disturbances, &world);
     let n = p.keys.len();
     let mut robot = Robot {
         world,
@@ -351,6 +388,10 @@ pub fn run_policy(
         Compiled::Machine(m) => Ex::M(MachineExec::new(m.clone(), opts.trace)),
     };
     let mut fired = vec![false; disturbances.len()];
+    // Timed disturbances not yet fired (a run is not over while one is).
+    let mut pending_timed = (disturbances.iter())
+        .filter(|d| matches!(d.when, When::At(_) | When::AfterDone(_)))
+        .count();
     let mut first_done: Option<f64> = None;
     let mut completion: Option<f64> = None;
     let mut low = false;
@@ -364,7 +405,7 @@ pub fn run_policy(
     }
     while steps < s.max_steps {
         if let Some(d) = opts.deadline
-            && steps % CLOCK_EVERY == 0
+            && steps % every == 0
             && Instant::now() >= d
         {
             ended = Some((
@@ -386,6 +427,9 @@ pub fn run_policy(
             };
             if go {
                 fired[i] = true;
+                if !matches!(d.when, When::Holds(_)) {
+                    pending_timed -= 1;
+                }
                 apply(d, &mut robot);
             }
         }
@@ -421,7 +465,7 @@ pub fn run_policy(
                         .to_string()
                 })
                 .collect();
-            trace.push(Step {
+            let step = Step {
                 t: round3(robot.world.time),
                 x: robot.world.robot.0,
                 y: robot.world.robot.1,
@@ -435,7 +479,11 @@ pub fn run_policy(
                             .collect()
                     })
                     .unwrap_or_default(),
-            });
+            };
+            match sink.as_mut() {
+                Some(f) => f(&step),
+                None => trace.push(step),
+            }
         }
         let finished = match &ex {
             Ex::Bt(_) => None,
@@ -451,10 +499,7 @@ pub fn run_policy(
         } else {
             completion = None;
         }
-        let pending = disturbances
-            .iter()
-            .zip(&fired)
-            .any(|(d, f)| !f && matches!(d.when, When::At(_) | When::AfterDone(_)));
+        let pending = pending_timed > 0;
         if robot.switches > s.chatter_switches {
             let text = format!("{} actions started without progress", robot.switches);
             robot.event("chattering", text.clone());
@@ -530,23 +575,60 @@ pub fn run_scenario_within(
     trace: bool,
     deadline: Option<Instant>,
 ) -> (Vec<Run>, bool) {
+    run_scenario_out(s, trace, deadline, None)
+}
+
+/// Receives the runs of a traced scenario as they are made, so that the
+/// trace is written out instead of kept (`sim --trace`).
+pub trait TraceOut {
+    /// A policy's run starts.
+    fn begin(&mut self);
+    /// One step of it.
+    fn step(&mut self, step: &Step);
+    /// It ended; `run.trajectory` is whole (it is thinned afterwards).
+    fn end(&mut self, run: &Run);
+}
+
+/// [`run_scenario_within`] with every step handed to `out` instead of kept
+/// in [`Run::trace`] (which stays empty).
+pub fn run_scenario_traced(
+    s: &Scenario,
+    deadline: Option<Instant>,
+    out: &mut dyn TraceOut,
+) -> (Vec<Run>, bool) {
+    run_scenario_out(s, true, deadline, Some(out))
+}
+
+fn run_scenario_out(
+    s: &Scenario,
+    trace: bool,
+    deadline: Option<Instant>,
+    mut out: Option<&mut dyn TraceOut>,
+) -> (Vec<Run>, bool) {
     let mut any_cut = false;
     let runs = prepare(s)
         .iter()
         .map(|p| {
-            let run = run_policy(
-                s,
-                p,
-                s.world.clone(),
-                &s.disturbances,
-                s.rates.clone(),
-                s.seed,
-                RunOptions {
-                    log: true,
-                    trace,
-                    deadline,
-                },
-            );
+            let opts = RunOptions {
+                log: true,
+                trace,
+                deadline,
+            };
+            let (world, ds, rates) = (s.world.clone(), &s.disturbances, s.rates.clone());
+            let mut run = match out.as_deref_mut() {
+                Some(o) => {
+                    o.begin();
+                    let mut sink = |st: &Step| o.step(st);
+                    let run =
+                        run_policy_into(s, p, world, ds, rates, s.seed, opts, Some(&mut sink));
+                    o.end(&run);
+                    run
+                }
+                None => run_policy(s, p, world, ds, rates, s.seed, opts),
+            };
+            // Kept for the verdicts and the plot: the points where the
+            // robot moved, at most TRAJECTORY_POINTS of them.
+            run.trajectory = compact_trajectory(std::mem::take(&mut run.trajectory));
             any_cut |= cut_short(s, &run);
             run
         })
@@ -628,50 +710,56 @@ pub fn monte_carlo_within(
     type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
     let mut per_thread: Vec<Vec<(u32, usize, Res)>> = Vec::new();
     std::thread::scope(|sc| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| {
-                let prepared = &prepared;
-                let stop = &stop;
-                sc.spawn(move || {
-                    let mut out = Vec::new();
-                    let mut i = t as u32;
-                    'episodes: while i < runs {
-                        if stop.load(Ordering::Relaxed) {
-                            break;
-                        }
-                        let (ep_seed, ds, rates) = episode(s, seed, i);
-                        let first = out.len();
-                        for (k, p) in prepared.iter().enumerate() {
-                            let r = run_policy(
-                                s,
-                                p,
-                                s.world.clone(),
-                                &ds,
-                                rates.clone(),
-                                ep_seed,
-                                RunOptions {
-                                    log: false,
-                                    trace: false,
-                                    deadline,
-                                },
-                            );
-                            if cut_short(s, &r) {
-                                stop.store(true, Ordering::Relaxed);
-                                out.truncate(first);
-                                break 'episodes;
-                            }
-                            out.push((
-                                i,
-                                k,
-                                (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s),
-                            ));
-                        }
-                        i += threads as u32;
+        let prepared = &prepared;
+        let stop = &stop;
+        // One worker's episodes: t, t + threads, ...
+        let work = move |t: usize| {
+            let mut out = Vec::new();
+            let mut i = t as u32;
+            'episodes: while i < runs {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
+                let (ep_seed, ds, rates) = episode(s, seed, i);
+                let first = out.len();
+                for (k, p) in prepared.iter().enumerate() {
+                    let r = run_policy(
+                        s,
+                        p,
+                        s.world.clone(),
+                        &ds,
+                        rates.clone(),
+                        ep_seed,
+                        RunOptions {
+                            log: false,
+                            trace: false,
+                            deadline,
+                        },
+                    );
+                    if cut_short(s, &r) {
+                        stop.store(true, Ordering::Relaxed);
+                        out.truncate(first);
+                        break 'episodes;
                     }
-                    out
-                })
-            })
-            .collect();
+                    out.push((
+                        i,
+                        k,
+                        (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s),
+                    ));
+                }
+                i += threads as u32;
+            }
+            out
+        };
+        let mut handles = Vec::new();
+        for t in 0..threads {
+            // A thread the system refuses (a limit on processes) does its
+            // share on this one instead: the same episodes, the same figures.
+            match std::thread::Builder::new().spawn_scoped(sc, move || work(t)) {
+                Ok(h) => handles.push(h),
+                Err(_) => per_thread.push(work(t)),
+            }
+        }
         for h in handles {
             per_thread.push(h.join().expect("episode thread"));
         }
