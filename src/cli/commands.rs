@@ -89,7 +89,9 @@ pub fn execute(cli: Cli) -> u8 {
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let Some((policy, opts)) = super::sim::dot_trace(&trace, &file, l.policy) else {
+            let Some((policy, opts)) =
+                super::sim::dot_trace(&trace, &file, l.policy, &limits.limits())
+            else {
                 return EXIT_BAD_INPUT;
             };
             draw(&policy, &opts, output.as_deref(), render)
