@@ -112,6 +112,7 @@ pub fn parse(
     let mut r = Reader {
         file: file.clone(),
         diags: Vec::new(),
+        terms: 0,
     };
     let (doc, errors) = DeTable::parse_recoverable(&file.text);
     if !errors.is_empty() {
@@ -161,13 +162,16 @@ pub const MAX_STATIONS: usize = 1024;
 pub const MAX_OBJECTS: usize = 1024;
 pub const MAX_OBSTACLES: usize = 1024;
 pub const MAX_DISTURBANCES: usize = 1024;
-/// Condition terms in one list (`goal`, a disturbance's `when`), evaluated
+/// Condition terms in all the lists of a scenario together (`goal`, the
+/// disturbances' `when`): those of pending disturbances are evaluated
 /// every step.
-pub const MAX_TERMS: usize = 256;
+pub const MAX_TERMS: usize = 1024;
 
 struct Reader {
     file: Arc<SourceFile>,
     diags: Vec<Diagnostic>,
+    /// Condition terms read so far (at most [`MAX_TERMS`]).
+    terms: usize,
 }
 
 /// A number as messages show it: short (`1e300`, not 301 digits).
@@ -486,7 +490,13 @@ impl Reader {
 
     fn terms(&mut self, v: &Val<'_>, world: &World) -> Option<Vec<(Call, bool)>> {
         let a = self.array(v, "a list of conditions")?;
-        if !self.at_most(v.span(), a.len(), MAX_TERMS, "conditions in a list") {
+        self.terms += a.len();
+        if !self.at_most(
+            v.span(),
+            self.terms,
+            MAX_TERMS,
+            "condition terms (`goal` and every `when` together)",
+        ) {
             return None;
         }
         let mut out = Vec::new();
@@ -1466,9 +1476,15 @@ file = "../paper/fig16a-bt.toml"
             all.contains("1025 obstacles (`block` disturbances included)"),
             "{all}"
         );
-        let terms = "{ if = \"Found\" }, ".repeat(MAX_TERMS + 1);
-        let all = errors_of(&format!("goal = [{terms}]\n[world]\n{CUBE}{ONE_POLICY}"));
-        assert!(all.contains("257 conditions in a list"), "{all}");
+        let terms = "{ if = \"Found\" }, ".repeat(MAX_TERMS / 2);
+        let whens = format!("[[disturbances]]\nwhen = [{terms}]\nbattery = 5\n").repeat(2);
+        let all = errors_of(&format!(
+            "goal = [{{ if = \"Found\" }}]\n[world]\n{CUBE}{ONE_POLICY}{whens}"
+        ));
+        assert!(
+            all.contains("1025 condition terms (`goal` and every `when` together), more than the limit of 1024"),
+            "{all}"
+        );
     }
 
     /// NaN and infinities passed the wall and obstacle checks, the battery
