@@ -126,7 +126,18 @@ struct Robot {
     mark: u64,
     low_at: Option<f64>,
     latencies: Vec<f64>,
+    /// An action start or an event was refused: the run's records are full
+    /// ([`MAX_SKILL_RECORDS`], [`MAX_EVENTS`]); the run ends after the step.
+    full: bool,
 }
+
+/// Executed skills a run records at most: a policy that picks and places
+/// every step for 10^6 steps held 2 million records (3.3 GB, and 1 GB of
+/// JSON); past this the run ends with outcome `timeout` (the bundled
+/// scenarios record at most 24).
+pub const MAX_SKILL_RECORDS: usize = 1024;
+/// Events a run records at most (likewise; the bundled scenarios: 50).
+pub const MAX_EVENTS: usize = 4096;
 
 /// The arguments of a resolved call, by name.
 pub fn call_args(c: &Call, w: &World) -> BTreeMap<String, String> {
@@ -158,6 +169,10 @@ pub fn call_args(c: &Call, w: &World) -> BTreeMap<String, String> {
 
 impl Robot {
     fn event(&mut self, kind: &str, text: String) {
+        if self.events.len() >= MAX_EVENTS {
+            self.full = true;
+            return;
+        }
         if self.log {
             self.events.push(Event {
                 t: round3(self.world.time),
@@ -215,6 +230,11 @@ impl Leaves for Robot {
     fn action(&mut self, key: usize, call: &Call) -> Status {
         self.ticked[key] = true;
         if self.live[key].as_ref().is_none_or(|r| r.call != *call) {
+            if self.records.len() >= MAX_SKILL_RECORDS {
+                // Not started: the run ends after this step.
+                self.full = true;
+                return Status::Failure;
+            }
             if let Some(mut old) = self.live[key].take() {
                 old.cancel(&mut self.world);
                 self.close(old.record, "cancelled");
@@ -378,6 +398,7 @@ pub fn run_policy_into(
         mark: 0,
         low_at: None,
         latencies: Vec::new(),
+        full: false,
     };
     enum Ex {
         Bt(BtExec),
@@ -500,6 +521,15 @@ pub fn run_policy_into(
             completion = None;
         }
         let pending = pending_timed > 0;
+        if robot.full {
+            ended = Some((
+                Outcome::Timeout,
+                format!(
+                    "record budget exhausted at step {steps}: a run records at most {MAX_SKILL_RECORDS} executed skills and {MAX_EVENTS} events"
+                ),
+            ));
+            break;
+        }
         if robot.switches > s.chatter_switches {
             let text = format!("{} actions started without progress", robot.switches);
             robot.event("chattering", text.clone());
@@ -557,7 +587,9 @@ pub fn run_policy_into(
 /// Whether the wall-clock budget cut `r` short: a timeout before the step
 /// budget was used up (the clock is read only while steps remain).
 fn cut_short(s: &Scenario, r: &Run) -> bool {
-    r.outcome == Outcome::Timeout && r.steps < s.max_steps
+    r.outcome == Outcome::Timeout
+        && r.steps < s.max_steps
+        && r.reason.starts_with("wall-clock budget")
 }
 
 /// Runs every policy of a scenario once (the scenario's own seed and
@@ -906,6 +938,40 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
             free.iter().map(key).collect::<Vec<_>>(),
             plain.iter().map(key).collect::<Vec<_>>()
         );
+    }
+
+    /// A BT that picks and places the cube every step (both instantaneous)
+    /// recorded two skills and four events a step, 3.3 GB over 10^6 steps:
+    /// a run now ends once its records are full, and that is not taken for
+    /// the wall-clock budget.
+    #[test]
+    fn a_run_ends_when_its_records_are_full() {
+        let dir = std::env::temp_dir().join(format!("btfsm-records-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("pp.toml"),
+            "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
+        )
+        .unwrap();
+        let text = "max_steps = 1000000\n[world]\nrobot = \"east-table\"\nparams = { manipulation_s = 0 }\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"pp.toml\"\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
+        let f = SourceFile::new("pp-scenario.toml", text);
+        let s = super::super::scenario::parse(&f, &dir, &Limits::default()).expect("valid");
+        let (runs, cut) = run_scenario_within(&s, false, None);
+        assert!(!cut);
+        let r = &runs[0];
+        assert_eq!(r.outcome, Outcome::Timeout);
+        assert!(
+            r.reason.starts_with("record budget exhausted at step"),
+            "{}",
+            r.reason
+        );
+        assert_eq!(r.skills.len(), MAX_SKILL_RECORDS);
+        assert!(r.events.len() <= MAX_EVENTS);
+        assert!(r.steps < 1000, "{}", r.steps);
+        // Monte Carlo: a timeout of the episode, not a budget cut.
+        let (stats, done) = monte_carlo_within(&s, 2, 1, 1, None);
+        assert_eq!((done, stats[0].timeouts), (2, 2));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -569,6 +569,47 @@ mod hostile {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// 64 policies picking and placing a cube every step for 10^6 steps
+    /// (a 400-byte scenario) recorded 2 million skills each: 3.3 GB per
+    /// policy. A run now records at most 1024 skills and 4096 events.
+    #[test]
+    fn sim_hostile_endless_skills_fill_a_bounded_record() {
+        let dir = common::scratch("endless-skills");
+        std::fs::write(
+            dir.join("pp.toml"),
+            "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
+        )
+        .unwrap();
+        let f = dir.join("pp-scenario.toml");
+        std::fs::write(
+            &f,
+            format!(
+                "max_steps = 1000000\n[world]\nrobot = \"east-table\"\nparams = {{ manipulation_s = 0 }}\nobjects = {{ cube2 = {{ at = \"east-table\" }} }}\n{}[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n",
+                "[[policies]]\nfile = \"pp.toml\"\n".repeat(64)
+            ),
+        )
+        .unwrap();
+        let (code, out, err, took) =
+            btfsm_within(512, &["sim", f.to_str().unwrap(), "--format", "json"]);
+        assert_eq!(code, 0, "{err}");
+        assert!(took < Duration::from_secs(20), "{took:?}");
+        assert!(out.len() < 64 << 20, "{} bytes of JSON", out.len());
+        let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+        for p in v["policies"].as_array().unwrap() {
+            assert_eq!(p["outcome"], "timeout");
+            assert!(
+                p["reason"]
+                    .as_str()
+                    .unwrap()
+                    .starts_with("record budget exhausted at step"),
+                "{}",
+                p["reason"]
+            );
+            assert_eq!(p["skills"].as_array().unwrap().len(), 1024);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     /// `dot --trace /dev/zero` read until memory ran out.
     #[test]
     fn dot_hostile_trace_is_read_within_the_file_limit() {
