@@ -101,7 +101,9 @@ pub fn execute(cli: Cli) -> u8 {
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let Some((policy, opts)) = super::sim::dot_trace(&trace, &file, l.policy) else {
+            let Some((policy, opts)) =
+                super::sim::dot_trace(&trace, &file, l.policy, &limits.limits())
+            else {
                 return EXIT_BAD_INPUT;
             };
             let timeout = std::time::Duration::from_millis(timeout_ms);

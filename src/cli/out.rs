@@ -39,7 +39,8 @@ mod tests {
                     continue;
                 }
                 if p.extension().is_none_or(|x| x != "rs")
-                    || p.file_name().is_some_and(|n| n == "tests.rs" || n == "main.rs")
+                    || p.file_name()
+                        .is_some_and(|n| n == "tests.rs" || n == "main.rs")
                 {
                     continue;
                 }

@@ -5,10 +5,13 @@
 use super::commands::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use crate::report::OutputFormat;
-use crate::sim::report::{McReport, SimReport};
+use crate::sim::report::{McReport, SimReport, TraceWriter};
 use crate::sim::{plot, run, scenario};
 use clap::Args;
 use std::path::PathBuf;
+
+/// `--threads` above this many per core are lowered to it.
+pub const MAX_THREADS_PER_CORE: usize = 4;
 
 #[derive(Debug, Args)]
 pub struct SimArgs {
@@ -29,13 +32,15 @@ pub struct SimArgs {
     /// Seed of the episodes (default: the scenario's seed)
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
-    /// Worker threads for --runs (default: the number of cores)
+    /// Worker threads for --runs (default: the number of cores; at least 1,
+    /// and more than 4 x the cores are lowered to 4 x the cores)
     #[arg(long)]
     pub threads: Option<usize>,
     /// Wall-clock budget for all the simulation work, in ms: when it runs
     /// out, runs stop cleanly (outcome `timeout` at the step reached; with
     /// --runs, the figures cover the episodes completed) and the report
-    /// says so; the exit code stays 0
+    /// says so; the exit code stays 0. A budget too large for the clock
+    /// (past the year 2^64 ns) is no budget
     #[arg(long, value_name = "MS")]
     pub timeout_ms: Option<u64>,
     #[command(flatten)]
@@ -64,18 +69,26 @@ pub fn execute(a: SimArgs) -> u8 {
     let file = a.scenario.display().to_string();
     // The budget's clock starts once the scenario is read.
     let t0 = std::time::Instant::now();
+    // Checked: a budget past what the clock can hold is no deadline.
     let deadline = a
         .timeout_ms
-        .map(|ms| t0 + std::time::Duration::from_millis(ms));
+        .and_then(|ms| t0.checked_add(std::time::Duration::from_millis(ms)));
     if let Some(n) = a.runs {
         if a.trace.is_some() || a.plot.is_some() {
             eprintln!("error: --trace and --plot record one run; leave them out with --runs");
             return EXIT_BAD_INPUT;
         }
         let seed = a.seed.unwrap_or(s.seed);
-        let threads = a
-            .threads
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let threads = match a.threads {
+            Some(0) => {
+                eprintln!("error: --threads must be at least 1");
+                return EXIT_BAD_INPUT;
+            }
+            // More threads than cores only wait; a few per core at most.
+            Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
+            None => cores,
+        };
         let (stats, done) = run::monte_carlo_within(&s, n, seed, threads, deadline);
         let rep = McReport {
             scenario: s.name.clone(),
@@ -110,8 +123,29 @@ pub fn execute(a: SimArgs) -> u8 {
     // The runs stop 5% early, leaving the verdicts time to compare them.
     let runs_deadline = a
         .timeout_ms
-        .map(|ms| t0 + std::time::Duration::from_micros(ms * 950));
-    let (runs, cut) = run::run_scenario_within(&s, a.trace.is_some(), runs_deadline);
+        .and_then(|ms| t0.checked_add(std::time::Duration::from_micros(ms.saturating_mul(950))));
+    // The trace goes to its (temporary) file as the runs make it.
+    let (runs, cut, trace_out) = match &a.trace {
+        Some(p) => {
+            let f = match crate::report::output::OutputFile::create(p) {
+                Ok(f) => f,
+                Err(e) => {
+                    eprintln!(
+                        "error: cannot write `{}`: {e}",
+                        crate::sanitize::shown(&p.display().to_string())
+                    );
+                    return EXIT_BAD_INPUT;
+                }
+            };
+            let mut w = TraceWriter::new(f, &s.name, &file, s.seed, s.dt);
+            let (runs, cut) = run::run_scenario_traced(&s, runs_deadline, &mut w);
+            (runs, cut, Some((p, w)))
+        }
+        None => {
+            let (runs, cut) = run::run_scenario_within(&s, false, runs_deadline);
+            (runs, cut, None)
+        }
+    };
     // The verdicts' trajectory distances get what is left of the budget:
     // fewer points per trajectory when little is (300 at the least).
     let pairs = runs.len() * runs.len().saturating_sub(1) / 2;
@@ -121,17 +155,22 @@ pub fn execute(a: SimArgs) -> u8 {
             d.saturating_duration_since(std::time::Instant::now()),
         )
     });
-    let rep = SimReport::with_points(&s.name, &file, s.seed, s.dt, runs, points);
+    // The verdicts stop at the deadline too; the pairs left are reported.
+    let rep = SimReport::within(&s.name, &file, s.seed, s.dt, runs, points, deadline);
     let millis = t0.elapsed().as_millis();
     let budget = a.timeout_ms.map(|ms| Budget {
         timeout_ms: ms,
-        exhausted: cut,
+        exhausted: cut || !rep.skipped_verdicts.is_empty(),
         requested_runs: None,
         millis: Some(millis),
     });
-    if let Some(p) = &a.trace
-        && emit_text(Some(p), rep.trace_json()) != EXIT_OK
+    if let Some((p, w)) = trace_out
+        && let Err(e) = w.finish(&rep).and_then(|f| f.commit())
     {
+        eprintln!(
+            "error: cannot write `{}`: {e}",
+            crate::sanitize::shown(&p.display().to_string())
+        );
         return EXIT_BAD_INPUT;
     }
     if let Some(p) = &a.plot
@@ -139,7 +178,7 @@ pub fn execute(a: SimArgs) -> u8 {
     {
         return EXIT_BAD_INPUT;
     }
-    let note = "the runs with outcome `timeout` stopped at the step shown in their reason";
+    let note = "the runs with outcome `timeout` stopped at the step shown in their reason, and the verdicts not computed are listed";
     let text = render(
         &rep,
         a.format,
@@ -230,6 +269,7 @@ pub fn dot_trace(
     a: &DotTraceArgs,
     file: &std::path::Path,
     policy: crate::model::Policy,
+    limits: &crate::format::Limits,
 ) -> Option<(crate::model::Policy, crate::render::dot::DotOptions)> {
     use crate::render::dot::{Highlight, Status};
     let (Some(trace), Some(step)) = (&a.trace, a.step) else {
@@ -239,9 +279,9 @@ pub fn dot_trace(
         eprintln!("error: {m}");
         None
     };
-    let text = match std::fs::read_to_string(trace) {
+    let text = match read_trace(trace, limits.max_file_bytes) {
         Ok(t) => t,
-        Err(e) => return fail(format!("cannot read `{}`: {e}", trace.display())),
+        Err(m) => return fail(m),
     };
     let v: serde_json::Value = match serde_json::from_str(&text) {
         Ok(v) => v,
@@ -301,4 +341,35 @@ pub fn dot_trace(
         }
     }
     Some((policy, opts))
+}
+
+/// Reads a trace file through `take(limit + 1)`, so that a device or pipe
+/// (`/dev/zero`) stops at `--max-file-bytes` instead of filling memory.
+fn read_trace(path: &std::path::Path, limit: u64) -> Result<String, String> {
+    use std::io::Read;
+    let shown = path.display();
+    let too_big = |size: String| {
+        format!(
+            "`{shown}` is {size} the limit of {limit} bytes\n  = hint: raise the limit with --max-file-bytes"
+        )
+    };
+    let cannot = |e: std::io::Error| format!("cannot read `{shown}`: {e}");
+    let f = std::fs::File::open(path).map_err(cannot)?;
+    let meta = f.metadata().map_err(cannot)?;
+    if meta.is_dir() {
+        return Err(format!("cannot read `{shown}`: it is a directory"));
+    }
+    if meta.len() > limit {
+        return Err(too_big(format!("{} bytes, more than", meta.len())));
+    }
+    let mut bytes = Vec::new();
+    f.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big("larger than".into()));
+    }
+    String::from_utf8(bytes).map_err(|_| {
+        format!("`{shown}` is not a trace written by `btfsm sim --trace`: not UTF-8 text")
+    })
 }

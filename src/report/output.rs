@@ -289,12 +289,19 @@ fn stdout_identity() -> Identity {
 }
 
 /// Writes into a device, FIFO or `/proc` file without renaming anything.
-/// The open does not block: a FIFO no process reads is an error (ENXIO),
-/// and the flag is cleared afterwards so that writes wait for the reader.
 fn write_in_place(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut f = open_in_place(path)?;
+    f.write_all(bytes)?;
+    f.flush()
+}
+
+/// Opens a device, FIFO or `/proc` file for writing in place. The open does
+/// not block: a FIFO no process reads is an error (ENXIO), and the flag is
+/// cleared afterwards so that writes wait for the reader.
+fn open_in_place(path: &Path) -> io::Result<File> {
     use std::os::fd::AsRawFd;
     let was_fifo = std::fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo());
-    let mut f = OpenOptions::new()
+    let f = OpenOptions::new()
         .write(true)
         .custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY)
         .open(path)
@@ -316,53 +323,142 @@ fn write_in_place(path: &Path, bytes: &[u8]) -> io::Result<()> {
         // A regular file reached through `/proc`: written as `>` would.
         f.set_len(0)?;
     }
-    f.write_all(bytes)?;
-    f.flush()
+    Ok(f)
 }
 
-/// Replaces `dir/name` atomically: a temporary beside it, created
-/// exclusively (a planted file or symlink of that name is never followed),
-/// given the existing file's owner and mode (a new file gets the default
-/// mode, 0666 less the umask), synced, renamed over the target.
+/// Replaces `dir/name` atomically (see [`Replacement`]).
 fn replace(dir: &Path, name: &OsStr, existing: Option<&Metadata>, bytes: &[u8]) -> io::Result<()> {
-    let target = dir.join(name);
-    remove_stale_temporaries(dir, name);
-    let tmp = dir.join(temp_name(name, std::process::id()));
-    let open = || {
-        OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            // Private until the existing file's mode is set.
-            .mode(if existing.is_some() { 0o600 } else { 0o666 })
-            .open(&tmp)
-    };
-    let mut f = match open() {
-        // Left by an earlier process with this pid.
-        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
-            std::fs::remove_file(&tmp)?;
-            open()?
-        }
-        r => r?,
-    };
-    let result = (|| {
+    let mut r = Replacement::create(dir, name, existing)?;
+    r.file.write_all(bytes)?;
+    r.commit()
+}
+
+/// The temporary that replaces `dir/name`: beside it, created exclusively
+/// (a planted file or symlink of that name is never followed), given the
+/// existing file's owner and mode (a new file gets the default mode, 0666
+/// less the umask); [`Replacement::commit`] syncs it and renames it over
+/// the target. Dropped uncommitted, it is removed.
+struct Replacement {
+    file: File,
+    tmp: PathBuf,
+    dir: PathBuf,
+    target: PathBuf,
+    done: bool,
+}
+
+impl Replacement {
+    fn create(dir: &Path, name: &OsStr, existing: Option<&Metadata>) -> io::Result<Replacement> {
+        remove_stale_temporaries(dir, name);
+        let tmp = dir.join(temp_name(name, std::process::id()));
+        let open = || {
+            OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                // Private until the existing file's mode is set.
+                .mode(if existing.is_some() { 0o600 } else { 0o666 })
+                .open(&tmp)
+        };
+        let file = match open() {
+            // Left by an earlier process with this pid.
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
+                std::fs::remove_file(&tmp)?;
+                open()?
+            }
+            r => r?,
+        };
+        let r = Replacement {
+            file,
+            tmp,
+            dir: dir.to_path_buf(),
+            target: dir.join(name),
+            done: false,
+        };
         if let Some(m) = existing {
             // Best effort: only root may give a file to another owner.
-            if f.metadata()?.uid() != m.uid() || f.metadata()?.gid() != m.gid() {
-                let _ = std::os::unix::fs::fchown(&f, Some(m.uid()), Some(m.gid()));
+            let mine = r.file.metadata()?;
+            if mine.uid() != m.uid() || mine.gid() != m.gid() {
+                let _ = std::os::unix::fs::fchown(&r.file, Some(m.uid()), Some(m.gid()));
             }
-            f.set_permissions(std::fs::Permissions::from_mode(m.mode() & 0o7777))?;
+            r.file
+                .set_permissions(std::fs::Permissions::from_mode(m.mode() & 0o7777))?;
         }
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, &target)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    } else if let Ok(d) = File::open(dir) {
-        // The rename itself, on disk (best effort).
-        let _ = d.sync_all();
+        Ok(r)
     }
-    result
+
+    fn commit(mut self) -> io::Result<()> {
+        self.file.sync_all()?;
+        std::fs::rename(&self.tmp, &self.target)?;
+        self.done = true;
+        if let Ok(d) = File::open(&self.dir) {
+            // The rename itself, on disk (best effort).
+            let _ = d.sync_all();
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Replacement {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// An output file written as it is made (`sim --trace`), with the rules of
+/// [`Destination`]: a regular file (or a symlink's target) is replaced
+/// whole or not at all when [`OutputFile::commit`] is called (dropped
+/// without it, the temporary is removed and the target left as it was); a
+/// device or FIFO is written into as the bytes come. Standard output is the
+/// command line's to write: `-` is refused here.
+pub struct OutputFile {
+    out: io::BufWriter<File>,
+    replacement: Option<Replacement>,
+}
+
+impl OutputFile {
+    pub fn create(path: &Path) -> io::Result<OutputFile> {
+        match Destination::resolve(path)? {
+            Destination::Stdout => Err(io::Error::other(
+                "this output cannot go to standard output; name a file",
+            )),
+            Destination::Direct { path } => Ok(OutputFile {
+                out: io::BufWriter::with_capacity(1 << 16, open_in_place(&path)?),
+                replacement: None,
+            }),
+            Destination::File {
+                dir,
+                name,
+                existing,
+            } => {
+                let r = Replacement::create(&dir, &name, existing.as_ref())?;
+                let f = r.file.try_clone()?;
+                Ok(OutputFile {
+                    out: io::BufWriter::with_capacity(1 << 16, f),
+                    replacement: Some(r),
+                })
+            }
+        }
+    }
+
+    /// Flushes, then (a file) syncs and renames the temporary over the target.
+    pub fn commit(mut self) -> io::Result<()> {
+        self.out.flush()?;
+        match self.replacement.take() {
+            Some(r) => r.commit(),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Write for OutputFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.out.write(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
 }
 
 const TMP_INFIX: &[u8] = b".btfsm-";

@@ -4,7 +4,7 @@
 //! `--runs` summary and the `--trace` file.
 
 use super::run::McStats;
-use super::trace::{FRECHET_POINTS, Run, Verdict, verdicts};
+use super::trace::{FRECHET_POINTS, Run, Verdict, verdicts_within};
 use crate::report::table::Table;
 use serde::Serialize;
 
@@ -17,6 +17,10 @@ pub struct SimReport {
     pub dt: f64,
     pub policies: Vec<Run>,
     pub verdicts: Vec<Verdict>,
+    /// Pairs whose verdict was not computed: the wall-clock budget
+    /// (`--timeout-ms`) ran out first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub skipped_verdicts: Vec<[String; 2]>,
 }
 
 impl SimReport {
@@ -34,7 +38,21 @@ impl SimReport {
         runs: Vec<Run>,
         points: usize,
     ) -> Self {
-        let verdicts = verdicts(&runs, points);
+        Self::within(scenario, file, seed, dt, runs, points, None)
+    }
+
+    /// The report, its verdicts computed until `deadline` (the others are
+    /// listed in `skipped_verdicts`).
+    pub fn within(
+        scenario: &str,
+        file: &str,
+        seed: u64,
+        dt: f64,
+        runs: Vec<Run>,
+        points: usize,
+        deadline: Option<std::time::Instant>,
+    ) -> Self {
+        let (verdicts, skipped_verdicts) = verdicts_within(&runs, points, deadline);
         SimReport {
             scenario: scenario.into(),
             file: file.into(),
@@ -42,6 +60,7 @@ impl SimReport {
             dt,
             policies: runs,
             verdicts,
+            skipped_verdicts,
         }
     }
 
@@ -69,6 +88,8 @@ impl SimReport {
             dt: f64,
             policies: Vec<TracedRun<'a>>,
             verdicts: &'a [Verdict],
+            #[serde(skip_serializing_if = "<[_]>::is_empty")]
+            skipped_verdicts: &'a [[String; 2]],
         }
         let t = TraceFile {
             scenario: &self.scenario,
@@ -85,6 +106,7 @@ impl SimReport {
                 })
                 .collect(),
             verdicts: &self.verdicts,
+            skipped_verdicts: &self.skipped_verdicts,
         };
         let mut s = crate::sanitize::json(serde_json::to_string(&t).expect("serializable"));
         s.push('\n');
@@ -195,6 +217,22 @@ impl SimReport {
                 }
             }
         }
+        if !self.skipped_verdicts.is_empty() {
+            let n = self.skipped_verdicts.len();
+            let shown: Vec<String> = (self.skipped_verdicts.iter().take(10))
+                .map(|[a, b]| format!("{a} vs {b}"))
+                .collect();
+            out.push_str(&format!(
+                "\n{n} verdict{} skipped, the wall-clock budget ran out first: {}{}\n",
+                if n == 1 { "" } else { "s" },
+                shown.join("; "),
+                if n > 10 {
+                    format!("; and {} more", n - 10)
+                } else {
+                    String::new()
+                }
+            ));
+        }
         out
     }
 }
@@ -248,6 +286,122 @@ impl McReport {
         }
         out.push_str(&t.render());
         out
+    }
+}
+
+/// Writes the `--trace` file as the runs go (see [`SimReport::trace_json`]
+/// for the same content in memory): the scenario's fields, then per policy
+/// its steps as they are made, its whole trajectory and the run's fields,
+/// then the verdicts. Memory holds one step at a time; the first write
+/// error is kept and returned by [`TraceWriter::finish`].
+pub struct TraceWriter<W: std::io::Write> {
+    w: W,
+    runs: usize,
+    steps: usize,
+    err: Option<std::io::Error>,
+}
+
+impl<W: std::io::Write> TraceWriter<W> {
+    pub fn new(w: W, scenario: &str, file: &str, seed: u64, dt: f64) -> Self {
+        let mut t = TraceWriter {
+            w,
+            runs: 0,
+            steps: 0,
+            err: None,
+        };
+        #[derive(Serialize)]
+        struct Head<'a> {
+            scenario: &'a str,
+            file: &'a str,
+            seed: u64,
+            dt: f64,
+        }
+        let head = serde_json::to_string(&Head {
+            scenario,
+            file,
+            seed,
+            dt,
+        })
+        .expect("serializable");
+        let head = crate::sanitize::json(head);
+        // The object without its closing brace.
+        t.put(&head.as_bytes()[..head.len() - 1]);
+        t.put(b",\"policies\":[");
+        t
+    }
+
+    fn put(&mut self, b: &[u8]) {
+        if self.err.is_none()
+            && let Err(e) = self.w.write_all(b)
+        {
+            self.err = Some(e);
+        }
+    }
+
+    /// A value as JSON with no raw control character
+    /// ([`crate::sanitize::json`]: names come from the scenario).
+    fn put_json<T: Serialize + ?Sized>(&mut self, v: &T) {
+        match serde_json::to_string(v) {
+            Ok(s) => self.put(crate::sanitize::json(s).as_bytes()),
+            Err(e) => {
+                self.err.get_or_insert(e.into());
+            }
+        }
+    }
+
+    /// Ends the file with the verdicts; the writer back, or the first error.
+    pub fn finish(mut self, rep: &SimReport) -> std::io::Result<W> {
+        self.put(b"],\"verdicts\":");
+        self.put_json(&rep.verdicts);
+        if !rep.skipped_verdicts.is_empty() {
+            self.put(b",\"skipped_verdicts\":");
+            self.put_json(&rep.skipped_verdicts);
+        }
+        self.put(b"}\n");
+        match self.err.take() {
+            Some(e) => Err(e),
+            None => {
+                self.w.flush()?;
+                Ok(self.w)
+            }
+        }
+    }
+}
+
+impl<W: std::io::Write> super::run::TraceOut for TraceWriter<W> {
+    fn begin(&mut self) {
+        if self.runs > 0 {
+            self.put(b",");
+        }
+        self.put(b"{\"trace\":[");
+        self.runs += 1;
+        self.steps = 0;
+    }
+
+    fn step(&mut self, step: &super::trace::Step) {
+        if self.steps > 0 {
+            self.put(b",");
+        }
+        self.steps += 1;
+        self.put_json(step);
+    }
+
+    fn end(&mut self, run: &Run) {
+        self.put(b"],\"trajectory\":[");
+        for (i, p) in run.trajectory.iter().enumerate() {
+            if i > 0 {
+                self.put(b",");
+            }
+            self.put_json(&[p.0, p.1]);
+        }
+        self.put(b"],");
+        // The run's own fields: its JSON object without the opening brace.
+        match serde_json::to_string(run) {
+            Ok(v) => self.put(&crate::sanitize::json(v).as_bytes()[1..]),
+            Err(e) => {
+                self.err.get_or_insert(e.into());
+            }
+        }
     }
 }
 
@@ -305,5 +459,67 @@ mod tests {
                 .is_empty()
         );
         assert_eq!(v["verdicts"][0]["match"], true);
+    }
+
+    /// `sim --trace` writes the trace as the runs go, one step at a time:
+    /// the same document as the trace built whole in memory.
+    #[test]
+    fn a_streamed_trace_is_the_trace_built_in_memory() {
+        use super::super::run;
+        let file = "policies/scenarios/exp1-pick-fails.toml";
+        let s = super::super::scenario::load(Path::new(file), &Limits::default()).unwrap();
+        let mut w = TraceWriter::new(Vec::new(), &s.name, file, s.seed, s.dt);
+        let (runs, cut) = run::run_scenario_traced(&s, None, &mut w);
+        assert!(!cut);
+        assert!(
+            runs.iter().all(|r| r.trace.is_empty()),
+            "not kept in memory"
+        );
+        let streamed = SimReport::new(&s.name, file, s.seed, s.dt, runs);
+        let bytes = w.finish(&streamed).expect("written");
+        let streamed: serde_json::Value = serde_json::from_slice(&bytes).expect("whole JSON");
+        // In memory: every step and the whole trajectory kept.
+        let whole: Vec<_> = run::prepare(&s)
+            .iter()
+            .map(|p| {
+                let opts = run::RunOptions {
+                    log: true,
+                    trace: true,
+                    deadline: None,
+                };
+                run::run_policy(
+                    &s,
+                    p,
+                    s.world.clone(),
+                    &s.disturbances,
+                    s.rates.clone(),
+                    s.seed,
+                    opts,
+                )
+            })
+            .collect();
+        let steps: usize = whole.iter().map(|r| r.trace.len()).sum();
+        assert!(steps > 500, "{steps}");
+        let mem = SimReport::new(&s.name, file, s.seed, s.dt, whole).trace_json();
+        let mem: serde_json::Value = serde_json::from_str(&mem).unwrap();
+        assert_eq!(streamed, mem);
+    }
+
+    /// The verdicts stop at the deadline; the pairs left are listed.
+    #[test]
+    fn skipped_verdicts_are_reported() {
+        let file = "policies/scenarios/exp1-nominal.toml";
+        let s = super::super::scenario::load(Path::new(file), &Limits::default()).unwrap();
+        let runs = super::super::run::run_scenario(&s, false);
+        let past = Some(std::time::Instant::now());
+        let r = SimReport::within(&s.name, file, s.seed, s.dt, runs, 300, past);
+        assert!(r.verdicts.is_empty());
+        assert_eq!(r.skipped_verdicts.len(), 6);
+        let v: serde_json::Value = serde_json::from_str(&r.json()).unwrap();
+        assert_eq!(v["skipped_verdicts"][0][0], "Fig. 1 BT baseline");
+        assert!(r.table().contains("6 verdicts skipped, the wall-clock budget ran out first: Fig. 1 BT baseline vs Fig. 1 BT baseline (HFSM);"), "{}", r.table());
+        let r = report(file);
+        assert!(r.skipped_verdicts.is_empty());
+        assert!(!r.json().contains("skipped_verdicts"));
     }
 }

@@ -12,7 +12,7 @@ use super::exec::{BtExec, CompiledBt, CompiledMachine, Leaves, MachineExec};
 use super::rng::SimRng;
 use super::scenario::{Disturbance, Effect, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Running, Status, Target};
-use super::trace::{Event, FinalWorld, Outcome, Run, SkillRecord, Step};
+use super::trace::{Event, FinalWorld, Outcome, Run, SkillRecord, Step, compact_trajectory};
 use super::world::{P2, Place, World};
 use crate::model::PolicyBody;
 use std::collections::BTreeMap;
@@ -126,7 +126,18 @@ struct Robot {
     mark: u64,
     low_at: Option<f64>,
     latencies: Vec<f64>,
+    /// An action start or an event was refused: the run's records are full
+    /// ([`MAX_SKILL_RECORDS`], [`MAX_EVENTS`]); the run ends after the step.
+    full: bool,
 }
+
+/// Executed skills a run records at most: a policy that picks and places
+/// every step for 10^6 steps held 2 million records (3.3 GB, and 1 GB of
+/// JSON); past this the run ends with outcome `timeout` (the bundled
+/// scenarios record at most 24).
+pub const MAX_SKILL_RECORDS: usize = 1024;
+/// Events a run records at most (likewise; the bundled scenarios: 50).
+pub const MAX_EVENTS: usize = 4096;
 
 /// The arguments of a resolved call, by name.
 pub fn call_args(c: &Call, w: &World) -> BTreeMap<String, String> {
@@ -158,6 +169,10 @@ pub fn call_args(c: &Call, w: &World) -> BTreeMap<String, String> {
 
 impl Robot {
     fn event(&mut self, kind: &str, text: String) {
+        if self.events.len() >= MAX_EVENTS {
+            self.full = true;
+            return;
+        }
         if self.log {
             self.events.push(Event {
                 t: round3(self.world.time),
@@ -215,6 +230,11 @@ impl Leaves for Robot {
     fn action(&mut self, key: usize, call: &Call) -> Status {
         self.ticked[key] = true;
         if self.live[key].as_ref().is_none_or(|r| r.call != *call) {
+            if self.records.len() >= MAX_SKILL_RECORDS {
+                // Not started: the run ends after this step.
+                self.full = true;
+                return Status::Failure;
+            }
             if let Some(mut old) = self.live[key].take() {
                 old.cancel(&mut self.world);
                 self.close(old.record, "cancelled");
@@ -311,6 +331,22 @@ fn holds(terms: &[(Call, bool)], w: &World) -> bool {
     terms.iter().all(|(c, neg)| skills::condition(c, w) != *neg)
 }
 
+/// Steps between two clock readings for a policy and disturbances: at most
+/// [`CLOCK_EVERY`], fewer as the work of a step grows (a BT of a million
+/// nodes, a thousand disturbances with conditions), so that the clock is
+/// read about every 64k units of work (node ticks, conditions) whatever
+/// the input.
+pub fn clock_every(p: &Prepared, disturbances: &[Disturbance], w: &World) -> u64 {
+    let terms: usize = (disturbances.iter())
+        .map(|d| match &d.when {
+            When::Holds(t) => t.len(),
+            _ => 1,
+        })
+        .sum();
+    let work = (p.keys.len() + terms + w.objects.len()).max(1) as u64;
+    (65_536 / work).clamp(1, CLOCK_EVERY)
+}
+
 /// Runs one policy in a scenario.
 pub fn run_policy(
     s: &Scenario,
@@ -321,6 +357,27 @@ pub fn run_policy(
     seed: u64,
     opts: RunOptions,
 ) -> Run {
+    run_policy_into(s, p, world, disturbances, rates, seed, opts, None)
+}
+
+/// Where the steps of a traced run go as they are made (instead of
+/// [`Run::trace`]), so that a trace never has to fit in memory.
+pub type StepSink<'a> = &'a mut dyn FnMut(&Step);
+
+/// [`run_policy`], handing each step of the trace (`opts.trace`) to `sink`
+/// when there is one.
+#[allow(clippy::too_many_arguments)]
+pub fn run_policy_into(
+    s: &Scenario,
+    p: &Prepared,
+    world: World,
+    disturbances: &[Disturbance],
+    rates: BTreeMap<String, f64>,
+    seed: u64,
+    opts: RunOptions,
+    mut sink: Option<StepSink<'_>>,
+) -> Run {
+    let every = clock_every(p, disturbances, &world);
     let n = p.keys.len();
     let mut robot = Robot {
         world,
@@ -341,6 +398,7 @@ pub fn run_policy(
         mark: 0,
         low_at: None,
         latencies: Vec::new(),
+        full: false,
     };
     enum Ex {
         Bt(BtExec),
@@ -351,6 +409,10 @@ pub fn run_policy(
         Compiled::Machine(m) => Ex::M(MachineExec::new(m.clone(), opts.trace)),
     };
     let mut fired = vec![false; disturbances.len()];
+    // Timed disturbances not yet fired (a run is not over while one is).
+    let mut pending_timed = (disturbances.iter())
+        .filter(|d| matches!(d.when, When::At(_) | When::AfterDone(_)))
+        .count();
     let mut first_done: Option<f64> = None;
     let mut completion: Option<f64> = None;
     let mut low = false;
@@ -364,7 +426,7 @@ pub fn run_policy(
     }
     while steps < s.max_steps {
         if let Some(d) = opts.deadline
-            && steps % CLOCK_EVERY == 0
+            && steps % every == 0
             && Instant::now() >= d
         {
             ended = Some((
@@ -386,6 +448,9 @@ pub fn run_policy(
             };
             if go {
                 fired[i] = true;
+                if !matches!(d.when, When::Holds(_)) {
+                    pending_timed -= 1;
+                }
                 apply(d, &mut robot);
             }
         }
@@ -421,7 +486,7 @@ pub fn run_policy(
                         .to_string()
                 })
                 .collect();
-            trace.push(Step {
+            let step = Step {
                 t: round3(robot.world.time),
                 x: robot.world.robot.0,
                 y: robot.world.robot.1,
@@ -435,7 +500,11 @@ pub fn run_policy(
                             .collect()
                     })
                     .unwrap_or_default(),
-            });
+            };
+            match sink.as_mut() {
+                Some(f) => f(&step),
+                None => trace.push(step),
+            }
         }
         let finished = match &ex {
             Ex::Bt(_) => None,
@@ -451,10 +520,16 @@ pub fn run_policy(
         } else {
             completion = None;
         }
-        let pending = disturbances
-            .iter()
-            .zip(&fired)
-            .any(|(d, f)| !f && matches!(d.when, When::At(_) | When::AfterDone(_)));
+        let pending = pending_timed > 0;
+        if robot.full {
+            ended = Some((
+                Outcome::Timeout,
+                format!(
+                    "record budget exhausted at step {steps}: a run records at most {MAX_SKILL_RECORDS} executed skills and {MAX_EVENTS} events"
+                ),
+            ));
+            break;
+        }
         if robot.switches > s.chatter_switches {
             let text = format!("{} actions started without progress", robot.switches);
             robot.event("chattering", text.clone());
@@ -512,7 +587,9 @@ pub fn run_policy(
 /// Whether the wall-clock budget cut `r` short: a timeout before the step
 /// budget was used up (the clock is read only while steps remain).
 fn cut_short(s: &Scenario, r: &Run) -> bool {
-    r.outcome == Outcome::Timeout && r.steps < s.max_steps
+    r.outcome == Outcome::Timeout
+        && r.steps < s.max_steps
+        && r.reason.starts_with("wall-clock budget")
 }
 
 /// Runs every policy of a scenario once (the scenario's own seed and
@@ -530,23 +607,60 @@ pub fn run_scenario_within(
     trace: bool,
     deadline: Option<Instant>,
 ) -> (Vec<Run>, bool) {
+    run_scenario_out(s, trace, deadline, None)
+}
+
+/// Receives the runs of a traced scenario as they are made, so that the
+/// trace is written out instead of kept (`sim --trace`).
+pub trait TraceOut {
+    /// A policy's run starts.
+    fn begin(&mut self);
+    /// One step of it.
+    fn step(&mut self, step: &Step);
+    /// It ended; `run.trajectory` is whole (it is thinned afterwards).
+    fn end(&mut self, run: &Run);
+}
+
+/// [`run_scenario_within`] with every step handed to `out` instead of kept
+/// in [`Run::trace`] (which stays empty).
+pub fn run_scenario_traced(
+    s: &Scenario,
+    deadline: Option<Instant>,
+    out: &mut dyn TraceOut,
+) -> (Vec<Run>, bool) {
+    run_scenario_out(s, true, deadline, Some(out))
+}
+
+fn run_scenario_out(
+    s: &Scenario,
+    trace: bool,
+    deadline: Option<Instant>,
+    mut out: Option<&mut dyn TraceOut>,
+) -> (Vec<Run>, bool) {
     let mut any_cut = false;
     let runs = prepare(s)
         .iter()
         .map(|p| {
-            let run = run_policy(
-                s,
-                p,
-                s.world.clone(),
-                &s.disturbances,
-                s.rates.clone(),
-                s.seed,
-                RunOptions {
-                    log: true,
-                    trace,
-                    deadline,
-                },
-            );
+            let opts = RunOptions {
+                log: true,
+                trace,
+                deadline,
+            };
+            let (world, ds, rates) = (s.world.clone(), &s.disturbances, s.rates.clone());
+            let mut run = match out.as_deref_mut() {
+                Some(o) => {
+                    o.begin();
+                    let mut sink = |st: &Step| o.step(st);
+                    let run =
+                        run_policy_into(s, p, world, ds, rates, s.seed, opts, Some(&mut sink));
+                    o.end(&run);
+                    run
+                }
+                None => run_policy(s, p, world, ds, rates, s.seed, opts),
+            };
+            // Kept for the verdicts and the plot: the points where the
+            // robot moved, at most TRAJECTORY_POINTS of them.
+            run.trajectory = compact_trajectory(std::mem::take(&mut run.trajectory));
             any_cut |= cut_short(s, &run);
             run
         })
@@ -628,50 +742,56 @@ pub fn monte_carlo_within(
     type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
     let mut per_thread: Vec<Vec<(u32, usize, Res)>> = Vec::new();
     std::thread::scope(|sc| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| {
-                let prepared = &prepared;
-                let stop = &stop;
-                sc.spawn(move || {
-                    let mut out = Vec::new();
-                    let mut i = t as u32;
-                    'episodes: while i < runs {
-                        if stop.load(Ordering::Relaxed) {
-                            break;
-                        }
-                        let (ep_seed, ds, rates) = episode(s, seed, i);
-                        let first = out.len();
-                        for (k, p) in prepared.iter().enumerate() {
-                            let r = run_policy(
-                                s,
-                                p,
-                                s.world.clone(),
-                                &ds,
-                                rates.clone(),
-                                ep_seed,
-                                RunOptions {
-                                    log: false,
-                                    trace: false,
-                                    deadline,
-                                },
-                            );
-                            if cut_short(s, &r) {
-                                stop.store(true, Ordering::Relaxed);
-                                out.truncate(first);
-                                break 'episodes;
-                            }
-                            out.push((
-                                i,
-                                k,
-                                (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s),
-                            ));
-                        }
-                        i += threads as u32;
+        let prepared = &prepared;
+        let stop = &stop;
+        // One worker's episodes: t, t + threads, ...
+        let work = move |t: usize| {
+            let mut out = Vec::new();
+            let mut i = t as u32;
+            'episodes: while i < runs {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
+                let (ep_seed, ds, rates) = episode(s, seed, i);
+                let first = out.len();
+                for (k, p) in prepared.iter().enumerate() {
+                    let r = run_policy(
+                        s,
+                        p,
+                        s.world.clone(),
+                        &ds,
+                        rates.clone(),
+                        ep_seed,
+                        RunOptions {
+                            log: false,
+                            trace: false,
+                            deadline,
+                        },
+                    );
+                    if cut_short(s, &r) {
+                        stop.store(true, Ordering::Relaxed);
+                        out.truncate(first);
+                        break 'episodes;
                     }
-                    out
-                })
-            })
-            .collect();
+                    out.push((
+                        i,
+                        k,
+                        (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s),
+                    ));
+                }
+                i += threads as u32;
+            }
+            out
+        };
+        let mut handles = Vec::new();
+        for t in 0..threads {
+            // A thread the system refuses (a limit on processes) does its
+            // share on this one instead: the same episodes, the same figures.
+            match std::thread::Builder::new().spawn_scoped(sc, move || work(t)) {
+                Ok(h) => handles.push(h),
+                Err(_) => per_thread.push(work(t)),
+            }
+        }
         for h in handles {
             per_thread.push(h.join().expect("episode thread"));
         }
@@ -818,6 +938,40 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
             free.iter().map(key).collect::<Vec<_>>(),
             plain.iter().map(key).collect::<Vec<_>>()
         );
+    }
+
+    /// A BT that picks and places the cube every step (both instantaneous)
+    /// recorded two skills and four events a step, 3.3 GB over 10^6 steps:
+    /// a run now ends once its records are full, and that is not taken for
+    /// the wall-clock budget.
+    #[test]
+    fn a_run_ends_when_its_records_are_full() {
+        let dir = std::env::temp_dir().join(format!("btfsm-records-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("pp.toml"),
+            "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
+        )
+        .unwrap();
+        let text = "max_steps = 1000000\n[world]\nrobot = \"east-table\"\nparams = { manipulation_s = 0 }\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"pp.toml\"\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
+        let f = SourceFile::new("pp-scenario.toml", text);
+        let s = super::super::scenario::parse(&f, &dir, &Limits::default()).expect("valid");
+        let (runs, cut) = run_scenario_within(&s, false, None);
+        assert!(!cut);
+        let r = &runs[0];
+        assert_eq!(r.outcome, Outcome::Timeout);
+        assert!(
+            r.reason.starts_with("record budget exhausted at step"),
+            "{}",
+            r.reason
+        );
+        assert_eq!(r.skills.len(), MAX_SKILL_RECORDS);
+        assert!(r.events.len() <= MAX_EVENTS);
+        assert!(r.steps < 1000, "{}", r.steps);
+        // Monte Carlo: a timeout of the episode, not a budget cut.
+        let (stats, done) = monte_carlo_within(&s, 2, 1, 1, None);
+        assert_eq!((done, stats[0].timeouts), (2, 2));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

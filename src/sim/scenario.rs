@@ -112,6 +112,7 @@ pub fn parse(
     let mut r = Reader {
         file: file.clone(),
         diags: Vec::new(),
+        terms: 0,
     };
     // The policies and their includes stay inside the scenario's root.
     let root = format::source::root_for(limits, base);
@@ -158,9 +159,37 @@ pub fn parse(
     }
 }
 
+/// Policies per scenario: their verdicts are pairwise, so 64 policies give
+/// 2016 verdicts (a fixed limit; docs/robustness.md, Limits).
+pub const MAX_POLICIES: usize = 64;
+/// Stations of `[world.stations]` (the paper room's seven included), objects
+/// of `[world.objects]`, obstacles of `[world.obstacles]` and `block`
+/// disturbances together, and disturbances: a fixed limit on each, so that
+/// checks pairing them (every pose against every obstacle, every object
+/// against every station in a final world) stay small.
+pub const MAX_STATIONS: usize = 1024;
+pub const MAX_OBJECTS: usize = 1024;
+pub const MAX_OBSTACLES: usize = 1024;
+pub const MAX_DISTURBANCES: usize = 1024;
+/// Condition terms in all the lists of a scenario together (`goal`, the
+/// disturbances' `when`): those of pending disturbances are evaluated
+/// every step.
+pub const MAX_TERMS: usize = 1024;
+
 struct Reader {
     file: Arc<SourceFile>,
     diags: Vec<Diagnostic>,
+    /// Condition terms read so far (at most [`MAX_TERMS`]).
+    terms: usize,
+}
+
+/// A number as messages show it: short (`1e300`, not 301 digits).
+pub fn show(x: f64) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-6..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 fn num(v: &DeValue<'_>) -> Option<f64> {
@@ -172,6 +201,9 @@ fn num(v: &DeValue<'_>) -> Option<f64> {
         _ => None,
     }
 }
+
+/// Largest `max_steps`: a run records its trajectory (16 bytes a step).
+pub const MAX_STEPS: u64 = 1_000_000;
 
 const TOP_KEYS: &[&str] = &[
     "name",
@@ -204,13 +236,35 @@ impl Reader {
         }
     }
 
+    /// Refuses a collection of more than `max` entries (at its value, before
+    /// any entry is read).
+    fn at_most(&mut self, span: Range<usize>, n: usize, max: usize, what: &str) -> bool {
+        if n <= max {
+            return true;
+        }
+        self.err(
+            span,
+            format!("{n} {what}, more than the limit of {max}"),
+            format!("a scenario holds at most {max} {what} (a fixed limit)"),
+        );
+        false
+    }
+
     fn number(&mut self, v: &Val<'_>, what: &str, min: f64, max: f64) -> Option<f64> {
         match num(v.get_ref()) {
+            Some(x) if !x.is_finite() => {
+                self.err(
+                    v.span(),
+                    format!("{what} must be a finite number, found {}", show(x)),
+                    format!("write a number from {min} to {max}"),
+                );
+                None
+            }
             Some(x) if (min..=max).contains(&x) => Some(x),
             Some(x) => {
                 self.err(
                     v.span(),
-                    format!("{what} must be between {min} and {max}, found {x}"),
+                    format!("{what} must be between {min} and {max}, found {}", show(x)),
                     format!("write a number from {min} to {max}"),
                 );
                 None
@@ -224,6 +278,58 @@ impl Reader {
                 None
             }
         }
+    }
+
+    /// A TOML integer from `min` to `max` (`1.5`, `1e3` and `nan` refused).
+    fn integer(&mut self, v: &Val<'_>, what: &str, min: u64, max: u64) -> Option<u64> {
+        let parsed = match v.get_ref() {
+            DeValue::Integer(i) => {
+                i64::from_str_radix(&i.as_str().replace('_', ""), i.radix()).ok()
+            }
+            _ => None,
+        };
+        match parsed {
+            Some(x) if x >= 0 && (min..=max).contains(&(x as u64)) => Some(x as u64),
+            Some(x) => {
+                self.err(
+                    v.span(),
+                    format!("{what} must be between {min} and {max}, found {x}"),
+                    format!("write a whole number from {min} to {max}"),
+                );
+                None
+            }
+            None => {
+                let found = match num(v.get_ref()) {
+                    Some(x) => format!(", found {}", show(x)),
+                    None => String::new(),
+                };
+                self.err(
+                    v.span(),
+                    format!("{what} must be an integer{found}"),
+                    format!("write a whole number from {min} to {max}, e.g. `{min}`"),
+                );
+                None
+            }
+        }
+    }
+
+    /// `[lo, hi]` with `min <= lo <= hi <= max` (a range of levels or times).
+    fn range(&mut self, v: &Val<'_>, what: &str, min: f64, max: f64) -> Option<(f64, f64)> {
+        if let Some(a) = v.get_ref().as_array()
+            && a.len() == 2
+            && let (Some(lo), Some(hi)) = (num(a[0].get_ref()), num(a[1].get_ref()))
+            && min <= lo
+            && lo <= hi
+            && hi <= max
+        {
+            return Some((lo, hi));
+        }
+        self.err(
+            v.span(),
+            format!("{what} must be a range `[low, high]` of finite numbers with {min} <= low <= high <= {max}"),
+            format!("write e.g. `[{min}, {max}]`"),
+        );
+        None
     }
 
     fn string(&mut self, v: &Val<'_>, what: &str) -> Option<String> {
@@ -273,12 +379,14 @@ impl Reader {
         if let Some(a) = v.get_ref().as_array()
             && a.len() == 2
             && let (Some(x), Some(y)) = (num(a[0].get_ref()), num(a[1].get_ref()))
+            && x.is_finite()
+            && y.is_finite()
         {
             return Some((x, y));
         }
         self.err(
             v.span(),
-            format!("{what} must be a position `[x, y]` in metres"),
+            format!("{what} must be a position `[x, y]` in metres (finite numbers)"),
             "write e.g. `[0.5, 2.1]`",
         );
         None
@@ -341,9 +449,13 @@ impl Reader {
                 let val = match v.get_ref() {
                     DeValue::String(s) => crate::model::ArgValue::Str(s.to_string()),
                     other => match num(other) {
-                        Some(x) => crate::model::ArgValue::Float(x),
-                        None => {
-                            self.err(v.span(), "an argument must be a name or a number", "");
+                        Some(x) if x.is_finite() => crate::model::ArgValue::Float(x),
+                        _ => {
+                            self.err(
+                                v.span(),
+                                "an argument must be a name or a finite number",
+                                "",
+                            );
                             return None;
                         }
                     },
@@ -387,6 +499,15 @@ impl Reader {
 
     fn terms(&mut self, v: &Val<'_>, world: &World) -> Option<Vec<(Call, bool)>> {
         let a = self.array(v, "a list of conditions")?;
+        self.terms += a.len();
+        if !self.at_most(
+            v.span(),
+            self.terms,
+            MAX_TERMS,
+            "condition terms (`goal` and every `when` together)",
+        ) {
+            return None;
+        }
         let mut out = Vec::new();
         for t in a {
             out.push(self.term(t, world)?);
@@ -445,20 +566,29 @@ impl Reader {
             }
         }
         if let Some(o) = t.get("obstacles") {
-            for ob in self.array(o, "`world.obstacles`")?.iter() {
+            let a = self.array(o, "`world.obstacles`")?;
+            if !self.at_most(o.span(), a.len(), MAX_OBSTACLES, "obstacles") {
+                return None;
+            }
+            for ob in a.iter() {
                 if let Some(r) = self.rect(ob) {
                     layout.obstacles.push(r);
                 }
             }
         }
         if let Some(s) = t.get("stations") {
-            for (k, v) in self.table(s, "`world.stations`")?.iter() {
+            let st = self.table(s, "`world.stations`")?;
+            // The paper room's stations count too (a scenario may move them).
+            let new = st
+                .iter()
+                .filter(|(k, _)| layout.station(k.get_ref()).is_none());
+            let n = layout.stations.len() + new.count();
+            if !self.at_most(s.span(), n, MAX_STATIONS, "stations") {
+                return None;
+            }
+            for (k, v) in st.iter() {
                 if let Some(p) = self.point(v, "a station") {
-                    let name = k.get_ref().to_string();
-                    match layout.stations.iter_mut().find(|(n, _)| *n == name) {
-                        Some(st) => st.1 = p,
-                        None => layout.stations.push((name, p)),
-                    }
+                    layout.set_station(k.get_ref(), p);
                 }
             }
             // Checked after every obstacle is known.
@@ -482,7 +612,11 @@ impl Reader {
             robot = p;
         }
         if let Some(ov) = t.get("objects") {
-            for (k, v) in self.table(ov, "`world.objects`")?.iter() {
+            let ot = self.table(ov, "`world.objects`")?;
+            if !self.at_most(ov.span(), ot.len(), MAX_OBJECTS, "objects") {
+                return None;
+            }
+            for (k, v) in ot.iter() {
                 let name = k.get_ref().to_string();
                 let Some(ot) = self.table(v, &format!("object `{name}`")) else {
                     continue;
@@ -540,12 +674,19 @@ impl Reader {
         let nums: Vec<f64> = rv
             .get_ref()
             .as_array()
-            .map(|a| a.iter().filter_map(|x| num(x.get_ref())).collect())
+            .map(|a| {
+                a.iter()
+                    .take(5)
+                    .filter_map(|x| num(x.get_ref()))
+                    .filter(|x| x.is_finite())
+                    .collect()
+            })
             .unwrap_or_default();
-        if nums.len() != 4 || nums[0] == nums[2] || nums[1] == nums[3] {
+        let len = rv.get_ref().as_array().map_or(0, |a| a.len());
+        if len != 4 || nums.len() != 4 || nums[0] == nums[2] || nums[1] == nums[3] {
             self.err(
                 rv.span(),
-                "`rect` must be four numbers `[x0, y0, x1, y1]` with x0 != x1 and y0 != y1",
+                "`rect` must be four finite numbers `[x0, y0, x1, y1]` with x0 != x1 and y0 != y1",
                 "write e.g. `rect = [-0.5, 1.2, 0.5, 1.4]`",
             );
             return None;
@@ -687,7 +828,7 @@ impl Reader {
             "fail" => {
                 let s = self.skill_name(t.get("fail").expect("checked above"))?;
                 let n = match t.get("times") {
-                    Some(n) => self.number(n, "`times`", 1.0, 1e6)? as u32,
+                    Some(n) => self.integer(n, "`times`", 1, 1_000_000)? as u32,
                     None => 1,
                 };
                 (
@@ -743,24 +884,24 @@ impl Reader {
         };
         let seed = t
             .get("seed")
-            .and_then(|v| self.number(v, "`seed`", 0.0, 9.0e15))
-            .unwrap_or(1.0) as u64;
+            .and_then(|v| self.integer(v, "`seed`", 0, i64::MAX as u64))
+            .unwrap_or(1);
         let dt = t
             .get("dt")
             .and_then(|v| self.number(v, "`dt`", 0.001, 10.0))
             .unwrap_or(0.1);
         let max_steps = t
             .get("max_steps")
-            .and_then(|v| self.number(v, "`max_steps`", 1.0, 1e6))
-            .unwrap_or(20_000.0) as u64;
+            .and_then(|v| self.integer(v, "`max_steps`", 1, MAX_STEPS))
+            .unwrap_or(20_000);
         let chatter_switches = t
             .get("chatter_switches")
-            .and_then(|v| self.number(v, "`chatter_switches`", 2.0, 1e6))
-            .unwrap_or(12.0) as u32;
+            .and_then(|v| self.integer(v, "`chatter_switches`", 2, 1_000_000))
+            .unwrap_or(12) as u32;
         let max_failures = t
             .get("max_failures")
-            .and_then(|v| self.number(v, "`max_failures`", 1.0, 1e6))
-            .unwrap_or(50.0) as u32;
+            .and_then(|v| self.integer(v, "`max_failures`", 1, 1_000_000))
+            .unwrap_or(50) as u32;
         let world = self.world(t.get("world"))?;
         let rates = match t.get("rates") {
             Some(r) => self.rates(r)?,
@@ -772,7 +913,28 @@ impl Reader {
         };
         let mut disturbances = Vec::new();
         if let Some(d) = t.get("disturbances") {
-            for x in self.array(d, "`disturbances`")? {
+            let a = self.array(d, "`disturbances`")?;
+            if !self.at_most(d.span(), a.len(), MAX_DISTURBANCES, "disturbances") {
+                return None;
+            }
+            // Every `block` adds an obstacle.
+            let blocks = (a.iter())
+                .filter(|x| {
+                    x.get_ref()
+                        .as_table()
+                        .is_some_and(|t| t.contains_key("block"))
+                })
+                .count();
+            let obstacles = world.layout.obstacles.len() + blocks;
+            if !self.at_most(
+                d.span(),
+                obstacles,
+                MAX_OBSTACLES,
+                "obstacles (`block` disturbances included)",
+            ) {
+                return None;
+            }
+            for x in a {
                 if let Some(d) = self.disturbance(x, &world) {
                     disturbances.push(d);
                 }
@@ -798,11 +960,11 @@ impl Reader {
                     .unwrap_or(0.5);
                 let level = bt
                     .get("level")
-                    .and_then(|v| self.point(v, "`level`"))
+                    .and_then(|v| self.range(v, "`level`", 0.0, 100.0))
                     .unwrap_or((5.0, 19.0));
                 let window = bt
                     .get("window")
-                    .and_then(|v| self.point(v, "`window`"))
+                    .and_then(|v| self.range(v, "`window`", 0.0, 1e9))
                     .unwrap_or((5.0, 60.0));
                 monte_carlo.battery_drop = Some((p, level, window));
             }
@@ -815,7 +977,11 @@ impl Reader {
                 "add `[[policies]]` with `file = \"../paper/fig01-bt.toml\"`",
             ),
             Some(p) => {
-                for e in self.array(p, "`policies`")? {
+                let a = self.array(p, "`policies`")?;
+                if !self.at_most(p.span(), a.len(), MAX_POLICIES, "policies") {
+                    return None;
+                }
+                for e in a {
                     if let Some(pe) = self.policy(e, base, limits, &world) {
                         policies.push(pe);
                     }
@@ -934,7 +1100,7 @@ impl Reader {
                 }
             }
         }
-        check_bindings(&policy, &loaded.path, world, &mut self.diags);
+        check_bindings(&policy, &loaded.path, limits, world, &mut self.diags);
         Some(PolicyEntry {
             file: path,
             convert,
@@ -944,21 +1110,36 @@ impl Reader {
 }
 
 /// Span of the line `key = ...` (bare or quoted key) in a TOML text.
+#[cfg(test)]
 fn key_span(text: &str, key: &str) -> Option<Range<usize>> {
+    key_spans(text, &[key].into_iter().collect()).remove(key)
+}
+
+/// Spans of the first lines `key = ...` (bare or quoted key) of the `keys`
+/// in a TOML text, in one pass over it.
+fn key_spans<'k>(
+    text: &str,
+    keys: &std::collections::HashSet<&'k str>,
+) -> std::collections::HashMap<&'k str, Range<usize>> {
+    let mut out = std::collections::HashMap::new();
     let mut off = 0;
     for line in text.split_inclusive('\n') {
         let t = line.trim_start();
         let lead = line.len() - t.len();
-        for k in [key.to_string(), format!("\"{key}\"")] {
-            if let Some(rest) = t.strip_prefix(&k)
-                && rest.trim_start().starts_with('=')
-            {
-                return Some(off + lead..off + lead + k.len());
+        if let Some((k, _)) = t.split_once('=') {
+            let written = k.trim_end();
+            let key = written
+                .strip_prefix('"')
+                .and_then(|q| q.strip_suffix('"'))
+                .unwrap_or(written);
+            if let Some(&k) = keys.get(key) {
+                out.entry(k)
+                    .or_insert(off + lead..off + lead + written.len());
             }
         }
         off += line.len();
     }
-    None
+    out
 }
 
 /// Whether a TOML text is a scenario rather than a policy, from its head:
@@ -988,28 +1169,31 @@ pub fn looks_like_scenario(head: &str) -> bool {
 
 /// Checks that every binding of a policy runs in the world: positioned in the
 /// policy file at the node or state.
-pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Diagnostic>) {
-    let src = std::fs::read_to_string(path)
-        .map(|t| SourceFile::new(path, t))
-        .ok();
-    let mut push = |what: String, span: Option<Range<usize>>, u: Unresolved| {
-        let mut d = Diagnostic::error(format!("{} in {what}", u.message)).hint(u.hint);
-        if let Some(f) = &src {
-            d = match span {
-                Some(s) => d.at(f, s),
-                None => d.in_file(f),
-            };
-        }
-        diags.push(d);
-    };
+/// The file is read again only to position the messages, and bounded as
+/// when it was loaded (`--max-file-bytes`; a device or pipe stops there).
+pub fn check_bindings(
+    p: &Policy,
+    path: &str,
+    limits: &Limits,
+    world: &World,
+    diags: &mut Vec<Diagnostic>,
+) {
+    /// Where a problem is: a span of the policy file, or the include of
+    /// the subtree it comes from (its key, found in the file's text).
+    enum Pos {
+        Span(Option<Range<usize>>),
+        Include(String),
+    }
+    let mut problems: Vec<(String, Pos, Unresolved)> = Vec::new();
+    let mut push = |what: String, pos: Pos, u: Unresolved| problems.push((what, pos, u));
     match &p.body {
         PolicyBody::Bt(bt) => {
             for n in &bt.nodes {
                 // Nodes of an included subtree (`include/...`) have spans in
                 // the included file: point at the include in this file.
                 let span = || match n.id.split_once('/') {
-                    None => n.span.clone(),
-                    Some((inc, _)) => src.as_ref().and_then(|f| key_span(&f.text, inc)),
+                    None => Pos::Span(n.span.clone()),
+                    Some((inc, _)) => Pos::Include(inc.to_string()),
                 };
                 if matches!(n.kind, BtNodeKind::Control | BtNodeKind::Decorator) {
                     let t = n.type_name.as_deref().unwrap_or(n.kind.keyword());
@@ -1048,7 +1232,7 @@ pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Dia
                 if s.pseudo.is_some() {
                     push(
                         format!("state `{}`", m.path(i)),
-                        s.span.clone(),
+                        Pos::Span(s.span.clone()),
                         Unresolved {
                             message: "the simulator does not execute history pseudo-states".into(),
                             hint: "re-entering a container at its last active state is not modelled; give the container an initial state instead".into(),
@@ -1061,7 +1245,7 @@ pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Dia
                     StateBody::Task(Some(c)) => calls.push(c),
                     StateBody::Task(None) => push(
                         format!("state `{}`", m.path(i)),
-                        s.span.clone(),
+                        Pos::Span(s.span.clone()),
                         Unresolved {
                             message: "no skill binding".into(),
                             hint: "the simulator needs `skill = \"...\"` on every state that is not a decision or container".into(),
@@ -1076,11 +1260,59 @@ pub fn check_bindings(p: &Policy, path: &str, world: &World, diags: &mut Vec<Dia
                 }
                 for c in calls {
                     if let Err(u) = skills::resolve(c, world) {
-                        push(format!("state `{}`", m.path(i)), s.span.clone(), u);
+                        push(
+                            format!("state `{}`", m.path(i)),
+                            Pos::Span(s.span.clone()),
+                            u,
+                        );
                     }
                 }
             }
         }
+    }
+    if problems.is_empty() {
+        return;
+    }
+    // At most this many messages per policy (the rest are counted), as the
+    // policy readers do.
+    const MAX_MESSAGES: usize = 200;
+    let more = problems.len().saturating_sub(MAX_MESSAGES);
+    problems.truncate(MAX_MESSAGES);
+    // Read once more only to position the messages, bounded as when loaded.
+    let src = format::toml::read_source(Path::new(path), path, limits).ok();
+    let includes: std::collections::HashSet<&str> = (problems.iter())
+        .filter_map(|(_, pos, _)| match pos {
+            Pos::Include(k) => Some(k.as_str()),
+            Pos::Span(_) => None,
+        })
+        .collect();
+    let spans = match &src {
+        Some(f) if !includes.is_empty() => key_spans(&f.text, &includes),
+        _ => Default::default(),
+    };
+    for (what, pos, u) in &problems {
+        let mut d = Diagnostic::error(format!("{} in {what}", u.message)).hint(u.hint.clone());
+        if let Some(f) = &src {
+            let span = match pos {
+                Pos::Span(s) => s.clone(),
+                Pos::Include(k) => spans.get(k.as_str()).cloned(),
+            };
+            d = match span {
+                Some(s) => d.at(f, s),
+                None => d.in_file(f),
+            };
+        }
+        diags.push(d);
+    }
+    if more > 0 {
+        let d = Diagnostic::error(format!(
+            "{more} more problem{} with the bindings of this policy",
+            if more == 1 { "" } else { "s" }
+        ));
+        diags.push(match &src {
+            Some(f) => d.in_file(f),
+            None => d,
+        });
     }
 }
 
@@ -1172,6 +1404,325 @@ file = "../paper/fig16a-bt.toml"
                 Err(d) => proptest::prop_assert!(d.iter().any(|x| x.is_error())),
             }
         }
+    }
+
+    fn errors_of(text: &str) -> String {
+        let e = parse_text(text).expect_err("refused");
+        e.iter().map(|d| d.to_string()).collect::<Vec<_>>().join("")
+    }
+
+    const ONE_POLICY: &str = "[[policies]]\nfile = \"../paper/fig01-bt.toml\"\n";
+    const CUBE: &str = "objects = { cube2 = { at = \"east-table\" } }\n";
+
+    /// 20,000 stations were read in quadratic time (each looked up by a scan
+    /// of those before it); now a scenario holds at most MAX_STATIONS, and
+    /// the limit is checked before any entry is read.
+    #[test]
+    fn stations_are_capped_and_read_in_linear_time() {
+        let stations = |n: usize| {
+            let mut t = format!("[world]\n{CUBE}[world.stations]\n");
+            for i in 0..n {
+                t.push_str(&format!("s{i} = [-2.0, -2.2]\n"));
+            }
+            t + ONE_POLICY
+        };
+        let t = std::time::Instant::now();
+        let all = errors_of(&stations(20_000));
+        assert!(
+            all.contains("20007 stations, more than the limit of 1024")
+                && all.contains("s.toml:3:1"),
+            "{all}"
+        );
+        // Up to the limit (the paper room's 7 included): accepted, and a
+        // moved paper station keeps its place.
+        let mut text = stations(MAX_STATIONS - 7);
+        text = text.replace(
+            "[world.stations]\n",
+            "[world.stations]\ndelivery = [0.5, 2.0]\n",
+        );
+        let s = parse_text(&text).expect("at the limit");
+        let l = &s.world.layout;
+        assert_eq!(l.stations.len(), MAX_STATIONS);
+        assert_eq!(l.stations[0], ("delivery".to_string(), (0.5, 2.0)));
+        assert_eq!(l.station_index("s1016"), Some(MAX_STATIONS - 1));
+        assert!(t.elapsed().as_secs() < 5, "{:?}", t.elapsed());
+    }
+
+    #[test]
+    fn policies_objects_obstacles_and_disturbances_are_capped() {
+        let policies = format!("[world]\n{CUBE}{}", ONE_POLICY.repeat(MAX_POLICIES + 1));
+        let all = errors_of(&policies);
+        assert!(
+            all.contains("65 policies, more than the limit of 64") && all.contains("s.toml:3:1"),
+            "{all}"
+        );
+        assert_eq!(
+            parse_text(&format!(
+                "[world]\n{CUBE}{}",
+                ONE_POLICY.repeat(MAX_POLICIES)
+            ))
+            .expect("64 policies")
+            .policies
+            .len(),
+            MAX_POLICIES
+        );
+        let objects: String = (0..=MAX_OBJECTS)
+            .map(|i| format!("o{i} = {{ at = \"east-table\" }}\n"))
+            .collect();
+        let all = errors_of(&format!("[world.objects]\n{objects}{ONE_POLICY}"));
+        assert!(
+            all.contains("1025 objects, more than the limit of 1024"),
+            "{all}"
+        );
+        let obstacles = "{ rect = [2.5, 2.5, 2.6, 2.6] }, ".repeat(MAX_OBSTACLES + 1);
+        let all = errors_of(&format!(
+            "[world]\n{CUBE}obstacles = [{obstacles}]\n{ONE_POLICY}"
+        ));
+        assert!(
+            all.contains("1025 obstacles, more than the limit of 1024"),
+            "{all}"
+        );
+        let ds = "[[disturbances]]\nat = 1.0\nbattery = 50\n".repeat(MAX_DISTURBANCES + 1);
+        let all = errors_of(&format!("[world]\n{CUBE}{ONE_POLICY}{ds}"));
+        assert!(
+            all.contains("1025 disturbances, more than the limit of 1024"),
+            "{all}"
+        );
+        // `block` disturbances add obstacles: 6 of the room + 1019 blocks.
+        let ds = "[[disturbances]]\nat = 1.0\nblock = { rect = [2.5, 2.5, 2.6, 2.6] }\n"
+            .repeat(MAX_OBSTACLES - 5);
+        let all = errors_of(&format!("[world]\n{CUBE}{ONE_POLICY}{ds}"));
+        assert!(
+            all.contains("1025 obstacles (`block` disturbances included)"),
+            "{all}"
+        );
+        let terms = "{ if = \"Found\" }, ".repeat(MAX_TERMS / 2);
+        let whens = format!("[[disturbances]]\nwhen = [{terms}]\nbattery = 5\n").repeat(2);
+        let all = errors_of(&format!(
+            "goal = [{{ if = \"Found\" }}]\n[world]\n{CUBE}{ONE_POLICY}{whens}"
+        ));
+        assert!(
+            all.contains("1025 condition terms (`goal` and every `when` together), more than the limit of 1024"),
+            "{all}"
+        );
+    }
+
+    /// NaN and infinities passed the wall and obstacle checks, the battery
+    /// drop took any level and window, and `max_steps = 1.5` was read as 1.
+    #[test]
+    fn numbers_are_finite_integers_where_counted_and_in_range() {
+        // (top-level keys, lines of [world], tables after the policy, message)
+        let cases: &[(&str, &str, &str, &str)] = &[
+            ("", "robot = [nan, 0.0]\n", "", "s.toml:3:9"),
+            (
+                "",
+                "robot = [0.0, inf]\n",
+                "",
+                "must be a position `[x, y]` in metres (finite numbers)",
+            ),
+            ("", "stations = { x = [nan, nan] }\n", "", "s.toml:3:18"),
+            (
+                "",
+                "obstacles = [{ rect = [nan, 0, 1, 1] }]\n",
+                "",
+                "`rect` must be four finite numbers",
+            ),
+            (
+                "",
+                "obstacles = [{ rect = [0, 0, inf, 1] }]\n",
+                "",
+                "s.toml:3:23",
+            ),
+            (
+                "",
+                "battery = nan\n",
+                "",
+                "`battery` must be a finite number, found NaN",
+            ),
+            (
+                "",
+                "params = { max_speed = inf }\n",
+                "",
+                "`max_speed` must be a finite number, found inf",
+            ),
+            (
+                "max_steps = 1.5\n",
+                "",
+                "",
+                "`max_steps` must be an integer, found 1.5",
+            ),
+            (
+                "max_steps = 10000000\n",
+                "",
+                "",
+                "`max_steps` must be between 1 and 1000000, found 10000000",
+            ),
+            (
+                "max_steps = nan\n",
+                "",
+                "",
+                "`max_steps` must be an integer, found NaN",
+            ),
+            (
+                "seed = 1e3\n",
+                "",
+                "",
+                "`seed` must be an integer, found 1000",
+            ),
+            ("seed = -1\n", "", "", "`seed` must be between 0 and"),
+            (
+                "chatter_switches = 2.5\n",
+                "",
+                "",
+                "`chatter_switches` must be an integer",
+            ),
+            (
+                "max_failures = inf\n",
+                "",
+                "",
+                "`max_failures` must be an integer, found inf",
+            ),
+            (
+                "dt = nan\n",
+                "",
+                "",
+                "`dt` must be a finite number, found NaN",
+            ),
+            (
+                "",
+                "",
+                "[[disturbances]]\nat = inf\nbattery = 5\n",
+                "`at` must be a finite number, found inf",
+            ),
+            (
+                "",
+                "",
+                "[[disturbances]]\nat = 1.0\nfail = \"Pick\"\ntimes = 1.5\n",
+                "`times` must be an integer, found 1.5",
+            ),
+            (
+                "",
+                "",
+                "[[disturbances]]\nat = 1.0\nmove = \"cube2\"\nto = [nan, 1.0]\n",
+                "s.toml:8:6",
+            ),
+            (
+                "",
+                "",
+                "[monte_carlo]\nbattery_drop = { level = [nan, 19] }\n",
+                "`level` must be a range `[low, high]` of finite numbers with 0 <= low <= high <= 100",
+            ),
+            (
+                "",
+                "",
+                "[monte_carlo]\nbattery_drop = { level = [5, 190] }\n",
+                "`level` must be a range",
+            ),
+            (
+                "",
+                "",
+                "[monte_carlo]\nbattery_drop = { level = [19, 5] }\n",
+                "`level` must be a range",
+            ),
+            (
+                "",
+                "",
+                "[monte_carlo]\nbattery_drop = { window = [5.0, inf] }\n",
+                "`window` must be a range",
+            ),
+            (
+                "",
+                "",
+                "[monte_carlo]\nbattery_drop = { window = [-5.0, 1.0] }\n",
+                "s.toml:6:27",
+            ),
+            (
+                "",
+                "",
+                "[monte_carlo]\nbattery_drop = { probability = nan }\n",
+                "`probability` must be a finite number",
+            ),
+            (
+                "",
+                "",
+                "[rates]\nPick = nan\n",
+                "failure rate of `Pick` must be a finite number",
+            ),
+            (
+                "goal = [{ if = \"Battery-Level\", args = { min = nan } }]\n",
+                "",
+                "",
+                "an argument must be a name or a finite number",
+            ),
+            (
+                "goal = [{ if = \"Battery-Level\", args = { min = 150 } }]\n",
+                "",
+                "",
+                "`min` of `Battery-Level` must be a percentage from 0 to 100, found 150",
+            ),
+            (
+                "goal = [{ if = \"Battery-Level\", args = { min = -inf } }]\n",
+                "",
+                "",
+                "s.toml:1:48",
+            ),
+        ];
+        for (top, world, tail, want) in cases {
+            let text = format!("{top}[world]\n{CUBE}{world}{ONE_POLICY}{tail}");
+            let all = match parse_text(&text) {
+                Ok(_) => panic!("accepted:\n{text}"),
+                Err(e) => e.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(""),
+            };
+            assert!(all.contains(want), "{text}\n=> {all}");
+        }
+        // Integers written as TOML integers still read, in any radix.
+        let s = parse_text(&format!(
+            "seed = 0x10\nmax_steps = 1_000\n[world]\n{CUBE}{ONE_POLICY}"
+        ))
+        .expect("integers");
+        assert_eq!((s.seed, s.max_steps), (16, 1000));
+    }
+
+    /// The bindings are positioned by reading the policy again, bounded by
+    /// --max-file-bytes (it was `read_to_string`, which `/dev/zero` fills).
+    #[test]
+    fn bindings_are_positioned_by_a_bounded_read() {
+        let s = parse_text(&format!("[world]\n{CUBE}{ONE_POLICY}")).expect("valid");
+        let policy = crate::format::load(
+            Path::new("policies/paper/fig01-bt.toml"),
+            &Limits::default(),
+        )
+        .expect("fig01")
+        .policy;
+        let mut world = s.world.clone();
+        world.objects.clear();
+        let world = World::new(
+            (*world.layout).clone(),
+            world.params.clone(),
+            world.robot,
+            vec![],
+        );
+        let limits = Limits {
+            max_file_bytes: 4096,
+            ..Limits::default()
+        };
+        let mut diags = Vec::new();
+        check_bindings(&policy, "/dev/zero", &limits, &world, &mut diags);
+        assert!(!diags.is_empty());
+        assert!(diags.iter().all(|d| d.file.is_none()), "{diags:?}");
+        let mut diags = Vec::new();
+        check_bindings(
+            &policy,
+            "policies/paper/fig01-bt.toml",
+            &limits,
+            &world,
+            &mut diags,
+        );
+        assert!(
+            diags[0].to_string().contains("fig01-bt.toml:9:1"),
+            "{}",
+            diags[0]
+        );
     }
 
     #[test]

@@ -134,14 +134,10 @@ fn object(w: &World, name: &str) -> Result<usize, Unresolved> {
 }
 
 fn station(w: &World, name: &str) -> Result<usize, Unresolved> {
-    w.layout
-        .stations
-        .iter()
-        .position(|(n, _)| n == name)
-        .ok_or_else(|| Unresolved {
-            message: format!("unknown station `{name}`"),
-            hint: suggest(name, w.layout.stations.iter().map(|(n, _)| n.as_str())),
-        })
+    w.layout.station_index(name).ok_or_else(|| Unresolved {
+        message: format!("unknown station `{name}`"),
+        hint: suggest(name, w.layout.stations.iter().map(|(n, _)| n.as_str())),
+    })
 }
 
 fn target(w: &World, name: &str) -> Result<Target, Unresolved> {
@@ -189,8 +185,20 @@ pub fn resolve(c: &SkillCall, w: &World) -> Result<Call, Unresolved> {
             at: station(w, arg_str(c, "at")?)?,
         },
         "Battery-Level" => Call::BatteryLevel(match c.args.get("min") {
-            Some(ArgValue::Int(i)) => *i as f64,
-            Some(ArgValue::Float(f)) => *f,
+            Some(ArgValue::Int(i)) if (0..=100).contains(i) => *i as f64,
+            Some(ArgValue::Float(f)) if (0.0..=100.0).contains(f) => *f,
+            Some(other @ (ArgValue::Int(_) | ArgValue::Float(_))) => {
+                let found = match other {
+                    ArgValue::Float(x) => crate::sim::scenario::show(*x),
+                    other => other.to_string(),
+                };
+                return Err(Unresolved {
+                    message: format!(
+                        "`min` of `Battery-Level` must be a percentage from 0 to 100, found {found}"
+                    ),
+                    hint: "write e.g. `args = { min = 20 }`".into(),
+                });
+            }
             _ => {
                 return Err(Unresolved {
                     message: "skill `Battery-Level` needs a number `min` (percent)".into(),

@@ -225,14 +225,29 @@ pub struct Verdict {
 /// The verdict of every pair of runs, in pair order, their trajectories
 /// thinned once to at most `points` points each for the Fréchet distance.
 pub fn verdicts(runs: &[Run], points: usize) -> Vec<Verdict> {
+    verdicts_within(runs, points, None).0
+}
+
+/// [`verdicts`] under a wall-clock deadline, read before each pair: the
+/// pairs not compared once it has passed are returned (names `a`, `b`).
+pub fn verdicts_within(
+    runs: &[Run],
+    points: usize,
+    deadline: Option<std::time::Instant>,
+) -> (Vec<Verdict>, Vec<[String; 2]>) {
     let thinned: Vec<Vec<P2>> = runs.iter().map(|r| thin(&r.trajectory, points)).collect();
     let mut out = Vec::new();
+    let mut skipped = Vec::new();
     for i in 0..runs.len() {
         for j in i + 1..runs.len() {
+            if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                skipped.push([runs[i].policy.clone(), runs[j].policy.clone()]);
+                continue;
+            }
             out.push(verdict_on(&runs[i], &runs[j], &thinned[i], &thinned[j]));
         }
     }
-    out
+    (out, skipped)
 }
 
 /// Trajectory points kept for the Fréchet distance when time allows.
@@ -278,6 +293,41 @@ fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
         }),
         trajectory_distance_m: (frechet_thinned(ta, tb) * 1000.0).round() / 1000.0,
     }
+}
+
+/// Trajectory points a run keeps once it has ended (for the verdicts and
+/// the plot): 1 MiB a run, whatever `max_steps`.
+pub const TRAJECTORY_POINTS: usize = 65_536;
+
+/// A run's trajectory as kept: the points where the robot moved (as
+/// [`thin`] keeps them), every k-th when there are more than
+/// [`TRAJECTORY_POINTS`], and the last point. The Fréchet distance of the
+/// verdicts is the same as on the whole trajectory up to that many points,
+/// and so is the plot.
+pub fn compact_trajectory(p: Vec<P2>) -> Vec<P2> {
+    let Some(&last) = p.last() else {
+        return p;
+    };
+    let n = p.len();
+    let mut out: Vec<P2> = Vec::new();
+    let mut kept_last = false;
+    for (i, &q) in p.iter().enumerate() {
+        if out.last().is_none_or(|&l| dist(l, q) > 1e-6) {
+            out.push(q);
+            kept_last = i + 1 == n;
+        }
+    }
+    drop(p);
+    if out.len() > TRAJECTORY_POINTS {
+        let stride = out.len().div_ceil(TRAJECTORY_POINTS);
+        out = out.into_iter().step_by(stride).collect();
+        kept_last = false;
+    }
+    if !kept_last && n > 1 {
+        out.push(last);
+    }
+    out.shrink_to_fit();
+    out
 }
 
 /// Keeps the points where the robot moved, at most `max` of them.
@@ -328,6 +378,30 @@ fn frechet_thinned(a: &[P2], b: &[P2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A run keeps at most TRAJECTORY_POINTS points of its trajectory once
+    /// it has ended (it kept one per step: 16 MB a run at 10^6 steps), and
+    /// the verdict's distance is the same below that.
+    #[test]
+    fn a_kept_trajectory_is_bounded_and_measures_the_same() {
+        // Standing still, then moving 1 cm a step, then standing still.
+        let mut p: Vec<P2> = vec![(0.0, 0.0); 50];
+        p.extend((0..5000).map(|i| (i as f64 * 0.01, 0.0)));
+        p.extend(std::iter::repeat_n((49.99, 0.0), 50));
+        let q: Vec<P2> = p.iter().map(|&(x, y)| (x, y + 0.5)).collect();
+        let (cp, cq) = (compact_trajectory(p.clone()), compact_trajectory(q.clone()));
+        assert_eq!(cp.len(), 5001, "the points where it moved, and the last");
+        for pts in [FRECHET_POINTS, FRECHET_POINTS_MIN] {
+            assert_eq!(thin(&cp, pts), thin(&p, pts));
+            assert_eq!(frechet_thinned(&thin(&cp, pts), &thin(&cq, pts)), 0.5);
+        }
+        let long: Vec<P2> = (0..1_000_000).map(|i| (i as f64 * 1e-5, 0.0)).collect();
+        let c = compact_trajectory(long);
+        assert!(c.len() <= TRAJECTORY_POINTS + 1, "{}", c.len());
+        assert_eq!(c.last(), Some(&(999_999.0 * 1e-5, 0.0)));
+        assert_eq!(compact_trajectory(vec![(1.0, 1.0)]), vec![(1.0, 1.0)]);
+        assert_eq!(compact_trajectory(vec![]), vec![]);
+    }
 
     #[test]
     fn frechet_points_fit_the_time_left() {

@@ -13,7 +13,7 @@
 //! An object's position is the pose from which the robot grasps it (the near
 //! edge of its table); "at a station" means within [`World::station_radius`].
 
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, HashMap};
 use std::sync::Arc;
 
 /// A point or pose position in metres.
@@ -155,16 +155,21 @@ pub struct Layout {
     pub room: Rect,
     pub obstacles: Vec<Rect>,
     /// Named poses, in order (delivery, charging, inspection, tables...).
+    /// Add or move one with [`Layout::set_station`], which keeps the index
+    /// by name.
     pub stations: Vec<(String, P2)>,
     /// Search waypoints, visited in order.
     pub waypoints: Vec<P2>,
+    /// Index of each station by name (lookups in constant time: a scenario
+    /// may define many stations and a policy many bindings).
+    station_ix: HashMap<String, usize>,
 }
 
 impl Layout {
     /// The paper's room (SPEC §6): a 6 m x 6 m room with a central table, two
     /// fetch tables, the delivery table, the charger and the inspection table.
     pub fn paper_room() -> Self {
-        Layout {
+        let mut l = Layout {
             room: Rect::new("room", -3.0, -3.0, 3.0, 3.0),
             obstacles: vec![
                 Rect::new("central table", -0.8, 0.4, 0.8, 1.0),
@@ -190,20 +195,43 @@ impl Layout {
                 (-0.9, 1.6),
                 (-1.2, 0.0),
             ],
-        }
+            station_ix: HashMap::new(),
+        };
+        l.station_ix = (l.stations.iter().enumerate())
+            .map(|(i, (n, _))| (n.clone(), i))
+            .collect();
+        l
+    }
+
+    /// The index of the station `name` in [`Layout::stations`].
+    pub fn station_index(&self, name: &str) -> Option<usize> {
+        self.station_ix.get(name).copied()
     }
 
     pub fn station(&self, name: &str) -> Option<P2> {
-        self.stations
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, p)| *p)
+        self.station_index(name).map(|i| self.stations[i].1)
+    }
+
+    /// Moves the station `name` to `p`, or adds it (after the others).
+    pub fn set_station(&mut self, name: &str, p: P2) {
+        match self.station_ix.get(name) {
+            Some(&i) => self.stations[i].1 = p,
+            None => {
+                self.station_ix
+                    .insert(name.to_string(), self.stations.len());
+                self.stations.push((name.to_string(), p));
+            }
+        }
     }
 
     /// Is a robot centred at `p` clear of walls and obstacles? `Err` names what
     /// it collides with.
     pub fn check_free(&self, p: P2, radius: f64) -> Result<(), String> {
         let r = &self.room;
+        // NaN compares false with everything: refuse it before the walls.
+        if !(p.0.is_finite() && p.1.is_finite()) {
+            return Err("no position (not a finite number)".into());
+        }
         if p.0 - radius < r.x0 || p.0 + radius > r.x1 || p.1 - radius < r.y0 || p.1 + radius > r.y1
         {
             return Err("a wall".into());
@@ -266,6 +294,23 @@ impl Planner {
                 pl.free[j * w + i] = pl.point_free(c);
             }
         }
+        pl
+    }
+
+    /// This planner with one more obstacle: the grid cells it covers are
+    /// marked (the cells of the others are kept), so adding k obstacles one
+    /// by one costs k grid passes, not k rebuilds of every obstacle.
+    pub fn with_obstacle(&self, o: &Rect, robot_radius: f64) -> Planner {
+        let mut pl = self.clone();
+        let r = o.inflated(robot_radius);
+        for j in 0..pl.h {
+            for i in 0..pl.w {
+                if r.contains(pl.center(i, j)) {
+                    pl.free[j * pl.w + i] = false;
+                }
+            }
+        }
+        pl.inflated.push(r);
         pl
     }
 
@@ -466,11 +511,18 @@ pub struct World {
     /// step makes (pick, place, object found, charge complete, dock, a
     /// disturbance); chattering is switching actions without it changing.
     pub progress: u64,
+    /// Index of each object by name (objects are never added or renamed).
+    object_ix: Arc<HashMap<String, usize>>,
 }
 
 impl World {
     pub fn new(layout: Layout, params: Params, robot: P2, objects: Vec<Object>) -> Self {
         let planner = Arc::new(Planner::new(&layout, &params));
+        let mut ix = HashMap::new();
+        for (i, o) in objects.iter().enumerate() {
+            ix.entry(o.name.clone()).or_insert(i);
+        }
+        let object_ix = Arc::new(ix);
         World {
             params,
             layout: Arc::new(layout),
@@ -487,11 +539,12 @@ impl World {
             objects,
             odometer: 0.0,
             progress: 0,
+            object_ix,
         }
     }
 
     pub fn object_index(&self, name: &str) -> Option<usize> {
-        self.objects.iter().position(|o| o.name == name)
+        self.object_ix.get(name).copied()
     }
 
     pub fn held(&self) -> Option<usize> {
@@ -509,8 +562,8 @@ impl World {
     /// Adds an obstacle (a blocked path) and rebuilds the planner.
     pub fn block(&mut self, r: Rect) {
         let mut layout = (*self.layout).clone();
+        self.planner = Arc::new(self.planner.with_obstacle(&r, self.params.robot_radius));
         layout.obstacles.push(r);
-        self.planner = Arc::new(Planner::new(&layout, &self.params));
         self.layout = Arc::new(layout);
         self.map_version += 1;
     }
@@ -632,6 +685,52 @@ mod tests {
         }
         assert_eq!(prev, b);
         assert!(len > 1.8 && len < 3.5, "{len}");
+    }
+
+    /// NaN compared false with the walls and obstacles, so it passed.
+    #[test]
+    fn a_position_that_is_not_a_number_is_not_free() {
+        let l = Layout::paper_room();
+        for p in [
+            (f64::NAN, 0.0),
+            (0.0, f64::NAN),
+            (f64::INFINITY, 0.0),
+            (0.0, f64::NEG_INFINITY),
+        ] {
+            assert!(l.check_free(p, 0.2).is_err(), "{p:?}");
+        }
+    }
+
+    /// A `block` disturbance adds its obstacle to the grid (it rebuilt the
+    /// grid from every obstacle, so k blocks cost k^2 obstacle passes): the
+    /// same planner as one built with the obstacle.
+    #[test]
+    fn adding_an_obstacle_gives_the_planner_built_with_it() {
+        let p = Params::default();
+        let mut l = Layout::paper_room();
+        let mut pl = Planner::new(&l, &p);
+        for (k, r) in [
+            Rect::new("a", -0.5, 1.4, 1.5, 1.5),
+            Rect::new("b", -2.9, -2.9, -2.5, 2.9),
+            Rect::new("c", 1.0, -1.0, 1.05, -0.2),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            pl = pl.with_obstacle(&r, p.robot_radius);
+            l.obstacles.push(r);
+            let fresh = Planner::new(&l, &p);
+            assert_eq!(pl.free, fresh.free, "{k}");
+            assert_eq!(pl.inflated, fresh.inflated, "{k}");
+        }
+        let mut w = world();
+        let t = std::time::Instant::now();
+        for i in 0..1000 {
+            let x = -2.5 + (i % 50) as f64 * 0.1;
+            w.block(Rect::new("b", x, 2.5, x + 0.01, 2.51));
+        }
+        assert_eq!(w.layout.obstacles.len(), 1006);
+        assert!(t.elapsed().as_secs() < 5, "{:?}", t.elapsed());
     }
 
     #[test]

@@ -407,3 +407,340 @@ fn validate_checks_scenarios_without_running_them() {
     assert_eq!(code, 2);
     assert!(err.contains("run it with `btfsm sim FILE`"), "{err}");
 }
+
+/// Issue 12, simulator side: hostile scenarios answered in bounded time and
+/// memory. Inputs are generated here, in milliseconds.
+mod hostile {
+    use super::*;
+    use std::time::{Duration, Instant};
+
+    /// Runs `btfsm` with its address space capped at `mb` MiB (`ulimit -v`):
+    /// (exit code, stdout, stderr, wall time).
+    fn btfsm_within(mb: u64, args: &[&str]) -> (i32, String, String, Duration) {
+        let t = Instant::now();
+        let out = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(format!("ulimit -v {}; exec \"$0\" \"$@\"", mb * 1024))
+            .arg(env!("CARGO_BIN_EXE_btfsm"))
+            .args(args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .expect("run btfsm");
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+            t.elapsed(),
+        )
+    }
+
+    /// A scratch folder holding the Fig. 1 BT: a scenario's policies stay
+    /// inside its root.
+    fn scratch(tag: &str) -> std::path::PathBuf {
+        let dir = common::scratch(tag);
+        let paper = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper");
+        std::fs::copy(paper.join("fig01-bt.toml"), dir.join("fig01-bt.toml")).expect("copy");
+        dir
+    }
+
+    fn policies(n: usize) -> String {
+        "[[policies]]\nfile = \"fig01-bt.toml\"\n".repeat(n)
+    }
+
+    const CUBE: &str = "[world]\nobjects = { cube2 = { at = \"east-table\" } }\n";
+
+    /// 200,000 stations took minutes (each looked up by a scan of the
+    /// others); now over the fixed limit of 1024 before any is read.
+    #[test]
+    fn sim_hostile_many_stations_are_refused_at_once() {
+        let dir = scratch("many-stations");
+        let mut text = format!("{CUBE}[world.stations]\n");
+        for i in 0..200_000 {
+            text.push_str(&format!("s{i} = [-2.0, -2.2]\n"));
+        }
+        text.push_str(&policies(1));
+        let f = dir.join("stations.toml");
+        std::fs::write(&f, text).unwrap();
+        let (code, _, err, took) = btfsm_within(1024, &["sim", f.to_str().unwrap()]);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("200007 stations, more than the limit of 1024")
+                && err.contains("stations.toml:3:1"),
+            "{err}"
+        );
+        assert!(took < Duration::from_secs(5), "{took:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// 3000 policies ran for minutes past `--timeout-ms 500` (their 4.5
+    /// million pairwise verdicts were not budgeted): now at most 64
+    /// policies, and the verdicts stop at the deadline, the pairs left
+    /// listed.
+    #[test]
+    fn sim_hostile_policies_are_capped_and_verdicts_stop_at_the_deadline() {
+        let dir = scratch("many-policies");
+        let f = dir.join("p65.toml");
+        std::fs::write(&f, format!("{CUBE}{}", policies(65))).unwrap();
+        let (code, _, err, _) = btfsm_within(1024, &["sim", f.to_str().unwrap()]);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("65 policies, more than the limit of 64") && err.contains("p65.toml:3:1"),
+            "{err}"
+        );
+        let f = dir.join("p64.toml");
+        std::fs::write(&f, format!("{CUBE}{}", policies(64))).unwrap();
+        let (code, out, err, took) = btfsm_within(
+            1024,
+            &[
+                "sim",
+                f.to_str().unwrap(),
+                "--timeout-ms",
+                "100",
+                "--format",
+                "json",
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        assert!(took < Duration::from_secs(5), "{took:?}");
+        let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+        let done = v["verdicts"].as_array().unwrap().len();
+        let skipped = v["skipped_verdicts"]
+            .as_array()
+            .expect("skipped pairs")
+            .len();
+        assert_eq!(done + skipped, 64 * 63 / 2);
+        assert!(skipped > 0, "{done} verdicts in 100 ms");
+        assert_eq!(v["budget"]["exhausted"], true);
+        assert!(
+            v["budget"]["millis"].as_u64().unwrap() < 1000,
+            "{}",
+            v["budget"]
+        );
+        let (code, table, _, _) =
+            btfsm_within(1024, &["sim", f.to_str().unwrap(), "--timeout-ms", "100"]);
+        assert_eq!(code, 0);
+        assert!(
+            table.contains("verdicts skipped, the wall-clock budget ran out first: "),
+            "{table}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// `sim --trace` kept every step of every run in memory (a run of
+    /// 200,000 steps: over 80 MiB; 10^6 steps of two policies: 1 GB): it is
+    /// now written as the runs go, in a temporary file renamed when whole.
+    #[test]
+    fn sim_hostile_long_trace_is_streamed_in_bounded_memory() {
+        let dir = scratch("long-trace");
+        let f = dir.join("long.toml");
+        std::fs::write(
+            &f,
+            format!(
+                "max_steps = 200000\n{CUBE}{}[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n",
+                policies(1)
+            ),
+        )
+        .unwrap();
+        let trace = dir.join("trace.json");
+        let (code, out, err, took) = btfsm_within(
+            80,
+            &[
+                "sim",
+                f.to_str().unwrap(),
+                "--trace",
+                trace.to_str().unwrap(),
+                "--format",
+                "json",
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        assert!(took < Duration::from_secs(20), "{took:?}");
+        let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+        assert_eq!(v["policies"][0]["steps"], 200_000);
+        let bytes = std::fs::read(&trace).expect("trace written");
+        assert!(bytes.len() > 20_000_000, "{}", bytes.len());
+        assert!(bytes.starts_with(b"{\"scenario\":\"long\",") && bytes.ends_with(b"}\n"));
+        assert!(
+            String::from_utf8_lossy(&bytes[bytes.len() - 4096..]).contains("\"verdicts\":[]"),
+            "ends with the verdicts"
+        );
+        let names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 3, "no temporary left: {names:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// 64 policies picking and placing a cube every step for 10^6 steps
+    /// (a 400-byte scenario) recorded 2 million skills each: 3.3 GB per
+    /// policy. A run now records at most 1024 skills and 4096 events.
+    #[test]
+    fn sim_hostile_endless_skills_fill_a_bounded_record() {
+        let dir = scratch("endless-skills");
+        std::fs::write(
+            dir.join("pp.toml"),
+            "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
+        )
+        .unwrap();
+        let f = dir.join("pp-scenario.toml");
+        std::fs::write(
+            &f,
+            format!(
+                "max_steps = 1000000\n[world]\nrobot = \"east-table\"\nparams = {{ manipulation_s = 0 }}\nobjects = {{ cube2 = {{ at = \"east-table\" }} }}\n{}[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n",
+                "[[policies]]\nfile = \"pp.toml\"\n".repeat(64)
+            ),
+        )
+        .unwrap();
+        let (code, out, err, took) =
+            btfsm_within(512, &["sim", f.to_str().unwrap(), "--format", "json"]);
+        assert_eq!(code, 0, "{err}");
+        assert!(took < Duration::from_secs(20), "{took:?}");
+        assert!(out.len() < 64 << 20, "{} bytes of JSON", out.len());
+        let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+        for p in v["policies"].as_array().unwrap() {
+            assert_eq!(p["outcome"], "timeout");
+            assert!(
+                p["reason"]
+                    .as_str()
+                    .unwrap()
+                    .starts_with("record budget exhausted at step"),
+                "{}",
+                p["reason"]
+            );
+            assert_eq!(p["skills"].as_array().unwrap().len(), 1024);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// `dot --trace /dev/zero` read until memory ran out.
+    #[test]
+    fn dot_hostile_trace_is_read_within_the_file_limit() {
+        let (code, _, err, took) = btfsm_within(
+            512,
+            &[
+                "dot",
+                "policies/paper/fig01-bt.toml",
+                "--trace",
+                "/dev/zero",
+                "--step",
+                "0",
+                "--max-file-bytes",
+                "1000000",
+            ],
+        );
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains("`/dev/zero` is larger than the limit of 1000000 bytes")
+                && err.contains("--max-file-bytes"),
+            "{err}"
+        );
+        assert!(took < Duration::from_secs(5), "{took:?}");
+    }
+
+    /// `--threads 100000` aborted (threads the system refused to create);
+    /// `--threads 0` is refused; a budget past the clock's range is none
+    /// (`ms * 950` overflowed).
+    #[test]
+    fn sim_hostile_threads_and_timeouts_are_bounded() {
+        let (code, out, err, _) = btfsm_within(
+            4096,
+            &[
+                "sim",
+                "policies/scenarios/exp1-nominal.toml",
+                "--runs",
+                "100000",
+                "--threads",
+                "100000",
+                "--timeout-ms",
+                "300",
+                "--format",
+                "json",
+            ],
+        );
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+        let threads = v["threads"].as_u64().unwrap();
+        assert!((1..=4 * cores).contains(&threads), "{threads}");
+        let (code, _, err) = btfsm(&[
+            "sim",
+            "policies/scenarios/exp1-nominal.toml",
+            "--runs",
+            "2",
+            "--threads",
+            "0",
+        ]);
+        assert_eq!(code, 2);
+        assert!(err.contains("--threads must be at least 1"), "{err}");
+        // u64::MAX / 950 + 1 ms: the runs' 95% wrapped to about 1.5 ms.
+        for ms in ["19417625340746898", "18446744073709551615"] {
+            let (code, out, err) = btfsm(&[
+                "sim",
+                "policies/scenarios/exp1-nominal.toml",
+                "--timeout-ms",
+                ms,
+                "--format",
+                "json",
+            ]);
+            assert_eq!(code, 0, "{err}");
+            let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+            assert_eq!(v["budget"]["exhausted"], false, "{ms}");
+            assert!(
+                v["policies"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .all(|p| p["outcome"] != "timeout"),
+                "{ms}"
+            );
+        }
+    }
+
+    /// NaN positions passed the wall check; `max_steps = 1.5` was read as 1;
+    /// a `Battery-Level` minimum took any number.
+    #[test]
+    fn sim_hostile_numbers_are_refused_with_positions() {
+        let dir = scratch("nan-scenario");
+        let f = dir.join("nan.toml");
+        std::fs::write(
+            &f,
+            format!(
+                "max_steps = 1.5\n[world]\nrobot = [nan, 0.0]\nobjects = {{ cube2 = {{ at = [0.5, inf] }} }}\n{}[monte_carlo]\nbattery_drop = {{ level = [nan, 19], window = [5.0, inf] }}\n",
+                policies(1)
+            ),
+        )
+        .unwrap();
+        let (code, _, err) = btfsm(&["validate", f.to_str().unwrap()]);
+        assert_eq!(code, 2, "{err}");
+        for want in [
+            "`max_steps` must be an integer, found 1.5",
+            "nan.toml:1:13",
+            "the robot's start must be a position `[x, y]` in metres (finite numbers)",
+            "nan.toml:3:9",
+            "nan.toml:4:28",
+            "`level` must be a range",
+            "nan.toml:8:26",
+            "`window` must be a range",
+        ] {
+            assert!(err.contains(want), "{want}:\n{err}");
+        }
+        std::fs::write(
+            &f,
+            format!(
+                "goal = [{{ if = \"Battery-Level\", args = {{ min = 1e300 }} }}]\n{CUBE}{}",
+                policies(1)
+            ),
+        )
+        .unwrap();
+        let (code, _, err) = btfsm(&["validate", f.to_str().unwrap()]);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains(
+                "`min` of `Battery-Level` must be a percentage from 0 to 100, found 1e300"
+            ) && err.contains("nan.toml:1:9"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
