@@ -990,7 +990,7 @@ impl Loader {
                         n.id = if j == sub.root {
                             id.clone()
                         } else {
-                            format!("{id}/{}", n.id)
+                            format!("{id}{}", n.id) // n.id is `/id` (prefix "")
                         };
                         for c in &mut n.children {
                             *c += offset;
