@@ -166,8 +166,18 @@ pub fn execute(cli: Cli) -> u8 {
                     }
                 }
             };
-            let text = crate::format::toml_write::write_policy(&policy);
-            emit(output.as_deref(), text.as_bytes())
+            // Only what reads back: a machine the TOML format can nest,
+            // within the file size limit.
+            match crate::format::toml_write::write_policy_within(&policy, limits.max_file_bytes) {
+                Ok(text) => emit(output.as_deref(), text.as_bytes()),
+                Err(e) => {
+                    eprintln!(
+                        "error: {}: {e}\n  = hint: convert a machine with --to scxml, which has no nesting limit",
+                        l.path
+                    );
+                    EXIT_BAD_INPUT
+                }
+            }
         }
         Command::Effort {
             files,
