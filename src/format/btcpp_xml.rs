@@ -21,7 +21,7 @@
 //!
 //! The expansion walks an explicit stack (no recursion on input depth).
 
-use super::xml::{self, XDoc, XElem};
+use super::xml::{self, XDoc, XElem, shown};
 use super::{AssumeLeaf, Limits, Loaded};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
 use crate::model::skill::{self, ArgValue, SkillCall, SkillKind};
@@ -241,6 +241,9 @@ struct Loader<'l> {
     /// Tree ID -> (document, `<BehaviorTree>` element).
     trees: BTreeMap<String, (usize, usize)>,
     models: BTreeMap<String, ModelEntry>,
+    /// What remains of `--max-nodes` for the elements of the files still to
+    /// read: every element of every file counts, used or not.
+    elems_left: usize,
 }
 
 fn load(
@@ -249,8 +252,10 @@ fn load(
     base: PathBuf,
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let main = xml::parse(&file).map_err(|d| vec![d])?;
+    let main = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    let elems_left = limits.max_nodes - main.elems.len();
     let mut l = Loader {
+        elems_left,
         limits,
         diags: Vec::new(),
         docs: vec![main],
@@ -269,6 +274,20 @@ impl Loader<'_> {
         self.diags.last_mut().expect("just pushed")
     }
 
+    /// Parses a file read for this policy, charging its elements to the
+    /// shared element budget.
+    fn parse_charged(&mut self, file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
+        let doc = xml::parse(file, self.elems_left, self.limits.max_nodes)?;
+        self.elems_left -= doc.elems.len();
+        Ok(doc)
+    }
+
+    /// Are hints still worth computing? Past the messages shown
+    /// (`finish` keeps the first ones), no did-you-mean search is done.
+    fn hinting(&self) -> bool {
+        self.diags.len() <= super::toml::MAX_DIAGNOSTICS
+    }
+
     fn warn(&mut self, d: usize, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
         let f = self.docs[d].file.clone();
         self.diags.push(Diagnostic::warning(msg).at(&f, span));
@@ -283,7 +302,10 @@ impl Loader<'_> {
             self.err(
                 0,
                 span,
-                format!("expected `<root>` as the document element, found `<{found}>`"),
+                format!(
+                    "expected `<root>` as the document element, found `<{}>`",
+                    shown(&found)
+                ),
             )
             .hint = Some(
                 "a BehaviorTree.CPP file is `<root BTCPP_format=\"4\"><BehaviorTree ID=\"...\">...</BehaviorTree></root>`"
@@ -352,8 +374,11 @@ impl Loader<'_> {
             let full = self.dirs[d].join(&pval);
             let canon = super::toml::canonical(&full);
             if let Some(at) = chain.iter().position(|c| *c == canon) {
-                let mut names: Vec<String> = shown_chain[at..].to_vec();
-                names.push(full.display().to_string());
+                let mut names: Vec<String> = shown_chain[at..]
+                    .iter()
+                    .map(|n| shown(n).into_owned())
+                    .collect();
+                names.push(shown(&full.display().to_string()).into_owned());
                 self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
                     .hint =
                     Some("a file must not include itself, directly or through others".into());
@@ -383,7 +408,7 @@ impl Loader<'_> {
                     continue;
                 }
             };
-            let doc = match xml::parse(&file) {
+            let doc = match self.parse_charged(&file) {
                 Ok(doc) => doc,
                 Err(diag) => {
                     self.diags.push(diag);
@@ -423,7 +448,7 @@ impl Loader<'_> {
                 return;
             }
         };
-        let doc = match xml::parse(&file) {
+        let doc = match self.parse_charged(&file) {
             Ok(doc) => doc,
             Err(d) => {
                 self.diags.push(d);
@@ -469,7 +494,7 @@ impl Loader<'_> {
                     self.err(
                         d,
                         el.span.clone(),
-                        format!("unknown entry `<{other}>` in `<TreeNodesModel>`"),
+                        format!("unknown entry `<{}>` in `<TreeNodesModel>`", shown(other)),
                     )
                     .hint = Some(h);
                     continue;
@@ -479,10 +504,16 @@ impl Loader<'_> {
                 self.err(
                     d,
                     el.span.clone(),
-                    format!("`<{}>` in `<TreeNodesModel>` needs an `ID`", el.name),
+                    format!(
+                        "`<{}>` in `<TreeNodesModel>` needs an `ID`",
+                        shown(&el.name)
+                    ),
                 );
                 continue;
             };
+            if self.too_long(d, &el, "node type", id) {
+                continue;
+            }
             if let Some(b) = builtin(id)
                 && b != cat
             {
@@ -490,7 +521,8 @@ impl Loader<'_> {
                     d,
                     el.span.clone(),
                     format!(
-                        "`{id}` is a built-in {} type; the model's `{}` is ignored",
+                        "`{}` is a built-in {} type; the model's `{}` is ignored",
+                        shown(id),
                         b.tag().to_lowercase(),
                         cat.tag()
                     ),
@@ -504,7 +536,11 @@ impl Loader<'_> {
                 self.err(
                     d,
                     el.span.clone(),
-                    format!("`{id}` is declared both as `{was}` and as `{}`", cat.tag()),
+                    format!(
+                        "`{}` is declared both as `{was}` and as `{}`",
+                        shown(id),
+                        cat.tag()
+                    ),
                 )
                 .hint = Some("keep one declaration per node type across the model files".into());
                 continue;
@@ -528,7 +564,10 @@ impl Loader<'_> {
             self.warn(
                 d,
                 span,
-                format!("unknown `BTCPP_format` \"{val}\"; read as format 4"),
+                format!(
+                    "unknown `BTCPP_format` \"{}\"; read as format 4",
+                    shown(&val)
+                ),
             )
             .hint = Some("BehaviorTree.CPP writes `BTCPP_format=\"4\"` (or \"3\")".into());
         }
@@ -538,14 +577,21 @@ impl Loader<'_> {
             match el.name.as_str() {
                 "BehaviorTree" => {
                     let id = el.attr("ID").unwrap_or("MainTree").to_string();
+                    if self.too_long(d, &el, "tree ID", &id) {
+                        continue;
+                    }
                     if let Some(&(pd, pe)) = self.trees.get(&id) {
                         let (l, c) = {
                             let f = &self.docs[pd].file;
                             f.line_col(self.docs[pd].elems[pe].span.start)
                         };
                         let first = format!("{}:{l}:{c}", self.docs[pd].file.path);
-                        self.err(d, el.span.clone(), format!("tree `{id}` is defined twice"))
-                            .hint = Some(format!(
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            format!("tree `{}` is defined twice", shown(&id)),
+                        )
+                        .hint = Some(format!(
                             "the first definition is at {first}; give each `<BehaviorTree>` its own `ID`"
                         ));
                         continue;
@@ -555,7 +601,10 @@ impl Loader<'_> {
                         self.err(
                             d,
                             el.span.clone(),
-                            format!("tree `{id}` must hold exactly one root node, found {n}"),
+                            format!(
+                                "tree `{}` must hold exactly one root node, found {n}",
+                                shown(&id)
+                            ),
                         )
                         .hint = Some("wrap several nodes in a `<Sequence>` or `<Fallback>`".into());
                         continue;
@@ -569,7 +618,7 @@ impl Loader<'_> {
                     self.warn(
                         d,
                         el.span.clone(),
-                        format!("`<{other}>` under `<root>` is ignored"),
+                        format!("`<{}>` under `<root>` is ignored", shown(other)),
                     )
                     .hint = Some(h);
                 }
@@ -590,7 +639,7 @@ impl Loader<'_> {
                     self.err(
                         0,
                         span,
-                        format!("`main_tree_to_execute` names unknown tree `{v}`"),
+                        format!("`main_tree_to_execute` names unknown tree `{}`", shown(&v)),
                     )
                     .hint = Some(h);
                     None
@@ -613,7 +662,14 @@ impl Loader<'_> {
                 None
             }
             many => {
-                let ids: Vec<String> = many.iter().map(|(id, _)| format!("`{id}`")).collect();
+                let mut ids: Vec<String> = many
+                    .iter()
+                    .take(10)
+                    .map(|(id, _)| format!("`{}`", shown(id)))
+                    .collect();
+                if many.len() > 10 {
+                    ids.push(format!("... ({} more)", many.len() - 10));
+                }
                 let span = self.docs[0].elems[root].span.clone();
                 self.err(
                     0,
@@ -629,13 +685,53 @@ impl Loader<'_> {
         }
     }
 
+    /// Is `value` (a name, type, ID or attribute of element `el` of document
+    /// `d`) longer than `--max-name-bytes`? Then an error at the element.
+    fn too_long(&mut self, d: usize, el: &XElem, what: &str, value: &str) -> bool {
+        if value.len() <= self.limits.max_name_bytes {
+            return false;
+        }
+        let max = self.limits.max_name_bytes;
+        self.err(
+            d,
+            el.span.clone(),
+            format!(
+                "{what} `{}` of `<{}>` is {} bytes long, more than the limit of {max} bytes",
+                shown(value),
+                shown(&el.name),
+                value.len()
+            ),
+        )
+        .hint = Some("shorten it, or raise the limit with --max-name-bytes".into());
+        true
+    }
+
+    /// Checks every name an element carries against `--max-name-bytes`: its
+    /// tag, and the name and value of each attribute (ports, IDs, names).
+    fn names_too_long(&mut self, d: usize, el: &XElem) -> bool {
+        if self.too_long(d, el, "element name", &el.name) {
+            return true;
+        }
+        for a in &el.attrs {
+            if self.too_long(d, el, "attribute name", &a.name)
+                || self.too_long(d, el, &format!("value of `{}`", shown(&a.name)), &a.value)
+            {
+                return true;
+            }
+        }
+        false
+    }
+
     /// Expands the tree from its root element into the arena (pre-order, explicit
-    /// stack), resolving every node's type and expanding SubTrees.
+    /// stack), resolving every node's type and expanding SubTrees. Depth and
+    /// name lengths are checked here, at the element, as it is read.
     fn expand(&mut self, tree_id: &str, d0: usize, e0: usize) -> Option<Bt> {
         struct Item {
             d: usize,
             e: usize,
             parent: Option<usize>,
+            /// Levels below the root (a SubTree's root takes its place).
+            depth: usize,
             /// Index into `frames`: the SubTree expansion this element is in.
             frame: usize,
             /// `name` of the SubTree element this root replaces.
@@ -647,11 +743,17 @@ impl Loader<'_> {
             remap: BTreeMap::new(),
             autoremap: false,
         }];
+        // The expansions enclosing the element being read (root first), and
+        // how often each tree ID is among them: recursion is found in O(1)
+        // per SubTree; the chain moves one step per expansion entered or left.
+        let mut active: Vec<usize> = vec![0];
+        let mut on_chain: HashMap<String, usize> = HashMap::from([(tree_id.to_string(), 1)]);
         let root_el = self.docs[d0].elems[e0].children[0];
         let mut stack = vec![Item {
             d: d0,
             e: root_el,
             parent: None,
+            depth: 0,
             frame: 0,
             name_override: None,
         }];
@@ -660,8 +762,41 @@ impl Loader<'_> {
         let mut explicit: Vec<Option<String>> = Vec::new();
         let mut failed = false;
         let mut budget = self.limits.max_nodes;
+        // SubTree elements are no nodes, but expanding one is work: at most
+        // as many expansions as nodes.
+        let mut expansions = self.limits.max_nodes;
         while let Some(it) = stack.pop() {
+            while let Some(&top) = active.last() {
+                if top == it.frame || Some(top) == frames[it.frame].parent {
+                    break;
+                }
+                active.pop();
+                if let Some(c) = on_chain.get_mut(&frames[top].id) {
+                    *c -= 1;
+                }
+            }
+            if active.last() != Some(&it.frame) {
+                active.push(it.frame);
+                *on_chain.entry(frames[it.frame].id.clone()).or_default() += 1;
+            }
             let el = self.docs[it.d].elems[it.e].clone();
+            if self.names_too_long(it.d, &el) {
+                return None;
+            }
+            if it.depth > self.limits.max_depth {
+                self.err(
+                    it.d,
+                    el.span.clone(),
+                    format!(
+                        "`<{}>` is {} levels below the root, deeper than the limit of {} levels",
+                        shown(&el.name),
+                        it.depth,
+                        self.limits.max_depth
+                    ),
+                )
+                .hint = Some("raise the limit with --max-depth".into());
+                return None;
+            }
             let tag = el.name.as_str();
             // SubTree: the referenced tree's root takes this element's place.
             if tag == "SubTree" || tag == "SubTreePlus" {
@@ -671,34 +806,51 @@ impl Loader<'_> {
                     continue;
                 };
                 let Some(&(sd, se)) = self.trees.get(&id) else {
-                    let h = suggest(&id, self.trees.keys().map(String::as_str));
+                    let h = if self.hinting() {
+                        suggest(&id, self.trees.keys().map(String::as_str))
+                    } else {
+                        String::new()
+                    };
                     self.err(
                         it.d,
                         el.span.clone(),
-                        format!("unknown tree `{id}` in `<SubTree>`"),
+                        format!("unknown tree `{}` in `<SubTree>`", shown(&id)),
                     )
                     .hint = Some(h);
                     failed = true;
                     continue;
                 };
-                let mut chain = vec![];
-                let mut f = Some(it.frame);
-                let mut recursive = false;
-                while let Some(fi) = f {
-                    chain.push(frames[fi].id.clone());
-                    if frames[fi].id == id {
-                        recursive = true;
+                if on_chain.get(&id).is_some_and(|&c| c > 0) {
+                    let chain: Vec<String> = active.iter().map(|&f| frames[f].id.clone()).collect();
+                    let at = chain.iter().position(|c| *c == id).unwrap_or(0);
+                    let mut shown_chain: Vec<String> =
+                        chain.iter().map(|c| shown(c).into_owned()).collect();
+                    shown_chain.push(shown(&id).into_owned());
+                    // The cycle itself, and at most a few trees before it.
+                    let from = at.saturating_sub(3);
+                    let mut cycle = shown_chain[from..].to_vec();
+                    if cycle.len() > 12 {
+                        let n = cycle.len();
+                        cycle.splice(6..n - 6, [format!("... ({} trees) ...", n - 12)]);
                     }
-                    f = frames[fi].parent;
-                }
-                if recursive {
-                    chain.reverse();
-                    chain.push(id.clone());
-                    self.err(it.d, el.span.clone(), format!("recursive subtree: {}", chain.join(" -> ")))
+                    if from > 0 {
+                        cycle.insert(0, "...".into());
+                    }
+                    self.err(it.d, el.span.clone(), format!("recursive subtree: {}", cycle.join(" -> ")))
                         .hint = Some("a tree must not contain itself as a `<SubTree>`, directly or through others".into());
                     failed = true;
                     continue;
                 }
+                if expansions == 0 {
+                    self.err(
+                        it.d,
+                        el.span.clone(),
+                        format!("more than {} SubTree expansions", self.limits.max_nodes),
+                    )
+                    .hint = Some("raise the limit with --max-nodes".into());
+                    return None;
+                }
+                expansions -= 1;
                 // Its ports remap the subtree's blackboard entries: a
                 // reference is resolved in the enclosing expansion now, so
                 // that the subtree's nodes get the value or the outer entry.
@@ -729,6 +881,7 @@ impl Loader<'_> {
                     d: sd,
                     e: child,
                     parent: it.parent,
+                    depth: it.depth,
                     frame: frames.len() - 1,
                     name_override: el.attr("name").map(str::to_string).or(it.name_override),
                 });
@@ -763,6 +916,7 @@ impl Loader<'_> {
                     d: it.d,
                     e: c,
                     parent: Some(idx),
+                    depth: it.depth + 1,
                     frame: it.frame,
                     name_override: None,
                 });
@@ -826,11 +980,13 @@ impl Loader<'_> {
                 d,
                 el.span.clone(),
                 format!(
-                    "`{ty}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`"
+                    "`{}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`",
+                    shown(&ty)
                 ),
             )
             .hint = Some(format!(
-                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{ty}>`)"
+                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{}>`)",
+                shown(&ty)
             ));
             let (k, c, keep) = builtin_kind(real, el, n);
             consumed = c;
@@ -843,12 +999,18 @@ impl Loader<'_> {
                 AssumeLeaf::Condition => (BtNodeKind::Condition, Category::Condition),
             }
         } else {
-            let cands: Vec<&str> = BUILTINS
-                .iter()
-                .map(|(b, _)| *b)
-                .chain(self.models.keys().map(String::as_str))
-                .collect();
-            let did = suggest(&ty, cands);
+            // Hints only for messages that will be shown (the rest are
+            // counted): bounded work under a million unknown types.
+            let did = if self.hinting() {
+                let cands = BUILTINS
+                    .iter()
+                    .map(|(b, _)| *b)
+                    .chain(self.models.keys().map(String::as_str));
+                suggest(&ty, cands)
+            } else {
+                String::new()
+            };
+            let ty = shown(&ty);
             let remedy = if n == 0 {
                 format!(
                     "declare it as `<Action ID=\"{ty}\"/>` or `<Condition ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition"
@@ -890,7 +1052,8 @@ impl Loader<'_> {
                 d,
                 el.span.clone(),
                 format!(
-                    "`{ty}` is a {} and takes {want}, found {n}",
+                    "`{}` is a {} and takes {want}, found {n}",
+                    shown(&ty),
                     cat.tag().to_lowercase()
                 ),
             )
@@ -1029,6 +1192,19 @@ pub fn arg_value(v: &str) -> ArgValue {
 /// index (keeps identities short on degenerate deep trees).
 const MAX_POSITIONAL_ID: usize = 200;
 
+/// `s` when at most 64 bytes long, else its first 32 bytes (on a character
+/// boundary): the prefix of generated identities.
+fn short_prefix(s: &str) -> &str {
+    if s.len() <= 64 {
+        return s;
+    }
+    let mut end = 32;
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    &s[..end]
+}
+
 /// Node identities of an XML tree (see the module documentation), in pre-order
 /// from `root`. `explicit(i, derived)` may give node `i` an identity of its own
 /// instead of the derived one (the reader passes `btfsm:id`; the writer passes
@@ -1049,6 +1225,9 @@ pub fn derive_ids(
     let mut ids = vec![String::new(); children.len()];
     let mut flags = vec![false; children.len()];
     let mut used: HashSet<String> = HashSet::new();
+    // Per clashing candidate, the next suffix to try: a thousand nodes
+    // clashing on one candidate cost a thousand probes, not a million.
+    let mut next_suffix: HashMap<String, usize> = HashMap::new();
     // (node, parent, position among its siblings)
     let mut stack: Vec<(usize, Option<usize>, usize)> = vec![(root, None, 0)];
     let mut order = 0usize;
@@ -1056,17 +1235,27 @@ pub fn derive_ids(
         let mut cand = match (&names[i], parent) {
             (Some(n), _) if count.get(n.as_str()) == Some(&1) => n.clone(),
             (_, None) => tree_id.to_string(),
-            (_, Some(p)) => format!("{}/{pos}", ids[p]),
+            // Built only when short enough (the length checked first).
+            (_, Some(p))
+                if ids[p].len() + 2 + pos.checked_ilog10().unwrap_or(0) as usize
+                    <= MAX_POSITIONAL_ID =>
+            {
+                format!("{}/{pos}", ids[p])
+            }
+            (_, Some(_)) => String::new(),
         };
-        if cand.len() > MAX_POSITIONAL_ID {
-            cand = format!("{tree_id}#{order}");
+        if cand.is_empty() || cand.len() > MAX_POSITIONAL_ID {
+            // Short whatever the tree's ID: a long ID is not repeated in
+            // every identity.
+            cand = format!("{}#{order}", short_prefix(tree_id));
         }
         if used.contains(&cand) {
-            let mut k = 2;
+            let k = next_suffix.entry(cand.clone()).or_insert(2);
             while used.contains(&format!("{cand}~{k}")) {
-                k += 1;
+                *k += 1;
             }
             cand = format!("{cand}~{k}");
+            *k += 1;
         }
         let id = match explicit(i, &cand) {
             Some(x) => {
@@ -1324,6 +1513,146 @@ mod tests {
         .unwrap_err();
         let msgs: Vec<&str> = e.iter().map(|d| d.message.as_str()).collect();
         assert_eq!(msgs, vec!["unknown node type `Mystery` (0 children)"]);
+    }
+
+    fn limited(text: &str, f: impl FnOnce(&mut Limits)) -> Result<Loaded, Vec<Diagnostic>> {
+        let mut lim = Limits::default();
+        f(&mut lim);
+        parse_str("t.xml", text, Path::new("."), &lim)
+    }
+
+    #[test]
+    fn elements_of_unused_trees_count_against_max_nodes() {
+        let text = format!(
+            "<root main_tree_to_execute=\"M\">\n<BehaviorTree ID=\"M\"><AlwaysSuccess/></BehaviorTree>\n<BehaviorTree ID=\"Unused\"><Sequence>\n{}</Sequence></BehaviorTree>\n</root>",
+            "<AlwaysSuccess/>\n".repeat(50)
+        );
+        assert!(limited(&text, |l| l.max_nodes = 60).is_ok());
+        let e = limited(&text, |l| l.max_nodes = 20).unwrap_err();
+        assert!(
+            e[0].message.starts_with("more than 20 elements"),
+            "{}",
+            e[0].message
+        );
+        // The 21st element: root, 2 trees, a leaf, a Sequence, then leaf 16.
+        let (_, line, col) = e[0].location().unwrap();
+        assert_eq!((line, col), (19, 1), "{}", e[0]);
+    }
+
+    #[test]
+    fn depth_and_long_names_are_errors_at_the_element() {
+        let deep = format!(
+            "<root>\n<BehaviorTree ID=\"T\">\n{}<AlwaysSuccess/>\n{}</BehaviorTree></root>",
+            "<Inverter>\n".repeat(8),
+            "</Inverter>".repeat(8)
+        );
+        assert!(limited(&deep, |l| l.max_depth = 8).is_ok());
+        let e = limited(&deep, |l| l.max_depth = 5).unwrap_err();
+        assert!(
+            e[0].message
+                .contains("is 6 levels below the root, deeper than the limit of 5 levels"),
+            "{}",
+            e[0].message
+        );
+        assert_eq!(e[0].location().unwrap().1, 9);
+        // Port names and values, types and names: --max-name-bytes.
+        let long = "v".repeat(5000);
+        for (text, what) in [
+            (
+                format!("<Action ID=\"Go\" goal=\"{long}\"/>"),
+                "value of `goal`",
+            ),
+            (
+                format!("<Action ID=\"Go\" {long}=\"1\"/>"),
+                "attribute name",
+            ),
+            (format!("<{long}/>"), "element name"),
+            (
+                format!("<Sequence name=\"{long}\"><Go/></Sequence>"),
+                "value of `name`",
+            ),
+        ] {
+            let doc = format!(
+                "<root>\n<BehaviorTree ID=\"T\">\n<Sequence>\n{text}</Sequence></BehaviorTree>\n<TreeNodesModel><Action ID=\"Go\"/></TreeNodesModel></root>"
+            );
+            let e = parse(&doc).unwrap_err();
+            assert!(
+                e[0].message.starts_with(what)
+                    && e[0]
+                        .message
+                        .contains("is 5000 bytes long, more than the limit of 4096 bytes"),
+                "{}",
+                e[0].message
+            );
+            assert!(e[0].message.len() < 300, "{}", e[0].message);
+            assert!(e[0].location().unwrap().1 >= 3, "{}", e[0]);
+        }
+    }
+
+    #[test]
+    fn messages_quote_long_names_truncated() {
+        let ty = "Q".repeat(3000);
+        let e = parse(&format!(
+            "<root main_tree_to_execute=\"{ty}x\"><BehaviorTree ID=\"T\"><{ty}/></BehaviorTree></root>"
+        ))
+        .unwrap_err();
+        assert!(!e.is_empty());
+        for d in &e {
+            let all = format!("{}{}", d.message, d.hint.as_deref().unwrap_or(""));
+            assert!(all.len() < 1000, "{} bytes: {}", all.len(), &all[..200]);
+            assert!(all.contains("…(300"), "{}", &all[..200.min(all.len())]);
+        }
+    }
+
+    #[test]
+    fn a_long_subtree_chain_and_its_recursion_stay_bounded() {
+        // T0 -> T1 -> ... -> T2999 -> T0: the message shows the cycle cut.
+        let n = 3000;
+        let mut text = String::from("<root main_tree_to_execute=\"T0\">");
+        for i in 0..n {
+            let next = (i + 1) % n;
+            text.push_str(&format!(
+                "<BehaviorTree ID=\"T{i}\"><Sequence><AlwaysSuccess/><SubTree ID=\"T{next}\"/></Sequence></BehaviorTree>"
+            ));
+        }
+        text.push_str("</root>");
+        let e = limited(&text, |l| l.max_depth = 10 * n).unwrap_err();
+        assert!(
+            e[0].message
+                .starts_with("recursive subtree: T0 -> T1 -> T2"),
+            "{}",
+            e[0].message
+        );
+        assert!(
+            e[0].message
+                .ends_with("trees) ... -> T2995 -> T2996 -> T2997 -> T2998 -> T2999 -> T0"),
+            "{}",
+            e[0].message
+        );
+        assert!(e[0].message.len() < 300, "{}", e[0].message);
+        // Without the cycle, the chain expands.
+        let ok = text.replace("<SubTree ID=\"T0\"/>", "<AlwaysFailure/>");
+        let l = limited(&ok, |l| l.max_depth = 10 * n).unwrap();
+        assert_eq!(bt(&l).nodes.len(), 2 * n + 1);
+    }
+
+    #[test]
+    fn generated_identities_stay_short_under_a_long_tree_id() {
+        let tree_id = "T".repeat(1000);
+        let children = vec![(1..=100).collect::<Vec<usize>>()]
+            .into_iter()
+            .chain((0..100).map(|_| vec![]))
+            .collect::<Vec<_>>();
+        let names = vec![None; 101];
+        let (ids, _) = derive_ids(&children, 0, &tree_id, &names, |_, _| None);
+        assert!(ids.iter().all(|i| i.len() < 64), "{}", ids[1]);
+        let distinct: HashSet<&String> = ids.iter().collect();
+        assert_eq!(distinct.len(), 101);
+        // Many clashes on one candidate get distinct suffixes.
+        let names: Vec<Option<String>> = (0..101).map(|i| Some(format!("T~{}", i + 1))).collect();
+        let (ids, _) = derive_ids(&children, 0, "T", &names, |_, _| None);
+        let distinct: HashSet<&String> = ids.iter().collect();
+        assert_eq!(distinct.len(), 101);
     }
 
     #[test]

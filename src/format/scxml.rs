@@ -26,14 +26,14 @@
 //! The document is walked with explicit stacks (no recursion on nesting depth).
 
 use super::btcpp_xml::arg_value;
-use super::xml::{self, BTFSM_NS, XDoc, XElem};
+use super::xml::{self, BTFSM_NS, XDoc, XElem, shown};
 use super::{Limits, Loaded};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
 use crate::model::skill::{Guard, GuardTerm, SkillCall};
 use crate::model::{
     Policy, PolicyBody, Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -63,10 +63,38 @@ enum Kind {
 }
 
 fn load(file: Arc<SourceFile>, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
-    let doc = xml::parse(&file).map_err(|d| vec![d])?;
+    // Transitions and executable content are elements too: a file holds at
+    // most four per state allowed.
+    let max_elems = limits.max_nodes.saturating_mul(4);
+    let doc = xml::parse(&file, max_elems, max_elems).map_err(|d| vec![d])?;
     let mut diags: Vec<Diagnostic> = Vec::new();
     let policy = read(&doc, limits, &mut diags);
     super::finish(&file, policy, diags, "state machine")
+}
+
+/// The first attribute of `e` (name or value) longer than
+/// `--max-name-bytes`, as an error at the element: ids, names, labels, skill
+/// arguments, events, conditions, targets.
+fn long_attr(e: &XElem, f: &Arc<SourceFile>, limits: &Limits) -> Option<Diagnostic> {
+    let max = limits.max_name_bytes;
+    let (what, text) = std::iter::once(("element name".to_string(), e.name.as_str()))
+        .chain(e.attrs.iter().flat_map(|a| {
+            [
+                ("attribute name".to_string(), a.name.as_str()),
+                (format!("value of `{}`", shown(&a.name)), a.value.as_str()),
+            ]
+        }))
+        .find(|(_, t)| t.len() > max)?;
+    Some(
+        Diagnostic::error(format!(
+            "{what} `{}` of `<{}>` is {} bytes long, more than the limit of {max} bytes",
+            shown(text),
+            shown(&e.name),
+            text.len()
+        ))
+        .at(f, e.span.clone())
+        .hint("shorten it, or raise the limit with --max-name-bytes"),
+    )
 }
 
 /// Is the element SCXML's (in its namespace, or in none)?
@@ -86,7 +114,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             root,
             format!(
                 "expected `<scxml>` as the document element, found `<{}>`",
-                root.name
+                shown(&root.name)
             ),
             "an SCXML file is `<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" initial=\"...\">`",
         );
@@ -95,6 +123,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
     // Pass 1: state-like elements in document order, with their parent state.
     // (element, kind, parent entry index)
     let mut found: Vec<(usize, Kind, Option<usize>)> = Vec::new();
+    if let Some(d) = long_attr(root, f, limits) {
+        diags.push(d);
+        return None;
+    }
+    // Containers around each entry of `found` (checked against --max-depth
+    // as the document is read).
+    let mut depth_of: Vec<usize> = Vec::new();
     // Ids inside unsupported `<parallel>` elements: transitions to them are
     // not reported again.
     let mut skipped: std::collections::HashSet<String> = std::collections::HashSet::new();
@@ -134,6 +169,24 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
             _ => continue, // transitions, initial, executable content: read later
         };
+        if let Some(d) = long_attr(el, f, limits) {
+            diags.push(d);
+            return None;
+        }
+        let depth = parent.map_or(0, |p| depth_of[p] + 1);
+        if depth > limits.max_depth && !matches!(kind, Kind::Final) {
+            err(
+                diags,
+                el,
+                format!(
+                    "state `{}` is nested {depth} containers deep, deeper than the limit of {} levels",
+                    shown(el.attr("id").unwrap_or(&el.name)),
+                    limits.max_depth
+                ),
+                "raise the limit with --max-depth",
+            );
+            return None;
+        }
         if found.len() >= limits.max_nodes {
             err(
                 diags,
@@ -145,6 +198,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         }
         let idx = found.len();
         found.push((e, kind, parent));
+        depth_of.push(depth);
         if matches!(found[idx].1, Kind::State) {
             for &c in el.children.iter().rev() {
                 stack.push((c, Some(idx)));
@@ -168,7 +222,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             err(
                 diags,
                 el,
-                format!("duplicate id `{id}`"),
+                format!("duplicate id `{}`", shown(&id)),
                 "every state id in an SCXML document is unique",
             );
         }
@@ -257,6 +311,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         .states
         .iter()
         .any(|s| matches!(s.body, StateBody::Container(_)));
+    // The entry of `found` (and id) of each model state.
+    let mut entry_of: Vec<usize> = vec![0; m.states.len()];
+    for (k, s) in state_of.iter().enumerate() {
+        if let Some(s) = s {
+            entry_of[*s] = k;
+        }
+    }
     // Initial states: (container, target id, position of the target).
     let region_owner = |k: Option<usize>| k.and_then(|p| state_of[p]);
     let mut initial_of: Vec<(Option<usize>, String, std::ops::Range<usize>)> = Vec::new();
@@ -282,10 +343,12 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 .children(*e)
                 .find(|(_, c)| is_scxml(c) && c.name == "initial")
             {
-                match doc
-                    .children_of_name(ini, "transition")
-                    .and_then(|t| t.attr_full("target"))
-                {
+                let it = doc.children_of_name(ini, "transition");
+                if let Some(d) = it.and_then(|t| long_attr(t, f, limits)) {
+                    diags.push(d);
+                    return None;
+                }
+                match it.and_then(|t| t.attr_full("target")) {
                     Some(a) => initial_of.push((Some(si), a.value.clone(), a.span.clone())),
                     None => err(
                         diags,
@@ -301,7 +364,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         let tid = target.trim();
         if tid.split_whitespace().count() > 1 {
             diags.push(
-                Diagnostic::error(format!("initial `{tid}` names several states"))
+                Diagnostic::error(format!("initial `{}` names several states", shown(tid)))
                     .at(f, span)
                     .hint("only one initial state per region is supported (several are for `<parallel>`)"),
             );
@@ -321,17 +384,23 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 }
             },
             None => {
-                let region: Vec<&str> = m
-                    .states
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, st)| st.parent == container && st.pseudo.is_none())
-                    .map(|(i, _)| ids_of_state(&ids, &state_of, i))
-                    .collect();
-                let h = suggest(tid, region.iter().copied());
+                // Hints only for messages that will be shown: bounded work
+                // under a million bad `initial`s.
+                let h = if diags.len() <= super::toml::MAX_DIAGNOSTICS {
+                    let region = m
+                        .states
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, st)| st.parent == container && st.pseudo.is_none())
+                        .map(|(i, _)| ids[entry_of[i]].as_str());
+                    suggest(tid, region)
+                } else {
+                    String::new()
+                };
                 diags.push(
                     Diagnostic::error(format!(
-                        "initial `{tid}` is not a state directly inside its region"
+                        "initial `{}` is not a state directly inside its region",
+                        shown(tid)
                     ))
                     .at(f, span)
                     .hint(if h.is_empty() {
@@ -392,7 +461,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     diags.push(
                         Diagnostic::error(format!(
                             "state `{}` holds only final states",
-                            m.states[c].name
+                            shown(&m.states[c].name)
                         ))
                         .at(f, span)
                         .hint("a compound state needs a state to start in; make it a plain state"),
@@ -407,20 +476,31 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         if matches!(kind, Kind::Final) {
             continue;
         }
-        let mut used_outcomes: Vec<String> = Vec::new();
+        let mut used_outcomes: HashSet<&str> = HashSet::new();
         let mut guards: Vec<Transition> = Vec::new();
         let mut outs: Vec<Transition> = Vec::new();
+        // Outcomes the source can return, once per state (a container may
+        // have many finals, and many transitions).
+        let valid: HashSet<&str> = match &m.states[si].body {
+            StateBody::Container(r) => r.outcomes.iter().map(String::as_str).collect(),
+            StateBody::Decision => HashSet::from(["RUNNING"]),
+            StateBody::Task(_) => TASK_OUTCOMES.iter().copied().collect(),
+        };
+        let src = shown(&ids[k]);
         for (_, t) in doc
             .children(*e)
             .filter(|(_, c)| is_scxml(c) && c.name == "transition")
         {
+            if let Some(d) = long_attr(t, f, limits) {
+                diags.push(d);
+                return None;
+            }
             let event = t.attr("event").map(str::trim).filter(|s| !s.is_empty());
             let cond = t.attr("cond").map(str::trim).filter(|s| !s.is_empty());
             let Some(ta) = t.attr_full("target") else {
                 diags.push(
                     Diagnostic::warning(format!(
-                        "transition of `{}` has no target; it changes no state and is not counted",
-                        ids[k]
+                        "transition of `{src}` has no target; it changes no state and is not counted"
                     ))
                     .at(f, t.span.clone())
                     .hint("give it a `target` to make it an arc of the machine's graph"),
@@ -431,8 +511,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             if targets.len() != 1 {
                 diags.push(
                     Diagnostic::error(format!(
-                        "transition of `{}` has {} targets",
-                        ids[k],
+                        "transition of `{src}` has {} targets",
                         targets.len()
                     ))
                     .at(f, ta.span.clone())
@@ -445,11 +524,15 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 if skipped.contains(tid) {
                     continue;
                 }
-                let h = suggest(tid, ids.iter().map(String::as_str));
+                let h = if diags.len() <= super::toml::MAX_DIAGNOSTICS {
+                    suggest(tid, ids.iter().map(String::as_str))
+                } else {
+                    String::new()
+                };
                 diags.push(
                     Diagnostic::error(format!(
-                        "unknown state `{tid}` in transition of `{}`",
-                        ids[k]
+                        "unknown state `{}` in transition of `{src}`",
+                        shown(tid)
                     ))
                     .at(f, ta.span.clone())
                     .hint(h),
@@ -466,8 +549,8 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     } else {
                         diags.push(
                             Diagnostic::error(format!(
-                                "transition from `{}` to final state `{tid}` of another region",
-                                ids[k]
+                                "transition from `{src}` to final state `{}` of another region",
+                                shown(tid)
                             ))
                             .at(f, ta.span.clone())
                             .hint("only a final state of the source's own region (its parent's outcome) is supported"),
@@ -476,19 +559,14 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     }
                 }
             };
-            let valid: Vec<String> = match &m.states[si].body {
-                StateBody::Container(r) => r.outcomes.clone(),
-                StateBody::Decision => vec!["RUNNING".to_string()],
-                StateBody::Task(_) => TASK_OUTCOMES.iter().map(|s| s.to_string()).collect(),
-            };
             let span = Some(t.span.clone());
             match (event, cond) {
                 (Some(ev), None)
                     if t.btfsm_attr("guard") != Some("true")
-                        && valid.iter().any(|v| v == ev)
-                        && !used_outcomes.iter().any(|u| u == ev) =>
+                        && valid.contains(ev)
+                        && !used_outcomes.contains(ev) =>
                 {
-                    used_outcomes.push(ev.to_string());
+                    used_outcomes.insert(ev);
                     outs.push(Transition {
                         trigger: Trigger::Outcome(ev.to_string()),
                         target,
@@ -505,7 +583,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                             Some(all) => all,
                             None => {
                                 diags.push(
-                                    Diagnostic::error(format!("unreadable `btfsm:terms` \"{text}\""))
+                                    Diagnostic::error(format!("unreadable `btfsm:terms` \"{}\"", shown(text)))
                                         .at(f, t.span.clone())
                                         .hint("write conditions as `Skill(arg=value, ...)`, `not ` to negate, separated by `; `"),
                                 );
@@ -532,7 +610,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             diags.push(
                 Diagnostic::warning(format!(
                     "state `{}` is unreachable from the initial state",
-                    m.path(i)
+                    shown(&ids[entry_of[i]])
                 ))
                 .at(f, m.states[i].span.clone().unwrap_or(0..0))
                 .hint("add a transition to it, or remove it"),
@@ -602,13 +680,6 @@ fn m_final_name(
         .btfsm_attr("name")
         .unwrap_or(&ids[k])
         .to_string()
-}
-
-fn ids_of_state<'a>(ids: &'a [String], state_of: &[Option<usize>], s: usize) -> &'a str {
-    state_of
-        .iter()
-        .position(|x| *x == Some(s))
-        .map_or("", |k| ids[k].as_str())
 }
 
 fn file_stem(path: &str) -> String {
@@ -770,6 +841,95 @@ mod tests {
         assert_eq!(l.warnings.len(), 1);
         assert!(l.warnings[0].message.contains("`z` is unreachable"));
         assert_eq!(l.warnings[0].location().unwrap().1, 3);
+    }
+
+    const HEAD: &str = "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" xmlns:btfsm=\"urn:btfsm\" version=\"1.0\">\n";
+
+    #[test]
+    fn long_events_conditions_and_names_are_errors_at_the_element() {
+        let long = "e".repeat(5000);
+        for (text, what) in [
+            (
+                format!("<state id=\"a\">\n<transition event=\"{long}\" target=\"a\"/></state>"),
+                "value of `event`",
+            ),
+            (
+                format!("<state id=\"a\">\n<transition cond=\"{long}\" target=\"a\"/></state>"),
+                "value of `cond`",
+            ),
+            (
+                format!("<state id=\"a\">\n<transition event=\"go\" target=\"{long}\"/></state>"),
+                "value of `target`",
+            ),
+            (
+                format!("<state id=\"a\">\n<state id=\"b\" btfsm:label=\"{long}\"/></state>"),
+                "value of `label`",
+            ),
+        ] {
+            let e = parse_str(
+                "t.scxml",
+                &format!("{HEAD}{text}\n</scxml>"),
+                &Limits::default(),
+            )
+            .unwrap_err();
+            assert!(
+                e[0].message.starts_with(what)
+                    && e[0]
+                        .message
+                        .contains("is 5000 bytes long, more than the limit of 4096 bytes"),
+                "{}",
+                e[0].message
+            );
+            assert!(e[0].message.len() < 300, "{}", e[0].message);
+            assert_eq!(e[0].location().unwrap().1, 3, "{}", e[0]);
+        }
+    }
+
+    #[test]
+    fn depth_is_an_error_at_the_state() {
+        let text = format!(
+            "{HEAD}{}{}\n</scxml>",
+            (0..8)
+                .map(|i| format!("<state id=\"s{i}\">\n"))
+                .collect::<String>(),
+            "</state>".repeat(8)
+        );
+        let lim = |d| Limits {
+            max_depth: d,
+            ..Default::default()
+        };
+        assert!(parse_str("t.scxml", &text, &lim(7)).is_ok());
+        let e = parse_str("t.scxml", &text, &lim(5)).unwrap_err();
+        assert!(
+            e[0].message
+                == "state `s6` is nested 6 containers deep, deeper than the limit of 5 levels",
+            "{}",
+            e[0].message
+        );
+        assert_eq!(e[0].location().unwrap().1, 8);
+    }
+
+    /// A deep machine where no state is reachable: each warning names the
+    /// state by its id, not by the path of ids above it (which made the
+    /// messages quadratic in depth).
+    #[test]
+    fn unreachable_states_of_a_deep_machine_are_named_by_id() {
+        let n = 50;
+        let id = |i: usize| format!("{i:0>100}");
+        let text = format!(
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" initial=\"z\"><state id=\"z\"/>{}{}</scxml>",
+            (0..n)
+                .map(|i| format!("<state id=\"{}\">", id(i)))
+                .collect::<String>(),
+            "</state>".repeat(n)
+        );
+        let l = parse_str("t.scxml", &text, &Limits::default()).unwrap();
+        assert_eq!(l.warnings.len(), n);
+        assert!(
+            l.warnings.iter().all(|w| w.message.len() < 250),
+            "{}",
+            l.warnings[n - 1].message
+        );
     }
 
     #[test]

@@ -80,13 +80,90 @@ impl XDoc {
     }
 }
 
-/// Parses a source file into an element arena.
-pub fn parse(file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
+/// At most this many bytes of a name are quoted in a message.
+pub const SHOWN_NAME_BYTES: usize = 64;
+
+/// A name as quoted in a message: whole when short, else its first
+/// [`SHOWN_NAME_BYTES`] bytes (on a character boundary) and how long it is,
+/// so that a 10 MB name gives a message of a hundred bytes.
+pub fn shown(s: &str) -> std::borrow::Cow<'_, str> {
+    if s.len() <= SHOWN_NAME_BYTES {
+        return std::borrow::Cow::Borrowed(s);
+    }
+    let mut end = SHOWN_NAME_BYTES;
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    std::borrow::Cow::Owned(format!("{}…({} bytes)", &s[..end], s.len()))
+}
+
+/// Byte offset of the start tag of the `(n + 1)`-th element (`<name`, in
+/// document order; comments, CDATA, processing instructions and end tags
+/// skipped), or `None` when the text has at most `n` start tags. One linear
+/// pass before parsing, so that a file of millions of elements is refused
+/// with a position before any of them is built.
+pub fn nth_start_tag(text: &str, n: usize) -> Option<usize> {
+    let b = text.as_bytes();
+    let mut count = 0usize;
+    let mut i = 0usize;
+    while let Some(k) = memchr_lt(&b[i..]) {
+        let at = i + k;
+        let rest = &b[at + 1..];
+        let skip_to = |end: &str| text[at..].find(end).map_or(b.len(), |e| at + e + end.len());
+        if rest.starts_with(b"!--") {
+            i = skip_to("-->");
+        } else if rest.starts_with(b"![CDATA[") {
+            i = skip_to("]]>");
+        } else if rest.starts_with(b"?") {
+            i = skip_to("?>");
+        } else if rest.starts_with(b"/") || rest.starts_with(b"!") {
+            i = at + 1;
+        } else {
+            if count == n {
+                return Some(at);
+            }
+            count += 1;
+            i = at + 1;
+        }
+    }
+    None
+}
+
+fn memchr_lt(b: &[u8]) -> Option<usize> {
+    b.iter().position(|&c| c == b'<')
+}
+
+/// Parses a source file into an element arena of at most `left` elements:
+/// more is an error at the first element beyond, saying that the files read
+/// hold more than `limit` elements (`--max-nodes`; `left` is what remains of
+/// it after the files read before).
+pub fn parse(file: &Arc<SourceFile>, left: usize, limit: usize) -> Result<XDoc, Diagnostic> {
+    let max_elems = left;
+    if let Some(at) = nth_start_tag(&file.text, max_elems) {
+        let end = at + 1 + qname_len(&file.text[at..]);
+        return Err(Diagnostic::error(format!(
+            "more than {limit} elements (every element of every file read counts, in used and unused trees alike)"
+        ))
+        .at(file, at..end)
+        .hint("raise the limit with --max-nodes"));
+    }
+    // Elements are bounded above; text, comments and processing
+    // instructions between them are nodes too (a backstop on memory).
+    let nodes_limit =
+        u32::try_from(max_elems.saturating_mul(4).saturating_add(1024)).unwrap_or(u32::MAX);
     let opts = roxmltree::ParsingOptions {
         allow_dtd: false,
+        nodes_limit,
         ..Default::default()
     };
     let doc = roxmltree::Document::parse_with_options(&file.text, opts).map_err(|e| {
+        if matches!(e, roxmltree::Error::NodesLimitReached) {
+            return Diagnostic::error(format!(
+                "more than {nodes_limit} XML nodes (elements, text, comments) in this file"
+            ))
+            .at(file, 0..1)
+            .hint("raise the limit with --max-nodes");
+        }
         let pos = e.pos();
         let off = offset_of(&file.text, pos.row as usize, pos.col as usize);
         let msg = e.to_string();
@@ -213,7 +290,7 @@ mod tests {
     #[test]
     fn attribute_without_separating_space_is_positioned() {
         let f = SourceFile::new("t.xml", "<root>\n  <Action ID=\"A\"name=\"x\"/>\n</root>\n");
-        let d = parse(&f).unwrap_err();
+        let d = parse(&f, 100, 100).unwrap_err();
         let (_, line, col) = d.location().unwrap();
         assert_eq!(line, 2);
         assert!(col > 10, "column {col}");
@@ -223,13 +300,39 @@ mod tests {
     #[test]
     fn elements_in_document_order_with_children() {
         let f = SourceFile::new("t.xml", "<a x=\"1\"><b/><c><d/></c></a>");
-        let d = parse(&f).unwrap();
+        let d = parse(&f, 100, 100).unwrap();
         let names: Vec<&str> = d.elems.iter().map(|e| e.name.as_str()).collect();
         assert_eq!(names, ["a", "b", "c", "d"]);
         assert_eq!(d.elems[0].children, vec![1, 2]);
         assert_eq!(d.elems[2].children, vec![3]);
         assert_eq!(d.elems[0].attr("x"), Some("1"));
         assert_eq!(&f.text[d.elems[2].span.clone()], "<c");
+    }
+
+    #[test]
+    fn elements_beyond_the_limit_are_refused_at_the_first_one_beyond() {
+        let text = "<a>\n<!-- <x/> --><![CDATA[<y/>]]><?pi <z/>?>\n  <b/><c/>\n  <d/>\n</a>";
+        let f = SourceFile::new("t.xml", text);
+        assert!(parse(&f, 4, 4).is_ok());
+        let d = parse(&f, 3, 10).unwrap_err();
+        assert_eq!(d.location().unwrap().1, 4, "{d}");
+        assert_eq!(&f.text[d.span.clone().unwrap()], "<d");
+        assert!(
+            d.message.starts_with("more than 10 elements"),
+            "{}",
+            d.message
+        );
+        assert_eq!(nth_start_tag(text, 0), Some(0));
+        assert_eq!(nth_start_tag(text, 4), None);
+    }
+
+    #[test]
+    fn long_names_are_shown_truncated() {
+        assert_eq!(shown("short"), "short");
+        let long = "é".repeat(1000);
+        let s = shown(&long);
+        assert!(s.len() < 100, "{s}");
+        assert!(s.ends_with("…(2000 bytes)"), "{s}");
     }
 
     #[test]
