@@ -743,11 +743,10 @@ impl Loader<'_> {
             remap: BTreeMap::new(),
             autoremap: false,
         }];
-        // The expansions enclosing the element being read (root first), and
-        // how often each tree ID is among them: recursion is found in O(1)
-        // per SubTree; the chain moves one step per expansion entered or left.
-        let mut active: Vec<usize> = vec![0];
-        let mut on_chain: HashMap<String, usize> = HashMap::from([(tree_id.to_string(), 1)]);
+        // The expansions enclosing the element being read: recursion and
+        // port remapping are looked up in O(1) per SubTree and port.
+        let mut chain = Chain::default();
+        chain.push(&frames, 0);
         let root_el = self.docs[d0].elems[e0].children[0];
         let mut stack = vec![Item {
             d: d0,
@@ -766,19 +765,7 @@ impl Loader<'_> {
         // as many expansions as nodes.
         let mut expansions = self.limits.max_nodes;
         while let Some(it) = stack.pop() {
-            while let Some(&top) = active.last() {
-                if top == it.frame || Some(top) == frames[it.frame].parent {
-                    break;
-                }
-                active.pop();
-                if let Some(c) = on_chain.get_mut(&frames[top].id) {
-                    *c -= 1;
-                }
-            }
-            if active.last() != Some(&it.frame) {
-                active.push(it.frame);
-                *on_chain.entry(frames[it.frame].id.clone()).or_default() += 1;
-            }
+            chain.enter(&frames, it.frame);
             let el = self.docs[it.d].elems[it.e].clone();
             if self.names_too_long(it.d, &el) {
                 return None;
@@ -820,8 +807,9 @@ impl Loader<'_> {
                     failed = true;
                     continue;
                 };
-                if on_chain.get(&id).is_some_and(|&c| c > 0) {
-                    let chain: Vec<String> = active.iter().map(|&f| frames[f].id.clone()).collect();
+                if chain.trees.get(&id).is_some_and(|&c| c > 0) {
+                    let chain: Vec<String> =
+                        chain.frames.iter().map(|&f| frames[f].id.clone()).collect();
                     let at = chain.iter().position(|c| *c == id).unwrap_or(0);
                     let mut shown_chain: Vec<String> =
                         chain.iter().map(|c| shown(c).into_owned()).collect();
@@ -864,7 +852,7 @@ impl Loader<'_> {
                         } else {
                             a.value.clone()
                         };
-                        (a.name.clone(), resolve_port(&frames, it.frame, &v))
+                        (a.name.clone(), chain.resolve(&frames, &v))
                     })
                     .collect();
                 let autoremap = ["_autoremap", "__autoremap", "__shared_blackboard"]
@@ -897,7 +885,7 @@ impl Loader<'_> {
                 return None;
             }
             budget -= 1;
-            let Some(node) = self.node(it.d, &el, |v| resolve_port(&frames, it.frame, v)) else {
+            let Some(node) = self.node(it.d, &el, |v| chain.resolve(&frames, v)) else {
                 failed = true;
                 continue;
             };
@@ -1137,17 +1125,97 @@ struct Frame {
     autoremap: bool,
 }
 
+/// The entry a port value refers to: `key` of a whole `{key}`.
+fn port_key(value: &str) -> Option<&str> {
+    value
+        .strip_prefix('{')
+        .and_then(|v| v.strip_suffix('}'))
+        .filter(|k| !k.is_empty() && !k.contains(['{', '}']))
+}
+
+/// The expansions enclosing the element being expanded (outermost first),
+/// kept as the expansion walks the tree depth-first, with what makes
+/// lookups O(1): how often each tree ID is on the chain (recursion), the
+/// positions of the expansions that do not share their blackboard by name,
+/// and per blackboard entry the positions of the expansions remapping it.
+/// Each expansion is entered and left once, so the whole expansion is
+/// linear in the remappings (a walk up the chain per port was quadratic on
+/// a long chain of `_autoremap` SubTrees).
+#[derive(Default)]
+struct Chain {
+    frames: Vec<usize>,
+    trees: HashMap<String, usize>,
+    barriers: Vec<usize>,
+    by_key: HashMap<String, Vec<usize>>,
+}
+
+impl Chain {
+    fn push(&mut self, frames: &[Frame], f: usize) {
+        let at = self.frames.len();
+        self.frames.push(f);
+        *self.trees.entry(frames[f].id.clone()).or_default() += 1;
+        if !frames[f].autoremap {
+            self.barriers.push(at);
+        }
+        for k in frames[f].remap.keys() {
+            self.by_key.entry(k.clone()).or_default().push(at);
+        }
+    }
+
+    fn pop(&mut self, frames: &[Frame]) {
+        let Some(f) = self.frames.pop() else { return };
+        let at = self.frames.len();
+        if let Some(c) = self.trees.get_mut(&frames[f].id) {
+            *c -= 1;
+        }
+        if self.barriers.last() == Some(&at) {
+            self.barriers.pop();
+        }
+        for k in frames[f].remap.keys() {
+            if let Some(v) = self.by_key.get_mut(k) {
+                v.pop();
+            }
+        }
+    }
+
+    /// Makes `f` the innermost expansion: leaves those the walk is done
+    /// with, enters `f` if it is new (a child of the innermost one).
+    fn enter(&mut self, frames: &[Frame], f: usize) {
+        while let Some(&top) = self.frames.last() {
+            if top == f || Some(top) == frames[f].parent {
+                break;
+            }
+            self.pop(frames);
+        }
+        if self.frames.last() != Some(&f) {
+            self.push(frames, f);
+        }
+    }
+
+    /// [`resolve_port`] in the innermost expansion, in O(1): the innermost
+    /// expansion remapping the entry, if no expansion in between (the
+    /// outer one included) keeps its blackboard to itself.
+    fn resolve(&self, frames: &[Frame], value: &str) -> String {
+        let Some(key) = port_key(value) else {
+            return value.to_string();
+        };
+        let barrier = self.barriers.last().copied().unwrap_or(0);
+        match self.by_key.get(key).and_then(|v| v.last()) {
+            Some(&at) if at >= barrier => frames[self.frames[at]].remap[key].clone(),
+            _ => value.to_string(),
+        }
+    }
+}
+
 /// The value a port written as `value` inside expansion `frame` has in the
 /// expanded tree: a blackboard reference `{key}` remapped by the enclosing
 /// SubTree elements is replaced by what they map it to (a literal or an outer
 /// `{key}`); anything else is kept as written. BehaviorTree.CPP gives a
 /// subtree its own blackboard, so inlining it means renaming its entries.
+/// (The reference definition; the reader uses [`Chain::resolve`].)
+#[cfg(test)]
 fn resolve_port(frames: &[Frame], frame: usize, value: &str) -> String {
-    let Some(key) = value
-        .strip_prefix('{')
-        .and_then(|v| v.strip_suffix('}'))
-        .filter(|k| !k.is_empty() && !k.contains(['{', '}']))
-    else {
+    let Some(key) = port_key(value) else {
         return value.to_string();
     };
     let mut f = frame;
@@ -1683,5 +1751,21 @@ mod tests {
         for v in ["{}", "{a}{b}", "x{goal}", "{goal", "goal}", "literal"] {
             assert_eq!(resolve_port(&frames, 1, v), v);
         }
+        // The chain the reader keeps gives the same answers in O(1).
+        let mut chain = Chain::default();
+        for f in 0..3 {
+            chain.enter(&frames, f);
+            for v in ["{goal}", "{x}", "{other}", "{target}", "{}", "x"] {
+                assert_eq!(
+                    chain.resolve(&frames, v),
+                    resolve_port(&frames, f, v),
+                    "{f} {v}"
+                );
+            }
+        }
+        // Back in Outer after Inner: Inner's remapping is gone.
+        chain.enter(&frames, 1);
+        assert_eq!(chain.frames, [0, 1]);
+        assert_eq!(chain.resolve(&frames, "{x}"), "{x}");
     }
 }
