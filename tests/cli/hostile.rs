@@ -786,3 +786,32 @@ fn hostile_wide_bt_converts_to_hfsm_in_linear_time() {
     assert_eq!(code, 0, "{}", head(&stderr, 2000));
     assert!(secs < 30.0, "{secs} s");
 }
+
+/// 20,000 SubTrees each inside the last, sharing their blackboard by name
+/// (`_autoremap`), around 100,000 ports: each port's entry is looked up in
+/// O(1) (it walked up the whole chain: over 100 s in a debug build).
+#[test]
+fn hostile_long_autoremap_subtree_chain_resolves_ports_in_linear_time() {
+    let dir = Scratch::new("autoremap-chain");
+    let k = 20_000;
+    let mut text = String::from("<root BTCPP_format=\"4\" main_tree_to_execute=\"T0\">");
+    for i in 0..k {
+        text.push_str(&format!(
+            "<BehaviorTree ID=\"T{i}\"><SubTree ID=\"T{}\" _autoremap=\"true\" d{i}=\"x\"/></BehaviorTree>",
+            i + 1
+        ));
+    }
+    text.push_str(&format!(
+        "<BehaviorTree ID=\"T{k}\"><Sequence>{}</Sequence></BehaviorTree></root>",
+        "<Script code=\"{c}\"/>".repeat(100_000)
+    ));
+    let f = dir.write("chain.xml", text);
+    let (code, stdout, stderr, secs) = btfsm_capped(1024, &["analyze", &f, "--format", "json"]);
+    assert_eq!(code, 0, "{}", head(&stderr, 2000));
+    assert!(
+        stdout.contains("\"vertices\": 100001"),
+        "{}",
+        head(&stdout, 2000)
+    );
+    assert!(secs < 30.0, "{secs} s");
+}
