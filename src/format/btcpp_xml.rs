@@ -235,7 +235,7 @@ struct ModelEntry {
 
 struct Loader<'l> {
     limits: &'l Limits,
-    diags: Vec<Diagnostic>,
+    diags: xml::Sink,
     docs: Vec<XDoc>,
     dirs: Vec<PathBuf>,
     /// Tree ID -> (document, `<BehaviorTree>` element).
@@ -257,21 +257,20 @@ fn load(
     let mut l = Loader {
         elems_left,
         limits,
-        diags: Vec::new(),
+        diags: xml::Sink::default(),
         docs: vec![main],
         dirs: vec![base],
         trees: BTreeMap::new(),
         models: BTreeMap::new(),
     };
     let policy = l.run(identity);
-    super::finish(&file, policy, l.diags, "behavior tree")
+    super::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")
 }
 
 impl Loader<'_> {
     fn err(&mut self, d: usize, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
         let f = self.docs[d].file.clone();
-        self.diags.push(Diagnostic::error(msg).at(&f, span));
-        self.diags.last_mut().expect("just pushed")
+        self.diags.push(Diagnostic::error(msg).at(&f, span))
     }
 
     /// Parses a file read for this policy, charging its elements to the
@@ -285,13 +284,12 @@ impl Loader<'_> {
     /// Are hints still worth computing? Past the messages shown
     /// (`finish` keeps the first ones), no did-you-mean search is done.
     fn hinting(&self) -> bool {
-        self.diags.len() <= super::toml::MAX_DIAGNOSTICS
+        self.diags.room_for_errors()
     }
 
     fn warn(&mut self, d: usize, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
         let f = self.docs[d].file.clone();
-        self.diags.push(Diagnostic::warning(msg).at(&f, span));
-        self.diags.last_mut().expect("just pushed")
+        self.diags.push(Diagnostic::warning(msg).at(&f, span))
     }
 
     fn run(&mut self, identity: PathBuf) -> Option<Policy> {
@@ -321,7 +319,7 @@ impl Loader<'_> {
         for d in 0..self.docs.len() {
             self.definitions(d);
         }
-        if self.diags.iter().any(Diagnostic::is_error) {
+        if self.diags.has_errors() {
             return None;
         }
         let (tree_id, (d, e)) = self.main_tree()?;

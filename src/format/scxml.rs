@@ -63,13 +63,12 @@ enum Kind {
 }
 
 fn load(file: Arc<SourceFile>, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
-    // Transitions and executable content are elements too: a file holds at
-    // most four per state allowed.
-    let max_elems = limits.max_nodes.saturating_mul(4);
-    let doc = xml::parse(&file, max_elems, max_elems).map_err(|d| vec![d])?;
-    let mut diags: Vec<Diagnostic> = Vec::new();
+    // Every element counts (states, transitions, executable content), as in
+    // BehaviorTree.CPP files: memory is bounded before the states are read.
+    let doc = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    let mut diags = xml::Sink::default();
     let policy = read(&doc, limits, &mut diags);
-    super::finish(&file, policy, diags, "state machine")
+    super::finish(&file, policy, diags.into_vec(&file), "state machine")
 }
 
 /// The first attribute of `e` (name or value) longer than
@@ -102,9 +101,9 @@ fn is_scxml(e: &XElem) -> bool {
     e.ns.is_none() || e.ns.as_deref() == Some(SCXML_NS)
 }
 
-fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Policy> {
+fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
     let f = &doc.file;
-    let err = |diags: &mut Vec<Diagnostic>, e: &XElem, msg: String, hint: &str| {
+    let err = |diags: &mut xml::Sink, e: &XElem, msg: String, hint: &str| {
         diags.push(Diagnostic::error(msg).at(f, e.span.clone()).hint(hint));
     };
     let root = &doc.elems[doc.root];
@@ -205,28 +204,31 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
         }
     }
-    // Ids: unique in the document.
-    let mut by_id: HashMap<String, usize> = HashMap::new();
+    // Ids: unique in the document (borrowed from the document where written).
     let mut generated = 0usize;
-    let mut ids: Vec<String> = Vec::with_capacity(found.len());
-    for (k, (e, _, _)) in found.iter().enumerate() {
-        let el = &doc.elems[*e];
-        let id = match el.attr("id") {
-            Some(id) => id.to_string(),
-            None => {
-                generated += 1;
-                format!("_{}{generated}", el.name)
+    let ids: Vec<std::borrow::Cow<'_, str>> = found
+        .iter()
+        .map(|(e, _, _)| {
+            let el = &doc.elems[*e];
+            match el.attr("id") {
+                Some(id) => std::borrow::Cow::Borrowed(id),
+                None => {
+                    generated += 1;
+                    std::borrow::Cow::Owned(format!("_{}{generated}", el.name))
+                }
             }
-        };
-        if by_id.insert(id.clone(), k).is_some() {
+        })
+        .collect();
+    let mut by_id: HashMap<&str, usize> = HashMap::with_capacity(ids.len());
+    for (k, id) in ids.iter().enumerate() {
+        if by_id.insert(id, k).is_some() {
             err(
                 diags,
-                el,
-                format!("duplicate id `{}`", shown(&id)),
+                &doc.elems[found[k].0],
+                format!("duplicate id `{}`", shown(id)),
                 "every state id in an SCXML document is unique",
             );
         }
-        ids.push(id);
     }
     // Model states (not finals), in document order.
     let mut m = StateMachine {
@@ -386,13 +388,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             None => {
                 // Hints only for messages that will be shown: bounded work
                 // under a million bad `initial`s.
-                let h = if diags.len() <= super::toml::MAX_DIAGNOSTICS {
+                let h = if diags.room_for_errors() {
                     let region = m
                         .states
                         .iter()
                         .enumerate()
                         .filter(|(_, st)| st.parent == container && st.pseudo.is_none())
-                        .map(|(i, _)| ids[entry_of[i]].as_str());
+                        .map(|(i, _)| &*ids[entry_of[i]]);
                     suggest(tid, region)
                 } else {
                     String::new()
@@ -524,8 +526,8 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 if skipped.contains(tid) {
                     continue;
                 }
-                let h = if diags.len() <= super::toml::MAX_DIAGNOSTICS {
-                    suggest(tid, ids.iter().map(String::as_str))
+                let h = if diags.room_for_errors() {
+                    suggest(tid, ids.iter().map(|i| &**i))
                 } else {
                     String::new()
                 };
@@ -602,7 +604,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         guards.extend(outs);
         m.states[si].transitions = guards;
     }
-    if diags.iter().any(Diagnostic::is_error) {
+    if diags.has_errors() {
         return None;
     }
     for (i, seen) in m.reachable().into_iter().enumerate() {
@@ -673,7 +675,7 @@ pub fn parse_terms(text: &str) -> Option<Vec<GuardTerm>> {
 fn m_final_name(
     doc: &XDoc,
     found: &[(usize, Kind, Option<usize>)],
-    ids: &[String],
+    ids: &[std::borrow::Cow<'_, str>],
     k: usize,
 ) -> String {
     doc.elems[found[k].0]
