@@ -815,3 +815,31 @@ fn hostile_long_autoremap_subtree_chain_resolves_ports_in_linear_time() {
     );
     assert!(secs < 30.0, "{secs} s");
 }
+
+/// Two million unknown BehaviorTree.CPP types: the reader keeps 200
+/// messages of each kind while reading, under a 1 GiB cap (it kept every
+/// one, about 2 GB, and trimmed when reporting).
+#[test]
+fn hostile_million_bad_xml_elements_keep_bounded_messages() {
+    let dir = Scratch::new("xml-many-errors");
+    let n = 1_990_000;
+    let bt = dir.write(
+        "unknown.xml",
+        format!(
+            "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\"><Sequence>{}</Sequence></BehaviorTree></root>",
+            "<Xy/>".repeat(n)
+        ),
+    );
+    let (code, _, stderr, secs) = btfsm_capped(1024, &["analyze", &bt]);
+    assert_eq!(code, 2, "{}", head(&stderr, 2000));
+    assert!(
+        stderr.contains(&format!(
+            "{} more errors not shown (the first 200 messages are)",
+            n - 200
+        )),
+        "{}",
+        head(&stderr, 2000)
+    );
+    assert!(stderr.len() < 300_000, "{} bytes of stderr", stderr.len());
+    assert!(secs < 60.0, "{secs} s");
+}
