@@ -586,7 +586,7 @@ fn hostile_convert_output_is_linear_in_depth() {
             assert_eq!(counts(&out), counts(&f), "{name} {n}: read back");
         }
         // Machines deeper than the TOML format nests: refused, briefly.
-        for (name, text, to) in [("bt.toml", &toml_bt, "hfsm"), ("m.scxml", &scxml, "toml")] {
+        for (name, to) in [("bt.toml", "hfsm"), ("m.scxml", "toml")] {
             let f = dir.0.join(format!("{n}-{name}")).display().to_string();
             let out = dir.0.join(format!("{n}-{name}.toml")).display().to_string();
             let (code, _, stderr) = btfsm(&["convert", &f, "--to", to, "-o", &out]);
