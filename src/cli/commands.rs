@@ -172,7 +172,7 @@ pub fn execute(cli: Cli) -> u8 {
                 Ok(text) => emit(output.as_deref(), text.as_bytes()),
                 Err(e) => {
                     eprintln!(
-                        "error: {}: {e}\n  = hint: convert a machine with --to scxml, which has no nesting limit",
+                        "error: {}: {e}\n  = hint: SCXML has no nesting limit: convert a machine with --to scxml (a BT more than 39 levels deep has no HFSM in TOML)",
                         l.path
                     );
                     EXIT_BAD_INPUT
