@@ -29,7 +29,7 @@ use super::btcpp_xml::arg_value;
 use super::xml::{self, BTFSM_NS, XDoc, XElem, shown};
 use super::{Limits, Loaded};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
-use crate::model::skill::{Guard, GuardTerm, SkillCall};
+use crate::model::skill::{self, Guard, GuardTerm, SkillCall, SkillKind};
 use crate::model::{
     Policy, PolicyBody, Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
@@ -283,6 +283,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
                 }
             })),
         };
+        // A skill binding is checked as the TOML reader checks it (so that
+        // the machine converts to TOML that reads back).
+        if let StateBody::Task(Some(call)) = &body
+            && let Some((msg, hint)) = call_problem(call, None)
+        {
+            diags.push(Diagnostic::error(msg).at(f, el.span.clone()).hint(hint));
+        }
         m.states.push(State {
             label: el.btfsm_attr("label").unwrap_or(&name).to_string(),
             name,
@@ -582,7 +589,20 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
                     let all = match t.btfsm_attr("terms") {
                         None => vec![],
                         Some(text) => match parse_terms(text) {
-                            Some(all) => all,
+                            Some(all) => {
+                                let bad = all.iter().find_map(|term| {
+                                    call_problem(&term.condition, Some(SkillKind::Condition))
+                                });
+                                if let Some((msg, hint)) = bad {
+                                    diags.push(
+                                        Diagnostic::error(format!("`btfsm:terms`: {msg}"))
+                                            .at(f, t.span.clone())
+                                            .hint(hint),
+                                    );
+                                    continue;
+                                }
+                                all
+                            }
                             None => {
                                 diags.push(
                                     Diagnostic::error(format!("unreadable `btfsm:terms` \"{}\"", shown(text)))
@@ -628,6 +648,64 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
         description: None,
         body: PolicyBody::Machine(m),
     })
+}
+
+/// What is wrong with a skill call written in `btfsm:` attributes, as the
+/// TOML reader would say it (`skill` and `args` of a state, `if` of a
+/// guard): an unknown skill, one of the other kind, a missing or unknown
+/// argument. `(message, hint)`.
+fn call_problem(call: &SkillCall, want: Option<SkillKind>) -> Option<(String, String)> {
+    let name = shown(&call.skill);
+    let Some(kind) = skill::skill_kind(&call.skill) else {
+        let cands: Vec<&str> = match want {
+            Some(k) => skill::skill_names(k),
+            None => skill::SKILLS.iter().map(|s| s.0).collect(),
+        };
+        return Some((
+            format!("unknown skill `{name}`"),
+            suggest(&call.skill, cands),
+        ));
+    };
+    if let Some(w) = want
+        && w != kind
+    {
+        return Some((
+            format!("`{name}` is not a condition skill"),
+            format!("condition skills are {}", skill::skill_names(w).join(", ")),
+        ));
+    }
+    let params = skill::skill_params(&call.skill).unwrap_or(&[]);
+    let all = || {
+        params
+            .iter()
+            .map(|(p, _)| *p)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some((p, _)) = params
+        .iter()
+        .find(|(p, required)| *required && !call.args.contains_key(*p))
+    {
+        return Some((
+            format!("skill `{name}` needs argument `{p}`"),
+            format!("its arguments are {}", all()),
+        ));
+    }
+    if let Some(k) = call
+        .args
+        .keys()
+        .find(|k| !params.iter().any(|(p, _)| p == k))
+    {
+        return Some((
+            format!("skill `{name}` has no argument `{}`", shown(k)),
+            if params.is_empty() {
+                format!("`{name}` takes no arguments")
+            } else {
+                format!("its arguments are {}", all())
+            },
+        ));
+    }
+    None
 }
 
 /// The label of a guard read from SCXML: `event`, `event [cond]` or `[cond]`.
@@ -932,6 +1010,40 @@ mod tests {
             "{}",
             l.warnings[n - 1].message
         );
+    }
+
+    /// Skill bindings are checked as in TOML (found by fuzzing: an unknown
+    /// skill was read, and its TOML conversion did not read back).
+    #[test]
+    fn skill_bindings_are_checked_as_in_toml() {
+        for (attrs, want) in [
+            (r#"btfsm:skill="Tu%k-Arm""#, "unknown skill `Tu%k-Arm`"),
+            (
+                r#"btfsm:skill="Pick""#,
+                "skill `Pick` needs argument `object`",
+            ),
+            (
+                r#"btfsm:skill="Dock" btfsm:arg.x="1""#,
+                "skill `Dock` has no argument `x`",
+            ),
+        ] {
+            let text = format!("{HEAD}<state id=\"a\" {attrs}/>\n</scxml>");
+            let e = parse_str("t.scxml", &text, &Limits::default()).unwrap_err();
+            assert_eq!(e[0].message, want);
+            assert_eq!(e[0].location().unwrap().1, 2);
+        }
+        let text = format!(
+            "{HEAD}<state id=\"a\"><transition event=\"go\" target=\"a\" btfsm:terms=\"Dock()\"/></state>\n</scxml>"
+        );
+        let e = parse_str("t.scxml", &text, &Limits::default()).unwrap_err();
+        assert_eq!(
+            e[0].message,
+            "`btfsm:terms`: `Dock` is not a condition skill"
+        );
+        let ok = format!(
+            "{HEAD}<state id=\"a\" btfsm:skill=\"Pick\" btfsm:arg.object=\"cube1\"><transition event=\"go\" target=\"a\" btfsm:terms=\"not Found()\"/></state>\n</scxml>"
+        );
+        assert!(parse_str("t.scxml", &ok, &Limits::default()).is_ok());
     }
 
     #[test]
