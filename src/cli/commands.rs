@@ -183,8 +183,18 @@ pub fn execute(cli: Cli) -> u8 {
                     }
                 }
             };
-            let text = crate::format::toml_write::write_policy(&policy);
-            emit_text(output.as_deref(), text)
+            // Only what reads back: a machine the TOML format can nest,
+            // within the file size limit.
+            match crate::format::toml_write::write_policy_within(&policy, limits.max_file_bytes) {
+                Ok(text) => emit_text(output.as_deref(), text),
+                Err(e) => {
+                    eprintln!(
+                        "error: {}: {e}\n  = hint: SCXML has no nesting limit: convert a machine with --to scxml (a BT more than 39 levels deep has no HFSM in TOML)",
+                        shown(&l.path)
+                    );
+                    EXIT_BAD_INPUT
+                }
+            }
         }
         Command::Effort {
             files,

@@ -132,7 +132,14 @@ pub fn edit(a: &EditArgs) -> u8 {
         (EditOp::AddState { .. }, _) => return wrong_kind("add-state", "FSMs and HFSMs"),
         (_, _) => return wrong_kind("insert-subtree and wrap-root", "BTs"),
     };
-    let text = crate::format::toml_write::write_policy(&policy);
+    let text = match crate::format::toml_write::write_policy_within(&policy, limits.max_file_bytes)
+    {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
     // The result must read back: an edit never writes an invalid file.
     let base = a.file.parent().unwrap_or(std::path::Path::new(""));
     if let Err(diags) = crate::format::toml::parse_str("edited policy", &text, base, &limits) {

@@ -21,7 +21,7 @@
 //!
 //! The expansion walks an explicit stack (no recursion on input depth).
 
-use super::xml::{self, XDoc, XElem};
+use super::xml::{self, XDoc, XElem, shown};
 use super::{AssumeLeaf, Limits, Loaded};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
 use crate::model::skill::{self, ArgValue, SkillCall, SkillKind};
@@ -245,7 +245,7 @@ struct ModelEntry {
 
 struct Loader<'l> {
     limits: &'l Limits,
-    diags: Vec<Diagnostic>,
+    diags: xml::Sink,
     docs: Vec<XDoc>,
     dirs: Vec<PathBuf>,
     /// Tree ID -> (document, `<BehaviorTree>` element).
@@ -253,6 +253,9 @@ struct Loader<'l> {
     models: BTreeMap<String, ModelEntry>,
     /// The directory every included file must be in (`None`: anywhere).
     root: Option<PathBuf>,
+    /// What remains of `--max-nodes` for the elements of the files still to
+    /// read: every element of every file counts, used or not.
+    elems_left: usize,
 }
 
 fn load(
@@ -261,32 +264,46 @@ fn load(
     base: PathBuf,
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let main = xml::parse(&file).map_err(|d| vec![d])?;
+    let main = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    let elems_left = limits.max_nodes - main.elems.len();
     let root = super::source::root_for(limits, &base);
     let mut l = Loader {
         root,
+        elems_left,
         limits,
-        diags: Vec::new(),
+        diags: xml::Sink::default(),
         docs: vec![main],
         dirs: vec![base],
         trees: BTreeMap::new(),
         models: BTreeMap::new(),
     };
     let policy = l.run(identity);
-    super::finish(&file, policy, l.diags, "behavior tree")
+    super::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")
 }
 
 impl Loader<'_> {
     fn err(&mut self, d: usize, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
         let f = self.docs[d].file.clone();
-        self.diags.push(Diagnostic::error(msg).at(&f, span));
-        self.diags.last_mut().expect("just pushed")
+        self.diags.push(Diagnostic::error(msg).at(&f, span))
+    }
+
+    /// Parses a file read for this policy, charging its elements to the
+    /// shared element budget.
+    fn parse_charged(&mut self, file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
+        let doc = xml::parse(file, self.elems_left, self.limits.max_nodes)?;
+        self.elems_left -= doc.elems.len();
+        Ok(doc)
+    }
+
+    /// Are hints still worth computing? Past the messages shown
+    /// (`finish` keeps the first ones), no did-you-mean search is done.
+    fn hinting(&self) -> bool {
+        self.diags.room_for_errors()
     }
 
     fn warn(&mut self, d: usize, span: Range<usize>, msg: impl Into<String>) -> &mut Diagnostic {
         let f = self.docs[d].file.clone();
-        self.diags.push(Diagnostic::warning(msg).at(&f, span));
-        self.diags.last_mut().expect("just pushed")
+        self.diags.push(Diagnostic::warning(msg).at(&f, span))
     }
 
     fn run(&mut self, identity: PathBuf) -> Option<Policy> {
@@ -297,7 +314,10 @@ impl Loader<'_> {
             self.err(
                 0,
                 span,
-                format!("expected `<root>` as the document element, found `<{found}>`"),
+                format!(
+                    "expected `<root>` as the document element, found `<{}>`",
+                    shown(&found)
+                ),
             )
             .hint = Some(
                 "a BehaviorTree.CPP file is `<root BTCPP_format=\"4\"><BehaviorTree ID=\"...\">...</BehaviorTree></root>`"
@@ -313,7 +333,7 @@ impl Loader<'_> {
         for d in 0..self.docs.len() {
             self.definitions(d);
         }
-        if self.diags.iter().any(Diagnostic::is_error) {
+        if self.diags.has_errors() {
             return None;
         }
         let (tree_id, (d, e)) = self.main_tree()?;
@@ -373,8 +393,11 @@ impl Loader<'_> {
             };
             let canon = super::toml::canonical(&full);
             if let Some(at) = chain.iter().position(|c| *c == canon) {
-                let mut names: Vec<String> = shown_chain[at..].to_vec();
-                names.push(full.display().to_string());
+                let mut names: Vec<String> = shown_chain[at..]
+                    .iter()
+                    .map(|n| shown(n).into_owned())
+                    .collect();
+                names.push(shown(&full.display().to_string()).into_owned());
                 self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
                     .hint =
                     Some("a file must not include itself, directly or through others".into());
@@ -404,7 +427,7 @@ impl Loader<'_> {
                     continue;
                 }
             };
-            let doc = match xml::parse(&file) {
+            let doc = match self.parse_charged(&file) {
                 Ok(doc) => doc,
                 Err(diag) => {
                     self.diags.push(diag);
@@ -444,7 +467,7 @@ impl Loader<'_> {
                 return;
             }
         };
-        let doc = match xml::parse(&file) {
+        let doc = match self.parse_charged(&file) {
             Ok(doc) => doc,
             Err(d) => {
                 self.diags.push(d);
@@ -490,7 +513,7 @@ impl Loader<'_> {
                     self.err(
                         d,
                         el.span.clone(),
-                        format!("unknown entry `<{other}>` in `<TreeNodesModel>`"),
+                        format!("unknown entry `<{}>` in `<TreeNodesModel>`", shown(other)),
                     )
                     .hint = Some(h);
                     continue;
@@ -500,10 +523,16 @@ impl Loader<'_> {
                 self.err(
                     d,
                     el.span.clone(),
-                    format!("`<{}>` in `<TreeNodesModel>` needs an `ID`", el.name),
+                    format!(
+                        "`<{}>` in `<TreeNodesModel>` needs an `ID`",
+                        shown(&el.name)
+                    ),
                 );
                 continue;
             };
+            if self.too_long(d, &el, "node type", id) {
+                continue;
+            }
             if let Some(b) = builtin(id)
                 && b != cat
             {
@@ -511,7 +540,8 @@ impl Loader<'_> {
                     d,
                     el.span.clone(),
                     format!(
-                        "`{id}` is a built-in {} type; the model's `{}` is ignored",
+                        "`{}` is a built-in {} type; the model's `{}` is ignored",
+                        shown(id),
                         b.tag().to_lowercase(),
                         cat.tag()
                     ),
@@ -525,7 +555,11 @@ impl Loader<'_> {
                 self.err(
                     d,
                     el.span.clone(),
-                    format!("`{id}` is declared both as `{was}` and as `{}`", cat.tag()),
+                    format!(
+                        "`{}` is declared both as `{was}` and as `{}`",
+                        shown(id),
+                        cat.tag()
+                    ),
                 )
                 .hint = Some("keep one declaration per node type across the model files".into());
                 continue;
@@ -549,7 +583,10 @@ impl Loader<'_> {
             self.warn(
                 d,
                 span,
-                format!("unknown `BTCPP_format` \"{val}\"; read as format 4"),
+                format!(
+                    "unknown `BTCPP_format` \"{}\"; read as format 4",
+                    shown(&val)
+                ),
             )
             .hint = Some("BehaviorTree.CPP writes `BTCPP_format=\"4\"` (or \"3\")".into());
         }
@@ -559,14 +596,21 @@ impl Loader<'_> {
             match el.name.as_str() {
                 "BehaviorTree" => {
                     let id = el.attr("ID").unwrap_or("MainTree").to_string();
+                    if self.too_long(d, &el, "tree ID", &id) {
+                        continue;
+                    }
                     if let Some(&(pd, pe)) = self.trees.get(&id) {
                         let (l, c) = {
                             let f = &self.docs[pd].file;
                             f.line_col(self.docs[pd].elems[pe].span.start)
                         };
                         let first = format!("{}:{l}:{c}", self.docs[pd].file.path);
-                        self.err(d, el.span.clone(), format!("tree `{id}` is defined twice"))
-                            .hint = Some(format!(
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            format!("tree `{}` is defined twice", shown(&id)),
+                        )
+                        .hint = Some(format!(
                             "the first definition is at {first}; give each `<BehaviorTree>` its own `ID`"
                         ));
                         continue;
@@ -576,7 +620,10 @@ impl Loader<'_> {
                         self.err(
                             d,
                             el.span.clone(),
-                            format!("tree `{id}` must hold exactly one root node, found {n}"),
+                            format!(
+                                "tree `{}` must hold exactly one root node, found {n}",
+                                shown(&id)
+                            ),
                         )
                         .hint = Some("wrap several nodes in a `<Sequence>` or `<Fallback>`".into());
                         continue;
@@ -590,7 +637,7 @@ impl Loader<'_> {
                     self.warn(
                         d,
                         el.span.clone(),
-                        format!("`<{other}>` under `<root>` is ignored"),
+                        format!("`<{}>` under `<root>` is ignored", shown(other)),
                     )
                     .hint = Some(h);
                 }
@@ -611,7 +658,7 @@ impl Loader<'_> {
                     self.err(
                         0,
                         span,
-                        format!("`main_tree_to_execute` names unknown tree `{v}`"),
+                        format!("`main_tree_to_execute` names unknown tree `{}`", shown(&v)),
                     )
                     .hint = Some(h);
                     None
@@ -634,7 +681,14 @@ impl Loader<'_> {
                 None
             }
             many => {
-                let ids: Vec<String> = many.iter().map(|(id, _)| format!("`{id}`")).collect();
+                let mut ids: Vec<String> = many
+                    .iter()
+                    .take(10)
+                    .map(|(id, _)| format!("`{}`", shown(id)))
+                    .collect();
+                if many.len() > 10 {
+                    ids.push(format!("... ({} more)", many.len() - 10));
+                }
                 let span = self.docs[0].elems[root].span.clone();
                 self.err(
                     0,
@@ -650,13 +704,53 @@ impl Loader<'_> {
         }
     }
 
+    /// Is `value` (a name, type, ID or attribute of element `el` of document
+    /// `d`) longer than `--max-name-bytes`? Then an error at the element.
+    fn too_long(&mut self, d: usize, el: &XElem, what: &str, value: &str) -> bool {
+        if value.len() <= self.limits.max_name_bytes {
+            return false;
+        }
+        let max = self.limits.max_name_bytes;
+        self.err(
+            d,
+            el.span.clone(),
+            format!(
+                "{what} `{}` of `<{}>` is {} bytes long, more than the limit of {max} bytes",
+                shown(value),
+                shown(&el.name),
+                value.len()
+            ),
+        )
+        .hint = Some("shorten it, or raise the limit with --max-name-bytes".into());
+        true
+    }
+
+    /// Checks every name an element carries against `--max-name-bytes`: its
+    /// tag, and the name and value of each attribute (ports, IDs, names).
+    fn names_too_long(&mut self, d: usize, el: &XElem) -> bool {
+        if self.too_long(d, el, "element name", &el.name) {
+            return true;
+        }
+        for a in &el.attrs {
+            if self.too_long(d, el, "attribute name", &a.name)
+                || self.too_long(d, el, &format!("value of `{}`", shown(&a.name)), &a.value)
+            {
+                return true;
+            }
+        }
+        false
+    }
+
     /// Expands the tree from its root element into the arena (pre-order, explicit
-    /// stack), resolving every node's type and expanding SubTrees.
+    /// stack), resolving every node's type and expanding SubTrees. Depth and
+    /// name lengths are checked here, at the element, as it is read.
     fn expand(&mut self, tree_id: &str, d0: usize, e0: usize) -> Option<Bt> {
         struct Item {
             d: usize,
             e: usize,
             parent: Option<usize>,
+            /// Levels below the root (a SubTree's root takes its place).
+            depth: usize,
             /// Index into `frames`: the SubTree expansion this element is in.
             frame: usize,
             /// `name` of the SubTree element this root replaces.
@@ -668,11 +762,16 @@ impl Loader<'_> {
             remap: BTreeMap::new(),
             autoremap: false,
         }];
+        // The expansions enclosing the element being read: recursion and
+        // port remapping are looked up in O(1) per SubTree and port.
+        let mut chain = Chain::default();
+        chain.push(&frames, 0);
         let root_el = self.docs[d0].elems[e0].children[0];
         let mut stack = vec![Item {
             d: d0,
             e: root_el,
             parent: None,
+            depth: 0,
             frame: 0,
             name_override: None,
         }];
@@ -681,8 +780,29 @@ impl Loader<'_> {
         let mut explicit: Vec<Option<String>> = Vec::new();
         let mut failed = false;
         let mut budget = self.limits.max_nodes;
+        // SubTree elements are no nodes, but expanding one is work: at most
+        // as many expansions as nodes.
+        let mut expansions = self.limits.max_nodes;
         while let Some(it) = stack.pop() {
+            chain.enter(&frames, it.frame);
             let el = self.docs[it.d].elems[it.e].clone();
+            if self.names_too_long(it.d, &el) {
+                return None;
+            }
+            if it.depth > self.limits.max_depth {
+                self.err(
+                    it.d,
+                    el.span.clone(),
+                    format!(
+                        "`<{}>` is {} levels below the root, deeper than the limit of {} levels",
+                        shown(&el.name),
+                        it.depth,
+                        self.limits.max_depth
+                    ),
+                )
+                .hint = Some("raise the limit with --max-depth".into());
+                return None;
+            }
             let tag = el.name.as_str();
             // SubTree: the referenced tree's root takes this element's place.
             if tag == "SubTree" || tag == "SubTreePlus" {
@@ -692,34 +812,52 @@ impl Loader<'_> {
                     continue;
                 };
                 let Some(&(sd, se)) = self.trees.get(&id) else {
-                    let h = suggest(&id, self.trees.keys().map(String::as_str));
+                    let h = if self.hinting() {
+                        suggest(&id, self.trees.keys().map(String::as_str))
+                    } else {
+                        String::new()
+                    };
                     self.err(
                         it.d,
                         el.span.clone(),
-                        format!("unknown tree `{id}` in `<SubTree>`"),
+                        format!("unknown tree `{}` in `<SubTree>`", shown(&id)),
                     )
                     .hint = Some(h);
                     failed = true;
                     continue;
                 };
-                let mut chain = vec![];
-                let mut f = Some(it.frame);
-                let mut recursive = false;
-                while let Some(fi) = f {
-                    chain.push(frames[fi].id.clone());
-                    if frames[fi].id == id {
-                        recursive = true;
+                if chain.trees.get(&id).is_some_and(|&c| c > 0) {
+                    let chain: Vec<String> =
+                        chain.frames.iter().map(|&f| frames[f].id.clone()).collect();
+                    let at = chain.iter().position(|c| *c == id).unwrap_or(0);
+                    let mut shown_chain: Vec<String> =
+                        chain.iter().map(|c| shown(c).into_owned()).collect();
+                    shown_chain.push(shown(&id).into_owned());
+                    // The cycle itself, and at most a few trees before it.
+                    let from = at.saturating_sub(3);
+                    let mut cycle = shown_chain[from..].to_vec();
+                    if cycle.len() > 12 {
+                        let n = cycle.len();
+                        cycle.splice(6..n - 6, [format!("... ({} trees) ...", n - 12)]);
                     }
-                    f = frames[fi].parent;
-                }
-                if recursive {
-                    chain.reverse();
-                    chain.push(id.clone());
-                    self.err(it.d, el.span.clone(), format!("recursive subtree: {}", chain.join(" -> ")))
+                    if from > 0 {
+                        cycle.insert(0, "...".into());
+                    }
+                    self.err(it.d, el.span.clone(), format!("recursive subtree: {}", cycle.join(" -> ")))
                         .hint = Some("a tree must not contain itself as a `<SubTree>`, directly or through others".into());
                     failed = true;
                     continue;
                 }
+                if expansions == 0 {
+                    self.err(
+                        it.d,
+                        el.span.clone(),
+                        format!("more than {} SubTree expansions", self.limits.max_nodes),
+                    )
+                    .hint = Some("raise the limit with --max-nodes".into());
+                    return None;
+                }
+                expansions -= 1;
                 // Its ports remap the subtree's blackboard entries: a
                 // reference is resolved in the enclosing expansion now, so
                 // that the subtree's nodes get the value or the outer entry.
@@ -733,7 +871,7 @@ impl Loader<'_> {
                         } else {
                             a.value.clone()
                         };
-                        (a.name.clone(), resolve_port(&frames, it.frame, &v))
+                        (a.name.clone(), chain.resolve(&frames, &v))
                     })
                     .collect();
                 let autoremap = ["_autoremap", "__autoremap", "__shared_blackboard"]
@@ -750,6 +888,7 @@ impl Loader<'_> {
                     d: sd,
                     e: child,
                     parent: it.parent,
+                    depth: it.depth,
                     frame: frames.len() - 1,
                     name_override: el.attr("name").map(str::to_string).or(it.name_override),
                 });
@@ -765,7 +904,7 @@ impl Loader<'_> {
                 return None;
             }
             budget -= 1;
-            let Some(node) = self.node(it.d, &el, |v| resolve_port(&frames, it.frame, v)) else {
+            let Some(node) = self.node(it.d, &el, |v| chain.resolve(&frames, v)) else {
                 failed = true;
                 continue;
             };
@@ -784,6 +923,7 @@ impl Loader<'_> {
                     d: it.d,
                     e: c,
                     parent: Some(idx),
+                    depth: it.depth + 1,
                     frame: it.frame,
                     name_override: None,
                 });
@@ -847,11 +987,13 @@ impl Loader<'_> {
                 d,
                 el.span.clone(),
                 format!(
-                    "`{ty}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`"
+                    "`{}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`",
+                    shown(&ty)
                 ),
             )
             .hint = Some(format!(
-                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{ty}>`)"
+                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{}>`)",
+                shown(&ty)
             ));
             let (k, c, keep) = builtin_kind(real, el, n);
             consumed = c;
@@ -864,12 +1006,18 @@ impl Loader<'_> {
                 AssumeLeaf::Condition => (BtNodeKind::Condition, Category::Condition),
             }
         } else {
-            let cands: Vec<&str> = BUILTINS
-                .iter()
-                .map(|(b, _)| *b)
-                .chain(self.models.keys().map(String::as_str))
-                .collect();
-            let did = suggest(&ty, cands);
+            // Hints only for messages that will be shown (the rest are
+            // counted): bounded work under a million unknown types.
+            let did = if self.hinting() {
+                let cands = BUILTINS
+                    .iter()
+                    .map(|(b, _)| *b)
+                    .chain(self.models.keys().map(String::as_str));
+                suggest(&ty, cands)
+            } else {
+                String::new()
+            };
+            let ty = shown(&ty);
             let remedy = if n == 0 {
                 format!(
                     "declare it as `<Action ID=\"{ty}\"/>` or `<Condition ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition"
@@ -911,7 +1059,8 @@ impl Loader<'_> {
                 d,
                 el.span.clone(),
                 format!(
-                    "`{ty}` is a {} and takes {want}, found {n}",
+                    "`{}` is a {} and takes {want}, found {n}",
+                    shown(&ty),
                     cat.tag().to_lowercase()
                 ),
             )
@@ -995,17 +1144,97 @@ struct Frame {
     autoremap: bool,
 }
 
+/// The entry a port value refers to: `key` of a whole `{key}`.
+fn port_key(value: &str) -> Option<&str> {
+    value
+        .strip_prefix('{')
+        .and_then(|v| v.strip_suffix('}'))
+        .filter(|k| !k.is_empty() && !k.contains(['{', '}']))
+}
+
+/// The expansions enclosing the element being expanded (outermost first),
+/// kept as the expansion walks the tree depth-first, with what makes
+/// lookups O(1): how often each tree ID is on the chain (recursion), the
+/// positions of the expansions that do not share their blackboard by name,
+/// and per blackboard entry the positions of the expansions remapping it.
+/// Each expansion is entered and left once, so the whole expansion is
+/// linear in the remappings (a walk up the chain per port was quadratic on
+/// a long chain of `_autoremap` SubTrees).
+#[derive(Default)]
+struct Chain {
+    frames: Vec<usize>,
+    trees: HashMap<String, usize>,
+    barriers: Vec<usize>,
+    by_key: HashMap<String, Vec<usize>>,
+}
+
+impl Chain {
+    fn push(&mut self, frames: &[Frame], f: usize) {
+        let at = self.frames.len();
+        self.frames.push(f);
+        *self.trees.entry(frames[f].id.clone()).or_default() += 1;
+        if !frames[f].autoremap {
+            self.barriers.push(at);
+        }
+        for k in frames[f].remap.keys() {
+            self.by_key.entry(k.clone()).or_default().push(at);
+        }
+    }
+
+    fn pop(&mut self, frames: &[Frame]) {
+        let Some(f) = self.frames.pop() else { return };
+        let at = self.frames.len();
+        if let Some(c) = self.trees.get_mut(&frames[f].id) {
+            *c -= 1;
+        }
+        if self.barriers.last() == Some(&at) {
+            self.barriers.pop();
+        }
+        for k in frames[f].remap.keys() {
+            if let Some(v) = self.by_key.get_mut(k) {
+                v.pop();
+            }
+        }
+    }
+
+    /// Makes `f` the innermost expansion: leaves those the walk is done
+    /// with, enters `f` if it is new (a child of the innermost one).
+    fn enter(&mut self, frames: &[Frame], f: usize) {
+        while let Some(&top) = self.frames.last() {
+            if top == f || Some(top) == frames[f].parent {
+                break;
+            }
+            self.pop(frames);
+        }
+        if self.frames.last() != Some(&f) {
+            self.push(frames, f);
+        }
+    }
+
+    /// [`resolve_port`] in the innermost expansion, in O(1): the innermost
+    /// expansion remapping the entry, if no expansion in between (the
+    /// outer one included) keeps its blackboard to itself.
+    fn resolve(&self, frames: &[Frame], value: &str) -> String {
+        let Some(key) = port_key(value) else {
+            return value.to_string();
+        };
+        let barrier = self.barriers.last().copied().unwrap_or(0);
+        match self.by_key.get(key).and_then(|v| v.last()) {
+            Some(&at) if at >= barrier => frames[self.frames[at]].remap[key].clone(),
+            _ => value.to_string(),
+        }
+    }
+}
+
 /// The value a port written as `value` inside expansion `frame` has in the
 /// expanded tree: a blackboard reference `{key}` remapped by the enclosing
 /// SubTree elements is replaced by what they map it to (a literal or an outer
 /// `{key}`); anything else is kept as written. BehaviorTree.CPP gives a
 /// subtree its own blackboard, so inlining it means renaming its entries.
+/// (The reference definition; the reader uses [`Chain::resolve`].)
+#[cfg(test)]
 fn resolve_port(frames: &[Frame], frame: usize, value: &str) -> String {
-    let Some(key) = value
-        .strip_prefix('{')
-        .and_then(|v| v.strip_suffix('}'))
-        .filter(|k| !k.is_empty() && !k.contains(['{', '}']))
-    else {
+    let Some(key) = port_key(value) else {
         return value.to_string();
     };
     let mut f = frame;
@@ -1050,6 +1279,19 @@ pub fn arg_value(v: &str) -> ArgValue {
 /// index (keeps identities short on degenerate deep trees).
 const MAX_POSITIONAL_ID: usize = 200;
 
+/// `s` when at most 64 bytes long, else its first 32 bytes (on a character
+/// boundary): the prefix of generated identities.
+fn short_prefix(s: &str) -> &str {
+    if s.len() <= 64 {
+        return s;
+    }
+    let mut end = 32;
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    &s[..end]
+}
+
 /// Node identities of an XML tree (see the module documentation), in pre-order
 /// from `root`. `explicit(i, derived)` may give node `i` an identity of its own
 /// instead of the derived one (the reader passes `btfsm:id`; the writer passes
@@ -1070,6 +1312,9 @@ pub fn derive_ids(
     let mut ids = vec![String::new(); children.len()];
     let mut flags = vec![false; children.len()];
     let mut used: HashSet<String> = HashSet::new();
+    // Per clashing candidate, the next suffix to try: a thousand nodes
+    // clashing on one candidate cost a thousand probes, not a million.
+    let mut next_suffix: HashMap<String, usize> = HashMap::new();
     // (node, parent, position among its siblings)
     let mut stack: Vec<(usize, Option<usize>, usize)> = vec![(root, None, 0)];
     let mut order = 0usize;
@@ -1077,17 +1322,27 @@ pub fn derive_ids(
         let mut cand = match (&names[i], parent) {
             (Some(n), _) if count.get(n.as_str()) == Some(&1) => n.clone(),
             (_, None) => tree_id.to_string(),
-            (_, Some(p)) => format!("{}/{pos}", ids[p]),
+            // Built only when short enough (the length checked first).
+            (_, Some(p))
+                if ids[p].len() + 2 + pos.checked_ilog10().unwrap_or(0) as usize
+                    <= MAX_POSITIONAL_ID =>
+            {
+                format!("{}/{pos}", ids[p])
+            }
+            (_, Some(_)) => String::new(),
         };
-        if cand.len() > MAX_POSITIONAL_ID {
-            cand = format!("{tree_id}#{order}");
+        if cand.is_empty() || cand.len() > MAX_POSITIONAL_ID {
+            // Short whatever the tree's ID: a long ID is not repeated in
+            // every identity.
+            cand = format!("{}#{order}", short_prefix(tree_id));
         }
         if used.contains(&cand) {
-            let mut k = 2;
+            let k = next_suffix.entry(cand.clone()).or_insert(2);
             while used.contains(&format!("{cand}~{k}")) {
-                k += 1;
+                *k += 1;
             }
             cand = format!("{cand}~{k}");
+            *k += 1;
         }
         let id = match explicit(i, &cand) {
             Some(x) => {
@@ -1347,6 +1602,146 @@ mod tests {
         assert_eq!(msgs, vec!["unknown node type `Mystery` (0 children)"]);
     }
 
+    fn limited(text: &str, f: impl FnOnce(&mut Limits)) -> Result<Loaded, Vec<Diagnostic>> {
+        let mut lim = Limits::default();
+        f(&mut lim);
+        parse_str("t.xml", text, Path::new("."), &lim)
+    }
+
+    #[test]
+    fn elements_of_unused_trees_count_against_max_nodes() {
+        let text = format!(
+            "<root main_tree_to_execute=\"M\">\n<BehaviorTree ID=\"M\"><AlwaysSuccess/></BehaviorTree>\n<BehaviorTree ID=\"Unused\"><Sequence>\n{}</Sequence></BehaviorTree>\n</root>",
+            "<AlwaysSuccess/>\n".repeat(50)
+        );
+        assert!(limited(&text, |l| l.max_nodes = 60).is_ok());
+        let e = limited(&text, |l| l.max_nodes = 20).unwrap_err();
+        assert!(
+            e[0].message.starts_with("more than 20 elements"),
+            "{}",
+            e[0].message
+        );
+        // The 21st element: root, 2 trees, a leaf, a Sequence, then leaf 16.
+        let (_, line, col) = e[0].location().unwrap();
+        assert_eq!((line, col), (19, 1), "{}", e[0]);
+    }
+
+    #[test]
+    fn depth_and_long_names_are_errors_at_the_element() {
+        let deep = format!(
+            "<root>\n<BehaviorTree ID=\"T\">\n{}<AlwaysSuccess/>\n{}</BehaviorTree></root>",
+            "<Inverter>\n".repeat(8),
+            "</Inverter>".repeat(8)
+        );
+        assert!(limited(&deep, |l| l.max_depth = 8).is_ok());
+        let e = limited(&deep, |l| l.max_depth = 5).unwrap_err();
+        assert!(
+            e[0].message
+                .contains("is 6 levels below the root, deeper than the limit of 5 levels"),
+            "{}",
+            e[0].message
+        );
+        assert_eq!(e[0].location().unwrap().1, 9);
+        // Port names and values, types and names: --max-name-bytes.
+        let long = "v".repeat(5000);
+        for (text, what) in [
+            (
+                format!("<Action ID=\"Go\" goal=\"{long}\"/>"),
+                "value of `goal`",
+            ),
+            (
+                format!("<Action ID=\"Go\" {long}=\"1\"/>"),
+                "attribute name",
+            ),
+            (format!("<{long}/>"), "element name"),
+            (
+                format!("<Sequence name=\"{long}\"><Go/></Sequence>"),
+                "value of `name`",
+            ),
+        ] {
+            let doc = format!(
+                "<root>\n<BehaviorTree ID=\"T\">\n<Sequence>\n{text}</Sequence></BehaviorTree>\n<TreeNodesModel><Action ID=\"Go\"/></TreeNodesModel></root>"
+            );
+            let e = parse(&doc).unwrap_err();
+            assert!(
+                e[0].message.starts_with(what)
+                    && e[0]
+                        .message
+                        .contains("is 5000 bytes long, more than the limit of 4096 bytes"),
+                "{}",
+                e[0].message
+            );
+            assert!(e[0].message.len() < 300, "{}", e[0].message);
+            assert!(e[0].location().unwrap().1 >= 3, "{}", e[0]);
+        }
+    }
+
+    #[test]
+    fn messages_quote_long_names_truncated() {
+        let ty = "Q".repeat(3000);
+        let e = parse(&format!(
+            "<root main_tree_to_execute=\"{ty}x\"><BehaviorTree ID=\"T\"><{ty}/></BehaviorTree></root>"
+        ))
+        .unwrap_err();
+        assert!(!e.is_empty());
+        for d in &e {
+            let all = format!("{}{}", d.message, d.hint.as_deref().unwrap_or(""));
+            assert!(all.len() < 1000, "{} bytes: {}", all.len(), &all[..200]);
+            assert!(all.contains("…(300"), "{}", &all[..200.min(all.len())]);
+        }
+    }
+
+    #[test]
+    fn a_long_subtree_chain_and_its_recursion_stay_bounded() {
+        // T0 -> T1 -> ... -> T2999 -> T0: the message shows the cycle cut.
+        let n = 3000;
+        let mut text = String::from("<root main_tree_to_execute=\"T0\">");
+        for i in 0..n {
+            let next = (i + 1) % n;
+            text.push_str(&format!(
+                "<BehaviorTree ID=\"T{i}\"><Sequence><AlwaysSuccess/><SubTree ID=\"T{next}\"/></Sequence></BehaviorTree>"
+            ));
+        }
+        text.push_str("</root>");
+        let e = limited(&text, |l| l.max_depth = 10 * n).unwrap_err();
+        assert!(
+            e[0].message
+                .starts_with("recursive subtree: T0 -> T1 -> T2"),
+            "{}",
+            e[0].message
+        );
+        assert!(
+            e[0].message
+                .ends_with("trees) ... -> T2995 -> T2996 -> T2997 -> T2998 -> T2999 -> T0"),
+            "{}",
+            e[0].message
+        );
+        assert!(e[0].message.len() < 300, "{}", e[0].message);
+        // Without the cycle, the chain expands.
+        let ok = text.replace("<SubTree ID=\"T0\"/>", "<AlwaysFailure/>");
+        let l = limited(&ok, |l| l.max_depth = 10 * n).unwrap();
+        assert_eq!(bt(&l).nodes.len(), 2 * n + 1);
+    }
+
+    #[test]
+    fn generated_identities_stay_short_under_a_long_tree_id() {
+        let tree_id = "T".repeat(1000);
+        let children = vec![(1..=100).collect::<Vec<usize>>()]
+            .into_iter()
+            .chain((0..100).map(|_| vec![]))
+            .collect::<Vec<_>>();
+        let names = vec![None; 101];
+        let (ids, _) = derive_ids(&children, 0, &tree_id, &names, |_, _| None);
+        assert!(ids.iter().all(|i| i.len() < 64), "{}", ids[1]);
+        let distinct: HashSet<&String> = ids.iter().collect();
+        assert_eq!(distinct.len(), 101);
+        // Many clashes on one candidate get distinct suffixes.
+        let names: Vec<Option<String>> = (0..101).map(|i| Some(format!("T~{}", i + 1))).collect();
+        let (ids, _) = derive_ids(&children, 0, "T", &names, |_, _| None);
+        let distinct: HashSet<&String> = ids.iter().collect();
+        assert_eq!(distinct.len(), 101);
+    }
+
     #[test]
     fn port_resolution_through_nested_expansions() {
         let frame = |parent, remap: &[(&str, &str)], autoremap| Frame {
@@ -1375,5 +1770,21 @@ mod tests {
         for v in ["{}", "{a}{b}", "x{goal}", "{goal", "goal}", "literal"] {
             assert_eq!(resolve_port(&frames, 1, v), v);
         }
+        // The chain the reader keeps gives the same answers in O(1).
+        let mut chain = Chain::default();
+        for f in 0..3 {
+            chain.enter(&frames, f);
+            for v in ["{goal}", "{x}", "{other}", "{target}", "{}", "x"] {
+                assert_eq!(
+                    chain.resolve(&frames, v),
+                    resolve_port(&frames, f, v),
+                    "{f} {v}"
+                );
+            }
+        }
+        // Back in Outer after Inner: Inner's remapping is gone.
+        chain.enter(&frames, 1);
+        assert_eq!(chain.frames, [0, 1]);
+        assert_eq!(chain.resolve(&frames, "{x}"), "{x}");
     }
 }

@@ -13,7 +13,7 @@
 use super::btcpp_xml::{self, BUILTINS, Category};
 use super::xml::{BTFSM_NS, escape_attr, escape_comment};
 use crate::model::{Bt, BtNode, BtNodeKind, Policy, PolicyBody};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
 
 /// Why a policy cannot be written as BehaviorTree.CPP XML.
@@ -111,7 +111,7 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
     while let Some((i, depth, close)) = stack.pop() {
         let n = &bt.nodes[i];
         let (ty, cat) = &types[i];
-        let pad = "  ".repeat(depth);
+        let pad = super::scxml_write::indent(depth);
         let (open, end) = if is_xml_name(ty) {
             (ty.clone(), ty.clone())
         } else {
@@ -167,12 +167,12 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
     }
     out.push_str("  </BehaviorTree>\n");
     // Types that are not built in, with the ports they are given.
-    let mut model: BTreeMap<String, (Category, Vec<String>)> = BTreeMap::new();
+    let mut model: BTreeMap<String, (Category, BTreeSet<String>)> = BTreeMap::new();
     for (n, (ty, cat)) in bt.nodes.iter().zip(&types) {
         if BUILTINS.iter().any(|(b, _)| b == ty) {
             continue;
         }
-        let e = model.entry(ty.clone()).or_insert((*cat, Vec::new()));
+        let e = model.entry(ty.clone()).or_insert((*cat, BTreeSet::new()));
         let keys = n
             .skill
             .iter()
@@ -180,14 +180,13 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
             .chain(n.ports.keys());
         for k in keys {
             if !e.1.contains(k) {
-                e.1.push(k.clone());
+                e.1.insert(k.clone());
             }
         }
     }
     if !model.is_empty() {
         out.push_str("  <TreeNodesModel>\n");
-        for (ty, (cat, mut ports)) in model {
-            ports.sort();
+        for (ty, (cat, ports)) in model {
             let tag = cat.tag();
             if ports.is_empty() {
                 let _ = writeln!(out, "    <{tag} ID=\"{}\"/>", escape_attr(&ty));
@@ -220,6 +219,44 @@ mod tests {
             .unwrap()
             .policy;
         insta::assert_snapshot!(write_policy(&p).unwrap());
+    }
+
+    /// Indentation stops growing with depth: the text of a deep tree is
+    /// linear in its depth, and reads back.
+    #[test]
+    fn deep_tree_text_is_linear_in_depth() {
+        let lim = Limits {
+            max_depth: 5000,
+            ..Default::default()
+        };
+        let mut sizes = vec![];
+        for n in [500, 2000] {
+            let input = format!(
+                "<root><BehaviorTree ID=\"T\">{}<AlwaysSuccess/>{}</BehaviorTree></root>",
+                "<Inverter>".repeat(n),
+                "</Inverter>".repeat(n)
+            );
+            let p = parse_str("t.xml", &input, Path::new("."), &lim)
+                .unwrap()
+                .policy;
+            let out = write_policy(&p).unwrap();
+            assert!(
+                out.len() < 10 * input.len(),
+                "{n}: {} bytes from {}",
+                out.len(),
+                input.len()
+            );
+            sizes.push(out.len());
+            let back = parse_str("b.xml", &out, Path::new("."), &lim)
+                .unwrap()
+                .policy;
+            let (PolicyBody::Bt(a), PolicyBody::Bt(b)) = (&p.body, &back.body) else {
+                panic!()
+            };
+            let ids = |t: &Bt| t.nodes.iter().map(|n| n.id.clone()).collect::<Vec<_>>();
+            assert_eq!(ids(a), ids(b));
+        }
+        assert!(sizes[1] < 5 * sizes[0], "{sizes:?}");
     }
 
     #[test]

@@ -26,14 +26,14 @@
 //! The document is walked with explicit stacks (no recursion on nesting depth).
 
 use super::btcpp_xml::arg_value;
-use super::xml::{self, BTFSM_NS, XDoc, XElem};
+use super::xml::{self, BTFSM_NS, XDoc, XElem, shown};
 use super::{Limits, Loaded};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
-use crate::model::skill::{Guard, GuardTerm, SkillCall};
+use crate::model::skill::{self, Guard, GuardTerm, SkillCall, SkillKind};
 use crate::model::{
     Policy, PolicyBody, Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -68,10 +68,37 @@ enum Kind {
 }
 
 fn load(file: Arc<SourceFile>, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
-    let doc = xml::parse(&file).map_err(|d| vec![d])?;
-    let mut diags: Vec<Diagnostic> = Vec::new();
+    // Every element counts (states, transitions, executable content), as in
+    // BehaviorTree.CPP files: memory is bounded before the states are read.
+    let doc = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    let mut diags = xml::Sink::default();
     let policy = read(&doc, limits, &mut diags);
-    super::finish(&file, policy, diags, "state machine")
+    super::finish(&file, policy, diags.into_vec(&file), "state machine")
+}
+
+/// The first attribute of `e` (name or value) longer than
+/// `--max-name-bytes`, as an error at the element: ids, names, labels, skill
+/// arguments, events, conditions, targets.
+fn long_attr(e: &XElem, f: &Arc<SourceFile>, limits: &Limits) -> Option<Diagnostic> {
+    let max = limits.max_name_bytes;
+    let (what, text) = std::iter::once(("element name".to_string(), e.name.as_str()))
+        .chain(e.attrs.iter().flat_map(|a| {
+            [
+                ("attribute name".to_string(), a.name.as_str()),
+                (format!("value of `{}`", shown(&a.name)), a.value.as_str()),
+            ]
+        }))
+        .find(|(_, t)| t.len() > max)?;
+    Some(
+        Diagnostic::error(format!(
+            "{what} `{}` of `<{}>` is {} bytes long, more than the limit of {max} bytes",
+            shown(text),
+            shown(&e.name),
+            text.len()
+        ))
+        .at(f, e.span.clone())
+        .hint("shorten it, or raise the limit with --max-name-bytes"),
+    )
 }
 
 /// Is the element SCXML's (in its namespace, or in none)?
@@ -79,9 +106,9 @@ fn is_scxml(e: &XElem) -> bool {
     e.ns.is_none() || e.ns.as_deref() == Some(SCXML_NS)
 }
 
-fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Policy> {
+fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
     let f = &doc.file;
-    let err = |diags: &mut Vec<Diagnostic>, e: &XElem, msg: String, hint: &str| {
+    let err = |diags: &mut xml::Sink, e: &XElem, msg: String, hint: &str| {
         diags.push(Diagnostic::error(msg).at(f, e.span.clone()).hint(hint));
     };
     let root = &doc.elems[doc.root];
@@ -91,7 +118,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             root,
             format!(
                 "expected `<scxml>` as the document element, found `<{}>`",
-                root.name
+                shown(&root.name)
             ),
             "an SCXML file is `<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" initial=\"...\">`",
         );
@@ -100,6 +127,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
     // Pass 1: state-like elements in document order, with their parent state.
     // (element, kind, parent entry index)
     let mut found: Vec<(usize, Kind, Option<usize>)> = Vec::new();
+    if let Some(d) = long_attr(root, f, limits) {
+        diags.push(d);
+        return None;
+    }
+    // Containers around each entry of `found` (checked against --max-depth
+    // as the document is read).
+    let mut depth_of: Vec<usize> = Vec::new();
     // Ids inside unsupported `<parallel>` elements: transitions to them are
     // not reported again.
     let mut skipped: std::collections::HashSet<String> = std::collections::HashSet::new();
@@ -139,6 +173,24 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             }
             _ => continue, // transitions, initial, executable content: read later
         };
+        if let Some(d) = long_attr(el, f, limits) {
+            diags.push(d);
+            return None;
+        }
+        let depth = parent.map_or(0, |p| depth_of[p] + 1);
+        if depth > limits.max_depth && !matches!(kind, Kind::Final) {
+            err(
+                diags,
+                el,
+                format!(
+                    "state `{}` is nested {depth} containers deep, deeper than the limit of {} levels",
+                    shown(el.attr("id").unwrap_or(&el.name)),
+                    limits.max_depth
+                ),
+                "raise the limit with --max-depth",
+            );
+            return None;
+        }
         if found.len() >= limits.max_nodes {
             err(
                 diags,
@@ -150,34 +202,38 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         }
         let idx = found.len();
         found.push((e, kind, parent));
+        depth_of.push(depth);
         if matches!(found[idx].1, Kind::State) {
             for &c in el.children.iter().rev() {
                 stack.push((c, Some(idx)));
             }
         }
     }
-    // Ids: unique in the document.
-    let mut by_id: HashMap<String, usize> = HashMap::new();
+    // Ids: unique in the document (borrowed from the document where written).
     let mut generated = 0usize;
-    let mut ids: Vec<String> = Vec::with_capacity(found.len());
-    for (k, (e, _, _)) in found.iter().enumerate() {
-        let el = &doc.elems[*e];
-        let id = match el.attr("id") {
-            Some(id) => id.to_string(),
-            None => {
-                generated += 1;
-                format!("_{}{generated}", el.name)
+    let ids: Vec<std::borrow::Cow<'_, str>> = found
+        .iter()
+        .map(|(e, _, _)| {
+            let el = &doc.elems[*e];
+            match el.attr("id") {
+                Some(id) => std::borrow::Cow::Borrowed(id),
+                None => {
+                    generated += 1;
+                    std::borrow::Cow::Owned(format!("_{}{generated}", el.name))
+                }
             }
-        };
-        if by_id.insert(id.clone(), k).is_some() {
+        })
+        .collect();
+    let mut by_id: HashMap<&str, usize> = HashMap::with_capacity(ids.len());
+    for (k, id) in ids.iter().enumerate() {
+        if by_id.insert(id, k).is_some() {
             err(
                 diags,
-                el,
-                format!("duplicate id `{id}`"),
+                &doc.elems[found[k].0],
+                format!("duplicate id `{}`", shown(id)),
                 "every state id in an SCXML document is unique",
             );
         }
-        ids.push(id);
     }
     // Model states (not finals), in document order.
     let mut m = StateMachine {
@@ -232,6 +288,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 }
             })),
         };
+        // A skill binding is checked as the TOML reader checks it (so that
+        // the machine converts to TOML that reads back).
+        if let StateBody::Task(Some(call)) = &body
+            && let Some((msg, hint)) = call_problem(call, None)
+        {
+            diags.push(Diagnostic::error(msg).at(f, el.span.clone()).hint(hint));
+        }
         m.states.push(State {
             label: el.btfsm_attr("label").unwrap_or(&name).to_string(),
             name,
@@ -262,6 +325,13 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         .states
         .iter()
         .any(|s| matches!(s.body, StateBody::Container(_)));
+    // The entry of `found` (and id) of each model state.
+    let mut entry_of: Vec<usize> = vec![0; m.states.len()];
+    for (k, s) in state_of.iter().enumerate() {
+        if let Some(s) = s {
+            entry_of[*s] = k;
+        }
+    }
     // Initial states: (container, target id, position of the target).
     let region_owner = |k: Option<usize>| k.and_then(|p| state_of[p]);
     let mut initial_of: Vec<(Option<usize>, String, std::ops::Range<usize>)> = Vec::new();
@@ -287,10 +357,12 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 .children(*e)
                 .find(|(_, c)| is_scxml(c) && c.name == "initial")
             {
-                match doc
-                    .children_of_name(ini, "transition")
-                    .and_then(|t| t.attr_full("target"))
-                {
+                let it = doc.children_of_name(ini, "transition");
+                if let Some(d) = it.and_then(|t| long_attr(t, f, limits)) {
+                    diags.push(d);
+                    return None;
+                }
+                match it.and_then(|t| t.attr_full("target")) {
                     Some(a) => initial_of.push((Some(si), a.value.clone(), a.span.clone())),
                     None => err(
                         diags,
@@ -306,7 +378,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         let tid = target.trim();
         if tid.split_whitespace().count() > 1 {
             diags.push(
-                Diagnostic::error(format!("initial `{tid}` names several states"))
+                Diagnostic::error(format!("initial `{}` names several states", shown(tid)))
                     .at(f, span)
                     .hint("only one initial state per region is supported (several are for `<parallel>`)"),
             );
@@ -326,17 +398,23 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 }
             },
             None => {
-                let region: Vec<&str> = m
-                    .states
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, st)| st.parent == container && st.pseudo.is_none())
-                    .map(|(i, _)| ids_of_state(&ids, &state_of, i))
-                    .collect();
-                let h = suggest(tid, region.iter().copied());
+                // Hints only for messages that will be shown: bounded work
+                // under a million bad `initial`s.
+                let h = if diags.room_for_errors() {
+                    let region = m
+                        .states
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, st)| st.parent == container && st.pseudo.is_none())
+                        .map(|(i, _)| &*ids[entry_of[i]]);
+                    suggest(tid, region)
+                } else {
+                    String::new()
+                };
                 diags.push(
                     Diagnostic::error(format!(
-                        "initial `{tid}` is not a state directly inside its region"
+                        "initial `{}` is not a state directly inside its region",
+                        shown(tid)
                     ))
                     .at(f, span)
                     .hint(if h.is_empty() {
@@ -397,7 +475,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     diags.push(
                         Diagnostic::error(format!(
                             "state `{}` holds only final states",
-                            m.states[c].name
+                            shown(&m.states[c].name)
                         ))
                         .at(f, span)
                         .hint("a compound state needs a state to start in; make it a plain state"),
@@ -412,20 +490,31 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         if matches!(kind, Kind::Final) {
             continue;
         }
-        let mut used_outcomes: Vec<String> = Vec::new();
+        let mut used_outcomes: HashSet<&str> = HashSet::new();
         let mut guards: Vec<Transition> = Vec::new();
         let mut outs: Vec<Transition> = Vec::new();
+        // Outcomes the source can return, once per state (a container may
+        // have many finals, and many transitions).
+        let valid: HashSet<&str> = match &m.states[si].body {
+            StateBody::Container(r) => r.outcomes.iter().map(String::as_str).collect(),
+            StateBody::Decision => HashSet::from(["RUNNING"]),
+            StateBody::Task(_) => TASK_OUTCOMES.iter().copied().collect(),
+        };
+        let src = shown(&ids[k]);
         for (_, t) in doc
             .children(*e)
             .filter(|(_, c)| is_scxml(c) && c.name == "transition")
         {
+            if let Some(d) = long_attr(t, f, limits) {
+                diags.push(d);
+                return None;
+            }
             let event = t.attr("event").map(str::trim).filter(|s| !s.is_empty());
             let cond = t.attr("cond").map(str::trim).filter(|s| !s.is_empty());
             let Some(ta) = t.attr_full("target") else {
                 diags.push(
                     Diagnostic::warning(format!(
-                        "transition of `{}` has no target; it changes no state and is not counted",
-                        ids[k]
+                        "transition of `{src}` has no target; it changes no state and is not counted"
                     ))
                     .at(f, t.span.clone())
                     .hint("give it a `target` to make it an arc of the machine's graph"),
@@ -436,8 +525,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             if targets.len() != 1 {
                 diags.push(
                     Diagnostic::error(format!(
-                        "transition of `{}` has {} targets",
-                        ids[k],
+                        "transition of `{src}` has {} targets",
                         targets.len()
                     ))
                     .at(f, ta.span.clone())
@@ -450,11 +538,15 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                 if skipped.contains(tid) {
                     continue;
                 }
-                let h = suggest(tid, ids.iter().map(String::as_str));
+                let h = if diags.room_for_errors() {
+                    suggest(tid, ids.iter().map(|i| &**i))
+                } else {
+                    String::new()
+                };
                 diags.push(
                     Diagnostic::error(format!(
-                        "unknown state `{tid}` in transition of `{}`",
-                        ids[k]
+                        "unknown state `{}` in transition of `{src}`",
+                        shown(tid)
                     ))
                     .at(f, ta.span.clone())
                     .hint(h),
@@ -471,8 +563,8 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     } else {
                         diags.push(
                             Diagnostic::error(format!(
-                                "transition from `{}` to final state `{tid}` of another region",
-                                ids[k]
+                                "transition from `{src}` to final state `{}` of another region",
+                                shown(tid)
                             ))
                             .at(f, ta.span.clone())
                             .hint("only a final state of the source's own region (its parent's outcome) is supported"),
@@ -481,19 +573,14 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     }
                 }
             };
-            let valid: Vec<String> = match &m.states[si].body {
-                StateBody::Container(r) => r.outcomes.clone(),
-                StateBody::Decision => vec!["RUNNING".to_string()],
-                StateBody::Task(_) => TASK_OUTCOMES.iter().map(|s| s.to_string()).collect(),
-            };
             let span = Some(t.span.clone());
             match (event, cond) {
                 (Some(ev), None)
                     if t.btfsm_attr("guard") != Some("true")
-                        && valid.iter().any(|v| v == ev)
-                        && !used_outcomes.iter().any(|u| u == ev) =>
+                        && valid.contains(ev)
+                        && !used_outcomes.contains(ev) =>
                 {
-                    used_outcomes.push(ev.to_string());
+                    used_outcomes.insert(ev);
                     outs.push(Transition {
                         trigger: Trigger::Outcome(ev.to_string()),
                         target,
@@ -507,10 +594,23 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
                     let all = match t.btfsm_attr("terms") {
                         None => vec![],
                         Some(text) => match parse_terms(text) {
-                            Some(all) => all,
+                            Some(all) => {
+                                let bad = all.iter().find_map(|term| {
+                                    call_problem(&term.condition, Some(SkillKind::Condition))
+                                });
+                                if let Some((msg, hint)) = bad {
+                                    diags.push(
+                                        Diagnostic::error(format!("`btfsm:terms`: {msg}"))
+                                            .at(f, t.span.clone())
+                                            .hint(hint),
+                                    );
+                                    continue;
+                                }
+                                all
+                            }
                             None => {
                                 diags.push(
-                                    Diagnostic::error(format!("unreadable `btfsm:terms` \"{text}\""))
+                                    Diagnostic::error(format!("unreadable `btfsm:terms` \"{}\"", shown(text)))
                                         .at(f, t.span.clone())
                                         .hint("write conditions as `Skill(arg=value, ...)`, `not ` to negate, separated by `; `"),
                                 );
@@ -529,7 +629,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         guards.extend(outs);
         m.states[si].transitions = guards;
     }
-    if diags.iter().any(Diagnostic::is_error) {
+    if diags.has_errors() {
         return None;
     }
     for (i, seen) in m.reachable().into_iter().enumerate() {
@@ -537,7 +637,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
             diags.push(
                 Diagnostic::warning(format!(
                     "state `{}` is unreachable from the initial state",
-                    m.path(i)
+                    shown(&ids[entry_of[i]])
                 ))
                 .at(f, m.states[i].span.clone().unwrap_or(0..0))
                 .hint("add a transition to it, or remove it"),
@@ -553,6 +653,64 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut Vec<Diagnostic>) -> Option<Poli
         description: None,
         body: PolicyBody::Machine(m),
     })
+}
+
+/// What is wrong with a skill call written in `btfsm:` attributes, as the
+/// TOML reader would say it (`skill` and `args` of a state, `if` of a
+/// guard): an unknown skill, one of the other kind, a missing or unknown
+/// argument. `(message, hint)`.
+fn call_problem(call: &SkillCall, want: Option<SkillKind>) -> Option<(String, String)> {
+    let name = shown(&call.skill);
+    let Some(kind) = skill::skill_kind(&call.skill) else {
+        let cands: Vec<&str> = match want {
+            Some(k) => skill::skill_names(k),
+            None => skill::SKILLS.iter().map(|s| s.0).collect(),
+        };
+        return Some((
+            format!("unknown skill `{name}`"),
+            suggest(&call.skill, cands),
+        ));
+    };
+    if let Some(w) = want
+        && w != kind
+    {
+        return Some((
+            format!("`{name}` is not a condition skill"),
+            format!("condition skills are {}", skill::skill_names(w).join(", ")),
+        ));
+    }
+    let params = skill::skill_params(&call.skill).unwrap_or(&[]);
+    let all = || {
+        params
+            .iter()
+            .map(|(p, _)| *p)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some((p, _)) = params
+        .iter()
+        .find(|(p, required)| *required && !call.args.contains_key(*p))
+    {
+        return Some((
+            format!("skill `{name}` needs argument `{p}`"),
+            format!("its arguments are {}", all()),
+        ));
+    }
+    if let Some(k) = call
+        .args
+        .keys()
+        .find(|k| !params.iter().any(|(p, _)| p == k))
+    {
+        return Some((
+            format!("skill `{name}` has no argument `{}`", shown(k)),
+            if params.is_empty() {
+                format!("`{name}` takes no arguments")
+            } else {
+                format!("its arguments are {}", all())
+            },
+        ));
+    }
+    None
 }
 
 /// The label of a guard read from SCXML: `event`, `event [cond]` or `[cond]`.
@@ -600,20 +758,13 @@ pub fn parse_terms(text: &str) -> Option<Vec<GuardTerm>> {
 fn m_final_name(
     doc: &XDoc,
     found: &[(usize, Kind, Option<usize>)],
-    ids: &[String],
+    ids: &[std::borrow::Cow<'_, str>],
     k: usize,
 ) -> String {
     doc.elems[found[k].0]
         .btfsm_attr("name")
         .unwrap_or(&ids[k])
         .to_string()
-}
-
-fn ids_of_state<'a>(ids: &'a [String], state_of: &[Option<usize>], s: usize) -> &'a str {
-    state_of
-        .iter()
-        .position(|x| *x == Some(s))
-        .map_or("", |k| ids[k].as_str())
 }
 
 fn file_stem(path: &str) -> String {
@@ -775,6 +926,129 @@ mod tests {
         assert_eq!(l.warnings.len(), 1);
         assert!(l.warnings[0].message.contains("`z` is unreachable"));
         assert_eq!(l.warnings[0].location().unwrap().1, 3);
+    }
+
+    const HEAD: &str = "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" xmlns:btfsm=\"urn:btfsm\" version=\"1.0\">\n";
+
+    #[test]
+    fn long_events_conditions_and_names_are_errors_at_the_element() {
+        let long = "e".repeat(5000);
+        for (text, what) in [
+            (
+                format!("<state id=\"a\">\n<transition event=\"{long}\" target=\"a\"/></state>"),
+                "value of `event`",
+            ),
+            (
+                format!("<state id=\"a\">\n<transition cond=\"{long}\" target=\"a\"/></state>"),
+                "value of `cond`",
+            ),
+            (
+                format!("<state id=\"a\">\n<transition event=\"go\" target=\"{long}\"/></state>"),
+                "value of `target`",
+            ),
+            (
+                format!("<state id=\"a\">\n<state id=\"b\" btfsm:label=\"{long}\"/></state>"),
+                "value of `label`",
+            ),
+        ] {
+            let e = parse_str(
+                "t.scxml",
+                &format!("{HEAD}{text}\n</scxml>"),
+                &Limits::default(),
+            )
+            .unwrap_err();
+            assert!(
+                e[0].message.starts_with(what)
+                    && e[0]
+                        .message
+                        .contains("is 5000 bytes long, more than the limit of 4096 bytes"),
+                "{}",
+                e[0].message
+            );
+            assert!(e[0].message.len() < 300, "{}", e[0].message);
+            assert_eq!(e[0].location().unwrap().1, 3, "{}", e[0]);
+        }
+    }
+
+    #[test]
+    fn depth_is_an_error_at_the_state() {
+        let text = format!(
+            "{HEAD}{}{}\n</scxml>",
+            (0..8)
+                .map(|i| format!("<state id=\"s{i}\">\n"))
+                .collect::<String>(),
+            "</state>".repeat(8)
+        );
+        let lim = |d| Limits {
+            max_depth: d,
+            ..Default::default()
+        };
+        assert!(parse_str("t.scxml", &text, &lim(7)).is_ok());
+        let e = parse_str("t.scxml", &text, &lim(5)).unwrap_err();
+        assert!(
+            e[0].message
+                == "state `s6` is nested 6 containers deep, deeper than the limit of 5 levels",
+            "{}",
+            e[0].message
+        );
+        assert_eq!(e[0].location().unwrap().1, 8);
+    }
+
+    /// A deep machine where no state is reachable: each warning names the
+    /// state by its id, not by the path of ids above it (which made the
+    /// messages quadratic in depth).
+    #[test]
+    fn unreachable_states_of_a_deep_machine_are_named_by_id() {
+        let n = 50;
+        let id = |i: usize| format!("{i:0>100}");
+        let text = format!(
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" initial=\"z\"><state id=\"z\"/>{}{}</scxml>",
+            (0..n)
+                .map(|i| format!("<state id=\"{}\">", id(i)))
+                .collect::<String>(),
+            "</state>".repeat(n)
+        );
+        let l = parse_str("t.scxml", &text, &Limits::default()).unwrap();
+        assert_eq!(l.warnings.len(), n);
+        assert!(
+            l.warnings.iter().all(|w| w.message.len() < 250),
+            "{}",
+            l.warnings[n - 1].message
+        );
+    }
+
+    /// Skill bindings are checked as in TOML (found by fuzzing: an unknown
+    /// skill was read, and its TOML conversion did not read back).
+    #[test]
+    fn skill_bindings_are_checked_as_in_toml() {
+        for (attrs, want) in [
+            (r#"btfsm:skill="Tu%k-Arm""#, "unknown skill `Tu%k-Arm`"),
+            (
+                r#"btfsm:skill="Pick""#,
+                "skill `Pick` needs argument `object`",
+            ),
+            (
+                r#"btfsm:skill="Dock" btfsm:arg.x="1""#,
+                "skill `Dock` has no argument `x`",
+            ),
+        ] {
+            let text = format!("{HEAD}<state id=\"a\" {attrs}/>\n</scxml>");
+            let e = parse_str("t.scxml", &text, &Limits::default()).unwrap_err();
+            assert_eq!(e[0].message, want);
+            assert_eq!(e[0].location().unwrap().1, 2);
+        }
+        let text = format!(
+            "{HEAD}<state id=\"a\"><transition event=\"go\" target=\"a\" btfsm:terms=\"Dock()\"/></state>\n</scxml>"
+        );
+        let e = parse_str("t.scxml", &text, &Limits::default()).unwrap_err();
+        assert_eq!(
+            e[0].message,
+            "`btfsm:terms`: `Dock` is not a condition skill"
+        );
+        let ok = format!(
+            "{HEAD}<state id=\"a\" btfsm:skill=\"Pick\" btfsm:arg.object=\"cube1\"><transition event=\"go\" target=\"a\" btfsm:terms=\"not Found()\"/></state>\n</scxml>"
+        );
+        assert!(parse_str("t.scxml", &ok, &Limits::default()).is_ok());
     }
 
     #[test]

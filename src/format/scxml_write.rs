@@ -7,9 +7,13 @@
 //!
 //! SCXML ids are unique XML names in a document while model names are unique per
 //! region and may hold spaces: a state's id is its name (or, when another state
-//! or final has the same name, its path), with characters outside XML names
-//! replaced by `_`; where the id differs from the name, the name is kept in
-//! `btfsm:name`. Skill bindings, display labels, decision states, a guard's
+//! or final has the same name, its path while that is at most
+//! [`MAX_PATH_ID_BYTES`] long, else a generated `s<index>` / `f<index>_<k>`),
+//! with characters outside XML names replaced by `_`; where the id differs
+//! from the name, the name is kept in `btfsm:name`. So every name is written
+//! once and every reference is short or the name itself: the output is
+//! linear in the machine whatever its depth (indentation stops growing after
+//! [`MAX_INDENT`] levels). Skill bindings, display labels, decision states, a guard's
 //! library conditions (`btfsm:terms`) and a label the event/cond split would not
 //! give back go in btfsm's namespace.
 
@@ -36,6 +40,18 @@ pub fn write_policy(p: &Policy) -> Result<String, NotAMachine> {
         });
     };
     Ok(write_machine(&p.name, p.description.as_deref(), m))
+}
+
+/// Longest path of names used as an id (longer: a generated id).
+pub const MAX_PATH_ID_BYTES: usize = 64;
+
+/// Nesting levels indented; deeper elements get no more indentation, so
+/// that a deep machine's text is not quadratic in its depth.
+pub const MAX_INDENT: usize = 32;
+
+/// Indentation of an element `depth` levels deep.
+pub(crate) fn indent(depth: usize) -> String {
+    "  ".repeat(depth.min(MAX_INDENT))
 }
 
 /// An SCXML id (an XML NCName: no spaces, no `/`) made from a name.
@@ -78,6 +94,15 @@ pub fn split_label(label: &str) -> (Option<&str>, Option<&str>) {
     }
 }
 
+/// Where each outcome of a region is (the first of a name).
+fn outcome_index(outcomes: &[String]) -> HashMap<&str, usize> {
+    let mut at: HashMap<&str, usize> = HashMap::with_capacity(outcomes.len());
+    for (k, o) in outcomes.iter().enumerate() {
+        at.entry(o.as_str()).or_insert(k);
+    }
+    at
+}
+
 fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> String {
     // Names of every state and every final; ids must be unique.
     let mut count: HashMap<&str, usize> = HashMap::new();
@@ -93,17 +118,30 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
         *count.entry(o.as_str()).or_default() += 1;
     }
     let mut used: HashSet<String> = HashSet::new();
+    // Per clashing candidate, the next suffix to try (no rescans from 2).
+    let mut next_suffix: HashMap<String, usize> = HashMap::new();
     let mut unique = |cand: String| {
         let cand = xml_id(&cand);
         let mut id = cand.clone();
-        let mut k = 2;
-        while used.contains(&id) {
-            id = format!("{cand}~{k}");
-            k += 1;
+        if used.contains(&id) {
+            let k = next_suffix.entry(cand.clone()).or_insert(2);
+            loop {
+                id = format!("{cand}~{k}");
+                *k += 1;
+                if !used.contains(&id) {
+                    break;
+                }
+            }
         }
         used.insert(id.clone());
         id
     };
+    // Length of each state's path, without building it.
+    let mut path_len: Vec<usize> = vec![0; m.states.len()];
+    for c in m.parents_first() {
+        let own = m.states[c].name.len();
+        path_len[c] = m.states[c].parent.map_or(own, |p| path_len[p] + 1 + own);
+    }
     // Top-level finals keep their names (they are vertices, keyed by name).
     let top_final: Vec<String> = m.top.outcomes.iter().map(|o| unique(o.clone())).collect();
     let state_id: Vec<String> = (0..m.states.len())
@@ -111,8 +149,10 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             let n = &m.states[i].name;
             unique(if count[n.as_str()] == 1 {
                 n.clone()
-            } else {
+            } else if path_len[i] <= MAX_PATH_ID_BYTES {
                 m.path(i)
+            } else {
+                format!("s{i}")
             })
         })
         .collect();
@@ -121,34 +161,39 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             StateBody::Container(r) => r
                 .outcomes
                 .iter()
-                .map(|o| {
+                .enumerate()
+                .map(|(k, o)| {
                     unique(if count[o.as_str()] == 1 {
                         o.clone()
-                    } else {
+                    } else if path_len[i] + 1 + o.len() <= MAX_PATH_ID_BYTES {
                         format!("{}/{o}", m.path(i))
+                    } else {
+                        format!("f{i}_{k}")
                     })
                 })
                 .collect(),
             _ => vec![],
         })
         .collect();
+    let top_at = outcome_index(&m.top.outcomes);
+    let region_at: Vec<Option<HashMap<&str, usize>>> = m
+        .states
+        .iter()
+        .map(|s| match &s.body {
+            StateBody::Container(r) => Some(outcome_index(&r.outcomes)),
+            _ => None,
+        })
+        .collect();
     let mut out = String::new();
     // The final id of outcome `o` in the region a state is in.
     let outcome_id = |src: usize, o: &str| -> String {
         match m.states[src].parent {
-            None => m
-                .top
-                .outcomes
-                .iter()
-                .position(|x| x == o)
-                .map_or(o.to_string(), |k| top_final[k].clone()),
-            Some(p) => match &m.states[p].body {
-                StateBody::Container(r) => r
-                    .outcomes
-                    .iter()
-                    .position(|x| x == o)
-                    .map_or(o.to_string(), |k| final_id[p][k].clone()),
-                _ => o.to_string(),
+            None => top_at
+                .get(o)
+                .map_or(o.to_string(), |&k| top_final[k].clone()),
+            Some(p) => match &region_at[p] {
+                Some(at) => at.get(o).map_or(o.to_string(), |&k| final_id[p][k].clone()),
+                None => o.to_string(),
             },
         }
     };
@@ -157,7 +202,7 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
         m.top.states.iter().rev().map(|&s| (s, 1, false)).collect();
     while let Some((i, depth, close)) = stack.pop() {
         let s = &m.states[i];
-        let pad = "  ".repeat(depth);
+        let pad = indent(depth);
         let tag = if s.pseudo.is_some() {
             "history"
         } else {
@@ -165,9 +210,8 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
         };
         if close {
             if let StateBody::Container(r) = &s.body {
-                for fid in &final_id[i] {
+                for (k, fid) in final_id[i].iter().enumerate() {
                     let _ = write!(out, "{pad}  <final id=\"{}\"", escape_attr(fid));
-                    let k = final_id[i].iter().position(|x| x == fid).unwrap_or(0);
                     if *fid != r.outcomes[k] {
                         let _ = write!(out, " btfsm:name=\"{}\"", escape_attr(&r.outcomes[k]));
                     }
@@ -292,6 +336,52 @@ mod tests {
             .unwrap()
             .policy;
         insta::assert_snapshot!(write_policy(&p).unwrap());
+    }
+
+    /// A machine `n` containers deep whose every state is named `s`.
+    fn deep_same_names(n: usize) -> String {
+        format!(
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" xmlns:btfsm=\"urn:btfsm\" initial=\"s0\">{}<state id=\"leaf\" btfsm:name=\"s\"/>{}</scxml>",
+            (0..n)
+                .map(|i| format!("<state id=\"s{i}\" btfsm:name=\"s\">"))
+                .collect::<String>(),
+            "</state>".repeat(n)
+        )
+    }
+
+    /// Ids of repeated names deep in the hierarchy are generated, not paths,
+    /// and indentation stops growing: the text is linear in the depth; it
+    /// reads back to the same machine.
+    #[test]
+    fn deep_machine_text_is_linear_in_depth() {
+        let lim = crate::format::Limits {
+            max_depth: 5000,
+            ..Default::default()
+        };
+        let mut sizes = vec![];
+        for n in [500, 2000] {
+            let input = deep_same_names(n);
+            let p = crate::format::scxml::parse_str("t.scxml", &input, &lim)
+                .unwrap()
+                .policy;
+            let out = write_policy(&p).unwrap();
+            assert!(
+                out.len() < 8 * input.len(),
+                "{n}: {} bytes from {}",
+                out.len(),
+                input.len()
+            );
+            sizes.push(out.len());
+            let back = crate::format::scxml::parse_str("b.scxml", &out, &lim)
+                .unwrap()
+                .policy;
+            let (PolicyBody::Machine(a), PolicyBody::Machine(b)) = (&p.body, &back.body) else {
+                panic!()
+            };
+            assert_eq!(a.keys(), b.keys());
+            assert_eq!(a.states.len(), b.states.len());
+        }
+        assert!(sizes[1] < 5 * sizes[0], "{sizes:?}");
     }
 
     #[test]

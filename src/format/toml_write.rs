@@ -1,5 +1,12 @@
 //! Writes a policy back as TOML in the format `format::toml` reads (used by
 //! `btfsm convert`). Reading the output gives back the same policy.
+//!
+//! An HFSM is written with `[states.a.states.b...]` headers and a state of
+//! another region is named by its path, so the text grows with depth times
+//! names; the TOML reader reads at most [`MAX_TOML_STATE_DEPTH`] nested
+//! containers. [`write_policy_within`] refuses what could not be read back
+//! (deeper machines, text beyond a byte budget) before writing it, so the
+//! output stays within a constant factor of the input.
 
 use crate::model::{
     ArgValue, Bt, BtNodeKind, Guard, Policy, PolicyBody, Pseudo, SkillCall, StateBody,
@@ -8,8 +15,55 @@ use crate::model::{
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
-/// TOML text of a policy.
+/// Most containers around a state that the TOML reader reads back (the
+/// `toml` crate's nesting limit, 80 levels, over `[states.a.states.b...]`
+/// headers): checked by `tests::deepest_readable_hfsm_reads_back`.
+pub const MAX_TOML_STATE_DEPTH: usize = 39;
+
+/// Why a policy is not written as TOML.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum Unwritable {
+    #[error(
+        "`{name}` nests a state {depth} containers deep; the TOML format reads back at most {MAX_TOML_STATE_DEPTH}"
+    )]
+    TooDeep { name: String, depth: usize },
+    #[error(
+        "the TOML text of `{name}` would be longer than {max} bytes (--max-file-bytes), too big to read back"
+    )]
+    TooBig { name: String, max: u64 },
+}
+
+/// TOML text of a policy, or why it would not read back: an HFSM nested
+/// deeper than [`MAX_TOML_STATE_DEPTH`], or text longer than `max_bytes`
+/// (stopped as soon as it is: memory stays within the budget).
+pub fn write_policy_within(p: &Policy, max_bytes: u64) -> Result<String, Unwritable> {
+    let name = super::xml::shown(&p.name).into_owned();
+    if let PolicyBody::Machine(m) = &p.body {
+        let mut depth = vec![0usize; m.states.len()];
+        for s in m.parents_first() {
+            depth[s] = m.states[s].parent.map_or(0, |q| depth[q] + 1);
+            if depth[s] > MAX_TOML_STATE_DEPTH {
+                return Err(Unwritable::TooDeep {
+                    name,
+                    depth: depth[s],
+                });
+            }
+        }
+    }
+    let max = usize::try_from(max_bytes).unwrap_or(usize::MAX);
+    write_bounded(p, max).ok_or(Unwritable::TooBig {
+        name,
+        max: max_bytes,
+    })
+}
+
+/// TOML text of a policy (however long).
 pub fn write_policy(p: &Policy) -> String {
+    write_bounded(p, usize::MAX).expect("no budget")
+}
+
+/// TOML text of a policy, or `None` once it is longer than `max` bytes.
+fn write_bounded(p: &Policy, max: usize) -> Option<String> {
     let mut out = String::new();
     let kind = p.kind();
     let _ = writeln!(out, "kind = {}", quote(kind.as_str()));
@@ -18,10 +72,10 @@ pub fn write_policy(p: &Policy) -> String {
         let _ = writeln!(out, "description = {}", quote(d));
     }
     match &p.body {
-        PolicyBody::Bt(bt) => write_bt(&mut out, bt),
-        PolicyBody::Machine(m) => write_machine(&mut out, m),
+        PolicyBody::Bt(bt) => write_bt(&mut out, bt, max)?,
+        PolicyBody::Machine(m) => write_machine(&mut out, m, max)?,
     }
-    out
+    (out.len() <= max).then_some(out)
 }
 
 /// A TOML basic string.
@@ -83,7 +137,7 @@ fn skill_fields(call: &SkillCall) -> String {
     s
 }
 
-fn write_bt(out: &mut String, bt: &Bt) {
+fn write_bt(out: &mut String, bt: &Bt, max: usize) -> Option<()> {
     let _ = writeln!(out, "root = {}", quote(&bt.nodes[bt.root].id));
     let _ = writeln!(out, "\n[nodes]");
     for i in bt.preorder() {
@@ -131,7 +185,11 @@ fn write_bt(out: &mut String, bt: &Bt) {
             fields.push(format!("ports = {{ {} }}", ports.join(", ")));
         }
         let _ = writeln!(out, "{} = {{ {} }}", key(&n.id), fields.join(", "));
+        if out.len() > max {
+            return None;
+        }
     }
+    Some(())
 }
 
 fn guard_inline(g: &Guard, to: &str) -> String {
@@ -163,7 +221,7 @@ fn guard_inline(g: &Guard, to: &str) -> String {
     )
 }
 
-fn write_machine(out: &mut String, m: &StateMachine) {
+fn write_machine(out: &mut String, m: &StateMachine, max: usize) -> Option<()> {
     let outcomes = |o: &[String]| o.iter().map(|s| quote(s)).collect::<Vec<_>>().join(", ");
     let _ = writeln!(out, "initial = {}", quote(&m.states[m.top.initial].name));
     let _ = writeln!(out, "outcomes = [{}]", outcomes(&m.top.outcomes));
@@ -214,27 +272,96 @@ fn write_machine(out: &mut String, m: &StateMachine) {
             Target::State(j) => m.states[*j].name.clone(),
             Target::Outcome(o) => o.clone(),
         };
-        let guards: Vec<String> = s
-            .transitions
-            .iter()
-            .filter_map(|t| match &t.trigger {
-                Trigger::Guard(g) => Some(guard_inline(g, &target(&t.target))),
-                Trigger::Outcome(_) => None,
-            })
-            .collect();
+        // The text of one state is bounded too (a state may have many
+        // transitions to a deep state named by its path).
+        let mut pending = out.len();
+        let mut within = |t: String| {
+            pending += t.len() + 4;
+            (pending <= max).then_some(t)
+        };
+        let mut guards: Vec<String> = Vec::new();
+        for t in &s.transitions {
+            if let Trigger::Guard(g) = &t.trigger {
+                guards.push(within(guard_inline(g, &target(&t.target)))?);
+            }
+        }
         if !guards.is_empty() {
             let _ = writeln!(out, "guards = [\n  {},\n]", guards.join(",\n  "));
         }
-        let on: Vec<String> = s
-            .transitions
-            .iter()
-            .filter_map(|t| match &t.trigger {
-                Trigger::Outcome(o) => Some(format!("{} = {}", key(o), quote(&target(&t.target)))),
-                Trigger::Guard(_) => None,
-            })
-            .collect();
+        let mut on: Vec<String> = Vec::new();
+        for t in &s.transitions {
+            if let Trigger::Outcome(o) = &t.trigger {
+                on.push(within(format!(
+                    "{} = {}",
+                    key(o),
+                    quote(&target(&t.target))
+                ))?);
+            }
+        }
         if !on.is_empty() {
             let _ = writeln!(out, "on = {{ {} }}", on.join(", "));
         }
+        if out.len() > max {
+            return None;
+        }
+    }
+    Some(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::Limits;
+    use std::path::Path;
+
+    fn deep_bt(levels: usize) -> Policy {
+        let mut s = String::from("kind = \"bt\"\nname = \"d\"\nroot = \"n0\"\n[nodes]\n");
+        for i in 0..levels {
+            s.push_str(&format!("n{i} = {{ sequence = [\"n{}\"] }}\n", i + 1));
+        }
+        s.push_str(&format!(
+            "n{levels} = {{ action = \"Dock!\", skill = \"Dock\" }}\n"
+        ));
+        crate::format::toml::parse_str("d.toml", &s, Path::new("."), &Limits::default())
+            .unwrap()
+            .policy
+    }
+
+    /// The BT -> HFSM construction of a BT `levels` deep nests its leaf
+    /// `levels` containers deep: up to MAX_TOML_STATE_DEPTH it is written
+    /// and reads back; deeper, it is refused (its text would not read back,
+    /// and grows with depth times names).
+    #[test]
+    fn deepest_readable_hfsm_reads_back() {
+        let to_hfsm = |n| crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&deep_bt(n)).unwrap();
+        let ok = to_hfsm(MAX_TOML_STATE_DEPTH);
+        let text = write_policy_within(&ok, 1 << 20).unwrap();
+        crate::format::toml::parse_str("h.toml", &text, Path::new("."), &Limits::default())
+            .unwrap_or_else(|e| panic!("{}", e[0]));
+        let deep = to_hfsm(MAX_TOML_STATE_DEPTH + 1);
+        assert_eq!(
+            write_policy_within(&deep, 1 << 20),
+            Err(Unwritable::TooDeep {
+                name: "d (HFSM)".into(),
+                depth: MAX_TOML_STATE_DEPTH + 1
+            })
+        );
+        // ... and the unchecked writer's text indeed does not read back.
+        let text = write_policy(&deep);
+        assert!(
+            crate::format::toml::parse_str("h.toml", &text, Path::new("."), &Limits::default())
+                .is_err()
+        );
+    }
+
+    #[test]
+    fn text_beyond_the_budget_is_refused() {
+        let p = deep_bt(30);
+        let full = write_policy(&p);
+        assert_eq!(write_policy_within(&p, full.len() as u64).unwrap(), full);
+        assert!(matches!(
+            write_policy_within(&p, full.len() as u64 - 1),
+            Err(Unwritable::TooBig { .. })
+        ));
     }
 }

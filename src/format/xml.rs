@@ -18,8 +18,9 @@ pub const BTFSM_NS: &str = "urn:btfsm";
 pub struct XAttr {
     /// Local name (without prefix).
     pub name: String,
-    /// Namespace URI, `None` for unprefixed attributes.
-    pub ns: Option<String>,
+    /// Namespace URI, `None` for unprefixed attributes (shared: one
+    /// allocation per namespace, not per attribute).
+    pub ns: Option<Arc<str>>,
     pub value: String,
     /// Byte range of the whole `name="value"`.
     pub span: Range<usize>,
@@ -31,7 +32,8 @@ pub struct XAttr {
 pub struct XElem {
     /// Local name (without prefix).
     pub name: String,
-    pub ns: Option<String>,
+    /// Namespace URI (shared, as [`XAttr::ns`]).
+    pub ns: Option<Arc<str>>,
     pub attrs: Vec<XAttr>,
     pub children: Vec<usize>,
     /// Byte range of the element's name in its start tag (`<Name`).
@@ -80,13 +82,176 @@ impl XDoc {
     }
 }
 
-/// Parses a source file into an element arena.
-pub fn parse(file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
+/// At most this many bytes of a name are quoted in a message.
+pub const SHOWN_NAME_BYTES: usize = 64;
+
+/// A name as quoted in a message: whole when short, else its first
+/// [`SHOWN_NAME_BYTES`] bytes (on a character boundary) and how long it is,
+/// so that a 10 MB name gives a message of a hundred bytes.
+pub fn shown(s: &str) -> std::borrow::Cow<'_, str> {
+    if s.len() <= SHOWN_NAME_BYTES {
+        return std::borrow::Cow::Borrowed(s);
+    }
+    let mut end = SHOWN_NAME_BYTES;
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    std::borrow::Cow::Owned(format!("{}…({} bytes)", &s[..end], s.len()))
+}
+
+/// Byte offset of the start tag of the `(n + 1)`-th element (`<name`, in
+/// document order; comments, CDATA, processing instructions and end tags
+/// skipped), or `None` when the text has at most `n` start tags. One linear
+/// pass before parsing, so that a file of millions of elements is refused
+/// with a position before any of them is built.
+pub fn nth_start_tag(text: &str, n: usize) -> Option<usize> {
+    let b = text.as_bytes();
+    let mut count = 0usize;
+    let mut i = 0usize;
+    while let Some(k) = memchr_lt(&b[i..]) {
+        let at = i + k;
+        let rest = &b[at + 1..];
+        let skip_to = |end: &str| text[at..].find(end).map_or(b.len(), |e| at + e + end.len());
+        if rest.starts_with(b"!--") {
+            i = skip_to("-->");
+        } else if rest.starts_with(b"![CDATA[") {
+            i = skip_to("]]>");
+        } else if rest.starts_with(b"?") {
+            i = skip_to("?>");
+        } else if rest.starts_with(b"/") || rest.starts_with(b"!") {
+            i = at + 1;
+        } else {
+            if count == n {
+                return Some(at);
+            }
+            count += 1;
+            i = at + 1;
+        }
+    }
+    None
+}
+
+fn memchr_lt(b: &[u8]) -> Option<usize> {
+    b.iter().position(|&c| c == b'<')
+}
+
+/// The messages of one reading, at most [`MAX_DIAGNOSTICS`] errors and as
+/// many warnings kept, the rest only counted (one message says how many), so
+/// that a file of a million bad elements holds a bounded number of messages
+/// in memory while it is read, not only when it is reported.
+///
+/// [`MAX_DIAGNOSTICS`]: super::toml::MAX_DIAGNOSTICS
+#[derive(Debug, Default)]
+pub struct Sink {
+    kept: Vec<Diagnostic>,
+    errors: usize,
+    warnings: usize,
+    dropped_errors: usize,
+    dropped_warnings: usize,
+    /// Where a dropped message is built (and its hint set) before it is
+    /// forgotten.
+    scratch: Option<Diagnostic>,
+}
+
+impl Sink {
+    /// Keeps `d` if there is room for its kind; returns it (or a scratch
+    /// copy) so that the caller may add a hint.
+    pub fn push(&mut self, d: Diagnostic) -> &mut Diagnostic {
+        let cap = super::toml::MAX_DIAGNOSTICS;
+        let (kept, dropped) = if d.is_error() {
+            (&mut self.errors, &mut self.dropped_errors)
+        } else {
+            (&mut self.warnings, &mut self.dropped_warnings)
+        };
+        if *kept >= cap {
+            *dropped += 1;
+            return self.scratch.insert(d);
+        }
+        *kept += 1;
+        self.kept.push(d);
+        self.kept.last_mut().expect("just pushed")
+    }
+
+    pub fn extend(&mut self, ds: impl IntoIterator<Item = Diagnostic>) {
+        for d in ds {
+            self.push(d);
+        }
+    }
+
+    /// Messages kept.
+    pub fn len(&self) -> usize {
+        self.kept.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.kept.is_empty()
+    }
+
+    pub fn has_errors(&self) -> bool {
+        self.errors > 0
+    }
+
+    /// Is there still room for an error (worth a did-you-mean search)?
+    pub fn room_for_errors(&self) -> bool {
+        self.errors < super::toml::MAX_DIAGNOSTICS
+    }
+
+    /// The messages kept, then one per kind saying how many were not kept
+    /// (at the end of `file`).
+    pub fn into_vec(self, file: &Arc<SourceFile>) -> Vec<Diagnostic> {
+        let mut all = self.kept;
+        let end = file.text.len()..file.text.len();
+        let cap = super::toml::MAX_DIAGNOSTICS;
+        if self.dropped_errors > 0 {
+            all.push(
+                Diagnostic::error(format!(
+                    "{} more errors not shown (the first {cap} messages are)",
+                    self.dropped_errors
+                ))
+                .at(file, end.clone()),
+            );
+        }
+        if self.dropped_warnings > 0 {
+            all.push(
+                Diagnostic::warning(format!("{} more warnings not shown", self.dropped_warnings))
+                    .at(file, end),
+            );
+        }
+        all
+    }
+}
+
+/// Parses a source file into an element arena of at most `left` elements:
+/// more is an error at the first element beyond, saying that the files read
+/// hold more than `limit` elements (`--max-nodes`; `left` is what remains of
+/// it after the files read before).
+pub fn parse(file: &Arc<SourceFile>, left: usize, limit: usize) -> Result<XDoc, Diagnostic> {
+    let max_elems = left;
+    if let Some(at) = nth_start_tag(&file.text, max_elems) {
+        let end = at + 1 + qname_len(&file.text[at..]);
+        return Err(Diagnostic::error(format!(
+            "more than {limit} elements (every element of every file read counts, in used and unused trees alike)"
+        ))
+        .at(file, at..end)
+        .hint("raise the limit with --max-nodes"));
+    }
+    // Elements are bounded above; text, comments and processing
+    // instructions between them are nodes too (a backstop on memory).
+    let nodes_limit =
+        u32::try_from(max_elems.saturating_mul(4).saturating_add(1024)).unwrap_or(u32::MAX);
     let opts = roxmltree::ParsingOptions {
         allow_dtd: false,
+        nodes_limit,
         ..Default::default()
     };
     let doc = roxmltree::Document::parse_with_options(&file.text, opts).map_err(|e| {
+        if matches!(e, roxmltree::Error::NodesLimitReached) {
+            return Diagnostic::error(format!(
+                "more than {nodes_limit} XML nodes (elements, text, comments) in this file"
+            ))
+            .at(file, 0..1)
+            .hint("raise the limit with --max-nodes");
+        }
         let pos = e.pos();
         let off = offset_of(&file.text, pos.row as usize, pos.col as usize);
         let msg = e.to_string();
@@ -100,20 +265,33 @@ pub fn parse(file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
             .hint("the file must be well-formed XML (every attribute `name=\"value\"`, separated by spaces; tags closed in order)")
     })?;
     let mut elems: Vec<XElem> = Vec::new();
-    let mut index: HashMap<roxmltree::NodeId, usize> = HashMap::new();
+    // Arena index of each roxmltree node (by its id; usize::MAX: no element).
+    let mut index: Vec<usize> = vec![usize::MAX; doc.descendants().len()];
+    let mut namespaces: HashMap<String, Arc<str>> = HashMap::new();
+    let mut intern = |ns: Option<&str>| -> Option<Arc<str>> {
+        let u = ns?;
+        if let Some(a) = namespaces.get(u) {
+            return Some(a.clone());
+        }
+        let a: Arc<str> = Arc::from(u);
+        namespaces.insert(u.to_string(), a.clone());
+        Some(a)
+    };
     for n in doc.descendants().filter(|n| n.is_element()) {
         let i = elems.len();
-        index.insert(n.id(), i);
+        if let Some(slot) = index.get_mut(n.id().get_usize()) {
+            *slot = i;
+        }
         let start = n.range().start;
         let tag = n.tag_name();
         elems.push(XElem {
             name: tag.name().to_string(),
-            ns: tag.namespace().map(str::to_string),
+            ns: intern(tag.namespace()),
             attrs: n
                 .attributes()
                 .map(|a| XAttr {
                     name: a.name().to_string(),
-                    ns: a.namespace().map(str::to_string),
+                    ns: intern(a.namespace()),
                     value: a.value().to_string(),
                     span: a.range(),
                 })
@@ -122,7 +300,8 @@ pub fn parse(file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
             span: start..(start + 1 + qname_len(&file.text[start..])),
         });
         if let Some(p) = n.parent_element()
-            && let Some(&pi) = index.get(&p.id())
+            && let Some(&pi) = index.get(p.id().get_usize())
+            && pi != usize::MAX
         {
             elems[pi].children.push(i);
         }
@@ -213,7 +392,7 @@ mod tests {
     #[test]
     fn attribute_without_separating_space_is_positioned() {
         let f = SourceFile::new("t.xml", "<root>\n  <Action ID=\"A\"name=\"x\"/>\n</root>\n");
-        let d = parse(&f).unwrap_err();
+        let d = parse(&f, 100, 100).unwrap_err();
         let (_, line, col) = d.location().unwrap();
         assert_eq!(line, 2);
         assert!(col > 10, "column {col}");
@@ -223,13 +402,66 @@ mod tests {
     #[test]
     fn elements_in_document_order_with_children() {
         let f = SourceFile::new("t.xml", "<a x=\"1\"><b/><c><d/></c></a>");
-        let d = parse(&f).unwrap();
+        let d = parse(&f, 100, 100).unwrap();
         let names: Vec<&str> = d.elems.iter().map(|e| e.name.as_str()).collect();
         assert_eq!(names, ["a", "b", "c", "d"]);
         assert_eq!(d.elems[0].children, vec![1, 2]);
         assert_eq!(d.elems[2].children, vec![3]);
         assert_eq!(d.elems[0].attr("x"), Some("1"));
         assert_eq!(&f.text[d.elems[2].span.clone()], "<c");
+    }
+
+    #[test]
+    fn elements_beyond_the_limit_are_refused_at_the_first_one_beyond() {
+        let text = "<a>\n<!-- <x/> --><![CDATA[<y/>]]><?pi <z/>?>\n  <b/><c/>\n  <d/>\n</a>";
+        let f = SourceFile::new("t.xml", text);
+        assert!(parse(&f, 4, 4).is_ok());
+        let d = parse(&f, 3, 10).unwrap_err();
+        assert_eq!(d.location().unwrap().1, 4, "{d}");
+        assert_eq!(&f.text[d.span.clone().unwrap()], "<d");
+        assert!(
+            d.message.starts_with("more than 10 elements"),
+            "{}",
+            d.message
+        );
+        assert_eq!(nth_start_tag(text, 0), Some(0));
+        assert_eq!(nth_start_tag(text, 4), None);
+    }
+
+    #[test]
+    fn the_sink_keeps_a_bounded_number_of_messages() {
+        let f = SourceFile::new("t.xml", "<a/>");
+        let cap = crate::format::toml::MAX_DIAGNOSTICS;
+        let mut sink = Sink::default();
+        for i in 0..100_000 {
+            sink.push(Diagnostic::error(format!("e{i}")).at(&f, 0..1))
+                .hint = Some("h".into());
+            sink.push(Diagnostic::warning(format!("w{i}")));
+        }
+        assert_eq!(sink.len(), 2 * cap);
+        assert!(sink.has_errors() && !sink.room_for_errors());
+        let all = sink.into_vec(&f);
+        assert_eq!(all.len(), 2 * cap + 2);
+        assert_eq!(
+            all[2 * cap].message,
+            format!(
+                "{} more errors not shown (the first {cap} messages are)",
+                100_000 - cap
+            )
+        );
+        assert_eq!(
+            all[2 * cap + 1].message,
+            format!("{} more warnings not shown", 100_000 - cap)
+        );
+    }
+
+    #[test]
+    fn long_names_are_shown_truncated() {
+        assert_eq!(shown("short"), "short");
+        let long = "é".repeat(1000);
+        let s = shown(&long);
+        assert!(s.len() < 100, "{s}");
+        assert!(s.ends_with("…(2000 bytes)"), "{s}");
     }
 
     #[test]

@@ -100,6 +100,9 @@ pub enum Target {
     Outcome(String),
 }
 
+/// Longest key made of a path of names (see [`StateMachine::keys`]).
+pub const MAX_PATH_KEY_BYTES: usize = 256;
+
 impl StateMachine {
     /// The region a state is in.
     pub fn region_of(&self, s: StateIdx) -> &Region {
@@ -120,7 +123,10 @@ impl StateMachine {
     /// subtree in a new container changes only what was really edited.
     /// Keys are unique: should the rule ever give two states one key (a name
     /// containing `/`), those states fall back to their full paths, numbered
-    /// by state index if even those clash.
+    /// by state index if even those clash. A key that would be longer than
+    /// [`MAX_PATH_KEY_BYTES`] (a repeated name deep in the hierarchy) is the
+    /// name and the state's index instead (`name#i`), so that keys take
+    /// memory linear in the machine, whatever its depth.
     pub fn keys(&self) -> Vec<String> {
         use std::collections::HashMap;
         let n = self.states.len();
@@ -132,11 +138,21 @@ impl StateMachine {
             *uses.entry(o.as_str()).or_default() += 1;
         }
         let mut key: Vec<Option<String>> = vec![None; n];
+        // Length of each state's path (without building it).
+        let mut path_len: Vec<usize> = vec![0; n];
         for c in self.parents_first() {
             let name = &self.states[c].name;
+            path_len[c] = self.states[c]
+                .parent
+                .map_or(name.len(), |p| path_len[p] + 1 + name.len());
             key[c] = Some(match self.states[c].parent {
                 Some(p) if uses[name.as_str()] > 1 => {
-                    format!("{}/{name}", key[p].as_deref().unwrap_or_default())
+                    let pk = key[p].as_deref().unwrap_or_default();
+                    if pk.len() + 1 + name.len() > MAX_PATH_KEY_BYTES {
+                        format!("{name}#{c}")
+                    } else {
+                        format!("{pk}/{name}")
+                    }
                 }
                 _ => name.clone(),
             });
@@ -148,7 +164,11 @@ impl StateMachine {
         }
         let clash: Vec<StateIdx> = (0..n).filter(|&i| seen[key[i].as_str()] > 1).collect();
         for &i in &clash {
-            key[i] = self.path(i);
+            key[i] = if path_len[i] > MAX_PATH_KEY_BYTES {
+                format!("{}#{i}", self.states[i].name)
+            } else {
+                self.path(i)
+            };
         }
         // A path can still equal a literal name with `/` in it: number those.
         let mut seen: HashMap<String, usize> = HashMap::with_capacity(n);
@@ -273,6 +293,42 @@ mod tests {
         );
         assert_eq!(m.path(6), "B/C/Move");
         assert_eq!(m.parents_first(), [0, 3, 1, 2, 4, 5, 6]);
+    }
+
+    /// A repeated name 5000 containers deep: keys stay short (linear
+    /// memory), unique, and the shallow ones are the paths as before.
+    #[test]
+    fn deep_repeated_names_give_short_unique_keys() {
+        let n = 5000;
+        let states: Vec<State> = (0..n)
+            .map(|i| {
+                let body = if i + 1 < n {
+                    region(i + 1, vec![i + 1])
+                } else {
+                    StateBody::Task(None)
+                };
+                state("s", i.checked_sub(1), body)
+            })
+            .collect();
+        let m = StateMachine {
+            hierarchical: true,
+            top: Region {
+                initial: 0,
+                outcomes: vec!["SUCCESS".into()],
+                states: vec![0],
+            },
+            states,
+        };
+        let k = m.keys();
+        assert_eq!(&k[..3], ["s", "s/s", "s/s/s"]);
+        let total: usize = k.iter().map(String::len).sum();
+        assert!(
+            total < n * (MAX_PATH_KEY_BYTES + 8),
+            "{total} bytes of keys"
+        );
+        assert!(k.iter().all(|x| x.len() <= MAX_PATH_KEY_BYTES));
+        let distinct: std::collections::HashSet<&String> = k.iter().collect();
+        assert_eq!(distinct.len(), n);
     }
 
     #[test]

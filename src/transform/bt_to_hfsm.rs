@@ -110,18 +110,19 @@ pub fn bt_to_hfsm(bt: &Bt) -> Result<StateMachine, Vec<Unsupported>> {
             span: None,
         })
         .collect();
+    // Each node's next sibling, in one pass (not a scan of the siblings per
+    // node: a node with 200,000 children stays linear).
+    let mut next_sibling: Vec<Option<usize>> = vec![None; bt.nodes.len()];
+    for n in &bt.nodes {
+        for w in n.children.windows(2) {
+            next_sibling[w[0]] = Some(w[1]);
+        }
+    }
     for i in 0..bt.nodes.len() {
         let node = &bt.nodes[i];
         let (parent_kind, next) = match parents[i] {
             None => (None, None),
-            Some(p) => {
-                let sib = &bt.nodes[p].children;
-                let pos = sib
-                    .iter()
-                    .position(|&c| c == i)
-                    .expect("child of its parent");
-                (Some(bt.nodes[p].kind), sib.get(pos + 1).copied())
-            }
+            Some(p) => (Some(bt.nodes[p].kind), next_sibling[i]),
         };
         let up = |o: &str| Target::Outcome(o.to_string());
         let next_or = |o: &str| next.map_or_else(|| up(o), Target::State);
@@ -156,4 +157,43 @@ pub fn bt_to_hfsm(bt: &Bt) -> Result<StateMachine, Vec<Unsupported>> {
         },
         states,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::BtNode;
+
+    fn node(id: String, kind: BtNodeKind, children: Vec<usize>) -> BtNode {
+        BtNode {
+            id,
+            label: String::new(),
+            kind,
+            children,
+            skill: None,
+            type_name: None,
+            ports: Default::default(),
+            span: None,
+        }
+    }
+
+    /// A Sequence of 100,000 actions: each goes on SUCCESS to the next
+    /// sibling (found in one pass, not by a scan of the siblings per child).
+    #[test]
+    fn wide_sequence_chains_its_children() {
+        let n = 100_000;
+        let mut nodes = vec![node("root".into(), BtNodeKind::Sequence, (1..=n).collect())];
+        nodes.extend((1..=n).map(|i| node(format!("a{i}"), BtNodeKind::Action, vec![])));
+        let m = bt_to_hfsm(&Bt { nodes, root: 0 }).unwrap();
+        for i in 1..=n {
+            let t = &m.states[i].transitions;
+            let want = if i < n {
+                Target::State(i + 1)
+            } else {
+                Target::Outcome(S.into())
+            };
+            assert_eq!(t[0].target, want, "child {i}");
+            assert_eq!(t[1].target, Target::Outcome(F.into()));
+        }
+    }
 }

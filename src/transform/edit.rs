@@ -325,10 +325,33 @@ pub fn check_call(call: &SkillCall, kind: SkillKind) -> Result<(), EditError> {
     Ok(())
 }
 
+/// Is `s` the path of state `i` (`m.path(i) == s`, without building the
+/// path: at most `s.len()` bytes compared, so trying every state of a deep
+/// machine stays linear in the machine times the length of `s`)?
+fn path_is(m: &StateMachine, i: usize, s: &str) -> bool {
+    let mut rest = s;
+    let mut cur = Some(i);
+    while let Some(c) = cur {
+        let name = m.states[c].name.as_str();
+        let Some(before) = rest.strip_suffix(name) else {
+            return false;
+        };
+        cur = m.states[c].parent;
+        match cur {
+            None => return before.is_empty(),
+            Some(_) => match before.strip_suffix('/') {
+                Some(b) => rest = b,
+                None => return false,
+            },
+        }
+    }
+    false
+}
+
 /// A state by path (`Container/State`) or by a name unique in the machine.
 fn find_state(m: &StateMachine, s: &str) -> Result<usize, EditError> {
     let n = m.states.len();
-    if let Some(i) = (0..n).find(|&i| m.path(i) == s) {
+    if let Some(i) = (0..n).find(|&i| path_is(m, i, s)) {
         return Ok(i);
     }
     let named: Vec<usize> = (0..n).filter(|&i| m.states[i].name == s).collect();
@@ -690,6 +713,30 @@ mod tests {
     use crate::transform::paper_policy as paper;
 
     use crate::transform::named_ged as named;
+
+    /// `path_is` agrees with `path` on every state and a few near misses,
+    /// names with `/` included.
+    #[test]
+    fn paths_are_matched_without_building_them() {
+        let p = crate::format::load(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper/fig06-hfsm.toml"),
+            &Limits::default(),
+        )
+        .unwrap()
+        .policy;
+        let PolicyBody::Machine(m) = &p.body else {
+            panic!()
+        };
+        for i in 0..m.states.len() {
+            let path = m.path(i);
+            for j in 0..m.states.len() {
+                assert_eq!(path_is(m, j, &path), i == j, "{path} vs {}", m.path(j));
+            }
+            assert!(!path_is(m, i, &format!("/{path}")));
+            assert!(!path_is(m, i, &format!("x{path}")));
+            assert!(!path_is(m, i, &path[1..]));
+        }
+    }
 
     fn bt(p: &mut Policy) -> &mut Bt {
         match &mut p.body {

@@ -864,3 +864,461 @@ fn hostile_baseline_numbers_out_of_range_are_refused() {
         assert_eq!(code, want, "{limit}: {stderr}");
     }
 }
+
+/// Runs the built `btfsm` in the crate root with its address space capped at
+/// `mib` MiB (`ulimit -v` of sh): (exit code, stdout, stderr, seconds).
+fn btfsm_capped(mib: u64, args: &[&str]) -> (i32, String, String, f64) {
+    let start = std::time::Instant::now();
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {} && exec \"$0\" \"$@\"", mib * 1024))
+        .arg(env!("CARGO_BIN_EXE_btfsm"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run btfsm");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+        start.elapsed().as_secs_f64(),
+    )
+}
+
+/// The first `n` bytes of `s` (for assertion messages).
+fn head(s: &str, n: usize) -> &str {
+    let mut end = s.len().min(n);
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    &s[..end]
+}
+
+/// Every element of every BehaviorTree.CPP file read counts against
+/// `--max-nodes`, in trees that are never run too, with the position of the
+/// first element beyond the limit (in the included file that holds it).
+#[test]
+fn hostile_unused_xml_trees_count_against_max_nodes() {
+    let dir = Scratch::new("xml-unused");
+    let unused = |id: &str, n: usize| {
+        format!(
+            "<BehaviorTree ID=\"{id}\">\n<Sequence>\n{}</Sequence>\n</BehaviorTree>\n",
+            "<AlwaysSuccess/>\n".repeat(n)
+        )
+    };
+    let lib = dir.write(
+        "lib.xml",
+        format!(
+            "<root BTCPP_format=\"4\">\n{}</root>\n",
+            unused("LibUnused", 600)
+        ),
+    );
+    let main = dir.write(
+        "main.xml",
+        format!(
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<include path=\"lib.xml\"/>\n<BehaviorTree ID=\"Main\"><AlwaysSuccess/></BehaviorTree>\n{}</root>\n",
+            unused("Unused", 600)
+        ),
+    );
+    let (code, _, stderr) = btfsm(&["analyze", &main, "--max-nodes", "2000"]);
+    assert_eq!(code, 0, "{stderr}");
+    // main.xml: 6 + 600 elements; lib.xml's 1000 - 606 + 1 = 395th is the
+    // first beyond: root, BehaviorTree, Sequence, then a leaf per line.
+    let (code, _, stderr) = btfsm(&["analyze", &main, "--max-nodes", "1000"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("more than 1000 elements") && stderr.contains("--max-nodes"),
+        "{stderr}"
+    );
+    assert!(stderr.contains(&format!("--> {lib}:395:1")), "{stderr}");
+    // With the default limit (150,000): 2.1 million elements of a tree never run.
+    let big = dir.write(
+        "big.xml",
+        format!(
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\"><AlwaysSuccess/></BehaviorTree>\n{}</root>\n",
+            unused("Unused", 2_100_000)
+        ),
+    );
+    let (code, _, stderr, secs) = btfsm_capped(1024, &["analyze", &big]);
+    assert_eq!(code, 2, "{}", head(&stderr, 2000));
+    assert!(
+        stderr.contains("more than 150000 elements")
+            && stderr.contains(&format!("--> {big}:150000:1")),
+        "{}",
+        head(&stderr, 2000)
+    );
+    assert!(stderr.len() < 2000, "{} bytes of stderr", stderr.len());
+    assert!(secs < 30.0, "{secs} s");
+}
+
+/// SCXML nested 999 states deep with 4000-byte ids or repeated 4000-byte
+/// names: keys, paths and warnings used to carry every ancestor's name
+/// (about 4 GB); now memory is linear in the 4 MB input, under a 1 GiB cap.
+#[test]
+fn hostile_deep_scxml_with_long_names_stays_linear() {
+    let dir = Scratch::new("scxml-deep-names");
+    let n = 999;
+    let long = |i: usize| format!("{i:x>4000}");
+    let head_sc = "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" xmlns:btfsm=\"urn:btfsm\" version=\"1.0\"";
+    // Unreachable chain of unique long ids: a warning per state.
+    let unreachable = format!(
+        "{head_sc} initial=\"z\"><state id=\"z\"/>{}{}</scxml>",
+        (0..n)
+            .map(|i| format!("<state id=\"{}\">\n", long(i)))
+            .collect::<String>(),
+        "</state>".repeat(n)
+    );
+    // The same long name at every level: keys by path.
+    let same = format!(
+        "{head_sc} initial=\"s0\">{}{}</scxml>",
+        (0..n)
+            .map(|i| format!("<state id=\"s{i}\" btfsm:name=\"{}\">\n", "n".repeat(4000)))
+            .collect::<String>(),
+        "</state>".repeat(n)
+    );
+    for (name, text, vertices) in [
+        ("unreachable.scxml", unreachable, 1000),
+        ("same.scxml", same, 999),
+    ] {
+        let f = dir.write(name, text);
+        let (code, stdout, stderr, secs) = btfsm_capped(1024, &["analyze", &f, "--format", "json"]);
+        assert_eq!(code, 0, "{name}: {}", head(&stderr, 2000));
+        assert!(
+            stdout.contains(&format!("\"vertices\": {vertices}")),
+            "{name}: {}",
+            head(&stdout, 2000)
+        );
+        assert!(
+            stderr.len() < 300_000,
+            "{name}: {} bytes of stderr",
+            stderr.len()
+        );
+        assert!(secs < 30.0, "{name}: {secs} s");
+    }
+}
+
+/// The text of `convert` is linear in the input: a policy N levels deep
+/// gives less than 8 bytes per input byte for N = 250 and 999, and reads
+/// back with the same counts; an HFSM the TOML format cannot nest is
+/// refused (it did not read back, and was quadratic: 55 MB from 21 KB).
+#[test]
+fn hostile_convert_output_is_linear_in_depth() {
+    let dir = Scratch::new("convert-deep");
+    let counts = |f: &str| {
+        let (code, stdout, stderr) = btfsm(&["analyze", f, "--format", "csv"]);
+        assert_eq!(code, 0, "{f}: {}", head(&stderr, 2000));
+        let row = stdout.lines().nth(1).expect("a row").to_string();
+        row.split_once(',').expect("file,").1.to_string()
+    };
+    for n in [250usize, 999] {
+        let toml_bt = format!(
+            "kind = \"bt\"\nroot = \"n0\"\n[nodes]\n{}n{n} = {{ action = \"Dock!\", skill = \"Dock\" }}\n",
+            (0..n)
+                .map(|i| format!("n{i} = {{ sequence = [\"n{}\"] }}\n", i + 1))
+                .collect::<String>()
+        );
+        let xml_bt = format!(
+            "<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\">{}<AlwaysSuccess/>{}</BehaviorTree></root>",
+            "<Inverter>".repeat(n),
+            "</Inverter>".repeat(n)
+        );
+        let scxml = format!(
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" xmlns:btfsm=\"urn:btfsm\" version=\"1.0\" initial=\"s0\">{}<state id=\"leaf\" btfsm:name=\"s\"/>{}</scxml>",
+            (0..n)
+                .map(|i| format!("<state id=\"s{i}\" btfsm:name=\"s\">"))
+                .collect::<String>(),
+            "</state>".repeat(n)
+        );
+        for (name, text, to, ext) in [
+            ("bt.toml", &toml_bt, "btcpp-xml", "xml"),
+            ("bt.xml", &xml_bt, "btcpp-xml", "xml"),
+            ("m.scxml", &scxml, "scxml", "scxml"),
+        ] {
+            let f = dir.write(&format!("{n}-{name}"), text);
+            let out = dir
+                .0
+                .join(format!("{n}-{name}.out.{ext}"))
+                .display()
+                .to_string();
+            let (code, _, stderr, secs) =
+                btfsm_capped(1024, &["convert", &f, "--to", to, "-o", &out]);
+            assert_eq!(code, 0, "{name} {n}: {}", head(&stderr, 2000));
+            let size = std::fs::metadata(&out).expect("written").len() as usize;
+            assert!(
+                size < 8 * text.len(),
+                "{name} {n} --to {to}: {size} bytes from {}",
+                text.len()
+            );
+            assert!(secs < 20.0, "{name} {n}: {secs} s");
+            assert_eq!(counts(&out), counts(&f), "{name} {n}: read back");
+        }
+        // Machines deeper than the TOML format nests: refused, briefly.
+        for (name, to) in [("bt.toml", "hfsm"), ("m.scxml", "toml")] {
+            let f = dir.0.join(format!("{n}-{name}")).display().to_string();
+            let out = dir.0.join(format!("{n}-{name}.toml")).display().to_string();
+            let (code, _, stderr) = btfsm(&["convert", &f, "--to", to, "-o", &out]);
+            assert_eq!(code, 2, "{name} {n} --to {to}: {stderr}");
+            assert!(
+                stderr.contains("the TOML format reads back at most 39") && stderr.len() < 1000,
+                "{stderr}"
+            );
+            assert!(!Path::new(&out).exists());
+        }
+    }
+    // As deep as TOML nests: written, and reads back.
+    let n = 39;
+    let f = dir.write(
+        "39.toml",
+        format!(
+            "kind = \"bt\"\nroot = \"n0\"\n[nodes]\n{}n{n} = {{ action = \"Dock!\", skill = \"Dock\" }}\n",
+            (0..n)
+                .map(|i| format!("n{i} = {{ sequence = [\"n{}\"] }}\n", i + 1))
+                .collect::<String>()
+        ),
+    );
+    let out = dir.0.join("39-hfsm.toml").display().to_string();
+    let (code, _, stderr) = btfsm(&["convert", &f, "--to", "hfsm", "-o", &out]);
+    assert_eq!(code, 0, "{stderr}");
+    let (code, stdout, stderr) = btfsm(&["analyze", &out, "--format", "json"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("\"kind\": \"hfsm\""), "{stdout}");
+}
+
+/// 10 MB names where the XML readers quoted them whole (an unknown node
+/// type three times: 31 MB of stderr), and ports and events that escaped
+/// `--max-name-bytes`: each refused at its element, with a short message.
+#[test]
+fn hostile_long_xml_names_are_limited_and_quoted_short() {
+    let dir = Scratch::new("xml-long-names");
+    let long = "x".repeat(10 << 20);
+    let bt = |body: &str| {
+        format!(
+            "<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"Main\">\n<Sequence>\n{body}\n</Sequence>\n</BehaviorTree>\n</root>\n"
+        )
+    };
+    let sc = |body: &str| {
+        format!(
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\">\n<state id=\"a\">\n{body}\n</state>\n</scxml>\n"
+        )
+    };
+    let cases = [
+        ("type.xml", bt(&format!("<{long}/>")), "element name", 4),
+        (
+            "port-value.xml",
+            bt(&format!("<Script code=\"{long}\"/>")),
+            "value of `code`",
+            4,
+        ),
+        (
+            "port-name.xml",
+            bt(&format!("<Script {long}=\"1\"/>")),
+            "attribute name",
+            4,
+        ),
+        (
+            "event.scxml",
+            sc(&format!("<transition event=\"{long}\" target=\"a\"/>")),
+            "value of `event`",
+            3,
+        ),
+        (
+            "target.scxml",
+            sc(&format!("<transition event=\"go\" target=\"{long}\"/>")),
+            "value of `target`",
+            3,
+        ),
+    ];
+    for (name, text, what, line) in cases {
+        let f = dir.write(name, text);
+        let (code, _, stderr, _) = btfsm_capped(1024, &["analyze", &f]);
+        assert_eq!(code, 2, "{name}: {}", head(&stderr, 2000));
+        assert!(
+            stderr.contains(what)
+                && stderr.contains("is 10485760 bytes long, more than the limit of 4096 bytes")
+                && stderr.contains("--max-name-bytes")
+                && stderr.contains(&format!("--> {f}:{line}:1")),
+            "{name}: {}",
+            head(&stderr, 2000)
+        );
+        assert!(
+            stderr.len() < 5000,
+            "{name}: {} bytes of stderr",
+            stderr.len()
+        );
+    }
+    // Long values that are no names are quoted short too.
+    let f = dir.write(
+        "main-tree.xml",
+        format!(
+            "<root BTCPP_format=\"{long}\" main_tree_to_execute=\"{long}\">\n<BehaviorTree ID=\"Main\"><AlwaysSuccess/></BehaviorTree>\n</root>\n"
+        ),
+    );
+    let (code, _, stderr) = btfsm(&["analyze", &f]);
+    assert_eq!(code, 2, "{}", head(&stderr, 2000));
+    assert!(
+        stderr.contains("names unknown tree `xxxx") && stderr.contains("…(10485760 bytes)"),
+        "{}",
+        head(&stderr, 2000)
+    );
+    assert!(stderr.len() < 5000, "{} bytes of stderr", stderr.len());
+}
+
+/// Limit errors of the XML readers say where: `--> file:line:col` of the
+/// element (they used to come from the shape check after reading, with no
+/// position).
+#[test]
+fn hostile_xml_limit_errors_are_positioned() {
+    let dir = Scratch::new("xml-positions");
+    let n = 1005;
+    let deep_bt = format!(
+        "<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"Main\">\n{}<AlwaysSuccess/>\n{}</BehaviorTree>\n</root>\n",
+        "  <Inverter>\n".repeat(n),
+        "</Inverter>".repeat(n)
+    );
+    let deep_sc = format!(
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\">\n{}{}</scxml>\n",
+        (0..n)
+            .map(|i| format!("  <state id=\"s{i}\">\n"))
+            .collect::<String>(),
+        "</state>".repeat(n)
+    );
+    let long = "y".repeat(5000);
+    let long_bt = format!(
+        "<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"Main\">\n  <Sequence name=\"{long}\"><AlwaysSuccess/></Sequence>\n</BehaviorTree>\n</root>\n"
+    );
+    let long_sc = format!(
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\">\n  <state id=\"{long}\"/>\n</scxml>\n"
+    );
+    for (name, text, want, at) in [
+        (
+            "deep.xml",
+            deep_bt,
+            "deeper than the limit of 1000 levels",
+            "1004:3",
+        ),
+        (
+            "deep.scxml",
+            deep_sc,
+            "deeper than the limit of 1000 levels",
+            "1003:3",
+        ),
+        (
+            "long.xml",
+            long_bt,
+            "more than the limit of 4096 bytes",
+            "3:3",
+        ),
+        (
+            "long.scxml",
+            long_sc,
+            "more than the limit of 4096 bytes",
+            "2:3",
+        ),
+    ] {
+        let f = dir.write(name, text);
+        let (code, _, stderr) = btfsm(&["analyze", &f]);
+        assert_eq!(code, 2, "{name}: {stderr}");
+        assert!(
+            stderr.contains(want) && stderr.contains(&format!("--> {f}:{at}\n")),
+            "{name}: {}",
+            head(&stderr, 2000)
+        );
+    }
+}
+
+/// Nodes of a TOML subtree include are `moma1/x`, as
+/// policies/paper/README.md says (they printed as `moma1//x`).
+#[test]
+fn included_node_ids_join_with_one_slash() {
+    let (code, stdout, stderr) = btfsm(&["convert", "policies/paper/scal-bt.toml", "--to", "toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("\"moma1/cube-delivered\" = {"), "{stdout}");
+    assert!(!stdout.contains("//"), "{stdout}");
+}
+
+/// BT -> HFSM of a Sequence with 200,000 children: linear (it scanned the
+/// siblings of every child: about a minute in a debug build).
+#[test]
+fn hostile_wide_bt_converts_to_hfsm_in_linear_time() {
+    let dir = Scratch::new("wide-hfsm");
+    let f = dir.write(
+        "wide.xml",
+        format!(
+            "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\"><ReactiveSequence>{}</ReactiveSequence></BehaviorTree></root>",
+            "<AlwaysSuccess/>".repeat(200_000)
+        ),
+    );
+    let out = dir.0.join("wide.toml").display().to_string();
+    let (code, _, stderr, secs) = btfsm_capped(
+        2048,
+        &[
+            "convert",
+            &f,
+            "--to",
+            "hfsm",
+            "-o",
+            &out,
+            "--max-nodes",
+            "300000",
+        ],
+    );
+    assert_eq!(code, 0, "{}", head(&stderr, 2000));
+    assert!(secs < 30.0, "{secs} s");
+}
+
+/// 20,000 SubTrees each inside the last, sharing their blackboard by name
+/// (`_autoremap`), around 100,000 ports: each port's entry is looked up in
+/// O(1) (it walked up the whole chain: over 100 s in a debug build).
+#[test]
+fn hostile_long_autoremap_subtree_chain_resolves_ports_in_linear_time() {
+    let dir = Scratch::new("autoremap-chain");
+    let k = 20_000;
+    let mut text = String::from("<root BTCPP_format=\"4\" main_tree_to_execute=\"T0\">");
+    for i in 0..k {
+        text.push_str(&format!(
+            "<BehaviorTree ID=\"T{i}\"><SubTree ID=\"T{}\" _autoremap=\"true\" d{i}=\"x\"/></BehaviorTree>",
+            i + 1
+        ));
+    }
+    text.push_str(&format!(
+        "<BehaviorTree ID=\"T{k}\"><Sequence>{}</Sequence></BehaviorTree></root>",
+        "<Script code=\"{c}\"/>".repeat(100_000)
+    ));
+    let f = dir.write("chain.xml", text);
+    let (code, stdout, stderr, secs) = btfsm_capped(1024, &["analyze", &f, "--format", "json"]);
+    assert_eq!(code, 0, "{}", head(&stderr, 2000));
+    assert!(
+        stdout.contains("\"vertices\": 100001"),
+        "{}",
+        head(&stdout, 2000)
+    );
+    assert!(secs < 30.0, "{secs} s");
+}
+
+/// Two million unknown BehaviorTree.CPP types: the reader keeps 200
+/// messages of each kind while reading, under a 1 GiB cap (it kept every
+/// one, about 2 GB, and trimmed when reporting).
+#[test]
+fn hostile_million_bad_xml_elements_keep_bounded_messages() {
+    let dir = Scratch::new("xml-many-errors");
+    let n = 1_990_000;
+    let bt = dir.write(
+        "unknown.xml",
+        format!(
+            "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\"><Sequence>{}</Sequence></BehaviorTree></root>",
+            "<Xy/>".repeat(n)
+        ),
+    );
+    let (code, _, stderr, secs) = btfsm_capped(1024, &["analyze", &bt, "--max-nodes", "2100000"]);
+    assert_eq!(code, 2, "{}", head(&stderr, 2000));
+    assert!(
+        stderr.contains(&format!(
+            "{} more errors not shown (the first 200 messages are)",
+            n - 200
+        )),
+        "{}",
+        head(&stderr, 2000)
+    );
+    assert!(stderr.len() < 300_000, "{} bytes of stderr", stderr.len());
+    assert!(secs < 60.0, "{secs} s");
+}
