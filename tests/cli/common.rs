@@ -23,3 +23,23 @@ pub fn scratch(tag: &str) -> PathBuf {
     std::fs::create_dir_all(&d).expect("tmp");
     d
 }
+
+/// Runs the built `btfsm` in the crate root with its address space capped at
+/// `mib` MiB (`ulimit -v` of sh): (exit code, stdout, stderr, wall time).
+pub fn btfsm_capped(mib: u64, args: &[&str]) -> (i32, String, String, std::time::Duration) {
+    let start = std::time::Instant::now();
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {} && exec \"$0\" \"$@\"", mib * 1024))
+        .arg(env!("CARGO_BIN_EXE_btfsm"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run btfsm");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+        start.elapsed(),
+    )
+}

@@ -865,24 +865,10 @@ fn hostile_baseline_numbers_out_of_range_are_refused() {
     }
 }
 
-/// Runs the built `btfsm` in the crate root with its address space capped at
-/// `mib` MiB (`ulimit -v` of sh): (exit code, stdout, stderr, seconds).
+/// [`crate::common::btfsm_capped`] with the wall time in seconds.
 fn btfsm_capped(mib: u64, args: &[&str]) -> (i32, String, String, f64) {
-    let start = std::time::Instant::now();
-    let out = std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!("ulimit -v {} && exec \"$0\" \"$@\"", mib * 1024))
-        .arg(env!("CARGO_BIN_EXE_btfsm"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run btfsm");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-        start.elapsed().as_secs_f64(),
-    )
+    let (code, out, err, took) = crate::common::btfsm_capped(mib, args);
+    (code, out, err, took.as_secs_f64())
 }
 
 /// The first `n` bytes of `s` (for assertion messages).

@@ -412,27 +412,9 @@ fn validate_checks_scenarios_without_running_them() {
 /// memory. Inputs are generated here, in milliseconds.
 mod hostile {
     use super::*;
-    use std::time::{Duration, Instant};
+    use std::time::Duration;
 
-    /// Runs `btfsm` with its address space capped at `mb` MiB (`ulimit -v`):
-    /// (exit code, stdout, stderr, wall time).
-    fn btfsm_within(mb: u64, args: &[&str]) -> (i32, String, String, Duration) {
-        let t = Instant::now();
-        let out = std::process::Command::new("sh")
-            .arg("-c")
-            .arg(format!("ulimit -v {}; exec \"$0\" \"$@\"", mb * 1024))
-            .arg(env!("CARGO_BIN_EXE_btfsm"))
-            .args(args)
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .output()
-            .expect("run btfsm");
-        (
-            out.status.code().unwrap_or(-1),
-            String::from_utf8_lossy(&out.stdout).into_owned(),
-            String::from_utf8_lossy(&out.stderr).into_owned(),
-            t.elapsed(),
-        )
-    }
+    use crate::common::btfsm_capped as btfsm_within;
 
     /// A scratch folder holding the Fig. 1 BT: a scenario's policies stay
     /// inside its root.
