@@ -279,11 +279,14 @@ pub fn dot_trace(
         eprintln!("error: {m}");
         None
     };
-    let text = match read_trace(trace, limits.max_file_bytes) {
+    let text = match read_trace(trace, limits) {
         Ok(t) => t,
-        Err(m) => return fail(m),
+        Err(diags) => {
+            super::commands::print_diagnostics(&mut std::io::stderr().lock(), &diags);
+            return None;
+        }
     };
-    let v: serde_json::Value = match serde_json::from_str(&text) {
+    let v: serde_json::Value = match serde_json::from_str(&text.text) {
         Ok(v) => v,
         Err(e) => {
             return fail(format!(
@@ -343,33 +346,13 @@ pub fn dot_trace(
     Some((policy, opts))
 }
 
-/// Reads a trace file through `take(limit + 1)`, so that a device or pipe
-/// (`/dev/zero`) stops at `--max-file-bytes` instead of filling memory.
-fn read_trace(path: &std::path::Path, limit: u64) -> Result<String, String> {
-    use std::io::Read;
-    let shown = path.display();
-    let too_big = |size: String| {
-        format!(
-            "`{shown}` is {size} the limit of {limit} bytes\n  = hint: raise the limit with --max-file-bytes"
-        )
-    };
-    let cannot = |e: std::io::Error| format!("cannot read `{shown}`: {e}");
-    let f = std::fs::File::open(path).map_err(cannot)?;
-    let meta = f.metadata().map_err(cannot)?;
-    if meta.is_dir() {
-        return Err(format!("cannot read `{shown}`: it is a directory"));
-    }
-    if meta.len() > limit {
-        return Err(too_big(format!("{} bytes, more than", meta.len())));
-    }
-    let mut bytes = Vec::new();
-    f.take(limit.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
-    if bytes.len() as u64 > limit {
-        return Err(too_big("larger than".into()));
-    }
-    String::from_utf8(bytes).map_err(|_| {
-        format!("`{shown}` is not a trace written by `btfsm sim --trace`: not UTF-8 text")
-    })
+/// Reads a trace file as every input is read (`format::source::read`):
+/// within `--max-file-bytes` (`/dev/zero` stops there), charged to the
+/// command's `--max-total-bytes`, never blocking on a FIFO.
+fn read_trace(
+    path: &std::path::Path,
+    limits: &crate::format::Limits,
+) -> Result<std::sync::Arc<crate::diagnostic::SourceFile>, Vec<crate::diagnostic::Diagnostic>> {
+    let shown = path.display().to_string();
+    crate::format::source::read(path, &shown, limits, false)
 }
