@@ -196,11 +196,7 @@ pub fn detect(path: &Path, text: &str) -> FileFormat {
         Some(e) if e.eq_ignore_ascii_case("scxml") => return FileFormat::Scxml,
         _ => {}
     }
-    let mut end = text.len().min(4096);
-    while !text.is_char_boundary(end) {
-        end -= 1;
-    }
-    let head = &text[..end];
+    let head = head(text);
     let is_xml_ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -239,6 +235,7 @@ pub fn read_input(
     Ok((file, input))
 }
 
+/// The first 4 KiB of a text (at a character boundary), for sniffing.
 fn head(text: &str) -> &str {
     let mut end = text.len().min(4096);
     while !text.is_char_boundary(end) {

@@ -491,6 +491,32 @@ mod tests {
     }
 
     #[test]
+    fn a_pipe_whose_writer_stays_silent_is_an_error_after_the_idle_time() {
+        let d = scratch("idle");
+        let p = d.0.join("f.toml");
+        let c = std::ffi::CString::new(p.to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let (tx, rx) = std::sync::mpsc::channel::<()>();
+        let w = p.clone();
+        // A writer that opens the FIFO, writes a little, then says nothing.
+        let writer = std::thread::spawn(move || {
+            use std::io::Write;
+            let mut f = std::fs::OpenOptions::new().write(true).open(w).unwrap();
+            f.write_all(b"# ").unwrap();
+            let _ = rx.recv_timeout(PIPE_IDLE * 2);
+        });
+        // Wait until the writer holds the FIFO open.
+        std::thread::sleep(Duration::from_millis(200));
+        let t = std::time::Instant::now();
+        let err = read_bytes(&p, "f.toml", &Limits::default(), false).unwrap_err();
+        assert!(err[0].message.contains("no data for 10 s"), "{}", err[0]);
+        assert!(t.elapsed() >= PIPE_IDLE && t.elapsed() < PIPE_IDLE * 2);
+        tx.send(()).unwrap();
+        writer.join().unwrap();
+    }
+
+    #[test]
     fn every_read_is_charged_to_the_command() {
         let d = scratch("budget");
         let p = d.0.join("a.toml");

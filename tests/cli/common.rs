@@ -5,8 +5,12 @@ use std::process::Command;
 
 /// Runs the built `btfsm` in the crate root: (exit code, stdout, stderr).
 pub fn btfsm(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_btfsm"))
-        .args(args)
+    run(Command::new(env!("CARGO_BIN_EXE_btfsm")).args(args))
+}
+
+/// Runs `cmd` in the crate root: (exit code, stdout, stderr).
+fn run(cmd: &mut Command) -> (i32, String, String) {
+    let out = cmd
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .expect("run btfsm");
@@ -28,18 +32,10 @@ pub fn scratch(tag: &str) -> PathBuf {
 /// `mib` MiB (`ulimit -v` of sh): (exit code, stdout, stderr, wall time).
 pub fn btfsm_capped(mib: u64, args: &[&str]) -> (i32, String, String, std::time::Duration) {
     let start = std::time::Instant::now();
-    let out = Command::new("sh")
+    let (code, out, err) = run(Command::new("sh")
         .arg("-c")
         .arg(format!("ulimit -v {} && exec \"$0\" \"$@\"", mib * 1024))
         .arg(env!("CARGO_BIN_EXE_btfsm"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run btfsm");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-        start.elapsed(),
-    )
+        .args(args));
+    (code, out, err, start.elapsed())
 }

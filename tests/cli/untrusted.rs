@@ -465,3 +465,33 @@ fn a_full_stderr_changes_no_exit_code() {
     let r = run_in(&d.0, &["validate", &leaf], Some("/dev/full"));
     assert_eq!(r.code, 0, "validate");
 }
+
+/// A command-line file is read once: `-` and `/dev/stdin` take a pipe.
+#[test]
+fn standard_input_is_read_once() {
+    use std::io::Write;
+    for arg in ["-", "/dev/stdin"] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_btfsm"))
+            .args(["analyze", arg, "--format", "json"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn");
+        child
+            .stdin
+            .take()
+            .expect("stdin")
+            .write_all(LEAF.as_bytes())
+            .expect("write");
+        let out = child.wait_with_output().expect("wait");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{arg}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains("\"vertices\": 1"), "{arg}: {stdout}");
+    }
+}
