@@ -9,7 +9,8 @@
 use btfsm::format::{Limits, load};
 use btfsm::model::PolicyBody;
 use btfsm::sim::exec::{BtExec, CompiledBt, Leaves};
-use btfsm::sim::run::{monte_carlo, run_scenario};
+use btfsm::sim::monte_carlo::monte_carlo;
+use btfsm::sim::run::run_scenario;
 use btfsm::sim::scenario;
 use btfsm::sim::skills::{Call, Status, condition, resolve};
 use btfsm::sim::world::{Place, World};

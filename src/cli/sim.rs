@@ -6,7 +6,7 @@ use super::commands::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use crate::report::OutputFormat;
 use crate::sim::report::{McReport, SimReport, TraceWriter};
-use crate::sim::{plot, run, scenario};
+use crate::sim::{monte_carlo, plot, run, scenario};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -89,7 +89,7 @@ pub fn execute(a: SimArgs) -> u8 {
             Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
             None => cores,
         };
-        let (stats, done) = run::monte_carlo_within(&s, n, seed, threads, deadline);
+        let (stats, done) = monte_carlo::monte_carlo_within(&s, n, seed, threads, deadline);
         let rep = McReport {
             scenario: s.name.clone(),
             seed,

@@ -5,9 +5,11 @@
 //! Monte Carlo episodes.
 
 pub mod exec;
+pub mod monte_carlo;
 pub mod plot;
 pub mod report;
 pub mod rng;
+pub mod robot;
 pub mod run;
 pub mod scenario;
 pub mod skills;

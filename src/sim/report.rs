@@ -3,7 +3,7 @@
 //! as a table or as JSON (a stable contract documented in the README). Also the
 //! `--runs` summary and the `--trace` file.
 
-use super::run::McStats;
+use super::monte_carlo::McStats;
 use super::trace::{FRECHET_POINTS, Run, Verdict, verdicts_within};
 use crate::report::table::Table;
 use serde::Serialize;

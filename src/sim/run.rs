@@ -8,16 +8,16 @@
 //! run ends with outcome `timeout` at the step reached; Monte Carlo keeps
 //! the first k whole episodes.
 
-use super::exec::{BtExec, CompiledBt, CompiledMachine, Leaves, MachineExec};
+use super::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
 use super::rng::SimRng;
-use super::scenario::{Disturbance, Effect, PolicyEntry, Scenario, When};
-use super::skills::{self, Call, Running, Status, Target};
-use super::trace::{Event, FinalWorld, Outcome, Run, SkillRecord, Step, compact_trajectory};
-use super::world::{P2, Place, World};
+use super::robot::{Faults, MAX_EVENTS, MAX_SKILL_RECORDS, Robot, apply, round3};
+use super::scenario::{Disturbance, PolicyEntry, Scenario, When};
+use super::skills::{self, Call, Status};
+use super::trace::{FinalWorld, Outcome, Run, Step, compact_trajectory};
+use super::world::{P2, World};
 use crate::model::PolicyBody;
 use std::collections::BTreeMap;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// A policy ready to run: bindings resolved against the scenario's world.
@@ -86,211 +86,6 @@ fn prepare_one(e: &PolicyEntry, w: &World) -> Prepared {
     }
 }
 
-/// Injected faults: "fail the next N times" and failure rates.
-#[derive(Debug, Clone)]
-struct Faults {
-    next: BTreeMap<String, u32>,
-    rates: BTreeMap<String, f64>,
-    rng: SimRng,
-}
-
-impl Faults {
-    fn doomed(&mut self, skill: &str) -> bool {
-        if let Some(n) = self.next.get_mut(skill)
-            && *n > 0
-        {
-            *n -= 1;
-            return true;
-        }
-        match self.rates.get(skill) {
-            Some(&p) => self.rng.chance(p),
-            None => false,
-        }
-    }
-}
-
-/// The robot as the executors see it: the world, the running actions and the
-/// records.
-struct Robot {
-    world: World,
-    dt: f64,
-    live: Vec<Option<Running>>,
-    ticked: Vec<bool>,
-    records: Vec<SkillRecord>,
-    events: Vec<Event>,
-    faults: Faults,
-    log: bool,
-    last_failed: Option<Call>,
-    switches: u32,
-    failures: u32,
-    mark: u64,
-    low_at: Option<f64>,
-    latencies: Vec<f64>,
-    /// An action start or an event was refused: the run's records are full
-    /// ([`MAX_SKILL_RECORDS`], [`MAX_EVENTS`]); the run ends after the step.
-    full: bool,
-}
-
-/// Executed skills a run records at most: a policy that picks and places
-/// every step for 10^6 steps held 2 million records (3.3 GB, and 1 GB of
-/// JSON); past this the run ends with outcome `timeout` (the bundled
-/// scenarios record at most 24).
-pub const MAX_SKILL_RECORDS: usize = 1024;
-/// Events a run records at most (likewise; the bundled scenarios: 50).
-pub const MAX_EVENTS: usize = 4096;
-
-/// The arguments of a resolved call, by name.
-pub fn call_args(c: &Call, w: &World) -> BTreeMap<String, String> {
-    let tgt = |t: &Target| match *t {
-        Target::Station(s) => w.layout.stations[s].0.clone(),
-        Target::Object(o) => w.objects[o].name.clone(),
-    };
-    let obj = |o: usize| w.objects[o].name.clone();
-    let st = |s: usize| w.layout.stations[s].0.clone();
-    let mut m = BTreeMap::new();
-    match c {
-        Call::MoveTo { target, .. } | Call::RobotAt(target) => {
-            m.insert("target".into(), tgt(target));
-        }
-        Call::Pick { object } | Call::InHand(object) => {
-            m.insert("object".into(), obj(*object));
-        }
-        Call::Place { object, at } | Call::ObjectAt { object, at } => {
-            m.insert("object".into(), obj(*object));
-            m.insert("at".into(), st(*at));
-        }
-        Call::BatteryLevel(x) => {
-            m.insert("min".into(), x.to_string());
-        }
-        _ => {}
-    }
-    m
-}
-
-impl Robot {
-    fn event(&mut self, kind: &str, text: String) {
-        if self.events.len() >= MAX_EVENTS {
-            self.full = true;
-            return;
-        }
-        if self.log {
-            self.events.push(Event {
-                t: round3(self.world.time),
-                kind: kind.into(),
-                text,
-                x: self.world.robot.0,
-                y: self.world.robot.1,
-            });
-        }
-    }
-
-    fn sync_progress(&mut self) {
-        if self.world.progress != self.mark {
-            self.mark = self.world.progress;
-            self.switches = 0;
-            self.failures = 0;
-        }
-    }
-
-    fn close(&mut self, rec: usize, outcome: &str) {
-        let t = round3(self.world.time);
-        let r = &mut self.records[rec];
-        r.outcome = outcome.into();
-        r.end = Some(t);
-        if self.log {
-            let text = r.text();
-            self.event("end", text);
-        }
-    }
-
-    /// Cancels the actions that were not ticked in this step.
-    fn end_step(&mut self) {
-        for k in 0..self.live.len() {
-            if !self.ticked[k]
-                && let Some(mut r) = self.live[k].take()
-            {
-                r.cancel(&mut self.world);
-                self.close(r.record, "cancelled");
-            }
-            self.ticked[k] = false;
-        }
-    }
-}
-
-fn round3(x: f64) -> f64 {
-    (x * 1000.0).round() / 1000.0
-}
-
-impl Leaves for Robot {
-    #[inline]
-    fn condition(&mut self, call: &Call) -> bool {
-        skills::condition(call, &self.world)
-    }
-
-    fn action(&mut self, key: usize, call: &Call) -> Status {
-        self.ticked[key] = true;
-        if self.live[key].as_ref().is_none_or(|r| r.call != *call) {
-            if self.records.len() >= MAX_SKILL_RECORDS {
-                // Not started: the run ends after this step.
-                self.full = true;
-                return Status::Failure;
-            }
-            if let Some(mut old) = self.live[key].take() {
-                old.cancel(&mut self.world);
-                self.close(old.record, "cancelled");
-            }
-            self.sync_progress();
-            // Every start counts, except a retry of the action that just failed.
-            if self.last_failed != Some(*call) {
-                self.switches += 1;
-            }
-            self.last_failed = None;
-            let doomed = self.faults.doomed(call.name());
-            if *call == Call::Recharge
-                && let Some(t) = self.low_at.take()
-            {
-                self.latencies.push(round3(self.world.time - t));
-            }
-            self.records.push(SkillRecord {
-                skill: call.name().into(),
-                args: call_args(call, &self.world),
-                outcome: "running".into(),
-                start: round3(self.world.time),
-                end: None,
-            });
-            if self.log {
-                let text = self.records.last().expect("pushed").text();
-                self.event("start", text.trim_end_matches(" -> running").to_string());
-            }
-            self.live[key] = Some(Running::new(*call, doomed, self.records.len() - 1));
-        }
-        let r = self.live[key].as_mut().expect("started above");
-        let s = r.tick(&mut self.world, self.dt);
-        if s != Status::Running {
-            let rec = r.record;
-            self.live[key] = None;
-            self.close(
-                rec,
-                if s == Status::Success {
-                    "success"
-                } else {
-                    "failure"
-                },
-            );
-            if s == Status::Failure {
-                self.sync_progress();
-                self.failures += 1;
-                self.last_failed = Some(*call);
-            }
-        }
-        s
-    }
-
-    fn now(&self) -> f64 {
-        self.world.time
-    }
-}
-
 /// What to record in a run.
 #[derive(Debug, Clone, Copy)]
 pub struct RunOptions {
@@ -307,25 +102,6 @@ pub struct RunOptions {
 /// step costs microseconds, so the run stops within about a millisecond of
 /// its deadline, and the clock (tens of nanoseconds) costs nothing.
 pub const CLOCK_EVERY: u64 = 1024;
-
-/// Applies a disturbance's effect.
-fn apply(d: &Disturbance, r: &mut Robot) {
-    let w = &mut r.world;
-    match &d.effect {
-        Effect::Battery(b) => w.battery = *b,
-        Effect::Move { object, to } => w.objects[*object].place = Place::At(*to),
-        Effect::Drop { object } => {
-            if w.objects[*object].place == Place::Held {
-                w.objects[*object].place = Place::At(w.robot);
-            }
-        }
-        Effect::Fail { skill, times } => *r.faults.next.entry(skill.clone()).or_insert(0) += times,
-        Effect::Block(rect) => w.block(rect.clone()),
-        Effect::Emergency(b) => w.emergency = *b,
-    }
-    r.world.progress += 1;
-    r.event("disturbance", d.text.clone());
-}
 
 fn holds(terms: &[(Call, bool)], w: &World) -> bool {
     terms.iter().all(|(c, neg)| skills::condition(c, w) != *neg)
@@ -586,7 +362,7 @@ pub fn run_policy_into(
 
 /// Whether the wall-clock budget cut `r` short: a timeout before the step
 /// budget was used up (the clock is read only while steps remain).
-fn cut_short(s: &Scenario, r: &Run) -> bool {
+pub(super) fn cut_short(s: &Scenario, r: &Run) -> bool {
     r.outcome == Outcome::Timeout
         && r.steps < s.max_steps
         && r.reason.starts_with("wall-clock budget")
@@ -668,191 +444,12 @@ fn run_scenario_out(
     (runs, any_cut)
 }
 
-/// Per-policy figures of `--runs N`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct McStats {
-    pub policy: String,
-    pub runs: u32,
-    pub successes: u32,
-    pub success_rate: f64,
-    pub chattering: u32,
-    pub timeouts: u32,
-    pub failures: u32,
-    /// Mean completion time of the successful episodes, s.
-    pub mean_completion_s: Option<f64>,
-    /// Mean latency from a battery-low event to the start of Recharge, s.
-    pub mean_recharge_latency_s: Option<f64>,
-    pub recharges: u32,
-}
-
-/// The disturbances and failure rates of episode `i`: the scenario's, with
-/// timed ones jittered, plus the `monte_carlo` battery drop and rates.
-pub fn episode(s: &Scenario, seed: u64, i: u32) -> (u64, Vec<Disturbance>, BTreeMap<String, f64>) {
-    let ep_seed = SimRng::named(seed, &format!("episode-{i}")).next_u64();
-    let mut rng = SimRng::named(ep_seed, "disturbances");
-    let mut ds = s.disturbances.clone();
-    // Timed disturbances happen anywhere from half to one and a half times
-    // their scenario time.
-    for d in &mut ds {
-        if let When::At(t) = &mut d.when {
-            *t = (*t * rng.range(0.5, 1.5) * 10.0).round() / 10.0;
-        }
-    }
-    if let Some((p, (lo, hi), (t0, t1))) = s.monte_carlo.battery_drop
-        && rng.chance(p)
-    {
-        let level = rng.range(lo, hi).round();
-        let at = (rng.range(t0, t1) * 10.0).round() / 10.0;
-        ds.push(Disturbance {
-            when: When::At(at),
-            effect: Effect::Battery(level),
-            text: format!("battery set to {level}%"),
-        });
-    }
-    let mut rates = s.rates.clone();
-    for (k, v) in &s.monte_carlo.rates {
-        let e = rates.entry(k.clone()).or_insert(0.0);
-        *e = 1.0 - (1.0 - *e) * (1.0 - v);
-    }
-    (ep_seed, ds, rates)
-}
-
-/// Runs `runs` seeded episodes of every policy on `threads` threads.
-pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<McStats> {
-    monte_carlo_within(s, runs, seed, threads, None).0
-}
-
-/// [`monte_carlo`] under a wall-clock deadline: once it passes, every
-/// thread stops (the episode in progress is cut within [`CLOCK_EVERY`]
-/// steps and dropped, no new one starts), and the figures cover the first
-/// k episodes, k the number returned (every episode before k completed for
-/// every policy; `runs` when the deadline never passed). The same k
-/// episodes give the same figures as `monte_carlo(s, k, seed, ..)`.
-pub fn monte_carlo_within(
-    s: &Scenario,
-    runs: u32,
-    seed: u64,
-    threads: usize,
-    deadline: Option<Instant>,
-) -> (Vec<McStats>, u32) {
-    let prepared = prepare(s);
-    let threads = threads.max(1).min(runs.max(1) as usize);
-    let stop = AtomicBool::new(false);
-    // results[policy][episode] = (outcome, goal, completion, latencies)
-    type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
-    let mut per_thread: Vec<Vec<(u32, usize, Res)>> = Vec::new();
-    std::thread::scope(|sc| {
-        let prepared = &prepared;
-        let stop = &stop;
-        // One worker's episodes: t, t + threads, ...
-        let work = move |t: usize| {
-            let mut out = Vec::new();
-            let mut i = t as u32;
-            'episodes: while i < runs {
-                if stop.load(Ordering::Relaxed) {
-                    break;
-                }
-                let (ep_seed, ds, rates) = episode(s, seed, i);
-                let first = out.len();
-                for (k, p) in prepared.iter().enumerate() {
-                    let r = run_policy(
-                        s,
-                        p,
-                        s.world.clone(),
-                        &ds,
-                        rates.clone(),
-                        ep_seed,
-                        RunOptions {
-                            log: false,
-                            trace: false,
-                            deadline,
-                        },
-                    );
-                    if cut_short(s, &r) {
-                        stop.store(true, Ordering::Relaxed);
-                        out.truncate(first);
-                        break 'episodes;
-                    }
-                    out.push((
-                        i,
-                        k,
-                        (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s),
-                    ));
-                }
-                i += threads as u32;
-            }
-            out
-        };
-        let mut handles = Vec::new();
-        for t in 0..threads {
-            // A thread the system refuses (a limit on processes) does its
-            // share on this one instead: the same episodes, the same figures.
-            match std::thread::Builder::new().spawn_scoped(sc, move || work(t)) {
-                Ok(h) => handles.push(h),
-                Err(_) => per_thread.push(work(t)),
-            }
-        }
-        for h in handles {
-            per_thread.push(h.join().expect("episode thread"));
-        }
-    });
-    let mut all: Vec<(u32, usize, Res)> = per_thread.into_iter().flatten().collect();
-    // Episodes come whole (all policies) or not at all: keep the prefix of
-    // consecutive completed ones.
-    let mut complete = vec![false; runs as usize];
-    for (i, _, _) in &all {
-        complete[*i as usize] = true;
-    }
-    let runs = complete.iter().position(|c| !c).unwrap_or(complete.len()) as u32;
-    all.retain(|(i, _, _)| *i < runs);
-    all.sort_by_key(|(i, k, _)| (*k, *i));
-    let stats = prepared
-        .iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let mine: Vec<&Res> = all
-                .iter()
-                .filter(|(_, kk, _)| *kk == k)
-                .map(|(_, _, r)| r)
-                .collect();
-            let ok: Vec<&&Res> = mine
-                .iter()
-                .filter(|r| r.0 == Outcome::Success && r.1 != Some(false))
-                .collect();
-            let comp: Vec<f64> = ok.iter().filter_map(|r| r.2).collect();
-            let lat: Vec<f64> = mine.iter().flat_map(|r| r.3.iter().copied()).collect();
-            let mean =
-                |v: &[f64]| (!v.is_empty()).then(|| round3(v.iter().sum::<f64>() / v.len() as f64));
-            let count = |o: Outcome| mine.iter().filter(|r| r.0 == o).count() as u32;
-            McStats {
-                policy: p.name.clone(),
-                runs,
-                successes: ok.len() as u32,
-                success_rate: if runs == 0 {
-                    0.0
-                } else {
-                    round3(ok.len() as f64 / runs as f64)
-                },
-                chattering: count(Outcome::Chattering),
-                timeouts: count(Outcome::Timeout),
-                failures: runs
-                    - ok.len() as u32
-                    - count(Outcome::Chattering)
-                    - count(Outcome::Timeout),
-                mean_completion_s: mean(&comp),
-                mean_recharge_latency_s: mean(&lat),
-                recharges: lat.len() as u32,
-            }
-        })
-        .collect();
-    (stats, runs)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::diagnostic::SourceFile;
     use crate::format::Limits;
+    use crate::sim::monte_carlo::{monte_carlo, monte_carlo_within};
     use std::path::Path;
 
     fn scenario(text: &str) -> Scenario {

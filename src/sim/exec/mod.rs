@@ -1,0 +1,54 @@
+//! Executors: how a BT, an FSM and an HFSM drive the robot, one step at a time
+//! (SPEC §6), against the shared skill library behind the [`Leaves`] trait.
+//!
+//! - BT (the paper's sec. II-A; Colledanchise & Ögren, "Behavior Trees in
+//!   Robotics and AI", ch. 1): the root is ticked once per step. Sequence and
+//!   Fallback are reactive (re-ticked from the first child), Sequence* and
+//!   Fallback* resume at the running child, Parallel succeeds when `success`
+//!   children succeed, decorators map their child's status. A node that was not
+//!   ticked on the previous step starts afresh (halting resets memory), and an
+//!   action not ticked in a step is cancelled by the caller.
+//! - FSM (sec. II-B, Algorithm 3): the current state's guards are checked, in
+//!   the order written, before its skill runs; the skill's outcome selects the
+//!   transition. A decision state (SELECTOR) only checks guards. Several states
+//!   may run in one step (a finished action's successor starts at once), until
+//!   an action returns RUNNING or the machine ends.
+//! - HFSM (sec. III): containers are entered at their initial state; a
+//!   transition to a container's outcome continues with the container's own
+//!   transition on that outcome; the guards of the enclosing containers are
+//!   checked first, outermost first. Reaching the top-level outcome `RUNNING`
+//!   ends the step and the next step re-enters the machine (the construction of
+//!   Fig. 6, which makes an HFSM tick like a BT); such a tick-driven machine is
+//!   also re-entered after reaching FAILURE, as a BT's root is ticked again,
+//!   and ends at SUCCESS.
+//!
+//! Both executors walk their structure with explicit stacks, never recursion.
+//! A BT's reactive skeleton (its Sequence and Fallback nodes from the root
+//! down to the first node with memory or a decorator) is compiled once into
+//! a table of successors ([`Plan`]): a tick then jumps from leaf to leaf as the
+//! short-circuit evaluation of an and/or expression does, and takes the stack
+//! walk only for the subtrees below the skeleton. When every node's status is
+//! noted (`sim --trace`), the composites a status leaves are noted with it (a
+//! reactive composite returns the status of the child it stops at). A unit
+//! test checks plan and stack walk, noting or not, against a recursive
+//! reference on random trees of every node kind.
+
+mod bt;
+mod machine;
+#[cfg(test)]
+mod tests;
+
+pub use bt::{BtExec, CompiledBt, XNode};
+pub use machine::{CompiledMachine, GuardTerms, MachineExec};
+
+use super::skills::{Call, Status};
+
+/// What an executor needs from the robot.
+pub trait Leaves {
+    /// Evaluates a condition.
+    fn condition(&mut self, call: &Call) -> bool;
+    /// Ticks the action of leaf `key` (continuing its running instance).
+    fn action(&mut self, key: usize, call: &Call) -> Status;
+    /// Simulated time, s (for Timeout).
+    fn now(&self) -> f64;
+}
