@@ -210,6 +210,13 @@ impl Leaves for Robot {
         s
     }
 
+    fn halt(&mut self, key: usize) {
+        if let Some(mut r) = self.live[key].take() {
+            r.cancel(&mut self.world);
+            self.close(r.record, "cancelled");
+        }
+    }
+
     fn now(&self) -> f64 {
         self.world.time
     }

@@ -49,6 +49,13 @@ pub trait Leaves {
     fn condition(&mut self, call: &Call) -> bool;
     /// Ticks the action of leaf `key` (continuing its running instance).
     fn action(&mut self, key: usize, call: &Call) -> Status;
+    /// Halts the running action of leaf `key` at once (BehaviorTree.CPP's
+    /// `halt()`): called when the executor leaves a RUNNING leaf — a
+    /// reactive composite re-ticks from an earlier child, a Parallel is done,
+    /// an FSM guard preempts its state. A leaf that is not running ignores it.
+    fn halt(&mut self, key: usize) {
+        let _ = key;
+    }
     /// Simulated time, s (for Timeout).
     fn now(&self) -> f64;
 }
