@@ -9,6 +9,7 @@ pub mod source;
 pub mod toml;
 pub mod toml_write;
 pub mod xml;
+pub mod yasmin;
 
 use crate::diagnostic::{Diagnostic, SourceFile};
 use crate::model::Policy;
@@ -186,9 +187,11 @@ pub enum FileFormat {
     Toml,
     BtcppXml,
     Scxml,
+    /// yasmin (ROS 2) state machine XML.
+    Yasmin,
 }
 
-/// The format of a file: by extension (`.toml`, `.scxml`, `.xml`), else by its
+/// first bytes (`<scxml`, `<StateMachine` for yasmin, `<root`, ...); TOML otherwise.
 /// first bytes (`<scxml`, `<root`, ...); TOML otherwise.
 pub fn detect(path: &Path, text: &str) -> FileFormat {
     match path.extension().and_then(|e| e.to_str()) {
@@ -203,6 +206,8 @@ pub fn detect(path: &Path, text: &str) -> FileFormat {
         .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
     if head.contains("<scxml") {
         FileFormat::Scxml
+    } else if yasmin::looks_like_yasmin(head) {
+        FileFormat::Yasmin
     } else if is_xml_ext || head.trim_start().starts_with('<') {
         FileFormat::BtcppXml
     } else {
@@ -263,6 +268,7 @@ pub fn load_read(
         FileFormat::Toml => toml::load_read(&file, path, limits),
         FileFormat::BtcppXml => btcpp_xml::load_read(file, path, limits),
         FileFormat::Scxml => scxml::load_read(file, limits),
+        FileFormat::Yasmin => yasmin::load_read(file, path, limits),
     }?;
     // Every format: node count and nesting depth (the TOML reader has
     // already said where).

@@ -577,7 +577,9 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
             match (event, cond) {
                 (Some(ev), None)
                     if t.btfsm_attr("guard") != Some("true")
-                        && valid.contains(ev)
+                        && (valid.contains(ev)
+                            || (t.btfsm_attr("outcome") == Some("true")
+                                && matches!(m.states[si].body, StateBody::Task(None))))
                         && !used_outcomes.contains(ev) =>
                 {
                     used_outcomes.insert(ev);

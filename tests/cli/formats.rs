@@ -519,3 +519,113 @@ fn compare_works_across_formats() {
     assert_eq!(v["named"]["ged"], 8, "{stdout}");
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
+
+/// Vertices and arcs of a yasmin file by the test's own tag scanner: every
+/// `<State>` and nested `<StateMachine>` is a vertex (an included file's
+/// states too), so is each top-level outcome; every `<Transition>` is an
+/// arc, and so is each container's arc to its start state.
+fn count_yasmin_graph(path: &Path) -> (usize, usize) {
+    let text = std::fs::read_to_string(path).expect("read");
+    let tags = scan_tags(&text);
+    let (mut v, mut e) = (0, 0);
+    let mut first = true;
+    for (name, attrs, _) in &tags {
+        match name.as_str() {
+            "StateMachine" if first => {
+                first = false;
+                v += attr(attrs, "outcomes").map_or(0, |o| o.split_whitespace().count());
+            }
+            "StateMachine" => {
+                v += 1;
+                e += 1;
+                if let Some(inc) = attr(attrs, "file_path") {
+                    let (iv, ie) = count_yasmin_graph(&path.parent().expect("dir").join(inc));
+                    let inner = std::fs::read_to_string(path.parent().expect("dir").join(inc))
+                        .expect("read");
+                    let top = scan_tags(&inner)
+                        .into_iter()
+                        .find(|t| t.0 == "StateMachine")
+                        .and_then(|t| attr(&t.1, "outcomes").map(|o| o.split_whitespace().count()))
+                        .unwrap_or(0);
+                    v += iv - top;
+                    e += ie;
+                }
+            }
+            "State" => v += 1,
+            "Transition" => e += 1,
+            _ => {}
+        }
+    }
+    (v, e)
+}
+
+#[test]
+fn corpus_yasmin_imports_analyzes_and_draws_orthogonal_states_are_refused() {
+    let files: Vec<PathBuf> = corpus_files("xml")
+        .into_iter()
+        .filter(|p| p.components().any(|c| c.as_os_str() == "yasmin"))
+        .collect();
+    assert!(files.len() >= 10, "{files:?}");
+    let mut loaded = 0;
+    for f in files {
+        let file = f.display().to_string();
+        let text = std::fs::read_to_string(&f).expect("read");
+        let (code, stdout, stderr) = btfsm(&["analyze", "--format", "json", &file]);
+        if text.contains("<OrthogonalState") {
+            assert_eq!(code, 2, "{file}");
+            assert!(
+                stderr.contains("`<OrthogonalState>` (concurrent regions) is not supported"),
+                "{stderr}"
+            );
+            continue;
+        }
+        assert_eq!(code, 0, "{file}: {stderr}");
+        let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+        let p = &v["policies"][0];
+        let (vertices, arcs) = count_yasmin_graph(&f);
+        assert_eq!(p["vertices"], vertices as u64, "{file}");
+        assert_eq!(p["edges"], arcs as u64, "{file}");
+        let nested = text.matches("<StateMachine").count() > 1;
+        assert_eq!(p["kind"], if nested { "hfsm" } else { "fsm" }, "{file}");
+        let (code, dot, stderr) = btfsm(&["dot", &file]);
+        assert_eq!(code, 0, "{file}: {stderr}");
+        assert!(dot.starts_with("digraph"));
+        loaded += 1;
+    }
+    assert!(loaded >= 8, "{loaded}");
+}
+
+#[test]
+fn yasmin_machines_round_trip_through_toml_and_scxml_at_named_ged_0() {
+    let dir = scratch("yasmin-rt");
+    for f in corpus_files("xml") {
+        let text = std::fs::read_to_string(&f).expect("read");
+        if f.components().any(|c| c.as_os_str() == "yasmin") && !text.contains("<OrthogonalState") {
+            round_trip(&f, "toml", "scxml", "toml", "scxml", &dir);
+        }
+    }
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn a_yasmin_file_path_outside_the_root_is_refused() {
+    let dir = scratch("yasmin-root");
+    std::fs::create_dir_all(dir.join("repo/.git")).expect("mkdir");
+    std::fs::write(
+        dir.join("outside.xml"),
+        "<StateMachine outcomes=\"end\"><State name=\"s\"><Transition from=\"ok\" to=\"end\"/></State></StateMachine>",
+    )
+    .expect("write");
+    let main = dir.join("repo/main.xml");
+    std::fs::write(
+        &main,
+        "<StateMachine outcomes=\"end\">\n  <StateMachine name=\"In\" file_path=\"../outside.xml\"><Transition from=\"end\" to=\"end\"/></StateMachine>\n</StateMachine>\n",
+    )
+    .expect("write");
+    let (code, _, stderr) = btfsm(&["analyze", &main.display().to_string()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("cannot include this file"), "{stderr}");
+    assert!(stderr.contains(":2:"), "positioned: {stderr}");
+    assert!(!stderr.contains("outside.xml\n"), "{stderr}");
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
