@@ -179,16 +179,24 @@ impl Reader<'_> {
         let machine_span = self.docs[doc].0.elems[elem].span.clone();
         let outer_span = machine_span.clone();
         // Outcomes: the attribute, then `<FinalOutcome>`s not already named.
-        let mut outcomes: Vec<String> = self.docs[doc].0.elems[elem]
+        // (A set beside the list: nothing is quadratic in the outcome count.)
+        let mut outcome_set: std::collections::HashSet<String> = Default::default();
+        let mut outcomes: Vec<String> = Vec::new();
+        for o in self.docs[doc].0.elems[elem]
             .attr("outcomes")
-            .map(|o| o.split_whitespace().map(str::to_string).collect())
-            .unwrap_or_default();
+            .unwrap_or_default()
+            .split_whitespace()
+        {
+            if outcome_set.insert(o.to_string()) {
+                outcomes.push(o.to_string());
+            }
+        }
         let kids: Vec<usize> = self.docs[doc].0.elems[elem].children.clone();
         for &c in &kids {
             let e = &self.docs[doc].0.elems[c];
             if e.name == "FinalOutcome"
                 && let Some(n) = e.attr("name")
-                && !outcomes.iter().any(|o| o == n)
+                && outcome_set.insert(n.to_string())
             {
                 outcomes.push(n.to_string());
             }
@@ -334,7 +342,7 @@ impl Reader<'_> {
                     continue;
                 };
                 let (from, to_v, to_span) = (from.to_string(), to.value.clone(), to.span.clone());
-                let target = if outcomes.iter().any(|o| *o == to_v) {
+                let target = if outcome_set.contains(&to_v) {
                     Target::Outcome(to_v)
                 } else if let Some(&n) = names.get(to_v.as_str()) {
                     Target::State(n)
