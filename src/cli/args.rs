@@ -170,6 +170,8 @@ pub enum ConvertTarget {
     BtcppXml,
     /// SCXML (FSMs and HFSMs)
     Scxml,
+    /// Mermaid (flowchart for BTs, stateDiagram-v2 for FSMs and HFSMs), as GitHub renders in markdown
+    Mermaid,
 }
 
 /// `--assume-leaf`: how to read BehaviorTree.CPP leaves of unknown type.

@@ -142,6 +142,12 @@ pub fn execute(cli: Cli) -> u8 {
                 ConvertTarget::BtcppXml | ConvertTarget::Scxml => {
                     return super::convert::to_xml(&l.policy, to, output.as_deref());
                 }
+                ConvertTarget::Mermaid => {
+                    return emit_text(
+                        output.as_deref(),
+                        crate::render::mermaid::policy_mermaid(&l.policy),
+                    );
+                }
                 ConvertTarget::FaultTolerant => {
                     match crate::transform::fault_tolerant::fault_tolerant_policy(&l.policy) {
                         Ok(p) => p,
