@@ -54,7 +54,8 @@ pub enum Command {
         /// Output file (default: stdout)
         #[arg(short, long)]
         output: Option<PathBuf>,
-        /// Render with Graphviz's `dot` instead of printing DOT
+        /// Render with Graphviz's `dot` instead of printing DOT (default: the
+        /// extension of -o when it is .svg, .png or .pdf, else DOT text)
         #[arg(long, value_enum)]
         render: Option<crate::render::dot::RenderFormat>,
         /// With --render: Graphviz's time budget; past it `dot` is killed
@@ -90,7 +91,8 @@ pub enum Command {
         #[arg(long, value_name = "OUT")]
         dot: Option<PathBuf>,
         /// With --dot: render through Graphviz instead of writing DOT (under
-        /// the --timeout-ms budget of one mode: past it `dot` is killed)
+        /// the --timeout-ms budget of one mode: past it `dot` is killed);
+        /// default: the extension of --dot when it is .svg, .png or .pdf
         #[arg(long, value_enum, requires = "dot")]
         render: Option<crate::render::dot::RenderFormat>,
         #[command(flatten)]

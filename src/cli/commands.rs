@@ -225,6 +225,8 @@ pub(super) fn draw(
 ) -> u8 {
     use crate::render::dot::{self, RenderFormat};
     let text = dot::policy_dot(policy, opts);
+    // `-o x.png` means PNG: the format follows the extension unless given.
+    let render = render.or_else(|| output.and_then(RenderFormat::from_path));
     let Some(fmt) = render else {
         return emit_text(output, text);
     };

@@ -629,3 +629,50 @@ fn a_yasmin_file_path_outside_the_root_is_refused() {
     assert!(!stderr.contains("outside.xml\n"), "{stderr}");
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
+
+#[test]
+fn the_render_format_follows_the_output_extension() {
+    let dir = scratch("render-ext");
+    let fig = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper/fig01-bt.toml");
+    let out = |name: &str| dir.join(name).display().to_string();
+    // `.dot`, `.gv` and no extension: DOT text.
+    for name in ["a.dot", "a.gv", "a"] {
+        let (code, _, stderr) = btfsm(&["dot", fig, "-o", &out(name)]);
+        assert_eq!(code, 0, "{stderr}");
+        let text = std::fs::read_to_string(dir.join(name)).expect("written");
+        assert!(text.starts_with("digraph"), "{name}");
+    }
+    // `.svg`, `.PNG`: rendered through Graphviz (make test installs it).
+    let (code, _, stderr) = btfsm(&["dot", fig, "-o", &out("a.svg")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read_to_string(dir.join("a.svg"))
+            .expect("svg")
+            .contains("<svg")
+    );
+    let (code, _, stderr) = btfsm(&["dot", fig, "-o", &out("a.PNG")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read(dir.join("a.PNG"))
+            .expect("png")
+            .starts_with(b"\x89PNG")
+    );
+    // An explicit --render wins over the extension.
+    let (code, _, stderr) = btfsm(&["dot", fig, "--render", "svg", "-o", &out("b.png")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read_to_string(dir.join("b.png"))
+            .expect("svg")
+            .contains("<svg")
+    );
+    // compare --dot follows its own extension the same way.
+    let fig3 = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper/fig03-bt.toml");
+    let (code, _, stderr) = btfsm(&["compare", fig, fig3, "--dot", &out("d.svg")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read_to_string(dir.join("d.svg"))
+            .expect("svg")
+            .contains("<svg")
+    );
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
