@@ -20,7 +20,8 @@ pub struct Cli {
 pub enum Command {
     /// Counts, complexity and Table I estimates of each policy
     Analyze {
-        /// Policy files (TOML, BehaviorTree.CPP XML or SCXML)
+        /// Policy files (TOML, BehaviorTree.CPP XML, SCXML, yasmin XML), `-`
+        /// for stdin, or directories (every policy file below, sorted)
         #[arg(required = true)]
         files: Vec<PathBuf>,
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
@@ -43,6 +44,8 @@ pub enum Command {
     },
     /// Checks policy files and reports every problem with its position
     Validate {
+        /// Policy or scenario files, `-` for stdin, or directories (every
+        /// policy and scenario file below, sorted)
         #[arg(required = true)]
         files: Vec<PathBuf>,
         #[command(flatten)]
@@ -112,6 +115,7 @@ pub enum Command {
     },
     /// Effort (Eq. 4/5) to make an FSM reactive: formula and measured named GED
     Effort {
+        /// FSM files (any policy format), `-` for stdin, or directories
         #[arg(required = true)]
         files: Vec<PathBuf>,
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]

@@ -3,6 +3,7 @@
 
 pub mod btcpp_xml;
 pub mod btcpp_xml_write;
+pub mod discover;
 pub mod scxml;
 pub mod scxml_write;
 pub mod source;

@@ -1612,6 +1612,9 @@ impl Loader {
         // (state, transitions to resolve)
         type RawTr = (Trigger, String, Range<usize>);
         let mut raw_trs: Vec<Vec<RawTr>> = Vec::new();
+        // Per state (as `raw_trs`): whether it names a skill at all (a state
+        // whose skill is misspelled is not a state without one).
+        let mut names_skill: Vec<bool> = Vec::new();
         let mut qi = 0;
         while qi < queue.len() {
             let Pending {
@@ -1868,6 +1871,7 @@ impl Loader {
                     span: Some(k.span()),
                 });
                 raw_trs.push(trs);
+                names_skill.push(st.contains_key("skill"));
                 region.states.push(idx);
                 local.push((name, idx, k.span()));
             }
@@ -1939,7 +1943,8 @@ impl Loader {
             // code does, as yasmin and SMACH states do; a near miss of
             // SUCCESS / FAILURE / RUNNING is worth a warning (yasmin's own
             // `SUCCEED` is one).
-            let free = matches!(m.states[si].body, StateBody::Task(None));
+            let free = matches!(m.states[si].body, StateBody::Task(None))
+                && !names_skill.get(si).copied().unwrap_or(true);
             for (trigger, target, span) in trs {
                 if free
                     && let Trigger::Outcome(o) = &trigger

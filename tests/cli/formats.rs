@@ -676,3 +676,58 @@ fn the_render_format_follows_the_output_extension() {
     );
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
+
+#[test]
+fn a_directory_is_every_policy_below_it_and_a_bad_file_hides_no_report() {
+    let dir = scratch("dir-input");
+    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper");
+    std::fs::create_dir_all(dir.join("sub/.hidden")).expect("mkdir");
+    std::fs::copy(format!("{paper}/fig01-bt.toml"), dir.join("b-fig01.toml")).expect("copy");
+    std::fs::copy(
+        format!("{paper}/fig04-fsm.toml"),
+        dir.join("sub/a-fig04.toml"),
+    )
+    .expect("copy");
+    std::fs::copy(
+        format!("{paper}/fig02-fsm.toml"),
+        dir.join("sub/.hidden/x.toml"),
+    )
+    .expect("copy");
+    std::fs::write(dir.join("Cargo.toml"), "[package]\nname = \"x\"\n").expect("write");
+    std::fs::write(dir.join("package.xml"), "<package><name>x</name></package>").expect("write");
+    std::fs::write(
+        dir.join("bad.toml"),
+        "kind = \"bt\"\nroot = \"nope\"\n[nodes]\n",
+    )
+    .expect("write");
+    let d = dir.display().to_string();
+    let (code, stdout, stderr) = btfsm(&["analyze", &d, "--format", "json"]);
+    assert_eq!(code, 2, "a bad file makes exit 2: {stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("the good files' report");
+    let files: Vec<&str> = v["policies"]
+        .as_array()
+        .expect("policies")
+        .iter()
+        .map(|p| p["file"].as_str().expect("file"))
+        .collect();
+    assert_eq!(files.len(), 2, "{files:?}");
+    assert!(files[0].ends_with("b-fig01.toml") && files[1].ends_with("sub/a-fig04.toml"));
+    assert!(stderr.contains("bad.toml"), "{stderr}");
+    assert!(stderr.contains("skipped 2 files"), "{stderr}");
+    // Without the bad file: exit 0, and `validate` also checks scenarios.
+    std::fs::remove_file(dir.join("bad.toml")).expect("rm");
+    let (code, _, stderr) = btfsm(&["analyze", &d]);
+    assert_eq!(code, 0, "{stderr}");
+    let scen = concat!(env!("CARGO_MANIFEST_DIR"), "/policies");
+    let (code, _, stderr) = btfsm(&["validate", scen]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("ok (scenario `exp1-nominal`"), "{stderr}");
+    assert!(stderr.contains("fig01-bt.toml: ok (bt"), "{stderr}");
+    // A directory without policies is an error, not an empty report.
+    let empty = scratch("dir-empty");
+    let (code, _, stderr) = btfsm(&["analyze", &empty.display().to_string()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("no policy file"), "{stderr}");
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+    std::fs::remove_dir_all(&empty).expect("cleanup");
+}
