@@ -24,6 +24,7 @@ pub enum Command {
         /// for stdin, or directories (every policy file below, sorted)
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Output format
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
         format: OutputFormat,
         /// Exit 1 when a policy's METRIC is above N, e.g. `--max cc=30`
@@ -53,6 +54,7 @@ pub enum Command {
     },
     /// Draws a policy as Graphviz DOT (or SVG/PNG with --render)
     Dot {
+        /// Policy file (any format), or `-` for stdin
         file: PathBuf,
         /// Output file (default: stdout)
         #[arg(short, long)]
@@ -87,6 +89,7 @@ pub enum Command {
         /// `exact: false`
         #[arg(long, default_value_t = 2000, value_name = "MS")]
         timeout_ms: u64,
+        /// Output format
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
         format: CompareFormat,
         /// Also draw B with added elements red and A's removed ones dashed grey
@@ -103,6 +106,7 @@ pub enum Command {
     },
     /// Converts a policy into another representation
     Convert {
+        /// Policy file (any format), or `-` for stdin
         file: PathBuf,
         /// Target representation
         #[arg(long, value_enum)]
@@ -118,6 +122,7 @@ pub enum Command {
         /// FSM files (any policy format), `-` for stdin, or directories
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Output format
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
         format: OutputFormat,
         /// Time budget of the structural GED per policy; when it runs out the
@@ -133,6 +138,19 @@ pub enum Command {
     Edit(Box<EditArgs>),
     /// Runs policies in the planar robot simulator and compares their behavior
     Sim(super::sim::SimArgs),
+    /// Prints a shell completion script (e.g. `btfsm completions bash >
+    /// ~/.local/share/bash-completion/completions/btfsm`)
+    Completions {
+        /// The shell to complete in
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Prints the man page (roff; `make man` writes target/man/btfsm*.1)
+    #[command(hide = true)]
+    Man {
+        /// A subcommand's page instead of the main one (`btfsm-sim.1`)
+        subcommand: Option<String>,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -253,6 +271,7 @@ impl LimitArgs {
 /// Flags of `btfsm paper`.
 #[derive(Debug, Clone, Args)]
 pub struct PaperArgs {
+    /// Output format
     #[arg(long, value_enum, default_value_t = crate::report::paper::PaperFormat::Table)]
     pub format: crate::report::paper::PaperFormat,
     /// Time budget of each exact GED; when it runs out the cell shows the
@@ -308,6 +327,7 @@ pub enum EditOp {
     },
     /// Puts a new control node above the root (the paper's Figs. 7c, 7d)
     WrapRoot {
+        /// Control node to put above the root
         #[arg(long, value_enum)]
         kind: WrapKind,
         /// Id of the new root
@@ -319,6 +339,7 @@ pub enum EditOp {
     },
     /// Adds an FSM state as the paper's sec. IV-A 1b does (Algorithm 1 for connected states)
     AddState {
+        /// How the new state is connected
         #[arg(long, value_enum)]
         kind: AddKind,
         /// Name of the new state
@@ -373,4 +394,42 @@ pub enum AddKind {
     Alternative,
     /// Reached from every other state (Algorithm 1, Fig. 8d)
     Connected,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    /// Every subcommand and every argument of every subcommand says what it
+    /// is for in `--help` (clap's own `--help`/`--version` aside).
+    #[test]
+    fn every_subcommand_and_argument_has_help() {
+        let mut missing = Vec::new();
+        let mut stack = vec![(String::from("btfsm"), Cli::command())];
+        while let Some((path, cmd)) = stack.pop() {
+            for a in cmd.get_arguments() {
+                let id = a.get_id().as_str();
+                if id == "help" || id == "version" || a.is_hide_set() {
+                    continue;
+                }
+                if a.get_help().is_none() && a.get_long_help().is_none() {
+                    missing.push(format!("{path} {id}"));
+                }
+            }
+            for sub in cmd.get_subcommands() {
+                if sub.get_about().is_none() && !sub.is_hide_set() {
+                    missing.push(format!("{path} {} (about)", sub.get_name()));
+                }
+                stack.push((format!("{path} {}", sub.get_name()), sub.clone()));
+            }
+        }
+        assert!(missing.is_empty(), "arguments without help: {missing:#?}");
+    }
+
+    /// Clap's own consistency checks (conflicting names, bad defaults).
+    #[test]
+    fn the_command_line_is_well_formed() {
+        Cli::command().debug_assert();
+    }
 }

@@ -254,6 +254,37 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Paper(args) => super::paper::paper(&args),
         Command::Edit(args) => super::edit::edit(&args),
         Command::Sim(args) => super::sim::execute(args),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            let mut out = Vec::new();
+            clap_complete::generate(shell, &mut super::args::Cli::command(), "btfsm", &mut out);
+            emit(None, &out)
+        }
+        Command::Man { subcommand } => {
+            use clap::CommandFactory;
+            let top = super::args::Cli::command();
+            let cmd = match subcommand.as_deref() {
+                None => top,
+                Some(name) => match top.find_subcommand(name) {
+                    Some(c) => c
+                        .clone()
+                        .name(format!("btfsm-{name}"))
+                        .version(env!("CARGO_PKG_VERSION")),
+                    None => {
+                        eprintln!("error: no subcommand `{}`", shown(name));
+                        return EXIT_BAD_INPUT;
+                    }
+                },
+            };
+            let mut out = Vec::new();
+            match clap_mangen::Man::new(cmd).render(&mut out) {
+                Ok(()) => emit(None, &out),
+                Err(e) => {
+                    eprintln!("error: cannot write the man page: {e}");
+                    EXIT_BAD_INPUT
+                }
+            }
+        }
     }
 }
 
