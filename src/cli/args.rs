@@ -225,6 +225,11 @@ pub struct LimitArgs {
     /// e.g. Nav2's nav2_tree_nodes.xml
     #[arg(long = "nodes-model", value_name = "FILE")]
     pub nodes_model: Vec<PathBuf>,
+    /// The BehaviorTree.CPP tree to read, by its `<BehaviorTree ID>` (over
+    /// `main_tree_to_execute`; needed when a file holds several trees and
+    /// names none, as a program names it to BT.CPP's factory)
+    #[arg(long, value_name = "ID")]
+    pub tree: Option<String>,
     /// Read BehaviorTree.CPP leaves of unknown type as actions or conditions
     /// (default: an error listing the known types)
     #[arg(long, value_enum, value_name = "KIND")]
@@ -263,6 +268,7 @@ impl LimitArgs {
             },
             read_budget: crate::format::source::Budget::new(self.max_total_bytes),
             expansion_budget: crate::format::source::Budget::new(self.max_nodes as u64),
+            tree: self.tree.clone(),
             ..Default::default()
         }
     }

@@ -58,6 +58,10 @@ pub struct Limits {
     /// `max_nodes` in all, so that a few kilobytes of files including each
     /// other twice per level cannot build millions of nodes per policy.
     pub expansion_budget: Arc<source::Budget>,
+    /// The BehaviorTree.CPP tree to read (`--tree ID`), as a program names
+    /// it to the factory; over `main_tree_to_execute`. Other formats
+    /// ignore it.
+    pub tree: Option<String>,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -89,6 +93,7 @@ impl Default for Limits {
             confinement: source::Confinement::Auto,
             read_budget: source::Budget::new(source::DEFAULT_MAX_TOTAL_BYTES),
             expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
+            tree: None,
         }
     }
 }
