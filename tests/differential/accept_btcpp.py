@@ -106,12 +106,22 @@ def worker_main():
         end = data.index(b"</root>") + len(b"</root>")
         return instantiated_shape(data[start:end].decode("utf-8", "replace"))
 
-    out = {"ok": False, "mode": "main", "error": "", "shapes": {}}
+    def tick(tree, name):
+        # One tick with every dummy returning SUCCESS: BehaviorTree.CPP checks
+        # some child-count rules (IfThenElse, WhileDoElse, Parallel
+        # thresholds) only when a node runs.
+        try:
+            tree.tick_once()
+        except Exception as e:  # noqa: BLE001
+            out["tick_errors"][name] = str(e)
+
+    out = {"ok": False, "mode": "main", "error": "", "shapes": {}, "tick_errors": {}}
     path = job["file"]
     try:
         tree = factory().create_tree_from_file(path)
         out["ok"] = True
         out["shapes"]["<main>"] = shape(tree)
+        tick(tree, "<main>")
     except Exception as e:  # noqa: BLE001 - the engine's verdict, any type
         msg = str(e)
         out["error"] = msg
@@ -129,6 +139,7 @@ def worker_main():
                     f.register_behavior_tree_from_text(Path(path).read_text("utf-8"))
                     t = f.create_tree(tid)
                     out["shapes"][tid] = shape(t)
+                    tick(t, tid)
                 except Exception as e2:  # noqa: BLE001
                     errors.append(f"{tid}: {e2}")
             out["ok"] = not errors
@@ -437,6 +448,52 @@ def btfsm_export(exe, path, out):
     return res.returncode, res.stderr.strip()
 
 
+def check_export(exe, f, rel, work, b, r, mismatches):
+    """btfsm's BehaviorTree.CPP export of an accepted file must load (and tick
+    once) in BehaviorTree.CPP, with the original's shape when the original
+    loaded. b: BehaviorTree.CPP's verdict on the original (None: not XML)."""
+    exp = work / "export.xml"
+    ecode, eerr = btfsm_export(exe, f, exp)
+    r["export_exit"] = ecode
+    if ecode != 0:
+        if b is None and "behavior trees only" in eerr:
+            r["export_exit"] = "not a BT"
+            return
+        mismatches.append((rel, "export", "-", f"convert exit {ecode}", "", short(eerr)))
+        return
+    e = btcpp(exp, work / "exp", base=work)
+    r["export_btcpp_ok"] = e["ok"]
+    r["export_btcpp_error"] = e["error"]
+    r["export_tick_errors"] = e.get("tick_errors", {})
+    if not e["ok"]:
+        mismatches.append((rel, "export", "export rejected", "exported",
+                           short(e["error"]), "btfsm wrote it"))
+        return
+    tick0 = (b or {}).get("tick_errors", {})
+    tick1 = e.get("tick_errors", {})
+    if tick1 and not tick0:
+        mismatches.append((rel, "export", "export fails its first tick", "exported",
+                           short(next(iter(tick1.values()))), "btfsm wrote it"))
+    if b is not None and b["ok"]:
+        s0 = next(iter(b["shapes"].values()), [])
+        s1 = e["shapes"].get("<main>", [])
+        r["shape_equal"] = s0 == s1
+        if s0 != s1:
+            diff = next((k for k in range(min(len(s0), len(s1))) if s0[k] != s1[k]),
+                        min(len(s0), len(s1)))
+            a0 = s0[diff] if diff < len(s0) else "end"
+            a1 = s1[diff] if diff < len(s1) else "end"
+            mismatches.append((rel, "export", "shape differs", "shape differs",
+                               f"original node #{diff}: {a0} ({len(s0)} nodes)",
+                               f"export node #{diff}: {a1} ({len(s1)} nodes)"))
+
+
+def toml_files():
+    """Bundled TOML policies: btfsm's own BTs, checked on export only."""
+    out = sorted((REPO / "policies").rglob("*.toml")) + sorted((FIXTURES / "valid").rglob("*.toml"))
+    return [p for p in out if not {"scenarios", "lib", "tables"} & set(p.parts)]
+
+
 # --------------------------------------------------------------------------
 # Driver
 # --------------------------------------------------------------------------
@@ -492,6 +549,8 @@ def main():
     ap.add_argument("--json", help="write every result as JSON here")
     ap.add_argument("--print-known", action="store_true",
                     help="print the current mismatches in the known-file format")
+    ap.add_argument("--no-toml", action="store_true",
+                    help="skip the export check of the bundled TOML behavior trees")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("files", nargs="*", type=Path)
     a = ap.parse_args()
@@ -511,7 +570,7 @@ def main():
         return 2
     files = [p.resolve() for p in a.files] if a.files else fixture_files()
     known = read_known()
-    results, mismatches = [], []
+    results, mismatches, toml_results = [], [], []
     tmp = Path(tempfile.mkdtemp(prefix="accept-btcpp-"))
     try:
         for i, f in enumerate(files):
@@ -531,46 +590,37 @@ def main():
                                    (f"[{b['mode']}] " if b["mode"] != "main" else "") + short(b["error"]),
                                    short(why)))
             if btfsm_ok:
-                exp = work / "export.xml"
-                ecode, eerr = btfsm_export(exe, f, exp)
-                r["export_exit"] = ecode
-                if ecode != 0:
-                    mismatches.append((rel, "export", "-", f"convert exit {ecode}", "", short(eerr)))
-                else:
-                    e = btcpp(exp, work / "exp", base=work)
-                    r["export_btcpp_ok"] = e["ok"]
-                    r["export_btcpp_error"] = e["error"]
-                    if not e["ok"]:
-                        mismatches.append((rel, "export", "export rejected", "exported",
-                                           short(e["error"]), "btfsm wrote it"))
-                    elif b["ok"]:
-                        s0 = next(iter(b["shapes"].values()), [])
-                        s1 = e["shapes"].get("<main>", [])
-                        r["shape_equal"] = s0 == s1
-                        if s0 != s1:
-                            diff = next((k for k in range(min(len(s0), len(s1))) if s0[k] != s1[k]),
-                                        min(len(s0), len(s1)))
-                            a0 = s0[diff] if diff < len(s0) else "end"
-                            a1 = s1[diff] if diff < len(s1) else "end"
-                            mismatches.append((rel, "export", "shape differs",
-                                               "shape differs",
-                                               f"original node #{diff}: {a0} ({len(s0)} nodes)",
-                                               f"export node #{diff}: {a1} ({len(s1)} nodes)"))
+                check_export(exe, f, rel, work, b, r, mismatches)
             results.append(r)
             print(f"[{i + 1}/{len(files)}] {rel}: btcpp={'accept' if b['ok'] else 'reject'} "
                   f"btfsm={'accept' if btfsm_ok else 'reject' if code == 2 else code}",
                   file=sys.stderr)
+        if not a.files and not a.no_toml:
+            for i, f in enumerate(toml_files()):
+                rel = str(f.relative_to(REPO))
+                work = tmp / f"t{i}"
+                work.mkdir()
+                r = {"file": rel, "toml": True}
+                check_export(exe, f, rel, work, None, r, mismatches)
+                if r.get("export_exit") != "not a BT":
+                    toml_results.append(r)
+                    print(f"[toml] {rel}: export={r.get('export_btcpp_ok')}", file=sys.stderr)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
     seen = {(m[0], m[1]) for m in mismatches}
     new = [m for m in mismatches if (m[0], m[1]) not in known]
     checked = {str(p.relative_to(REPO)) if p.is_relative_to(REPO) else str(p) for p in files}
+    checked |= {r["file"] for r in toml_results}
     stale = [k for k in known if k not in seen and k[0] in checked]
     missing = [k for k in known if k[0] not in checked and not a.files]
 
     print(f"\n{len(files)} files; BehaviorTree.CPP accepts {sum(r['btcpp_ok'] for r in results)}, "
           f"btfsm accepts {sum(r['btfsm_exit'] == 0 for r in results)}; "
+          f"exports loaded {sum(bool(r.get('export_btcpp_ok')) for r in results + toml_results)}"
+          f"/{sum('export_btcpp_ok' in r for r in results + toml_results)} "
+          f"(+{len(toml_results)} TOML BTs), same shape "
+          f"{sum(bool(r.get('shape_equal')) for r in results)}/{sum('shape_equal' in r for r in results)}; "
           f"{len(mismatches)} mismatches ({len(mismatches) - len(new)} known, {len(new)} new), "
           f"{len(stale) + len(missing)} stale known entries\n")
     if mismatches:
@@ -589,7 +639,8 @@ def main():
         for m in mismatches:
             print(f"{m[0]} {m[1]} {known.get((m[0], m[1]), '?: ' + (m[4] or m[5]))}")
     if a.json:
-        Path(a.json).write_text(json.dumps({"results": results, "mismatches": mismatches}, indent=1))
+        Path(a.json).write_text(json.dumps({"results": results + toml_results,
+                                            "mismatches": mismatches}, indent=1))
     return 1 if new or stale or missing else 0
 
 
