@@ -82,9 +82,18 @@ def worker_main():
     def ok_tick(*_args):
         return bt.NodeStatus.SUCCESS
 
+    statuses = job.get("statuses", {})
+
+    def leaf_tick(name):
+        status = getattr(bt.NodeStatus, statuses.get(name, "SUCCESS"))
+        return lambda *_args: status
+
     def factory():
         f = bt.BehaviorTreeFactory()
         for name, kind in job["regs"].items():
+            if name in statuses:
+                f.register_simple_action(name, leaf_tick(name))
+                continue
             if kind == "condition":
                 f.register_simple_condition(name, ok_tick)
             elif kind == "decorator":
@@ -111,17 +120,18 @@ def worker_main():
         # some child-count rules (IfThenElse, WhileDoElse, Parallel
         # thresholds) only when a node runs.
         try:
-            tree.tick_once()
+            out["status"].setdefault(name, str(tree.tick_once()).split(".")[-1])
         except Exception as e:  # noqa: BLE001
             out["tick_errors"][name] = str(e)
 
-    out = {"ok": False, "mode": "main", "error": "", "shapes": {}, "tick_errors": {}}
+    out = {"ok": False, "mode": "main", "error": "", "shapes": {}, "tick_errors": {}, "status": {}}
     path = job["file"]
     try:
         tree = factory().create_tree_from_file(path)
         out["ok"] = True
         out["shapes"]["<main>"] = shape(tree)
-        tick(tree, "<main>")
+        # Ticked on a fresh copy: no logger attached to it.
+        tick(factory().create_tree_from_file(path), "<main>")
     except Exception as e:  # noqa: BLE001 - the engine's verdict, any type
         msg = str(e)
         out["error"] = msg
@@ -137,9 +147,8 @@ def worker_main():
                     os.chdir(Path(path).parent)
                     f = factory()
                     f.register_behavior_tree_from_text(Path(path).read_text("utf-8"))
-                    t = f.create_tree(tid)
-                    out["shapes"][tid] = shape(t)
-                    tick(t, tid)
+                    out["shapes"][tid] = shape(f.create_tree(tid))
+                    tick(f.create_tree(tid), tid)
                 except Exception as e2:  # noqa: BLE001
                     errors.append(f"{tid}: {e2}")
             out["ok"] = not errors
@@ -387,7 +396,7 @@ def _in_model(el, root):
     return False
 
 
-def btcpp(path, outdir, base=None):
+def btcpp(path, outdir, base=None, statuses=None):
     """BehaviorTree.CPP's verdict on one file: dict(ok, mode, error, shapes)."""
     files, roots, regs, controls, tree_ids = plan(path)
     if not files:
@@ -400,7 +409,7 @@ def btcpp(path, outdir, base=None):
         written = rewrite(files, {p: roots[p] for p in files}, regs, controls, outdir,
                           base or FIXTURES)
         target = written[0]
-    job = {"file": str(target), "regs": regs, "tree_ids": tree_ids}
+    job = {"file": str(target), "regs": regs, "tree_ids": tree_ids, "statuses": statuses or {}}
     try:
         res = subprocess.run(
             [sys.executable, str(Path(__file__).resolve()), "--worker"],
@@ -488,6 +497,83 @@ def check_export(exe, f, rel, work, b, r, mismatches):
                                f"export node #{diff}: {a1} ({len(s1)} nodes)"))
 
 
+# Semantic probes: a TOML tree whose meaning the README states, exported and
+# ticked once in BehaviorTree.CPP with the leaves returning fixed statuses.
+# (name, TOML text, leaf statuses, the status the TOML tree gives)
+PARALLEL = """kind = "bt"
+name = "probe"
+[nodes]
+root = { parallel = ["a", "b", "c"]%s }
+a = { action = "A" }
+b = { action = "B" }
+c = { action = "C" }
+"""
+PROBES = [
+    ("parallel-2-of-3-one-fails", PARALLEL % ", success = 2",
+     {"A": "SUCCESS", "B": "FAILURE", "C": "SUCCESS"}, "SUCCESS"),
+    ("parallel-2-of-3-two-fail", PARALLEL % ", success = 2",
+     {"A": "FAILURE", "B": "FAILURE", "C": "SUCCESS"}, "FAILURE"),
+    ("parallel-all-one-fails", PARALLEL % "",
+     {"A": "SUCCESS", "B": "FAILURE", "C": "SUCCESS"}, "FAILURE"),
+    ("parallel-all-succeed", PARALLEL % "",
+     {"A": "SUCCESS", "B": "SUCCESS", "C": "SUCCESS"}, "SUCCESS"),
+]
+
+
+def check_probes(exe, tmp, mismatches, results):
+    for name, text, statuses, want in PROBES:
+        work = tmp / f"probe-{name}"
+        work.mkdir()
+        src = work / f"{name}.toml"
+        src.write_text(text)
+        exp = work / "export.xml"
+        rel = f"probe:{name}"
+        ecode, eerr = btfsm_export(exe, src, exp)
+        if ecode != 0:
+            mismatches.append((rel, "export", "-", f"convert exit {ecode}", "", short(eerr)))
+            continue
+        e = btcpp(exp, work / "exp", base=work, statuses=statuses)
+        got = e.get("status", {}).get("<main>") or short(e["error"] or str(e.get("tick_errors")))
+        results.append({"file": rel, "probe": True, "want": want, "got": got})
+        print(f"[probe] {name}: TOML semantics {want}, BehaviorTree.CPP {got}", file=sys.stderr)
+        if got != want:
+            leaves = " ".join(f"{k}={v}" for k, v in statuses.items())
+            mismatches.append((rel, "export", f"first tick: {got}", f"TOML semantics: {want}",
+                               f"leaves {leaves}", short(exp.read_text().split("<BehaviorTree", 1)[1]
+                                                        .split("</BehaviorTree>")[0], 120)))
+
+
+# Child-count and threshold rules, as one-tree files (BehaviorTree.CPP checks
+# some of them only at the first tick).
+XML_PROBES = [
+    ("ifthenelse-1-child", "<IfThenElse><AlwaysSuccess/></IfThenElse>"),
+    ("ifthenelse-2-children", "<IfThenElse><AlwaysSuccess/><AlwaysSuccess/></IfThenElse>"),
+    ("ifthenelse-3-children", "<IfThenElse><AlwaysSuccess/><AlwaysSuccess/><AlwaysFailure/></IfThenElse>"),
+    ("ifthenelse-4-children",
+     "<IfThenElse><AlwaysSuccess/><AlwaysSuccess/><AlwaysFailure/><AlwaysFailure/></IfThenElse>"),
+    ("whiledoelse-1-child", "<WhileDoElse><AlwaysSuccess/></WhileDoElse>"),
+    ("whiledoelse-2-children", "<WhileDoElse><AlwaysSuccess/><AlwaysSuccess/></WhileDoElse>"),
+    ("whiledoelse-4-children",
+     "<WhileDoElse><AlwaysSuccess/><AlwaysSuccess/><AlwaysFailure/><AlwaysFailure/></WhileDoElse>"),
+    ("trycatch-2-children", "<TryCatch><AlwaysSuccess/><AlwaysSuccess/></TryCatch>"),
+    ("parallel-success-count-above-children",
+     '<Parallel success_count="4"><AlwaysSuccess/><AlwaysSuccess/><AlwaysSuccess/></Parallel>'),
+    ("parallel-success-count-minus-1",
+     '<Parallel success_count="-1"><AlwaysSuccess/><AlwaysSuccess/></Parallel>'),
+    ("parallel-failure-count-2",
+     '<Parallel success_count="2" failure_count="2"><AlwaysSuccess/><AlwaysFailure/><AlwaysSuccess/></Parallel>'),
+    ("switch2-3-children",
+     '<Switch2 variable="a" case_1="a" case_2="b"><AlwaysSuccess/><AlwaysSuccess/><AlwaysFailure/></Switch2>'),
+    ("switch2-2-children",
+     '<Switch2 variable="a" case_1="a" case_2="b"><AlwaysSuccess/><AlwaysSuccess/></Switch2>'),
+    ("retry-without-num-attempts", "<RetryUntilSuccessful><AlwaysSuccess/></RetryUntilSuccessful>"),
+    ("timeout-msec", '<Timeout msec="100"><AlwaysSuccess/></Timeout>'),
+    ("sequence-no-children", "<Sequence/>"),
+    ("inverter-2-children", "<Inverter><AlwaysSuccess/><AlwaysSuccess/></Inverter>"),
+    ("leaf-with-child", "<AlwaysSuccess><AlwaysFailure/></AlwaysSuccess>"),
+]
+
+
 def toml_files():
     """Bundled TOML policies: btfsm's own BTs, checked on export only."""
     out = sorted((REPO / "policies").rglob("*.toml")) + sorted((FIXTURES / "valid").rglob("*.toml"))
@@ -523,17 +609,17 @@ def find_btfsm(given):
     return None
 
 
-def read_known():
+def read_known(path):
     known = {}
-    if not KNOWN.is_file():
+    if not path.is_file():
         return known
-    for n, line in enumerate(KNOWN.read_text().splitlines(), 1):
+    for n, line in enumerate(path.read_text().splitlines(), 1):
         line = line.strip()
         if not line or line.startswith("#"):
             continue
         parts = line.split(None, 2)
         if len(parts) < 3 or parts[1] not in ("accept", "export"):
-            raise SystemExit(f"{KNOWN}:{n}: expected `<path> <accept|export> <side>: <reason>`")
+            raise SystemExit(f"{path}:{n}: expected `<path> <accept|export> <side>: <reason>`")
         known[(parts[0], parts[1])] = parts[2]
     return known
 
@@ -547,6 +633,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--btfsm", help="btfsm binary")
     ap.add_argument("--json", help="write every result as JSON here")
+    ap.add_argument("--known", type=Path, default=KNOWN,
+                    help="known-mismatch file (default: accept_btcpp_known.txt beside this script)")
     ap.add_argument("--print-known", action="store_true",
                     help="print the current mismatches in the known-file format")
     ap.add_argument("--no-toml", action="store_true",
@@ -569,15 +657,29 @@ def main():
               file=sys.stderr)
         return 2
     files = [p.resolve() for p in a.files] if a.files else fixture_files()
-    known = read_known()
+    known = read_known(a.known)
     results, mismatches, toml_results = [], [], []
     tmp = Path(tempfile.mkdtemp(prefix="accept-btcpp-"))
     try:
-        for i, f in enumerate(files):
-            rel = str(f.relative_to(REPO)) if f.is_relative_to(REPO) else str(f)
+        todo = [(f, str(f.relative_to(REPO)) if f.is_relative_to(REPO) else str(f)) for f in files]
+        if not a.files and not a.no_toml:
+            pdir = tmp / "xml-probes"
+            pdir.mkdir()
+            for name, body in XML_PROBES:
+                f = pdir / f"{name}.xml"
+                f.write_text(f'<root BTCPP_format="4">\n  <BehaviorTree ID="probe">\n    {body}\n'
+                             f'  </BehaviorTree>\n</root>\n')
+                todo.append((f, f"probe:{name}"))
+        for i, (f, rel) in enumerate(todo):
             work = tmp / f"f{i}"
             work.mkdir()
             b = btcpp(f, work / "orig")
+            if b["ok"] and b.get("tick_errors"):
+                # BehaviorTree.CPP checks some child counts only when the node
+                # runs: an error at the first tick (all dummies SUCCESS) is a
+                # rejection too.
+                b["ok"] = False
+                b["error"] = "first tick: " + next(iter(b["tick_errors"].values()))
             code, why = btfsm_validate(exe, f)
             r = {"file": rel, "btcpp_ok": b["ok"], "btcpp_mode": b["mode"],
                  "btcpp_error": b["error"], "btfsm_exit": code, "btfsm_error": why,
@@ -592,10 +694,11 @@ def main():
             if btfsm_ok:
                 check_export(exe, f, rel, work, b, r, mismatches)
             results.append(r)
-            print(f"[{i + 1}/{len(files)}] {rel}: btcpp={'accept' if b['ok'] else 'reject'} "
+            print(f"[{i + 1}/{len(todo)}] {rel}: btcpp={'accept' if b['ok'] else 'reject'} "
                   f"btfsm={'accept' if btfsm_ok else 'reject' if code == 2 else code}",
                   file=sys.stderr)
         if not a.files and not a.no_toml:
+            check_probes(exe, tmp, mismatches, toml_results)
             for i, f in enumerate(toml_files()):
                 rel = str(f.relative_to(REPO))
                 work = tmp / f"t{i}"
@@ -612,14 +715,16 @@ def main():
     new = [m for m in mismatches if (m[0], m[1]) not in known]
     checked = {str(p.relative_to(REPO)) if p.is_relative_to(REPO) else str(p) for p in files}
     checked |= {r["file"] for r in toml_results}
+    checked |= ({f"probe:{p[0]}" for p in PROBES} | {f"probe:{p[0]}" for p in XML_PROBES}
+                if not a.files and not a.no_toml else set())
     stale = [k for k in known if k not in seen and k[0] in checked]
     missing = [k for k in known if k[0] not in checked and not a.files]
 
-    print(f"\n{len(files)} files; BehaviorTree.CPP accepts {sum(r['btcpp_ok'] for r in results)}, "
+    print(f"\n{len(files)} fixture files + {len(results) - len(files)} probe trees; BehaviorTree.CPP accepts {sum(r['btcpp_ok'] for r in results)}, "
           f"btfsm accepts {sum(r['btfsm_exit'] == 0 for r in results)}; "
           f"exports loaded {sum(bool(r.get('export_btcpp_ok')) for r in results + toml_results)}"
           f"/{sum('export_btcpp_ok' in r for r in results + toml_results)} "
-          f"(+{len(toml_results)} TOML BTs), same shape "
+          f"(with {len(toml_results)} TOML BTs and probes), same shape "
           f"{sum(bool(r.get('shape_equal')) for r in results)}/{sum('shape_equal' in r for r in results)}; "
           f"{len(mismatches)} mismatches ({len(mismatches) - len(new)} known, {len(new)} new), "
           f"{len(stale) + len(missing)} stale known entries\n")
@@ -631,7 +736,7 @@ def main():
             print(f"| {m[0]} | {m[1]} | {m[2]} | {m[3]} | {m[4].replace('|', '/')} | "
                   f"{m[5].replace('|', '/')} | {('yes: ' + k.replace('|', '/')) if k else 'NEW'} |")
     for k in stale:
-        print(f"STALE known mismatch (no longer mismatches, remove it from {KNOWN.name}): {k[0]} {k[1]}")
+        print(f"STALE known mismatch (no longer mismatches, remove it from {a.known.name}): {k[0]} {k[1]}")
     for k in missing:
         print(f"STALE known mismatch (file no longer checked): {k[0]} {k[1]}")
     if a.print_known:
