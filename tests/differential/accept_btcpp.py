@@ -571,6 +571,11 @@ XML_PROBES = [
     ("sequence-no-children", "<Sequence/>"),
     ("inverter-2-children", "<Inverter><AlwaysSuccess/><AlwaysSuccess/></Inverter>"),
     ("leaf-with-child", "<AlwaysSuccess><AlwaysFailure/></AlwaysSuccess>"),
+    # What tinyxml2 (BehaviorTree.CPP's parser) tolerates and XML 1.0 does not.
+    ("xml-duplicate-attribute", '<AlwaysSuccess name="a" name="b"/>'),
+    ("xml-bare-ampersand", '<AlwaysSuccess name="fish & chips"/>'),
+    ("xml-text-between-nodes", "<Sequence>some text<AlwaysSuccess/></Sequence>"),
+    ("xml-undeclared-prefix", '<AlwaysSuccess name="a" x:y="1"/>'),
 ]
 
 
