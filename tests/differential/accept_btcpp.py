@@ -325,7 +325,7 @@ def plan(path):
                 tree_ids.add(t.get("ID"))
         for typ, n in node_uses(r).items():
             uses[typ] = max(uses.get(typ, 0), n)
-    if roots.get(files[0]) is None and files:
+    if files and roots.get(files[0]) is None:
         # Our parser refuses the text (tinyxml2 may not): registrations from a
         # tag scan, every unknown tag a leaf.
         text = Path(files[0]).read_text("utf-8", "replace")
