@@ -438,8 +438,28 @@ def btfsm_args(path):
     return args
 
 
+def unnamed_trees(path):
+    """The tree IDs of a file with several <BehaviorTree>s and no
+    main_tree_to_execute (a program names one in code: `--tree ID`)."""
+    root = parse(path)
+    if root is None or root.get("main_tree_to_execute"):
+        return []
+    ids = [el.get("ID") for el in root if local(el.tag) == "BehaviorTree" and el.get("ID")]
+    return ids if len(ids) > 1 else []
+
+
 def btfsm_validate(exe, path):
-    res = subprocess.run([exe, "validate", *btfsm_args(path), str(path)],
+    # Several trees and no main tree: BehaviorTree.CPP registers them all and
+    # a program creates one; btfsm must accept each with `--tree ID`.
+    for tid in unnamed_trees(path):
+        code, why = btfsm_validate_one(exe, path, ["--tree", tid])
+        if code != 0:
+            return code, f"--tree {tid}: {why}"
+    return btfsm_validate_one(exe, path, [] if not unnamed_trees(path) else ["--tree", unnamed_trees(path)[0]])
+
+
+def btfsm_validate_one(exe, path, extra):
+    res = subprocess.run([exe, "validate", *btfsm_args(path), *extra, str(path)],
                          capture_output=True, text=True, timeout=WORKER_TIMEOUT, check=False)
     lines = res.stderr.splitlines()
     first = next((ln for ln in lines if ln.startswith("error")), "")
@@ -451,7 +471,9 @@ def btfsm_validate(exe, path):
 
 
 def btfsm_export(exe, path, out):
-    res = subprocess.run([exe, "convert", *btfsm_args(path), str(path), "--to", "btcpp-xml",
+    ids = unnamed_trees(path)
+    extra = ["--tree", ids[0]] if ids else []
+    res = subprocess.run([exe, "convert", *btfsm_args(path), *extra, str(path), "--to", "btcpp-xml",
                           "-o", str(out)], capture_output=True, text=True,
                          timeout=WORKER_TIMEOUT, check=False)
     return res.returncode, res.stderr.strip()
