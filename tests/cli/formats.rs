@@ -165,8 +165,10 @@ fn count_tree_nodes(path: &Path) -> usize {
 /// Vertices and arcs of an SCXML file's HFSM graph by the test's own scanner:
 /// every `<state>` and `<history>`, plus the `<final>` states of the top level
 /// (the machine's outcomes; nested finals are their container's outcomes, not
-/// vertices); one arc per `<transition>` with a target, plus one per state
-/// holding states (to its initial child).
+/// vertices); one arc per `<transition>` with a target (not the one of an
+/// `<initial>`, which is the container's arc), plus one per state holding
+/// states (to its initial child). A machine embedded in `<invoke>` is
+/// another machine: not counted.
 fn count_scxml_graph(path: &Path) -> (usize, usize) {
     let text = std::fs::read_to_string(path).expect("read");
     // (element name, holds a state)
@@ -181,7 +183,15 @@ fn count_scxml_graph(path: &Path) -> (usize, usize) {
             }
             continue;
         }
+        let inside = |tag: &str| stack.iter().any(|(p, _)| p == tag);
+        if inside("invoke") {
+            if !self_closing {
+                stack.push((name, false));
+            }
+            continue;
+        }
         match name.as_str() {
+            "transition" if stack.last().map(|(p, _)| p.as_str()) == Some("initial") => {}
             "state" | "history" => {
                 n += 1;
                 if let Some(parent) = stack.last_mut().filter(|(p, _)| p == "state") {
