@@ -90,7 +90,7 @@ pub const BUILTINS: &[(&str, Category)] = &[
     ("LoopBool", Category::Decorator),
     ("EntryUpdated", Category::Decorator),
     ("SkipUnlessUpdated", Category::Decorator),
-    ("WaitValueUpdated", Category::Decorator),
+    ("WaitValueUpdate", Category::Decorator),
     ("BlackboardCheckInt", Category::Decorator),
     ("BlackboardCheckDouble", Category::Decorator),
     ("BlackboardCheckString", Category::Decorator),
@@ -102,7 +102,7 @@ pub const BUILTINS: &[(&str, Category)] = &[
     ("UnsetBlackboard", Category::Action),
     ("Sleep", Category::Action),
     ("ScriptCondition", Category::Condition),
-    ("WasEntryUpdated", Category::Condition),
+    ("WasEntryUpdated", Category::Action),
 ];
 
 /// The category of a built-in type.
