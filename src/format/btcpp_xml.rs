@@ -267,7 +267,10 @@ fn load(
     base: PathBuf,
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let main = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    // BehaviorTree.CPP reads with tinyxml2, which is lenient: so is this
+    // reader, with a warning at each place (`xml_lenient`).
+    let (main, repaired) =
+        xml::parse_lenient(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
     let elems_left = limits.max_nodes - main.elems.len();
     let root = super::source::root_for(limits, &base);
     let mut l = Loader {
@@ -281,6 +284,7 @@ fn load(
         models: BTreeMap::new(),
         unknown: Default::default(),
     };
+    l.diags.extend(repaired);
     let policy = l.run(identity);
     super::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")
 }
@@ -294,7 +298,8 @@ impl Loader<'_> {
     /// Parses a file read for this policy, charging its elements to the
     /// shared element budget.
     fn parse_charged(&mut self, file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
-        let doc = xml::parse(file, self.elems_left, self.limits.max_nodes)?;
+        let (doc, repaired) = xml::parse_lenient(file, self.elems_left, self.limits.max_nodes)?;
+        self.diags.extend(repaired);
         self.elems_left -= doc.elems.len();
         Ok(doc)
     }
