@@ -1,7 +1,7 @@
 # btfsm: `make run` runs the main job on the bundled policies and scenarios,
 # `make test` is what CI runs.
 CARGO ?= cargo
-BIN := target/release/btfsm
+BIN := $(or $(CARGO_TARGET_DIR),target)/release/btfsm
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
