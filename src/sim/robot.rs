@@ -44,8 +44,14 @@ pub(super) struct Robot {
     pub(super) events: Vec<Event>,
     pub(super) faults: Faults,
     pub(super) log: bool,
-    pub(super) last_failed: Option<Call>,
-    pub(super) switches: u32,
+    /// Actions that ended in FAILURE so far (the run loop re-ticks a policy
+    /// whose root failed because one did, within the same step).
+    pub(super) failed_ends: u64,
+    /// Leaves whose action started in this step, a retry of the action that
+    /// just failed excepted (livelock detection; cleared by the run loop).
+    pub(super) started: Vec<usize>,
+    /// The leaf whose action failed last, until the next start.
+    pub(super) failed_key: Option<usize>,
     pub(super) failures: u32,
     pub(super) mark: u64,
     pub(super) low_at: Option<f64>,
@@ -111,7 +117,6 @@ impl Robot {
     fn sync_progress(&mut self) {
         if self.world.progress != self.mark {
             self.mark = self.world.progress;
-            self.switches = 0;
             self.failures = 0;
         }
     }
@@ -164,11 +169,10 @@ impl Leaves for Robot {
                 self.close(old.record, "cancelled");
             }
             self.sync_progress();
-            // Every start counts, except a retry of the action that just failed.
-            if self.last_failed != Some(*call) {
-                self.switches += 1;
+            if self.failed_key != Some(key) && self.started.len() < 64 {
+                self.started.push(key);
             }
-            self.last_failed = None;
+            self.failed_key = None;
             let doomed = self.faults.doomed(call.name());
             if *call == Call::Recharge
                 && let Some(t) = self.low_at.take()
@@ -204,7 +208,8 @@ impl Leaves for Robot {
             if s == Status::Failure {
                 self.sync_progress();
                 self.failures += 1;
-                self.last_failed = Some(*call);
+                self.failed_ends += 1;
+                self.failed_key = Some(key);
             }
         }
         s

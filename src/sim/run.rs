@@ -11,10 +11,10 @@
 use super::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
 use super::rng::SimRng;
 use super::robot::{Faults, MAX_EVENTS, MAX_SKILL_RECORDS, Robot, apply, round3};
-use super::scenario::{Disturbance, PolicyEntry, Scenario, When};
+use super::scenario::{AfterSuccess, Disturbance, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Status};
-use super::trace::{FinalWorld, Outcome, Run, Step, compact_trajectory};
-use super::world::{P2, World};
+use super::trace::{FinalWorld, Outcome, Run, Step, compact_track, compact_trajectory};
+use super::world::{P2, Place, World, dist};
 use crate::model::PolicyBody;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -27,6 +27,8 @@ pub struct Prepared {
     pub file: String,
     pub kind: String,
     pub convert: Option<String>,
+    /// What the policy does after it reports SUCCESS.
+    pub after_success: AfterSuccess,
     pub exec: Compiled,
     /// Node id / state path per key (for statuses).
     pub keys: Arc<Vec<String>>,
@@ -81,6 +83,7 @@ fn prepare_one(e: &PolicyEntry, w: &World) -> Prepared {
         file: e.file.display().to_string(),
         kind: e.policy.kind().to_string(),
         convert: e.convert.clone(),
+        after_success: e.after_success,
         exec,
         keys: Arc::new(keys),
     }
@@ -168,8 +171,9 @@ pub fn run_policy_into(
             rng: SimRng::named(seed, "skill-faults"),
         },
         log: opts.log,
-        last_failed: None,
-        switches: 0,
+        failed_ends: 0,
+        started: Vec::new(),
+        failed_key: None,
         failures: 0,
         mark: 0,
         low_at: None,
@@ -180,10 +184,21 @@ pub fn run_policy_into(
         Bt(BtExec),
         M(MachineExec),
     }
+    let keep_ticking = p.after_success == AfterSuccess::KeepTicking;
     let mut ex = match &p.exec {
         Compiled::Bt(b) => Ex::Bt(BtExec::new(b.clone(), opts.trace)),
-        Compiled::Machine(m) => Ex::M(MachineExec::new(m.clone(), opts.trace)),
+        Compiled::Machine(m) => {
+            let mut m = MachineExec::new(m.clone(), opts.trace);
+            m.keep_ticking = keep_ticking;
+            Ex::M(m)
+        }
     };
+    // `after_success = "stop"`: the policy is no longer ticked once it has
+    // reported SUCCESS (a machine ends at its outcome by itself).
+    let mut stopped = false;
+    let mut livelock = Livelock::new(s.livelock_repeats);
+    let goal_terms: &[(Call, bool)] = s.goal.as_deref().unwrap_or(&[]);
+    let mut track: Vec<(u64, P2)> = Vec::new();
     let mut fired = vec![false; disturbances.len()];
     // Timed disturbances not yet fired (a run is not over while one is).
     let mut pending_timed = (disturbances.iter())
@@ -199,6 +214,7 @@ pub fn run_policy_into(
     let mut last = Status::Running;
     if opts.log {
         trajectory.push(robot.world.robot);
+        track.push((0, robot.world.robot));
     }
     while steps < s.max_steps {
         if let Some(d) = opts.deadline
@@ -213,6 +229,7 @@ pub fn run_policy_into(
         }
         steps += 1;
         let now = robot.world.time + 1e-9;
+        let mut disturbed = false;
         for (i, d) in disturbances.iter().enumerate() {
             if fired[i] {
                 continue;
@@ -228,6 +245,7 @@ pub fn run_policy_into(
                     pending_timed -= 1;
                 }
                 apply(d, &mut robot);
+                disturbed = true;
             }
         }
         let lowb = robot.world.battery <= robot.world.params.low_battery;
@@ -237,14 +255,45 @@ pub fn run_policy_into(
             robot.event("battery-low", format!("battery at {b:.1}%"));
         }
         low = lowb;
-        last = match &mut ex {
-            Ex::Bt(b) => b.tick(&mut robot),
-            Ex::M(m) => m.step(&mut robot),
-        };
+        if !stopped {
+            // A policy whose root failed because an action failed, and
+            // which goes on (a BT, a machine re-entered after FAILURE), is
+            // ticked again in the same step, as an FSM's failure arc starts
+            // its next action in the step of the failure: no representation
+            // gets a step for free. Bounded: MAX_TICKS_PER_STEP ticks.
+            let mut ticks = 0;
+            loop {
+                ticks += 1;
+                let failed = robot.failed_ends;
+                last = match &mut ex {
+                    Ex::Bt(b) => b.tick(&mut robot),
+                    Ex::M(m) => m.step(&mut robot),
+                };
+                let goes_on = match &ex {
+                    Ex::Bt(_) => true,
+                    Ex::M(m) => m.finished.is_none(),
+                };
+                if last != Status::Failure
+                    || !goes_on
+                    || robot.failed_ends == failed
+                    || ticks >= MAX_TICKS_PER_STEP
+                {
+                    break;
+                }
+                // The last tick of the step says which actions go on.
+                robot.ticked.iter_mut().for_each(|t| *t = false);
+            }
+            if last == Status::Success && !keep_ticking && matches!(ex, Ex::Bt(_)) {
+                stopped = true;
+            }
+        }
         robot.end_step();
         robot.world.advance(s.dt);
         if opts.log {
             trajectory.push(robot.world.robot);
+            if track.last().is_none_or(|&(_, q)| dist(q, robot.world.robot) > 1e-6) {
+                track.push((steps, robot.world.robot));
+            }
         }
         if opts.trace {
             let st = match &ex {
@@ -306,8 +355,17 @@ pub fn run_policy_into(
             ));
             break;
         }
-        if robot.switches > s.chatter_switches {
-            let text = format!("{} actions started without progress", robot.switches);
+        let measure = (goal_terms.iter())
+            .filter(|(c, neg)| skills::condition(c, &robot.world) != *neg)
+            .count()
+            + usize::from(done);
+        let fresh = !robot.started.is_empty();
+        let state = abstract_state(&robot);
+        robot.started.clear();
+        if let Some(n) = livelock.step(state, fresh, measure, disturbed) {
+            let text = format!(
+                "livelock: an abstract state (world facts, running skills) entered {n} times without progress toward the goal"
+            );
             robot.event("chattering", text.clone());
             ended = Some((Outcome::Chattering, text));
             break;
@@ -348,6 +406,8 @@ pub fn run_policy_into(
         reason,
         goal_met,
         steps,
+        dt: s.dt,
+        after_success: p.after_success.as_str(),
         completion_s: completion.map(round3),
         duration_s: round3(robot.world.time),
         distance_m: round3(robot.world.odometer),
@@ -356,13 +416,94 @@ pub fn run_policy_into(
         final_world: FinalWorld::of(&robot.world),
         recharge_latency_s: robot.latencies,
         trajectory,
+        track,
         trace,
     }
 }
 
+/// Ticks of a policy in one step at most: the first, and the re-ticks after
+/// a FAILURE caused by a failed action.
+pub const MAX_TICKS_PER_STEP: u32 = 4;
+
+/// Abstract states a run remembers at most between two progresses toward
+/// the goal (the set is cleared when full: a cycle through more distinct
+/// states is not detected, and runs to its step budget).
+pub const LIVELOCK_STATES: usize = 4096;
+
+/// Livelock detection (SPEC §6): the abstract state — world facts and the
+/// running skills — is noted each time it changes; entering one state
+/// `repeats` times without progress toward the goal (the number of goal
+/// terms that hold, and whether the policy reports SUCCESS) and without a
+/// disturbance is a livelock. Memory: at most [`LIVELOCK_STATES`] hashes.
+struct Livelock {
+    repeats: u32,
+    seen: std::collections::HashMap<u64, u32>,
+    last: Option<u64>,
+    measure: usize,
+}
+
+impl Livelock {
+    fn new(repeats: u32) -> Self {
+        Livelock {
+            repeats,
+            seen: std::collections::HashMap::new(),
+            last: None,
+            measure: usize::MAX,
+        }
+    }
+
+    /// Notes a step's state (`fresh`: an action started in the step, so
+    /// the state is entered again even if it is the last one); `Some(times)`
+    /// when it is a livelock.
+    fn step(&mut self, state: u64, fresh: bool, measure: usize, disturbed: bool) -> Option<u32> {
+        if measure != self.measure || disturbed || self.seen.len() >= LIVELOCK_STATES {
+            self.measure = measure;
+            self.seen.clear();
+            self.last = None;
+        }
+        if !fresh && self.last == Some(state) {
+            return None;
+        }
+        self.last = Some(state);
+        let n = self.seen.entry(state).or_insert(0);
+        *n += 1;
+        (*n >= self.repeats).then_some(*n)
+    }
+}
+
+/// The abstract state of the robot, hashed: where each object is (held, or
+/// its place to the centimetre) and whether it was seen, the arm, shut-down,
+/// emergency, charging, the battery by tenths (and whether it is low),
+/// which leaf runs which skill, and which leaves started an action in the
+/// step (an action may start and finish within one step). The robot's position is left out: moving is
+/// what a running navigation does.
+fn abstract_state(r: &Robot) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let w = &r.world;
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for o in &w.objects {
+        match o.place {
+            Place::Held => u8::MAX.hash(&mut h),
+            Place::At(p) => ((p.0 * 100.0).round() as i64, (p.1 * 100.0).round() as i64).hash(&mut h),
+        }
+        o.found.hash(&mut h);
+    }
+    (w.arm_tucked, w.shut_down, w.emergency, w.charging).hash(&mut h);
+    ((w.battery / 10.0).floor() as i64, w.battery <= w.params.low_battery).hash(&mut h);
+    for (k, l) in r.live.iter().enumerate() {
+        if let Some(l) = l {
+            (k, l.call.name()).hash(&mut h);
+        }
+    }
+    // The actions started in the step (and maybe done in it already).
+    u32::MAX.hash(&mut h);
+    r.started.hash(&mut h);
+    h.finish()
+}
+
 /// Whether the wall-clock budget cut `r` short: a timeout before the step
 /// budget was used up (the clock is read only while steps remain).
-pub(super) fn cut_short(s: &Scenario, r: &Run) -> bool {
+pub fn cut_short(s: &Scenario, r: &Run) -> bool {
     r.outcome == Outcome::Timeout
         && r.steps < s.max_steps
         && r.reason.starts_with("wall-clock budget")
@@ -437,6 +578,7 @@ fn run_scenario_out(
             // Kept for the verdicts and the plot: the points where the
             // robot moved, at most TRAJECTORY_POINTS of them.
             run.trajectory = compact_trajectory(std::mem::take(&mut run.trajectory));
+            run.track = compact_track(std::mem::take(&mut run.track));
             any_cut |= cut_short(s, &run);
             run
         })

@@ -69,6 +69,10 @@ pub struct MachineExec {
     pub finished: Option<(String, String)>,
     /// When `Some`, every state run in the last step with its status.
     pub statuses: Option<Vec<(usize, Status)>>,
+    /// `after_success = "keep-ticking"`: reaching the top-level outcome
+    /// SUCCESS returns SUCCESS and the next step re-enters the machine at
+    /// its initial state, instead of ending it.
+    pub keep_ticking: bool,
 }
 
 enum Flow {
@@ -85,6 +89,7 @@ impl MachineExec {
             current,
             finished: None,
             statuses: record.then(Vec::new),
+            keep_ticking: false,
         }
     }
 
@@ -132,6 +137,8 @@ impl MachineExec {
         'anc: for &a in anc.iter().rev() {
             for (g, t) in &c.guards[a] {
                 if Self::holds(g, leaves) {
+                    // The running state is left: its action is halted now.
+                    leaves.halt(self.current);
                     flow = self.follow(a, t);
                     break 'anc;
                 }
@@ -148,6 +155,10 @@ impl MachineExec {
                     if o == "RUNNING" {
                         self.current = c.m.top.initial;
                         return Status::Running;
+                    }
+                    if o == "SUCCESS" && self.keep_ticking {
+                        self.current = c.m.top.initial;
+                        return Status::Success;
                     }
                     // A tick-driven machine (top-level outcome RUNNING, as the
                     // BT -> HFSM construction makes) is re-entered after a
@@ -168,6 +179,9 @@ impl MachineExec {
                 Flow::Enter(s) => {
                     // A state left by a guard runs nothing (and is not noted).
                     if let Some((_, t)) = c.guards[s].iter().find(|(g, _)| Self::holds(g, leaves)) {
+                        // Preempted: a running action of the state is halted
+                        // at once (a state entered afresh has none).
+                        leaves.halt(s);
                         flow = self.follow(s, t);
                         continue;
                     }
