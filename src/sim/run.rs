@@ -640,6 +640,8 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
         let one = monte_carlo(&s, 6, 3, 1);
         let two = monte_carlo(&s, 6, 3, 2);
         assert_eq!(one, two);
+        assert_eq!(one.pairs.len(), 1);
+        let one = one.policies;
         assert_eq!(one.len(), 2);
         assert_eq!(one[0].runs, 6);
         // Every episode drops the battery, so every policy recharges.
@@ -654,12 +656,14 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
     fn a_spent_wall_clock_budget_stops_every_run_at_once() {
         let s = scenario(FLAKY);
         // No deadline: the same figures as without the budget.
-        let (stats, done) = monte_carlo_within(&s, 6, 3, 2, None);
-        assert_eq!((stats, done), (monte_carlo(&s, 6, 3, 2), 6));
+        let mc = monte_carlo_within(&s, 6, 3, 2, None);
+        assert_eq!(mc.runs, 6);
+        assert_eq!(mc, monte_carlo(&s, 6, 3, 2));
         // A deadline already past: no episode completes, no figure is made up.
-        let (stats, done) = monte_carlo_within(&s, 6, 3, 2, Some(Instant::now()));
-        assert_eq!(done, 0);
-        assert!(stats.iter().all(|p| p.runs == 0 && p.successes == 0));
+        let mc = monte_carlo_within(&s, 6, 3, 2, Some(Instant::now()));
+        assert_eq!(mc.runs, 0);
+        assert!(mc.policies.iter().all(|p| p.runs == 0 && p.successes == 0));
+        assert!(mc.pairs.iter().all(|p| p.runs == 0 && p.first_divergence.is_none()));
         let (runs, cut) = run_scenario_within(&s, false, Some(Instant::now()));
         assert!(cut);
         for r in &runs {
@@ -692,7 +696,7 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
             "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
         )
         .unwrap();
-        let text = "max_steps = 1000000\n[world]\nrobot = \"east-table\"\nparams = { manipulation_s = 0 }\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"pp.toml\"\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
+        let text = "max_steps = 1000000\nlivelock_repeats = 1000000\n[world]\nrobot = \"east-table\"\nparams = { manipulation_s = 0 }\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"pp.toml\"\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
         let f = SourceFile::new("pp-scenario.toml", text);
         let s = super::super::scenario::parse(&f, &dir, &Limits::default()).expect("valid");
         let (runs, cut) = run_scenario_within(&s, false, None);
@@ -708,8 +712,8 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
         assert!(r.events.len() <= MAX_EVENTS);
         assert!(r.steps < 1000, "{}", r.steps);
         // Monte Carlo: a timeout of the episode, not a budget cut.
-        let (stats, done) = monte_carlo_within(&s, 2, 1, 1, None);
-        assert_eq!((done, stats[0].timeouts), (2, 2));
+        let mc = monte_carlo_within(&s, 2, 1, 1, None);
+        assert_eq!((mc.runs, mc.policies[0].timeouts), (2, 2));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
