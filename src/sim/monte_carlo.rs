@@ -74,7 +74,10 @@ pub fn wilson(k: u32, n: u32) -> [f64; 2] {
     let z2 = z * z;
     let centre = (p + z2 / (2.0 * n)) / (1.0 + z2 / n);
     let half = z / (1.0 + z2 / n) * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
-    [round3((centre - half).max(0.0)), round3((centre + half).min(1.0))]
+    [
+        round3((centre - half).max(0.0)),
+        round3((centre + half).min(1.0)),
+    ]
 }
 
 /// Nearest-rank quantiles 10 %, 50 %, 90 % of `v` (sorted here).
@@ -228,8 +231,10 @@ pub fn monte_carlo_within(
                     round3(matches as f64 / runs as f64)
                 },
                 match_ci95: wilson(matches, runs),
-                first_divergence: (agree.iter().find(|e| !e.2[x]))
-                    .map(|e| Diverged { episode: e.0, seed: e.1 }),
+                first_divergence: (agree.iter().find(|e| !e.2[x])).map(|e| Diverged {
+                    episode: e.0,
+                    seed: e.1,
+                }),
             }
         })
         .collect();

@@ -336,16 +336,21 @@ impl McReport {
         out.push_str(&table(md, &head, rows));
         if !self.pairs.is_empty() {
             out.push('\n');
-            let head = ["pair", "behavior match rate", "95% CI", "first diverging episode (seed)"];
+            let head = [
+                "pair",
+                "behavior match rate",
+                "95% CI",
+                "first diverging episode (seed)",
+            ];
             let rows = (self.pairs.iter())
                 .map(|p| {
                     vec![
                         format!("{} vs {}", p.a, p.b),
                         format!("{:.3}", p.match_rate),
                         format!("[{:.3}, {:.3}]", p.match_ci95[0], p.match_ci95[1]),
-                        p.first_divergence.as_ref().map_or("-".into(), |d| {
-                            format!("{} (--seed {})", d.episode, d.seed)
-                        }),
+                        p.first_divergence
+                            .as_ref()
+                            .map_or("-".into(), |d| format!("{} (--seed {})", d.episode, d.seed)),
                     ]
                 })
                 .collect();

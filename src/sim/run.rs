@@ -291,7 +291,10 @@ pub fn run_policy_into(
         robot.world.advance(s.dt);
         if opts.log {
             trajectory.push(robot.world.robot);
-            if track.last().is_none_or(|&(_, q)| dist(q, robot.world.robot) > 1e-6) {
+            if track
+                .last()
+                .is_none_or(|&(_, q)| dist(q, robot.world.robot) > 1e-6)
+            {
                 track.push((steps, robot.world.robot));
             }
         }
@@ -484,12 +487,18 @@ fn abstract_state(r: &Robot) -> u64 {
     for o in &w.objects {
         match o.place {
             Place::Held => u8::MAX.hash(&mut h),
-            Place::At(p) => ((p.0 * 100.0).round() as i64, (p.1 * 100.0).round() as i64).hash(&mut h),
+            Place::At(p) => {
+                ((p.0 * 100.0).round() as i64, (p.1 * 100.0).round() as i64).hash(&mut h)
+            }
         }
         o.found.hash(&mut h);
     }
     (w.arm_tucked, w.shut_down, w.emergency, w.charging).hash(&mut h);
-    ((w.battery / 10.0).floor() as i64, w.battery <= w.params.low_battery).hash(&mut h);
+    (
+        (w.battery / 10.0).floor() as i64,
+        w.battery <= w.params.low_battery,
+    )
+        .hash(&mut h);
     for (k, l) in r.live.iter().enumerate() {
         if let Some(l) = l {
             (k, l.call.name()).hash(&mut h);
@@ -663,7 +672,11 @@ battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
         let mc = monte_carlo_within(&s, 6, 3, 2, Some(Instant::now()));
         assert_eq!(mc.runs, 0);
         assert!(mc.policies.iter().all(|p| p.runs == 0 && p.successes == 0));
-        assert!(mc.pairs.iter().all(|p| p.runs == 0 && p.first_divergence.is_none()));
+        assert!(
+            mc.pairs
+                .iter()
+                .all(|p| p.runs == 0 && p.first_divergence.is_none())
+        );
         let (runs, cut) = run_scenario_within(&s, false, Some(Instant::now()));
         assert!(cut);
         for r in &runs {

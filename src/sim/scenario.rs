@@ -922,7 +922,9 @@ impl Reader {
             .and_then(|v| self.integer(v, "`max_steps`", 1, MAX_STEPS))
             .unwrap_or(20_000);
         if let Some(v) = t.get("chatter_switches")
-            && self.integer(v, "`chatter_switches`", 2, 1_000_000).is_some()
+            && self
+                .integer(v, "`chatter_switches`", 2, 1_000_000)
+                .is_some()
         {
             self.diags.push(
                 Diagnostic::warning("`chatter_switches` is no longer used: a livelock is a recurring abstract state without progress toward the goal")
@@ -1128,8 +1130,10 @@ impl Reader {
         if convert.is_none()
             && let PolicyBody::Machine(m) = &policy.body
             && m.top.outcomes.iter().any(|o| o == "RUNNING")
-            && let Some(st) = (m.states.iter())
-                .find(|st| matches!(st.body, StateBody::Container(_)) && (st.label == "Sequence*" || st.label == "Fallback*"))
+            && let Some(st) = (m.states.iter()).find(|st| {
+                matches!(st.body, StateBody::Container(_))
+                    && (st.label == "Sequence*" || st.label == "Fallback*")
+            })
         {
             self.diags.push(
                 Diagnostic::warning(format!(

@@ -250,7 +250,9 @@ impl Reader {
                 };
                 let range = match v.get_ref() {
                     DeValue::Array(_) => self.range(v, "a completion time", 0.0, 1e9),
-                    _ => self.number(v, "a completion time", 0.0, 1e9).map(|h| (0.0, h)),
+                    _ => self
+                        .number(v, "a completion time", 0.0, 1e9)
+                        .map(|h| (0.0, h)),
                 };
                 if let Some((lo, hi)) = range {
                     out.push(Expectation {
@@ -333,7 +335,10 @@ pub fn check(
                             pass((lo..=hi).contains(&c), cut[i]),
                             format!("completed at {c} s"),
                         ),
-                        None => (pass(false, cut[i]), format!("not completed ({})", goal_text(r))),
+                        None => (
+                            pass(false, cut[i]),
+                            format!("not completed ({})", goal_text(r)),
+                        ),
                     },
                 },
                 Check::Match(a, b) | Check::Differ(a, b) => match verdict(a, b) {

@@ -99,7 +99,11 @@ impl Reader {
             }
         }
         if out.is_empty() {
-            self.err(v.span(), format!("{what} must name at least one object"), "");
+            self.err(
+                v.span(),
+                format!("{what} must name at least one object"),
+                "",
+            );
             return None;
         }
         Some(out)
@@ -146,7 +150,11 @@ impl Reader {
                 "move" | "move_after_done" => {
                     let objects = self.names_of(bt.get("objects"), world, "`objects`")?;
                     let Some(to) = bt.get("to") else {
-                        self.err(b.span(), format!("`{key}` needs `to`"), "write `to = [\"west-table\"]`");
+                        self.err(
+                            b.span(),
+                            format!("`{key}` needs `to`"),
+                            "write `to = [\"west-table\"]`",
+                        );
                         return None;
                     };
                     let ta = self.array(to, "`to`")?;
@@ -156,7 +164,12 @@ impl Reader {
                     }
                     let mut places = Vec::new();
                     for x in ta {
-                        places.push(self.pose(x, "a place", &world.layout, world.params.robot_radius)?);
+                        places.push(self.pose(
+                            x,
+                            "a place",
+                            &world.layout,
+                            world.params.robot_radius,
+                        )?);
                     }
                     RandomEffect::Move {
                         objects,
@@ -168,7 +181,11 @@ impl Reader {
                 },
                 "block" => {
                     let Some(rs) = bt.get("rects") else {
-                        self.err(b.span(), "`block` needs `rects`", "write `rects = [{ name = \"box\", rect = [1.0, 1.3, 2.9, 1.6] }]`");
+                        self.err(
+                            b.span(),
+                            "`block` needs `rects`",
+                            "write `rects = [{ name = \"box\", rect = [1.0, 1.3, 2.9, 1.6] }]`",
+                        );
                         return None;
                     };
                     let ra = self.array(rs, "`rects`")?;
