@@ -131,7 +131,9 @@ pub fn monte_carlo_within(
     // results[policy][episode] = (outcome, goal, completion, latencies)
     type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
     // Per episode: its seed and, per pair, whether the behavior matched.
-    let mut per_thread: Vec<(Vec<(u32, usize, Res)>, Vec<(u32, u64, Vec<bool>)>)> = Vec::new();
+    type Agree = (u32, u64, Vec<bool>);
+    type Results = (Vec<(u32, usize, Res)>, Vec<Agree>);
+    let mut per_thread: Vec<Results> = Vec::new();
     std::thread::scope(|sc| {
         let prepared = &prepared;
         let stop = &stop;
@@ -201,7 +203,7 @@ pub fn monte_carlo_within(
         }
     });
     let mut all: Vec<(u32, usize, Res)> = Vec::new();
-    let mut agree: Vec<(u32, u64, Vec<bool>)> = Vec::new();
+    let mut agree: Vec<Agree> = Vec::new();
     for (o, a) in per_thread {
         all.extend(o);
         agree.extend(a);
