@@ -393,7 +393,13 @@ pub fn run_policy_into(
     let (outcome, reason) = ended.unwrap_or_else(|| match finished {
         Some((o, why)) if o == "SUCCESS" => (Outcome::Success, why),
         Some((_, why)) => (Outcome::Failure, why),
-        None if last == Status::Success => (Outcome::Success, "the root returned SUCCESS".into()),
+        None if last == Status::Success => (
+            Outcome::Success,
+            match &ex {
+                Ex::Bt(_) => "the root returned SUCCESS".into(),
+                Ex::M(_) => "reached the outcome SUCCESS (and ticks on)".into(),
+            },
+        ),
         None => (
             Outcome::Timeout,
             format!("step budget of {} steps exhausted", s.max_steps),
@@ -623,6 +629,167 @@ file = "../paper/fig04-fsm.toml"
 [monte_carlo]
 battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
 "#;
+
+    /// Equivalent policies produce equal timelines: with grasps failing at
+    /// random, the BT of Fig. 1, its HFSM and the fault-tolerant FSM of
+    /// Fig. 4 start every skill in the same step (no step lost after a
+    /// failure), so their verdict is a match for every seed.
+    #[test]
+    fn equivalent_bt_and_fsm_produce_equal_timelines() {
+        let mut s = scenario(&FLAKY.replace(
+            "[[policies]]\nfile = \"../paper/fig04-fsm.toml\"",
+            "[[policies]]\nfile = \"../paper/fig04-fsm.toml\"\n[[policies]]\nfile = \"../paper/fig01-bt.toml\"\nconvert = \"hfsm\"",
+        ));
+        let mut failed = 0;
+        for seed in 0..20 {
+            s.seed = seed;
+            let runs = run_scenario(&s, false);
+            failed += (runs[0].skills.iter())
+                .filter(|r| r.outcome == "failure")
+                .count();
+            for v in crate::sim::trace::verdicts(&runs, 300) {
+                assert!(v.matches, "seed {seed}: {v:?}");
+                assert_eq!(v.trajectory_distance_m, 0.0);
+            }
+            let starts = |r: &Run| r.skills.iter().map(|k| k.start).collect::<Vec<_>>();
+            assert_eq!(starts(&runs[0]), starts(&runs[1]), "seed {seed}");
+            assert_eq!(starts(&runs[0]), starts(&runs[2]), "seed {seed}");
+        }
+        assert!(failed >= 10, "the grasps failed {failed} times");
+    }
+
+    /// Retrying an action that failed is not a livelock (that is what
+    /// `max_failures` bounds): five failed grasps in a row, then success.
+    #[test]
+    fn retries_of_a_failing_action_are_not_a_livelock() {
+        let s = scenario(
+            r#"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+[[disturbances]]
+at = 0.0
+fail = "Pick"
+times = 5
+"#,
+        );
+        for r in run_scenario(&s, false) {
+            assert_eq!(
+                (r.outcome, r.goal_met),
+                (Outcome::Success, Some(true)),
+                "{}",
+                r.policy
+            );
+        }
+    }
+
+    /// What happens after SUCCESS is written per policy: a BT told to stop
+    /// ignores the cube moved after completion, the BT that keeps ticking
+    /// fetches it again. An FSM told to keep ticking is re-entered at its
+    /// initial state: Fig. 4's is `Move-To cube2`, so it starts its task
+    /// over at once — it picks the delivered cube up again — and so also
+    /// ends with the cube delivered, by other skills than the BT's.
+    #[test]
+    fn after_success_is_a_property_of_the_run() {
+        let s = scenario(
+            r#"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+name = "BT stop"
+after_success = "stop"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+name = "FSM keep-ticking"
+after_success = "keep-ticking"
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[disturbances]]
+after_done = 2.0
+move = "cube2"
+to = "west-table"
+"#,
+        );
+        let runs = run_scenario(&s, false);
+        assert_eq!(runs[0].goal_met, Some(false));
+        assert_eq!(runs[1].goal_met, Some(true));
+        assert_eq!(runs[2].goal_met, Some(true));
+        assert_eq!(runs[0].skills.len(), 4);
+        assert_eq!(
+            (runs[1].skills[4].skill.as_str(), runs[1].skills[4].start),
+            ("Move-To", 16.1)
+        );
+        assert_eq!(
+            (runs[1].skills[5].skill.as_str(), runs[1].skills[5].start),
+            ("Pick", 16.1)
+        );
+        let v = crate::sim::trace::verdicts(&runs, 300);
+        assert!(v.iter().all(|v| !v.matches), "{v:?}");
+    }
+
+    /// `sim --seed S` runs episode S of `--runs`: for every episode, the
+    /// single run with its seed gives the pair verdicts Monte Carlo counted,
+    /// and the first diverging episode is the first whose replay differs.
+    #[test]
+    fn the_seed_of_an_episode_replays_it() {
+        let s = crate::sim::scenario::load(
+            Path::new("tests/fixtures/sim/monte-carlo-pick.toml"),
+            &Limits::default(),
+        )
+        .expect("valid");
+        let n = 30;
+        let mc = monte_carlo(&s, n, 7, 2);
+        let mut first = vec![None; mc.pairs.len()];
+        let mut diverged = 0;
+        for i in 0..n {
+            let seed = crate::sim::monte_carlo::episode_seed(7, i);
+            let (ds, rates) = crate::sim::monte_carlo::episode(&s, seed);
+            let mut one = s.clone();
+            (one.seed, one.disturbances, one.rates) = (seed, ds, rates);
+            let runs = run_scenario(&one, false);
+            for (k, v) in crate::sim::trace::verdicts(&runs, 300).iter().enumerate() {
+                if !v.matches && first[k].is_none() {
+                    first[k] = Some((i, seed));
+                    diverged += 1;
+                }
+            }
+        }
+        assert!(diverged >= 2, "{mc:?}");
+        for (p, f) in mc.pairs.iter().zip(first) {
+            let got = p.first_divergence.as_ref().map(|d| (d.episode, d.seed));
+            assert_eq!(got, f, "{} vs {}", p.a, p.b);
+        }
+    }
+
+    #[test]
+    fn wilson_intervals_are_the_textbook_ones() {
+        use crate::sim::monte_carlo::wilson;
+        assert_eq!(wilson(0, 10), [0.0, 0.278]);
+        assert_eq!(wilson(10, 10), [0.722, 1.0]);
+        assert_eq!(wilson(5, 10), [0.237, 0.763]);
+        assert_eq!(wilson(0, 0), [0.0, 1.0]);
+    }
+
+    /// The livelock detector remembers at most LIVELOCK_STATES states: a
+    /// run through ever new states never fires and never grows past it.
+    #[test]
+    fn livelock_memory_is_bounded() {
+        let mut l = Livelock::new(2);
+        for x in 0..3 * LIVELOCK_STATES as u64 {
+            assert_eq!(l.step(x, true, 0, false), None);
+            assert!(l.seen.len() <= LIVELOCK_STATES);
+        }
+        // A state entered twice without progress fires; progress resets it.
+        assert_eq!(l.step(7, true, 0, false), None);
+        assert_eq!(l.step(7, true, 1, false), None);
+        assert_eq!(l.step(7, true, 1, false), Some(2));
+    }
 
     #[test]
     fn runs_are_deterministic_given_the_seed() {

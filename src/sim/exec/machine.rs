@@ -237,3 +237,82 @@ impl MachineExec {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::{Limits, toml::parse_str};
+    use crate::model::PolicyBody;
+    use std::path::Path;
+
+    /// Leaves that log what the executor does: ticks and halts, in order.
+    struct Log {
+        battery_ok: bool,
+        log: Vec<String>,
+    }
+
+    impl Leaves for Log {
+        fn condition(&mut self, _: &Call) -> bool {
+            self.battery_ok
+        }
+        fn action(&mut self, key: usize, call: &Call) -> Status {
+            self.log.push(format!("tick {key} {}", call.name()));
+            Status::Running
+        }
+        fn halt(&mut self, key: usize) {
+            self.log.push(format!("halt {key}"));
+        }
+        fn now(&self) -> f64 {
+            0.0
+        }
+    }
+
+    /// A guard that preempts a state whose action is running halts that
+    /// action at once, before the next state's action is ticked; with
+    /// `keep_ticking`, SUCCESS re-enters the machine instead of ending it.
+    #[test]
+    fn a_preempting_guard_halts_the_running_action_first() {
+        let text = r#"
+kind = "fsm"
+initial = "A"
+outcomes = ["SUCCESS"]
+[states.A]
+skill = "Tuck-Arm"
+guards = [{ unless = "Battery-Level", args = { min = 20 }, to = "R" }]
+on = { SUCCESS = "SUCCESS" }
+[states.R]
+skill = "Recharge"
+on = { SUCCESS = "A" }
+"#;
+        let l = parse_str("f.toml", text, Path::new("."), &Limits::default()).unwrap();
+        let PolicyBody::Machine(m) = &l.policy.body else {
+            panic!("an FSM")
+        };
+        let cm = CompiledMachine::new(m, |c| {
+            Ok::<_, ()>(match c.skill.as_str() {
+                "Battery-Level" => Call::BatteryLevel(20.0),
+                "Recharge" => Call::Recharge,
+                _ => Call::TuckArm,
+            })
+        })
+        .unwrap();
+        let a = m.states.iter().position(|s| s.name == "A").unwrap();
+        let r = m.states.iter().position(|s| s.name == "R").unwrap();
+        let mut ex = MachineExec::new(Arc::new(cm), false);
+        let mut leaves = Log {
+            battery_ok: true,
+            log: vec![],
+        };
+        assert_eq!(ex.step(&mut leaves), Status::Running);
+        leaves.battery_ok = false;
+        assert_eq!(ex.step(&mut leaves), Status::Running);
+        assert_eq!(
+            leaves.log,
+            vec![
+                format!("tick {a} Tuck-Arm"),
+                format!("halt {a}"),
+                format!("tick {r} Recharge"),
+            ]
+        );
+    }
+}
