@@ -540,7 +540,24 @@ mod tests {
         ] {
             assert!(p.get(k).is_some(), "{k}");
         }
+        assert!(p.get("after_success").is_some());
         assert!(p.get("trace").is_none() && p.get("trajectory").is_none());
+        for k in [
+            "a",
+            "b",
+            "match",
+            "same_skills",
+            "same_outcome",
+            "same_final_world",
+            "tolerance_s",
+            "first_divergence",
+            "trajectory_distance_m",
+            "path_distance_m",
+        ] {
+            assert!(v["verdicts"][0].get(k).is_some(), "{k}");
+        }
+        assert!(v["expectations"].as_array().unwrap().is_empty());
+        assert_eq!(v["expectations_failed"], 0);
         let t: serde_json::Value = serde_json::from_str(&r.trace_json()).unwrap();
         assert!(t["policies"][0]["trace"].as_array().unwrap().is_empty());
         assert!(
