@@ -40,6 +40,10 @@ pub(super) struct Robot {
     pub(super) dt: f64,
     pub(super) live: Vec<Option<Running>>,
     pub(super) ticked: Vec<bool>,
+    /// The keys ticked in this step or live, so that a step's bookkeeping
+    /// costs what it touched, not the size of the policy; after
+    /// [`Robot::end_step`], the live keys in ascending order.
+    pub(super) touched: Vec<usize>,
     pub(super) records: Vec<SkillRecord>,
     pub(super) events: Vec<Event>,
     pub(super) faults: Faults,
@@ -134,13 +138,27 @@ impl Robot {
 
     /// Cancels the actions that were not ticked in this step.
     pub(super) fn end_step(&mut self) {
-        for k in 0..self.live.len() {
+        // In key order, as a walk over every key would cancel them.
+        let mut keys = std::mem::take(&mut self.touched);
+        keys.sort_unstable();
+        keys.dedup();
+        keys.retain(|&k| {
             if !self.ticked[k]
                 && let Some(mut r) = self.live[k].take()
             {
                 r.cancel(&mut self.world);
                 self.close(r.record, "cancelled");
             }
+            self.ticked[k] = false;
+            self.live[k].is_some()
+        });
+        self.touched = keys;
+    }
+
+    /// Forgets which keys were ticked in this step (the run loop ticks the
+    /// policy again: its last tick says which actions go on).
+    pub(super) fn untick(&mut self) {
+        for &k in &self.touched {
             self.ticked[k] = false;
         }
     }
@@ -157,7 +175,10 @@ impl Leaves for Robot {
     }
 
     fn action(&mut self, key: usize, call: &Call) -> Status {
-        self.ticked[key] = true;
+        if !self.ticked[key] {
+            self.ticked[key] = true;
+            self.touched.push(key);
+        }
         if self.live[key].as_ref().is_none_or(|r| r.call != *call) {
             if self.records.len() >= MAX_SKILL_RECORDS {
                 // Not started: the run ends after this step.

@@ -163,6 +163,7 @@ pub fn run_policy_into(
         dt: s.dt,
         live: vec![None; n],
         ticked: vec![false; n],
+        touched: Vec::new(),
         records: Vec::new(),
         events: Vec::new(),
         faults: Faults {
@@ -281,7 +282,7 @@ pub fn run_policy_into(
                     break;
                 }
                 // The last tick of the step says which actions go on.
-                robot.ticked.iter_mut().for_each(|t| *t = false);
+                robot.untick();
             }
             if last == Status::Success && !keep_ticking && matches!(ex, Ex::Bt(_)) {
                 stopped = true;
@@ -487,33 +488,40 @@ impl Livelock {
 /// step (an action may start and finish within one step). The robot's position is left out: moving is
 /// what a running navigation does.
 fn abstract_state(r: &Robot) -> u64 {
-    use std::hash::{Hash, Hasher};
+    // A fast multiplicative mix (deterministic, no allocation): this runs
+    // every step.
+    let mut h: u64 = 0;
+    let mut mix = |x: u64| h = (h.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
     let w = &r.world;
-    let mut h = std::collections::hash_map::DefaultHasher::new();
     for o in &w.objects {
         match o.place {
-            Place::Held => u8::MAX.hash(&mut h),
+            Place::Held => mix(u64::MAX),
             Place::At(p) => {
-                ((p.0 * 100.0).round() as i64, (p.1 * 100.0).round() as i64).hash(&mut h)
+                mix((p.0 * 100.0).round() as i64 as u64);
+                mix((p.1 * 100.0).round() as i64 as u64);
             }
         }
-        o.found.hash(&mut h);
+        mix(o.found as u64);
     }
-    (w.arm_tucked, w.shut_down, w.emergency, w.charging).hash(&mut h);
-    (
-        (w.battery / 10.0).floor() as i64,
-        w.battery <= w.params.low_battery,
-    )
-        .hash(&mut h);
-    for (k, l) in r.live.iter().enumerate() {
-        if let Some(l) = l {
-            (k, l.call.name()).hash(&mut h);
+    mix(w.arm_tucked as u64
+        | (w.shut_down as u64) << 1
+        | (w.emergency as u64) << 2
+        | (w.charging as u64) << 3);
+    mix((w.battery / 10.0).floor() as i64 as u64);
+    mix((w.battery <= w.params.low_battery) as u64);
+    // The live keys, in order (after `end_step`).
+    for &k in &r.touched {
+        // A key runs one skill: its binding.
+        if r.live[k].is_some() {
+            mix(k as u64);
         }
     }
     // The actions started in the step (and maybe done in it already).
-    u32::MAX.hash(&mut h);
-    r.started.hash(&mut h);
-    h.finish()
+    mix(u64::MAX - 1);
+    for &k in &r.started {
+        mix(k as u64);
+    }
+    h
 }
 
 /// Whether the wall-clock budget cut `r` short: a timeout before the step

@@ -17,6 +17,21 @@ pub struct CompiledMachine {
     pub call: Vec<Option<Call>>,
     /// Per state: its guards in order, with their targets.
     pub guards: Vec<Vec<(GuardTerms, Target)>>,
+    /// Per state, the index of its transition on RUNNING, SUCCESS and
+    /// FAILURE (the first written), so a step compares no strings.
+    pub on_status: Vec<[Option<u32>; 3]>,
+    /// The top-level outcomes include `RUNNING` (the Fig. 6 construction):
+    /// the machine is re-entered after FAILURE.
+    pub tick_driven: bool,
+}
+
+fn status_index(o: &str) -> Option<usize> {
+    match o {
+        "RUNNING" => Some(0),
+        "SUCCESS" => Some(1),
+        "FAILURE" => Some(2),
+        _ => None,
+    }
 }
 
 impl CompiledMachine {
@@ -49,10 +64,25 @@ impl CompiledMachine {
             }
         }
         if errs.is_empty() {
+            let on_status = (m.states.iter())
+                .map(|s| {
+                    let mut on = [None; 3];
+                    for (i, t) in s.transitions.iter().enumerate() {
+                        if let Trigger::Outcome(o) = &t.trigger
+                            && let Some(k) = status_index(o)
+                        {
+                            on[k].get_or_insert(i as u32);
+                        }
+                    }
+                    on
+                })
+                .collect();
             Ok(CompiledMachine {
                 m: m.clone(),
                 call,
                 guards,
+                on_status,
+                tick_driven: m.top.outcomes.iter().any(|x| x == "RUNNING"),
             })
         } else {
             Err(errs)
@@ -75,10 +105,10 @@ pub struct MachineExec {
     pub keep_ticking: bool,
 }
 
-enum Flow {
+enum Flow<'a> {
     Enter(usize),
     /// An outcome of the region of the state's parent (`None`: top level).
-    Up(Option<usize>, String),
+    Up(Option<usize>, &'a str),
 }
 
 impl MachineExec {
@@ -97,10 +127,10 @@ impl MachineExec {
         terms.iter().all(|(c, neg)| leaves.condition(c) != *neg)
     }
 
-    fn follow(&self, from: usize, t: &Target) -> Flow {
+    fn follow<'a>(c: &'a CompiledMachine, from: usize, t: &'a Target) -> Flow<'a> {
         match t {
             Target::State(s) => Flow::Enter(*s),
-            Target::Outcome(o) => Flow::Up(self.c.m.states[from].parent, o.clone()),
+            Target::Outcome(o) => Flow::Up(c.m.states[from].parent, o),
         }
     }
 
@@ -139,7 +169,7 @@ impl MachineExec {
                 if Self::holds(g, leaves) {
                     // The running state is left: its action is halted now.
                     leaves.halt(self.current);
-                    flow = self.follow(a, t);
+                    flow = Self::follow(&c, a, t);
                     break 'anc;
                 }
             }
@@ -163,7 +193,7 @@ impl MachineExec {
                     // A tick-driven machine (top-level outcome RUNNING, as the
                     // BT -> HFSM construction makes) is re-entered after a
                     // failure, as a BT's root is ticked again.
-                    if o != "SUCCESS" && c.m.top.outcomes.iter().any(|x| x == "RUNNING") {
+                    if o != "SUCCESS" && c.tick_driven {
                         self.current = c.m.top.initial;
                         return Status::Failure;
                     }
@@ -172,7 +202,7 @@ impl MachineExec {
                     } else {
                         Status::Failure
                     };
-                    self.finished = Some((o.clone(), format!("reached the outcome {o}")));
+                    self.finished = Some((o.to_string(), format!("reached the outcome {o}")));
                     return st;
                 }
                 Flow::Up(Some(container), o) => (container, o),
@@ -182,7 +212,7 @@ impl MachineExec {
                         // Preempted: a running action of the state is halted
                         // at once (a state entered afresh has none).
                         leaves.halt(s);
-                        flow = self.follow(s, t);
+                        flow = Self::follow(&c, s, t);
                         continue;
                     }
                     let st = match &c.m.states[s].body {
@@ -204,15 +234,17 @@ impl MachineExec {
                         },
                     };
                     self.note(s, st);
-                    (s, st.as_str().to_string())
+                    (s, st.as_str())
                 }
             };
-            let tr = c.m.states[from]
-                .transitions
-                .iter()
-                .find(|t| matches!(&t.trigger, Trigger::Outcome(o) if *o == outcome));
+            let transitions = &c.m.states[from].transitions;
+            let tr = match status_index(outcome) {
+                Some(k) => c.on_status[from][k].map(|i| &transitions[i as usize]),
+                None => (transitions.iter())
+                    .find(|t| matches!(&t.trigger, Trigger::Outcome(o) if *o == outcome)),
+            };
             match tr {
-                Some(t) => match self.follow(from, &t.target) {
+                Some(t) => match Self::follow(&c, from, &t.target) {
                     Flow::Enter(next) if outcome == "RUNNING" => {
                         self.current = next;
                         return Status::Running;
