@@ -65,7 +65,8 @@ pub struct McResult {
 }
 
 /// 95 % Wilson score interval of `k` successes in `n` trials
-/// (`[0, 1]` when `n` is 0), rounded to 3 decimals.
+/// (`[0, 1]` when `n` is 0), rounded to 4 decimals (10,000 successes in
+/// 10,000 give `[0.9996, 1]`).
 pub fn wilson(k: u32, n: u32) -> [f64; 2] {
     if n == 0 {
         return [0.0, 1.0];
@@ -74,10 +75,8 @@ pub fn wilson(k: u32, n: u32) -> [f64; 2] {
     let z2 = z * z;
     let centre = (p + z2 / (2.0 * n)) / (1.0 + z2 / n);
     let half = z / (1.0 + z2 / n) * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
-    [
-        round3((centre - half).max(0.0)),
-        round3((centre + half).min(1.0)),
-    ]
+    let r4 = |x: f64| (x * 10_000.0).round() / 10_000.0;
+    [r4((centre - half).max(0.0)), r4((centre + half).min(1.0))]
 }
 
 /// Nearest-rank quantiles 10 %, 50 %, 90 % of `v` (sorted here).

@@ -321,7 +321,7 @@ impl McReport {
                 vec![
                     p.policy.clone(),
                     format!("{:.3}", p.success_rate),
-                    format!("[{:.3}, {:.3}]", p.success_ci95[0], p.success_ci95[1]),
+                    format!("[{:.4}, {:.4}]", p.success_ci95[0], p.success_ci95[1]),
                     p.failures.to_string(),
                     p.chattering.to_string(),
                     p.timeouts.to_string(),
@@ -347,7 +347,7 @@ impl McReport {
                     vec![
                         format!("{} vs {}", p.a, p.b),
                         format!("{:.3}", p.match_rate),
-                        format!("[{:.3}, {:.3}]", p.match_ci95[0], p.match_ci95[1]),
+                        format!("[{:.4}, {:.4}]", p.match_ci95[0], p.match_ci95[1]),
                         p.first_divergence
                             .as_ref()
                             .map_or("-".into(), |d| format!("{} (--seed {})", d.episode, d.seed)),

@@ -115,14 +115,14 @@ fn holds(terms: &[(Call, bool)], w: &World) -> bool {
 /// nodes, a thousand disturbances with conditions), so that the clock is
 /// read about every 64k units of work (node ticks, conditions) whatever
 /// the input.
-pub fn clock_every(p: &Prepared, disturbances: &[Disturbance], w: &World) -> u64 {
+pub fn clock_every(p: &Prepared, disturbances: &[Disturbance], w: &World, goal: usize) -> u64 {
     let terms: usize = (disturbances.iter())
         .map(|d| match &d.when {
             When::Holds(t) => t.len(),
             _ => 1,
         })
         .sum();
-    let work = (p.keys.len() + terms + w.objects.len()).max(1) as u64;
+    let work = (p.keys.len() + terms + goal + w.objects.len()).max(1) as u64;
     (65_536 / work).clamp(1, CLOCK_EVERY)
 }
 
@@ -156,7 +156,9 @@ pub fn run_policy_into(
     opts: RunOptions,
     mut sink: Option<StepSink<'_>>,
 ) -> Run {
-    let every = clock_every(p, disturbances, &world);
+    // The goal's terms are evaluated every step too (progress toward it).
+    let goal_terms_n = s.goal.as_ref().map_or(0, Vec::len);
+    let every = clock_every(p, disturbances, &world, goal_terms_n);
     let n = p.keys.len();
     let mut robot = Robot {
         world,
@@ -778,9 +780,10 @@ to = "west-table"
     #[test]
     fn wilson_intervals_are_the_textbook_ones() {
         use crate::sim::monte_carlo::wilson;
-        assert_eq!(wilson(0, 10), [0.0, 0.278]);
-        assert_eq!(wilson(10, 10), [0.722, 1.0]);
-        assert_eq!(wilson(5, 10), [0.237, 0.763]);
+        assert_eq!(wilson(0, 10), [0.0, 0.2775]);
+        assert_eq!(wilson(10, 10), [0.7225, 1.0]);
+        assert_eq!(wilson(5, 10), [0.2366, 0.7634]);
+        assert_eq!(wilson(10_000, 10_000), [0.9996, 1.0]);
         assert_eq!(wilson(0, 0), [0.0, 1.0]);
     }
 
