@@ -373,3 +373,70 @@ fn pass(ok: bool, cut: bool) -> Status {
         (false, false) => Status::Fail,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostic::SourceFile;
+    use crate::format::Limits;
+    use crate::sim::run::run_scenario;
+    use crate::sim::trace::verdicts;
+    use std::path::Path;
+
+    const SCENARIO: &str = r#"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+[expect]
+completion_s = { "Fig. 1 BT baseline" = [10.0, 20.0], "Fig. 2 FSM sequential" = 15.0 }
+outcome = { "Fig. 2 FSM sequential" = "success" }
+match = [["Fig. 1 BT baseline", "Fig. 2 FSM sequential"]]
+"#;
+
+    /// Time bounds hold or fail on the completion time (a number is an
+    /// upper bound); what the wall-clock budget cut short, or a verdict it
+    /// skipped, is undecided.
+    #[test]
+    fn time_bounds_and_undecided_expectations() {
+        let f = SourceFile::new("t.toml", SCENARIO);
+        let s = super::super::parse(&f, Path::new("policies/scenarios"), &Limits::default())
+            .expect("valid");
+        assert_eq!(s.expect.len(), 4);
+        let runs = run_scenario(&s, false);
+        let v = verdicts(&runs, 300);
+        let r = check(&s.expect, &runs, &v, &[false, false]);
+        let got: Vec<(&str, Status)> = r.iter().map(|e| (e.name.as_str(), e.status)).collect();
+        assert_eq!(
+            got,
+            vec![
+                ("Fig. 2 FSM sequential ends with success", Status::Pass),
+                (
+                    "Fig. 1 BT baseline matches Fig. 2 FSM sequential",
+                    Status::Pass
+                ),
+                (
+                    "Fig. 1 BT baseline completes within [10, 20] s",
+                    Status::Pass
+                ),
+                (
+                    "Fig. 2 FSM sequential completes within [0, 15] s",
+                    Status::Fail
+                ),
+            ]
+        );
+        assert_eq!(r[3].found, "completed at 16.1 s");
+        // A run cut short: what names it is undecided (what names only the
+        // other is still checked); no verdict: likewise.
+        let r = check(&s.expect, &runs, &[], &[false, true]);
+        let st: Vec<Status> = r.iter().map(|e| e.status).collect();
+        use Status::*;
+        assert_eq!(st, vec![Undecided, Undecided, Pass, Undecided], "{r:?}");
+        let r = check(&s.expect, &runs, &[], &[false, false]);
+        assert_eq!(r[1].status, Status::Undecided);
+        assert_eq!(r[2].status, Status::Pass);
+    }
+}
