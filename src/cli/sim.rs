@@ -53,7 +53,8 @@ pub struct SimArgs {
     /// Wall-clock budget for all the simulation work, in ms: when it runs
     /// out, runs stop cleanly (outcome `timeout` at the step reached; with
     /// --runs, the figures cover the episodes completed) and the report
-    /// says so; the exit code stays 0. A budget too large for the clock
+    /// says so; the exit code stays 0, unless an expectation of the
+    /// scenario cannot be decided (exit 1). A budget too large for the clock
     /// (past the year 2^64 ns) is no budget
     #[arg(long, value_name = "MS")]
     pub timeout_ms: Option<u64>,
