@@ -12,7 +12,7 @@ use super::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
 use super::livelock::{Livelock, abstract_state};
 use super::rng::SimRng;
 use super::robot::{Faults, MAX_EVENTS, MAX_SKILL_RECORDS, Robot, apply, round3};
-use super::scenario::{AfterSuccess, Disturbance, PolicyEntry, Scenario, When};
+use super::scenario::{Afterwards, Disturbance, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Status};
 use super::trace::{FinalWorld, Outcome, Run, Step, compact_track, compact_trajectory};
 use super::world::{P2, World, dist};
@@ -29,7 +29,9 @@ pub struct Prepared {
     pub kind: String,
     pub convert: Option<String>,
     /// What the policy does after it reports SUCCESS.
-    pub after_success: AfterSuccess,
+    pub after_success: Afterwards,
+    /// What the policy does after it reports FAILURE.
+    pub after_failure: Afterwards,
     pub exec: Compiled,
     /// Node id / state path per key (for statuses).
     pub keys: Arc<Vec<String>>,
@@ -85,6 +87,7 @@ fn prepare_one(e: &PolicyEntry, w: &World) -> Prepared {
         kind: e.policy.kind().to_string(),
         convert: e.convert.clone(),
         after_success: e.after_success,
+        after_failure: e.after_failure,
         exec,
         keys: Arc::new(keys),
     }
@@ -188,12 +191,13 @@ pub fn run_policy_into(
         Bt(BtExec),
         M(MachineExec),
     }
-    let keep_ticking = p.after_success == AfterSuccess::KeepTicking;
+    let keep_ticking = p.after_success == Afterwards::KeepTicking;
     let mut ex = match &p.exec {
         Compiled::Bt(b) => Ex::Bt(BtExec::new(b.clone(), opts.trace)),
         Compiled::Machine(m) => {
             let mut m = MachineExec::new(m.clone(), opts.trace);
             m.keep_ticking = keep_ticking;
+            m.reenter_on_failure = p.after_failure == Afterwards::KeepTicking;
             Ex::M(m)
         }
     };
@@ -274,7 +278,7 @@ pub fn run_policy_into(
                     Ex::M(m) => m.step(&mut robot),
                 };
                 let goes_on = match &ex {
-                    Ex::Bt(_) => true,
+                    Ex::Bt(_) => p.after_failure == Afterwards::KeepTicking,
                     Ex::M(m) => m.finished.is_none(),
                 };
                 if last != Status::Failure
@@ -289,6 +293,19 @@ pub fn run_policy_into(
             }
             if last == Status::Success && !keep_ticking && matches!(ex, Ex::Bt(_)) {
                 stopped = true;
+            }
+            // `after_failure = "stop"` for a BT: its root's FAILURE ends the
+            // run (a machine ends at its outcome by itself).
+            if last == Status::Failure
+                && p.after_failure == Afterwards::Stop
+                && matches!(ex, Ex::Bt(_))
+            {
+                robot.end_step();
+                ended = Some((
+                    Outcome::Failure,
+                    "the root returned FAILURE (after_failure = \"stop\")".into(),
+                ));
+                break;
             }
         }
         robot.end_step();
@@ -421,6 +438,7 @@ pub fn run_policy_into(
         steps,
         dt: s.dt,
         after_success: p.after_success.as_str(),
+        after_failure: p.after_failure.as_str(),
         completion_s: completion.map(round3),
         duration_s: round3(robot.world.time),
         distance_m: round3(robot.world.odometer),

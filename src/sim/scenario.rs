@@ -21,11 +21,12 @@ pub mod mc;
 
 type Val<'i> = Spanned<DeValue<'i>>;
 
-/// What a policy does once it has reported SUCCESS (a property of the run,
-/// written per policy in the scenario: `after_success`).
+/// What a policy does once it has reported SUCCESS, or FAILURE (a property
+/// of the run, written per policy in the scenario: `after_success`,
+/// `after_failure`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
-pub enum AfterSuccess {
+pub enum Afterwards {
     /// No longer ticked: the robot stands idle (SMACH's final state; the
     /// default for FSMs and HFSMs).
     Stop,
@@ -34,11 +35,11 @@ pub enum AfterSuccess {
     KeepTicking,
 }
 
-impl AfterSuccess {
+impl Afterwards {
     pub fn as_str(self) -> &'static str {
         match self {
-            AfterSuccess::Stop => "stop",
-            AfterSuccess::KeepTicking => "keep-ticking",
+            Afterwards::Stop => "stop",
+            Afterwards::KeepTicking => "keep-ticking",
         }
     }
 }
@@ -54,7 +55,9 @@ pub struct PolicyEntry {
     /// `name` when it has one).
     pub policy: Policy,
     /// What the policy does after SUCCESS.
-    pub after_success: AfterSuccess,
+    pub after_success: Afterwards,
+    /// What the policy does after FAILURE.
+    pub after_failure: Afterwards,
 }
 
 /// When a disturbance fires.
@@ -1027,6 +1030,29 @@ impl Reader {
         })
     }
 
+    /// `after_success` / `after_failure`: `"stop"` or `"keep-ticking"`.
+    fn afterwards(&mut self, v: Option<&Val<'_>>, key: &str, keep: bool) -> Option<Afterwards> {
+        let Some(a) = v else {
+            return Some(if keep {
+                Afterwards::KeepTicking
+            } else {
+                Afterwards::Stop
+            });
+        };
+        match a.get_ref().as_str() {
+            Some("stop") => Some(Afterwards::Stop),
+            Some("keep-ticking") => Some(Afterwards::KeepTicking),
+            _ => {
+                self.err(
+                    a.span(),
+                    format!("`{key}` must be \"stop\" or \"keep-ticking\""),
+                    format!("write `{key} = \"keep-ticking\"` to tick the policy again (a BT's default), `\"stop\"` to end it (an FSM's and an HFSM's)"),
+                );
+                None
+            }
+        }
+    }
+
     fn policy(
         &mut self,
         v: &Val<'_>,
@@ -1037,7 +1063,7 @@ impl Reader {
         let t = self.table(v, "a policy entry")?;
         self.keys(
             t,
-            &["file", "convert", "name", "after_success"],
+            &["file", "convert", "name", "after_success", "after_failure"],
             "field of a policy entry",
         );
         let Some(f) = t.get("file") else {
@@ -1147,27 +1173,23 @@ impl Reader {
         if let Some(n) = t.get("name") {
             policy.name = self.string(n, "`name`")?;
         }
-        let after_success = match t.get("after_success") {
-            None if matches!(policy.body, PolicyBody::Bt(_)) => AfterSuccess::KeepTicking,
-            None => AfterSuccess::Stop,
-            Some(a) => match a.get_ref().as_str() {
-                Some("stop") => AfterSuccess::Stop,
-                Some("keep-ticking") => AfterSuccess::KeepTicking,
-                _ => {
-                    self.err(
-                        a.span(),
-                        "`after_success` must be \"stop\" or \"keep-ticking\"",
-                        "write `after_success = \"keep-ticking\"` to tick the policy again after it reports SUCCESS (a BT's default), `\"stop\"` to leave it idle (an FSM's and an HFSM's)",
-                    );
-                    return None;
-                }
-            },
+        // Defaults: a BT keeps ticking after both (its root is ticked every
+        // step); a machine stops, unless its top-level outcomes include
+        // RUNNING (the Fig. 6 construction says it is ticked), which keeps
+        // ticking after FAILURE.
+        let (bt, tick_driven) = match &policy.body {
+            PolicyBody::Bt(_) => (true, true),
+            PolicyBody::Machine(m) => (false, m.top.outcomes.iter().any(|o| o == "RUNNING")),
         };
+        let after_success = self.afterwards(t.get("after_success"), "after_success", bt)?;
+        let after_failure =
+            self.afterwards(t.get("after_failure"), "after_failure", tick_driven)?;
         Some(PolicyEntry {
             file: path,
             convert,
             policy,
             after_success,
+            after_failure,
         })
     }
 }

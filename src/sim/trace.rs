@@ -192,6 +192,8 @@ pub struct Run {
     pub dt: f64,
     /// What the policy did after SUCCESS (`stop` or `keep-ticking`).
     pub after_success: &'static str,
+    /// What the policy did after FAILURE (`stop` or `keep-ticking`).
+    pub after_failure: &'static str,
     /// Time at which the policy last reported it was done, s.
     pub completion_s: Option<f64>,
     pub duration_s: f64,

@@ -103,6 +103,12 @@ pub struct MachineExec {
     /// SUCCESS returns SUCCESS and the next step re-enters the machine at
     /// its initial state, instead of ending it.
     pub keep_ticking: bool,
+    /// `after_failure = "keep-ticking"`: reaching FAILURE (a top-level
+    /// outcome other than SUCCESS, or a state's outcome with no transition)
+    /// returns FAILURE and the next tick re-enters the machine at its
+    /// initial state (a task reset), instead of ending it. Set by default
+    /// for a machine whose top-level outcomes include RUNNING.
+    pub reenter_on_failure: bool,
 }
 
 enum Flow<'a> {
@@ -115,11 +121,12 @@ impl MachineExec {
     pub fn new(c: Arc<CompiledMachine>, record: bool) -> Self {
         let current = c.m.top.initial;
         MachineExec {
-            c,
             current,
             finished: None,
             statuses: record.then(Vec::new),
             keep_ticking: false,
+            reenter_on_failure: c.tick_driven,
+            c,
         }
     }
 
@@ -190,10 +197,11 @@ impl MachineExec {
                         self.current = c.m.top.initial;
                         return Status::Success;
                     }
-                    // A tick-driven machine (top-level outcome RUNNING, as the
-                    // BT -> HFSM construction makes) is re-entered after a
+                    // `after_failure = "keep-ticking"` (the default of a
+                    // tick-driven machine, top-level outcome RUNNING, as the
+                    // BT -> HFSM construction makes): re-entered after a
                     // failure, as a BT's root is ticked again.
-                    if o != "SUCCESS" && c.tick_driven {
+                    if o != "SUCCESS" && self.reenter_on_failure {
                         self.current = c.m.top.initial;
                         return Status::Failure;
                     }
@@ -254,6 +262,10 @@ impl MachineExec {
                 None if outcome == "RUNNING" => {
                     self.current = from;
                     return Status::Running;
+                }
+                None if self.reenter_on_failure && outcome != "SUCCESS" => {
+                    self.current = c.m.top.initial;
+                    return Status::Failure;
                 }
                 None => {
                     self.finished = Some((

@@ -131,6 +131,65 @@ to = "west-table"
     assert!(v.iter().all(|v| !v.matches), "{v:?}");
 }
 
+/// What happens after FAILURE is written per policy too: the sequential
+/// FSM of Fig. 2 told to keep ticking is re-entered at its initial state
+/// after its failed grasp (the paper's "task reset") and reaches the goal;
+/// the BT told to stop ends at its root's first FAILURE; the defaults
+/// (FSM stops, BT and its HFSM keep ticking) are as before.
+#[test]
+fn after_failure_is_a_property_of_the_run() {
+    let s = scenario(
+        r#"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+name = "FSM reset"
+after_failure = "keep-ticking"
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+[[policies]]
+file = "../paper/fig01-bt.toml"
+name = "BT stop"
+after_failure = "stop"
+[[policies]]
+file = "../paper/fig01-bt.toml"
+convert = "hfsm"
+[[disturbances]]
+at = 0.0
+fail = "Pick"
+"#,
+    );
+    let runs = run_scenario(&s, false);
+    let got: Vec<(Outcome, Option<bool>, &str)> = (runs.iter())
+        .map(|r| (r.outcome, r.goal_met, r.after_failure))
+        .collect();
+    assert_eq!(
+        got,
+        vec![
+            (Outcome::Success, Some(true), "keep-ticking"),
+            (Outcome::Failure, Some(false), "stop"),
+            (Outcome::Failure, Some(false), "stop"),
+            (Outcome::Success, Some(true), "keep-ticking"),
+        ]
+    );
+    assert_eq!(
+        runs[2].reason,
+        "the root returned FAILURE (after_failure = \"stop\")"
+    );
+    // The reset starts the task over at once: Move-To cube2 (already there).
+    let r = &runs[0].skills;
+    assert_eq!(
+        (r[1].skill.as_str(), r[1].outcome.as_str()),
+        ("Pick", "failure")
+    );
+    assert_eq!(
+        (r[2].skill.as_str(), r[2].start),
+        ("Move-To", r[1].end.unwrap())
+    );
+}
+
 /// `sim --seed S` runs episode S of `--runs`: for every episode, the
 /// single run with its seed gives the pair verdicts Monte Carlo counted,
 /// and the first diverging episode is the first whose replay differs.
