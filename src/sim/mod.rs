@@ -5,6 +5,7 @@
 //! Monte Carlo episodes.
 
 pub mod exec;
+mod livelock;
 pub mod monte_carlo;
 pub mod plot;
 pub mod report;

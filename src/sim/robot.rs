@@ -40,12 +40,22 @@ pub(super) struct Robot {
     pub(super) dt: f64,
     pub(super) live: Vec<Option<Running>>,
     pub(super) ticked: Vec<bool>,
+    /// The keys ticked in this step or live, so that a step's bookkeeping
+    /// costs what it touched, not the size of the policy; after
+    /// [`Robot::end_step`], the live keys in ascending order.
+    pub(super) touched: Vec<usize>,
     pub(super) records: Vec<SkillRecord>,
     pub(super) events: Vec<Event>,
     pub(super) faults: Faults,
     pub(super) log: bool,
-    pub(super) last_failed: Option<Call>,
-    pub(super) switches: u32,
+    /// Actions that ended in FAILURE so far (the run loop re-ticks a policy
+    /// whose root failed because one did, within the same step).
+    pub(super) failed_ends: u64,
+    /// Leaves whose action started in this step, a retry of the action that
+    /// just failed excepted (livelock detection; cleared by the run loop).
+    pub(super) started: Vec<usize>,
+    /// The leaf whose action failed last, until the next start.
+    pub(super) failed_key: Option<usize>,
     pub(super) failures: u32,
     pub(super) mark: u64,
     pub(super) low_at: Option<f64>,
@@ -111,7 +121,6 @@ impl Robot {
     fn sync_progress(&mut self) {
         if self.world.progress != self.mark {
             self.mark = self.world.progress;
-            self.switches = 0;
             self.failures = 0;
         }
     }
@@ -129,13 +138,27 @@ impl Robot {
 
     /// Cancels the actions that were not ticked in this step.
     pub(super) fn end_step(&mut self) {
-        for k in 0..self.live.len() {
+        // In key order, as a walk over every key would cancel them.
+        let mut keys = std::mem::take(&mut self.touched);
+        keys.sort_unstable();
+        keys.dedup();
+        keys.retain(|&k| {
             if !self.ticked[k]
                 && let Some(mut r) = self.live[k].take()
             {
                 r.cancel(&mut self.world);
                 self.close(r.record, "cancelled");
             }
+            self.ticked[k] = false;
+            self.live[k].is_some()
+        });
+        self.touched = keys;
+    }
+
+    /// Forgets which keys were ticked in this step (the run loop ticks the
+    /// policy again: its last tick says which actions go on).
+    pub(super) fn untick(&mut self) {
+        for &k in &self.touched {
             self.ticked[k] = false;
         }
     }
@@ -152,7 +175,10 @@ impl Leaves for Robot {
     }
 
     fn action(&mut self, key: usize, call: &Call) -> Status {
-        self.ticked[key] = true;
+        if !self.ticked[key] {
+            self.ticked[key] = true;
+            self.touched.push(key);
+        }
         if self.live[key].as_ref().is_none_or(|r| r.call != *call) {
             if self.records.len() >= MAX_SKILL_RECORDS {
                 // Not started: the run ends after this step.
@@ -164,11 +190,10 @@ impl Leaves for Robot {
                 self.close(old.record, "cancelled");
             }
             self.sync_progress();
-            // Every start counts, except a retry of the action that just failed.
-            if self.last_failed != Some(*call) {
-                self.switches += 1;
+            if self.failed_key != Some(key) && self.started.len() < 64 {
+                self.started.push(key);
             }
-            self.last_failed = None;
+            self.failed_key = None;
             let doomed = self.faults.doomed(call.name());
             if *call == Call::Recharge
                 && let Some(t) = self.low_at.take()
@@ -204,7 +229,8 @@ impl Leaves for Robot {
             if s == Status::Failure {
                 self.sync_progress();
                 self.failures += 1;
-                self.last_failed = Some(*call);
+                self.failed_ends += 1;
+                self.failed_key = Some(key);
             }
         }
         s
