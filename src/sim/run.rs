@@ -9,7 +9,6 @@
 //! the first k whole episodes.
 
 use super::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
-use super::rng::SimRng;
 use super::robot::{Faults, MAX_EVENTS, MAX_SKILL_RECORDS, Robot, apply, round3};
 use super::scenario::{Disturbance, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Status};
@@ -155,27 +154,7 @@ pub fn run_policy_into(
 ) -> Run {
     let every = clock_every(p, disturbances, &world);
     let n = p.keys.len();
-    let mut robot = Robot {
-        world,
-        dt: s.dt,
-        live: vec![None; n],
-        ticked: vec![false; n],
-        records: Vec::new(),
-        events: Vec::new(),
-        faults: Faults {
-            next: BTreeMap::new(),
-            rates,
-            rng: SimRng::named(seed, "skill-faults"),
-        },
-        log: opts.log,
-        last_failed: None,
-        switches: 0,
-        failures: 0,
-        mark: 0,
-        low_at: None,
-        latencies: Vec::new(),
-        full: false,
-    };
+    let mut robot = Robot::new(world, s.dt, n, Faults::new(seed, rates), opts.log);
     enum Ex {
         Bt(BtExec),
         M(MachineExec),

@@ -11,7 +11,11 @@
 //! by line-of-sight checks against the exact rectangles ("string pulling").
 //!
 //! An object's position is the pose from which the robot grasps it (the near
-//! edge of its table); "at a station" means within [`World::station_radius`].
+//! edge of its table). An object lies on a surface (a table or box within
+//! [`SURFACE_REACH`] of that pose), on the floor (dropped) or in the gripper;
+//! the robot acts on its *believed* pose, which the camera updates when the
+//! object is within range and in line of sight (tables, boxes and walls
+//! occlude: [`Planner::visible`]). docs/simulator-model.md states the model.
 
 use std::collections::{BinaryHeap, HashMap};
 use std::sync::Arc;
@@ -58,6 +62,18 @@ impl Rect {
         p.0 > self.x0 && p.0 < self.x1 && p.1 > self.y0 && p.1 < self.y1
     }
 
+    /// Distance from `p` to the closed rectangle (0 inside).
+    pub fn distance(&self, p: P2) -> f64 {
+        let dx = (self.x0 - p.0).max(p.0 - self.x1).max(0.0);
+        let dy = (self.y0 - p.1).max(p.1 - self.y1).max(0.0);
+        (dx * dx + dy * dy).sqrt()
+    }
+
+    /// Does the rectangle overlap the open box `[x0, x1] x [y0, y1]`?
+    fn overlaps(&self, x0: f64, y0: f64, x1: f64, y1: f64) -> bool {
+        self.x0 < x1 && x0 < self.x1 && self.y0 < y1 && y0 < self.y1
+    }
+
     /// Does the segment a-b pass through the open rectangle (slab method)?
     fn hits_segment(&self, a: P2, b: P2) -> bool {
         let (dx, dy) = (b.0 - a.0, b.1 - a.1);
@@ -86,7 +102,10 @@ impl Rect {
 /// Where an object is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Place {
+    /// On a surface (a table or box), grasped from this pose.
     At(P2),
+    /// On the floor where it fell: never "at" a station.
+    Floor(P2),
     /// In the robot's gripper.
     Held,
 }
@@ -97,7 +116,32 @@ pub struct Object {
     pub place: Place,
     /// Seen by the camera (or known from the start).
     pub found: bool,
+    /// Where the robot believes it is (meaningful when `found`): updated only
+    /// when the camera sees it ([`World::sense`]).
+    pub belief: P2,
 }
+
+impl Object {
+    /// An object at `p`, known there (`found`) or not yet seen.
+    pub fn new(name: &str, place: Place, p: P2, found: bool) -> Self {
+        Object {
+            name: name.into(),
+            place,
+            found,
+            belief: p,
+        }
+    }
+}
+
+/// How far from a pose a table or box still counts as the surface in front
+/// of it (beyond the robot's radius), m: the paper room's stations stand
+/// 0.3 m from their tables.
+pub const SURFACE_REACH: f64 = 0.15;
+/// Spacing of the places an object is put on a surface, m (5 cm cubes with
+/// 2 cm between them); Place uses the first free one, centre first.
+pub const SLOT_SPACING: f64 = 0.07;
+/// Places per surface (centre, then alternately right and left).
+pub const SLOTS: usize = 9;
 
 /// Physical constants of a world (defaults: the paper's room and a TIAGo-like
 /// base).
@@ -107,21 +151,33 @@ pub struct Params {
     pub robot_radius: f64,
     /// Top speed of Move-To, m/s (Safe-Move-To and Dock go at half of it).
     pub max_speed: f64,
+    /// Top turn rate of the base, rad/s (the holonomic base translates in
+    /// any direction; its heading turns toward the motion at most this fast).
+    pub max_turn_rate: f64,
     /// Battery drain per metre driven, percent.
     pub drain_per_m: f64,
     /// Battery drain per second, percent.
     pub drain_per_s: f64,
-    /// Charging rate at the charging station, percent per second.
+    /// Charging rate at the charging station, percent per second;
+    /// `f64::INFINITY` (the default, the paper's assumption) fills the
+    /// battery the step the robot arrives.
     pub charge_per_s: f64,
     /// Battery level at or below which the "battery low" event is logged.
     pub low_battery: f64,
-    /// Camera range for Search, m.
+    /// Camera range, m (the camera sees every step, not only in Search).
     pub camera_range: f64,
-    /// Distance within which an object counts as at a station, m.
-    pub station_radius: f64,
+    /// Distance within which an object on a surface counts as at a station
+    /// (Object-At), m.
+    pub object_tolerance: f64,
     /// Distance within which the robot counts as at a target, m.
     pub at_tolerance: f64,
-    /// Duration of Pick and Place, s.
+    /// Distance from the robot within which Pick grasps an object and Place
+    /// reaches its station, m.
+    pub reach: f64,
+    /// A navigation that has not moved for this long aborts, s (Nav2's
+    /// progress checker).
+    pub stall_s: f64,
+    /// Duration of Pick (grasp and tuck) and Place, s.
     pub manipulation_s: f64,
     /// Duration of Tuck-Arm and Shut-Down, s.
     pub arm_s: f64,
@@ -134,13 +190,16 @@ impl Default for Params {
         Params {
             robot_radius: 0.2,
             max_speed: 0.5,
+            max_turn_rate: 1.0,
             drain_per_m: 1.0,
             drain_per_s: 0.05,
-            charge_per_s: 20.0,
+            charge_per_s: f64::INFINITY,
             low_battery: 20.0,
             camera_range: 1.6,
-            station_radius: 0.3,
+            object_tolerance: 0.15,
             at_tolerance: 0.02,
+            reach: 0.1,
+            stall_s: 10.0,
             manipulation_s: 1.5,
             arm_s: 0.5,
             grid: 0.1,
@@ -224,6 +283,19 @@ impl Layout {
         }
     }
 
+    /// The table or box in front of the pose `p` (the nearest obstacle within
+    /// `radius + SURFACE_REACH`), on which an object at `p` lies.
+    pub fn surface_near(&self, p: P2, radius: f64) -> Option<&Rect> {
+        let mut best: Option<(&Rect, f64)> = None;
+        for o in &self.obstacles {
+            let d = o.distance(p);
+            if d <= radius + SURFACE_REACH + 1e-9 && best.is_none_or(|(_, b)| d < b) {
+                best = Some((o, d));
+            }
+        }
+        best.map(|(o, _)| o)
+    }
+
     /// Is a robot centred at `p` clear of walls and obstacles? `Err` names what
     /// it collides with.
     pub fn check_free(&self, p: P2, radius: f64) -> Result<(), String> {
@@ -256,6 +328,9 @@ pub struct Planner {
     w: usize,
     h: usize,
     free: Vec<bool>,
+    /// Cells any obstacle (not inflated) overlaps: what the camera cannot
+    /// see through ([`Planner::visible`]).
+    opaque: Vec<bool>,
     /// Obstacles inflated by the robot radius (for line-of-sight checks).
     inflated: Vec<Rect>,
     walls: Rect,
@@ -285,6 +360,7 @@ impl Planner {
             w,
             h,
             free: vec![false; w * h],
+            opaque: vec![false; w * h],
             inflated,
             walls,
         };
@@ -294,7 +370,75 @@ impl Planner {
                 pl.free[j * w + i] = pl.point_free(c);
             }
         }
+        for o in &layout.obstacles {
+            pl.mark_opaque(o);
+        }
         pl
+    }
+
+    /// Marks the cells `o` overlaps as opaque (only the cells of its
+    /// bounding box are visited).
+    fn mark_opaque(&mut self, o: &Rect) {
+        let (i0, j0) = self.cell((o.x0, o.y0));
+        let (i1, j1) = self.cell((o.x1, o.y1));
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                let (x0, y0) = (
+                    self.origin.0 + i as f64 * self.res,
+                    self.origin.1 + j as f64 * self.res,
+                );
+                if o.overlaps(x0, y0, x0 + self.res, y0 + self.res) {
+                    self.opaque[j * self.w + i] = true;
+                }
+            }
+        }
+    }
+
+    /// Line of sight from `a` to `b`: the segment crosses no opaque cell
+    /// (a grid traversal, Amanatides and Woo 1987: at most one cell per
+    /// grid line crossed, so a check costs O(length / resolution)). The
+    /// grid is conservative: a segment crossing an obstacle is never
+    /// visible (test `line_of_sight_never_sees_through_an_obstacle`).
+    pub fn visible(&self, a: P2, b: P2) -> bool {
+        let (mut i, mut j) = self.cell(a);
+        let (gi, gj) = self.cell(b);
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let (si, sj): (i64, i64) = (if dx > 0.0 { 1 } else { -1 }, if dy > 0.0 { 1 } else { -1 });
+        let next = |p: f64, d: f64, c: usize, o: f64| -> (f64, f64) {
+            if d.abs() < 1e-12 {
+                return (f64::INFINITY, f64::INFINITY);
+            }
+            let lo = o + c as f64 * self.res;
+            let edge = if d > 0.0 { lo + self.res } else { lo };
+            ((edge - p) / d, self.res / d.abs())
+        };
+        let (mut tx, ddx) = next(a.0, dx, i, self.origin.0);
+        let (mut ty, ddy) = next(a.1, dy, j, self.origin.1);
+        let n = gi.abs_diff(i) + gj.abs_diff(j) + 1;
+        for _ in 0..n {
+            if self.opaque[j * self.w + i] {
+                return false;
+            }
+            if (i, j) == (gi, gj) {
+                break;
+            }
+            if tx < ty {
+                let ni = i as i64 + si;
+                if ni < 0 || ni >= self.w as i64 {
+                    break;
+                }
+                i = ni as usize;
+                tx += ddx;
+            } else {
+                let nj = j as i64 + sj;
+                if nj < 0 || nj >= self.h as i64 {
+                    break;
+                }
+                j = nj as usize;
+                ty += ddy;
+            }
+        }
+        true
     }
 
     /// This planner with one more obstacle: the grid cells it covers are
@@ -311,6 +455,7 @@ impl Planner {
             }
         }
         pl.inflated.push(r);
+        pl.mark_opaque(o);
         pl
     }
 
@@ -554,9 +699,59 @@ impl World {
     /// Where an object is (the robot's position when held).
     pub fn object_pos(&self, i: usize) -> P2 {
         match self.objects[i].place {
-            Place::At(p) => p,
+            Place::At(p) | Place::Floor(p) => p,
             Place::Held => self.robot,
         }
+    }
+
+    /// Where the robot believes an object is: in its gripper, where the
+    /// camera last saw it, or unknown (`None`: never seen).
+    pub fn believed(&self, i: usize) -> Option<P2> {
+        let o = &self.objects[i];
+        match o.place {
+            Place::Held => Some(self.robot),
+            _ => o.found.then_some(o.belief),
+        }
+    }
+
+    /// Where an object put down at `p` comes to rest: on the surface in
+    /// front of `p`, or on the floor when there is none.
+    pub fn rest_at(&self, p: P2) -> Place {
+        match self.layout.surface_near(p, self.params.robot_radius) {
+            Some(_) => Place::At(p),
+            None => Place::Floor(p),
+        }
+    }
+
+    /// Where Place puts `object` at station `at`: the first free place on
+    /// the station's surface, along the table's edge (centre first, then
+    /// alternately either side, [`SLOT_SPACING`] apart), or the floor at the
+    /// robot's feet when the station has no surface. O(objects) per slot.
+    pub fn place_spot(&self, object: usize, at: usize) -> Place {
+        let s = self.layout.stations[at].1;
+        let Some(r) = self.layout.surface_near(s, self.params.robot_radius) else {
+            return Place::Floor(self.robot);
+        };
+        // The edge faces the station: along x when the table is above or
+        // below it, along y otherwise.
+        let (dx, dy) = (
+            (r.x0 - s.0).max(s.0 - r.x1).max(0.0),
+            (r.y0 - s.1).max(s.1 - r.y1).max(0.0),
+        );
+        let dir = if dy >= dx { (1.0, 0.0) } else { (0.0, 1.0) };
+        let mut spot = s;
+        for k in 0..SLOTS {
+            let m = k.div_ceil(2) as f64 * if k % 2 == 1 { 1.0 } else { -1.0 };
+            spot = (s.0 + dir.0 * m * SLOT_SPACING, s.1 + dir.1 * m * SLOT_SPACING);
+            let taken = self.objects.iter().enumerate().any(|(i, o)| {
+                i != object
+                    && matches!(o.place, Place::At(q) if dist(q, spot) < SLOT_SPACING / 2.0)
+            });
+            if !taken {
+                break;
+            }
+        }
+        Place::At(spot)
     }
 
     /// Adds an obstacle (a blocked path) and rebuilds the planner.
@@ -568,35 +763,48 @@ impl World {
         self.map_version += 1;
     }
 
-    /// Moves the robot toward `goal` by at most `speed * dt`, draining the
-    /// battery; returns `true` on arrival.
-    pub fn drive_toward(&mut self, goal: P2, speed: f64, dt: f64) -> bool {
-        let d = dist(self.robot, goal);
-        let step = speed * dt;
-        if d > 1e-12 {
-            self.yaw = (goal.1 - self.robot.1).atan2(goal.0 - self.robot.0);
+    /// How far the base may drive this step at `speed`: nothing while shut
+    /// down, and no further than the battery lasts.
+    pub fn drive_budget(&self, speed: f64, dt: f64) -> f64 {
+        if self.shut_down || self.battery <= 0.0 {
+            return 0.0;
         }
-        if d <= step {
-            self.robot = goal;
-            self.drain(d);
-            true
-        } else {
-            let f = step / d;
-            self.robot = (
-                self.robot.0 + (goal.0 - self.robot.0) * f,
-                self.robot.1 + (goal.1 - self.robot.1) * f,
-            );
-            self.drain(step);
-            false
+        let mut b = speed.min(self.params.max_speed) * dt;
+        if self.params.drain_per_m > 0.0 {
+            b = b.min(self.battery / self.params.drain_per_m);
+        }
+        b.max(0.0)
+    }
+
+    /// Moves the robot straight to `p` (the caller keeps within the
+    /// step's budget), draining the battery.
+    pub fn translate(&mut self, p: P2) {
+        let d = dist(self.robot, p);
+        self.robot = p;
+        self.odometer += d;
+        self.battery = (self.battery - d * self.params.drain_per_m).max(0.0);
+    }
+
+    /// Turns the heading toward `heading` by at most `max_turn_rate * dt`.
+    pub fn turn_toward(&mut self, heading: f64, dt: f64) {
+        use std::f64::consts::{PI, TAU};
+        let mut d = (heading - self.yaw) % TAU;
+        if d > PI {
+            d -= TAU;
+        } else if d < -PI {
+            d += TAU;
+        }
+        let m = self.params.max_turn_rate * dt;
+        self.yaw += d.clamp(-m, m);
+        if self.yaw > PI {
+            self.yaw -= TAU;
+        } else if self.yaw < -PI {
+            self.yaw += TAU;
         }
     }
 
-    fn drain(&mut self, metres: f64) {
-        self.odometer += metres;
-        self.battery = (self.battery - metres * self.params.drain_per_m).max(0.0);
-    }
-
-    /// Time passes: the clock advances and the battery drains.
+    /// Time passes: the clock advances and the battery drains (not while
+    /// charging).
     pub fn advance(&mut self, dt: f64) {
         self.time += dt;
         if !self.charging {
@@ -613,29 +821,49 @@ impl World {
             .map(|(n, _)| n.as_str())
     }
 
-    /// The station an object is at, if any.
-    pub fn object_station(&self, i: usize) -> Option<&str> {
-        let Place::At(p) = self.objects[i].place else {
-            return None;
-        };
-        self.layout
-            .stations
-            .iter()
-            .find(|(_, s)| dist(*s, p) <= self.params.station_radius)
-            .map(|(n, _)| n.as_str())
+    /// Object-At: the object lies on a surface within
+    /// [`Params::object_tolerance`] of the station (on the floor or in the
+    /// gripper it is at no station).
+    pub fn object_at(&self, i: usize, at: usize) -> bool {
+        let s = self.layout.stations[at].1;
+        let r = self.params.object_tolerance;
+        match self.objects[i].place {
+            Place::At(p) => (p.0 - s.0).powi(2) + (p.1 - s.1).powi(2) <= r * r,
+            _ => false,
+        }
     }
 
-    /// Marks the objects within camera range as found; returns how many were new.
-    pub fn look(&mut self) -> usize {
+    /// The station an object is at (Object-At holds), if any.
+    pub fn object_station(&self, i: usize) -> Option<&str> {
+        (0..self.layout.stations.len())
+            .find(|&s| self.object_at(i, s))
+            .map(|s| self.layout.stations[s].0.as_str())
+    }
+
+    /// The camera: every object within [`Params::camera_range`] and in line
+    /// of sight is seen, its believed pose set to where it is. Returns how
+    /// many beliefs changed (newly found or seen elsewhere). O(objects x
+    /// range / grid) per call.
+    pub fn sense(&mut self) -> usize {
         let (r, range) = (self.robot, self.params.camera_range);
-        let mut new = 0;
+        let mut changed = 0;
         for i in 0..self.objects.len() {
-            if !self.objects[i].found && dist(self.object_pos(i), r) <= range {
-                self.objects[i].found = true;
-                new += 1;
+            let p = match self.objects[i].place {
+                Place::At(p) | Place::Floor(p) => p,
+                Place::Held => continue,
+            };
+            let o = &self.objects[i];
+            if o.found && o.belief == p {
+                continue;
+            }
+            if dist(p, r) <= range && self.planner.visible(r, p) {
+                let o = &mut self.objects[i];
+                o.found = true;
+                o.belief = p;
+                changed += 1;
             }
         }
-        new
+        changed
     }
 }
 
