@@ -6,6 +6,8 @@
 
 pub mod exec;
 pub mod monte_carlo;
+#[cfg(test)]
+mod physics_tests;
 pub mod plot;
 pub mod report;
 pub mod rng;

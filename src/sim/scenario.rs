@@ -563,7 +563,8 @@ impl Reader {
                 "world parameter",
             );
             for (k, v) in pt.iter() {
-                let Some(&(name, lo, hi)) = PARAMS.iter().find(|p| p.0 == k.get_ref().as_ref()) else {
+                let Some(&(name, lo, hi)) = PARAMS.iter().find(|p| p.0 == k.get_ref().as_ref())
+                else {
                     continue;
                 };
                 let Some(x) = self.number(v, &format!("`{name}`"), lo, hi) else {
@@ -707,9 +708,7 @@ impl Reader {
         radius: f64,
         what: &str,
     ) -> bool {
-        let hit = stations
-            .iter()
-            .find(|(_, p)| r.distance(*p) < radius);
+        let hit = stations.iter().find(|(_, p)| r.distance(*p) < radius);
         if let Some((n, p)) = hit {
             self.err(
                 span,
@@ -913,7 +912,13 @@ impl Reader {
             "block" => {
                 let bv = t.get("block").expect("checked above");
                 let r = self.rect(bv)?;
-                if !self.covers_no_station(bv.span(), &r, &world.layout.stations, world.params.robot_radius, "`block`") {
+                if !self.covers_no_station(
+                    bv.span(),
+                    &r,
+                    &world.layout.stations,
+                    world.params.robot_radius,
+                    "`block`",
+                ) {
                     return None;
                 }
                 if r.distance(world.robot) < world.params.robot_radius {
