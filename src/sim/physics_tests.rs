@@ -380,3 +380,30 @@ fn a_dropped_cube_is_not_delivered() {
     assert_eq!(c.at, None);
     assert!(!c.held);
 }
+
+/// A `block` that would land on the robot during a run is refused, with an
+/// event saying so (the scenario check refuses one over the start).
+#[test]
+fn a_block_over_the_robot_is_refused() {
+    let mut r = robot(world(), 1);
+    let n = r.world.layout.obstacles.len();
+    let here = r.world.robot;
+    apply(
+        &Disturbance {
+            when: When::At(0.0),
+            effect: Effect::Block(super::world::Rect::new(
+                "box",
+                here.0 - 0.1,
+                here.1 - 0.1,
+                here.0 + 0.1,
+                here.1 + 0.1,
+            )),
+            text: "path blocked by box".into(),
+        },
+        &mut r,
+    );
+    assert_eq!(r.world.layout.obstacles.len(), n);
+    assert_eq!(r.world.map_version, 0);
+    let e = r.events.last().expect("an event");
+    assert!(e.text.contains("refused"), "{}", e.text);
+}
