@@ -234,6 +234,8 @@ pub fn run_policy_into(
                 .live
                 .iter()
                 .flatten()
+                // An outcome reached while moving is no longer running.
+                .filter(|r| r.result.is_none())
                 .map(|r| {
                     robot.records[r.record]
                         .text()
