@@ -559,10 +559,23 @@ impl Reader {
             let pt = self.table(p, "`world.params`")?;
             self.keys(
                 pt,
-                &PARAMS.iter().map(|p| p.0).collect::<Vec<_>>(),
+                &(PARAMS.iter().map(|p| p.0))
+                    .chain(["follow_belief"])
+                    .collect::<Vec<_>>(),
                 "world parameter",
             );
             for (k, v) in pt.iter() {
+                if k.get_ref().as_ref() == "follow_belief" {
+                    match v.get_ref() {
+                        DeValue::Boolean(b) => params.follow_belief = *b,
+                        _ => self.err(
+                            v.span(),
+                            "`follow_belief` must be true or false",
+                            "write `follow_belief = true`",
+                        ),
+                    }
+                    continue;
+                }
                 let Some(&(name, lo, hi)) = PARAMS.iter().find(|p| p.0 == k.get_ref().as_ref())
                 else {
                     continue;

@@ -494,6 +494,18 @@ impl Running {
             return None;
         }
         let tol = w.params.at_tolerance;
+        if w.params.follow_belief
+            && let Call::MoveTo {
+                target: Target::Object(o),
+                ..
+            } = self.call
+            && let Some(b) = w.believed(o)
+            && self.goal != Some(b)
+        {
+            // Re-targeted: replanned below.
+            self.goal = Some(b);
+            self.planned_for = u32::MAX;
+        }
         let Some(goal) = self.target(w) else {
             // Search past its last waypoint.
             return self.settle(w);

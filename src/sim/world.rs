@@ -177,6 +177,11 @@ pub struct Params {
     /// A navigation that has not moved for this long aborts, s (Nav2's
     /// progress checker).
     pub stall_s: f64,
+    /// A Move-To toward an object re-targets when the robot's belief about
+    /// the object changes (a skill that tracks its marker); default `false`:
+    /// the goal is the believed pose when the action started, as a
+    /// navigation action server's goal.
+    pub follow_belief: bool,
     /// Duration of Pick (grasp and tuck) and Place, s.
     pub manipulation_s: f64,
     /// Duration of Tuck-Arm and Shut-Down, s.
@@ -200,6 +205,7 @@ impl Default for Params {
             at_tolerance: 0.02,
             reach: 0.1,
             stall_s: 10.0,
+            follow_belief: false,
             manipulation_s: 1.5,
             arm_s: 0.5,
             grid: 0.1,
