@@ -108,6 +108,35 @@ fn sim_a_cube_moved_during_the_task_defeats_only_the_sequential_fsm() {
     assert_eq!(fsm2["final_world"]["objects"]["cube2"]["y"], -0.8);
 }
 
+/// An injected navigation fault stops the base short of its goal: the
+/// sequential FSM is left part-way, the reactive policies drive on from
+/// there with a new Move-To.
+#[test]
+fn sim_a_navigation_fault_stops_the_robot_short_of_its_goal() {
+    let v = sim_json("tests/fixtures/sim/navigation-fault.toml");
+    let fsm2 = sim_policy(&v, FSM2);
+    assert_eq!(fsm2["outcome"], "failure");
+    assert_eq!(fsm2["final_world"]["robot_at"], serde_json::Value::Null);
+    let [x, y] = [0, 1].map(|i| fsm2["final_world"]["robot"][i].as_f64().unwrap());
+    // Part-way from the start (-2.0, -2.2) to the east table (1.7, 0.0).
+    assert!(x > -1.9 && x < 1.6, "{x}");
+    assert!(y > -2.2 && y < -0.05, "{y}");
+    for p in [BT1, FSM4] {
+        let r = sim_policy(&v, p);
+        assert_eq!(r["goal_met"], true, "{p}");
+        let s = r["skills"].as_array().unwrap();
+        assert_eq!(
+            (s[0]["skill"].as_str(), s[0]["outcome"].as_str()),
+            (Some("Move-To"), Some("failure"))
+        );
+        assert_eq!(s[1]["skill"], "Move-To", "{p}");
+        // Within a step of the failure (whether a representation restarts
+        // in the failing step is the executors' business, not the world's).
+        let gap = s[1]["start"].as_f64().unwrap() - s[0]["end"].as_f64().unwrap();
+        assert!((-1e-9..=0.1 + 1e-9).contains(&gap), "{p}: {gap}");
+    }
+}
+
 /// A cube moved out of the camera's view is seen by no policy: the BT
 /// tries where it believes the cube is and gives up.
 #[test]
