@@ -434,3 +434,24 @@ fn following_the_belief_is_a_setting_that_changes_the_verdict() {
     assert_ne!(follow, text);
     assert_eq!(fsm2(&follow), Some(true));
 }
+
+/// Shut-Down with no emergency to clear stays down: nothing moves again.
+#[test]
+fn a_shut_down_without_an_emergency_stays_down() {
+    let mut r = robot(world(), 1);
+    let mut s = Status::Running;
+    while s == Status::Running {
+        s = r.action(0, &Call::ShutDown);
+        end(&mut r);
+    }
+    assert_eq!(s, Status::Success);
+    let here = r.world.robot;
+    let a = to(&r, "delivery");
+    for _ in 0..200 {
+        let _ = r.action(0, &a);
+        end(&mut r);
+    }
+    assert!(r.world.shut_down);
+    assert_eq!(r.world.robot, here);
+    assert!(r.records.iter().skip(1).all(|k| k.outcome == "failure"));
+}
