@@ -648,7 +648,9 @@ mod hostile {
         let (code, out, err, took) =
             btfsm_within(512, &["sim", f.to_str().unwrap(), "--format", "json"]);
         assert_eq!(code, 0, "{err}");
-        assert!(took < Duration::from_secs(20), "{took:?}");
+        // About 2,100 steps per policy (every action takes a step), 13 s
+        // alone on the shared 2-core machine, 21 s beside the other tests.
+        assert!(took < Duration::from_secs(40), "{took:?}");
         assert!(out.len() < 64 << 20, "{} bytes of JSON", out.len());
         let v: serde_json::Value = serde_json::from_str(&out).expect("json");
         for p in v["policies"].as_array().unwrap() {
