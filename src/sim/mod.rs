@@ -8,6 +8,7 @@ pub mod exec;
 pub mod monte_carlo;
 #[cfg(test)]
 mod physics_tests;
+pub mod planner;
 pub mod plot;
 pub mod report;
 pub mod rng;
