@@ -2,7 +2,8 @@
 //! rule, sec. V: BTs and FSMs call the same low-level skills). A binding from a
 //! policy ([`crate::model::SkillCall`]) is resolved against the world once into a
 //! [`Call`]; actions then run over many steps as [`Running`] instances that return
-//! RUNNING, SUCCESS or FAILURE and are cancelled by dropping them (an action
+//! RUNNING, SUCCESS or FAILURE and are cancelled ([`Running::cancel`]) when
+//! halted, not ticked, or aborted by a new goal for their resource (an action
 //! leaves nothing half-done in the world: a cancelled Recharge stops charging).
 //!
 //! Conventions (docs/simulator-model.md states each with its test): every
