@@ -455,3 +455,119 @@ fn a_shut_down_without_an_emergency_stays_down() {
     assert_eq!(r.world.robot, here);
     assert!(r.records.iter().skip(1).all(|k| k.outcome == "failure"));
 }
+
+/// No panic, and the limits hold, on random worlds: extreme parameters,
+/// objects on tables and floors, blocks, drops, moves, faults, emergencies
+/// and battery drops at random times, for the paper's BTs and FSMs.
+#[test]
+fn random_worlds_and_disturbances_never_panic() {
+    let mut rng = super::rng::SimRng::named(13, "random-worlds");
+    let policies = [
+        "fig01-bt",
+        "fig02-fsm",
+        "fig04-fsm",
+        "fig09a-bt",
+        "fig09b-fsm",
+        "fig15-bt",
+        "fig15-fsm",
+        "fig16a-bt",
+        "fig16b-fsm",
+    ];
+    let base = Path::new("policies/scenarios");
+    let mut ran = 0;
+    for k in 0..80 {
+        let pick = |rng: &mut super::rng::SimRng, lo: f64, hi: f64| {
+            if rng.chance(0.3) {
+                if rng.chance(0.5) { lo } else { hi }
+            } else {
+                rng.range(lo, hi)
+            }
+        };
+        let mut params = Vec::new();
+        for &(name, lo, hi) in scenario::PARAMS {
+            if rng.chance(0.5) {
+                params.push(format!("{name} = {}", pick(&mut rng, lo, hi)));
+            }
+        }
+        if rng.chance(0.3) {
+            params.push("follow_belief = true".into());
+        }
+        let mut text = format!(
+            "seed = {k}\nmax_steps = 1500\n[world]\nbattery = {}\nparams = {{ {} }}\n[world.objects]\n",
+            pick(&mut rng, 0.0, 100.0),
+            params.join(", ")
+        );
+        for c in 1..=5 {
+            let at = [
+                "east-table",
+                "west-table",
+                "central-table",
+                "[1.2, 1.4]",
+                "[-1.0, -2.0]",
+                "[1.7, -0.8]",
+            ][(rng.next_u64() % 6) as usize];
+            let at = if at.starts_with('[') {
+                at.to_string()
+            } else {
+                format!("\"{at}\"")
+            };
+            text.push_str(&format!(
+                "cube{c} = {{ at = {at}, found = {} }}\n",
+                rng.chance(0.5)
+            ));
+        }
+        for _ in 0..3 {
+            let f = policies[(rng.next_u64() % policies.len() as u64) as usize];
+            text.push_str(&format!("[[policies]]\nfile = \"../paper/{f}.toml\"\n"));
+        }
+        for _ in 0..(rng.next_u64() % 8) {
+            let t = rng.range(0.0, 50.0);
+            let effect = match rng.next_u64() % 7 {
+                0 => format!("battery = {}", pick(&mut rng, 0.0, 100.0)),
+                1 => format!("drop = \"cube{}\"", 1 + rng.next_u64() % 5),
+                2 => format!("move = \"cube{}\"\nto = [1.2, 1.4]", 1 + rng.next_u64() % 5),
+                3 => format!(
+                    "fail = \"{}\"\ntimes = {}",
+                    ["Move-To", "Pick", "Place", "Recharge", "Dock", "Search"]
+                        [(rng.next_u64() % 6) as usize],
+                    1 + rng.next_u64() % 3
+                ),
+                4 => {
+                    let (x, y) = (rng.range(-1.0, 2.0), rng.range(-1.5, 0.0));
+                    format!(
+                        "block = {{ name = \"b\", rect = [{x}, {y}, {}, {}] }}",
+                        x + 0.05,
+                        y + 0.5
+                    )
+                }
+                5 => "emergency = true".into(),
+                _ => "emergency = false".into(),
+            };
+            text.push_str(&format!("[[disturbances]]\nat = {t}\n{effect}\n"));
+        }
+        let f = SourceFile::new("random.toml", &text);
+        // A random block may cover a station or the start: refused, fine.
+        let s = match scenario::parse(&f, base, &Limits::default()) {
+            Ok(s) => s,
+            Err(d) => {
+                assert!(
+                    d.iter().all(|d| d.message.contains("covers")),
+                    "{k}: {d:?}\n{text}"
+                );
+                continue;
+            }
+        };
+        ran += 1;
+        let p = s.world.params.clone();
+        for run in run_scenario(&s, true) {
+            let mut prev = s.world.robot;
+            for st in &run.trace {
+                let d = dist(prev, (st.x, st.y));
+                assert!(d <= p.max_speed * s.dt + 1e-9, "{k}: {d}\n{text}");
+                assert!((0.0..=100.0).contains(&st.battery), "{k}");
+                prev = (st.x, st.y);
+            }
+        }
+    }
+    assert!(ran >= 40, "{ran}");
+}
