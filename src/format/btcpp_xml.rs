@@ -3,7 +3,7 @@
 //!
 //! - `<root>` holds `<BehaviorTree ID>` definitions, `<include path>` (relative to
 //!   the including file; cycles rejected) and `<TreeNodesModel>`; the tree run is
-//!   `main_tree_to_execute`, or the only tree of the main file.
+//!   `--tree ID`, else `main_tree_to_execute`, else the only tree of the main file.
 //! - Nodes in compact (`<Sequence>`) or explicit (`<Action ID="...">`) syntax.
 //!   `<SubTree ID>` (and format 3's `<SubTreePlus>`) is expanded in place: the
 //!   subtree's root takes the SubTree element's place, as TOML subtree includes
@@ -90,7 +90,7 @@ pub const BUILTINS: &[(&str, Category)] = &[
     ("LoopBool", Category::Decorator),
     ("EntryUpdated", Category::Decorator),
     ("SkipUnlessUpdated", Category::Decorator),
-    ("WaitValueUpdated", Category::Decorator),
+    ("WaitValueUpdate", Category::Decorator),
     ("BlackboardCheckInt", Category::Decorator),
     ("BlackboardCheckDouble", Category::Decorator),
     ("BlackboardCheckString", Category::Decorator),
@@ -102,7 +102,7 @@ pub const BUILTINS: &[(&str, Category)] = &[
     ("UnsetBlackboard", Category::Action),
     ("Sleep", Category::Action),
     ("ScriptCondition", Category::Condition),
-    ("WasEntryUpdated", Category::Condition),
+    ("WasEntryUpdated", Category::Action),
 ];
 
 /// The category of a built-in type.
@@ -256,6 +256,9 @@ struct Loader<'l> {
     /// What remains of `--max-nodes` for the elements of the files still to
     /// read: every element of every file counts, used or not.
     elems_left: usize,
+    /// Unknown node types already reported: each is an error once, at its
+    /// first use, however often it is used.
+    unknown: std::collections::HashSet<String>,
 }
 
 fn load(
@@ -276,6 +279,7 @@ fn load(
         dirs: vec![base],
         trees: BTreeMap::new(),
         models: BTreeMap::new(),
+        unknown: Default::default(),
     };
     let policy = l.run(identity);
     super::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")
@@ -645,10 +649,30 @@ impl Loader<'_> {
         }
     }
 
-    /// The tree to run: `main_tree_to_execute`, or the only tree of the main file.
+    /// The tree to run: `--tree ID`, else `main_tree_to_execute`, else the
+    /// only tree of the main file.
     fn main_tree(&mut self) -> Option<(String, (usize, usize))> {
         let root = self.docs[0].root;
         let all: Vec<String> = self.trees.keys().cloned().collect();
+        if let Some(id) = self.limits.tree.clone() {
+            return match self.trees.get(&id) {
+                Some(&t) => Some((id, t)),
+                None => {
+                    let span = self.docs[0].elems[root].span.clone();
+                    let h = suggest(&id, all.iter().map(String::as_str));
+                    self.err(
+                        0,
+                        span,
+                        format!(
+                            "--tree `{}`: no `<BehaviorTree ID>` of that name",
+                            shown(&id)
+                        ),
+                    )
+                    .hint = Some(h);
+                    None
+                }
+            };
+        }
         if let Some(a) = self.docs[0].elems[root].attr_full("main_tree_to_execute") {
             let (v, span) = (a.value.clone(), a.span.clone());
             return match self.trees.get(&v) {
@@ -696,7 +720,7 @@ impl Loader<'_> {
                     format!("{} trees and no `main_tree_to_execute`", many.len()),
                 )
                 .hint = Some(format!(
-                    "add `main_tree_to_execute` with one of {}",
+                    "choose one with --tree ID, or add `main_tree_to_execute`: {}",
                     ids.join(", ")
                 ));
                 None
@@ -1005,6 +1029,13 @@ impl Loader<'_> {
                 AssumeLeaf::Action => (BtNodeKind::Action, Category::Action),
                 AssumeLeaf::Condition => (BtNodeKind::Condition, Category::Condition),
             }
+        } else if !self.unknown.insert(ty.clone()) {
+            // Reported at its first use already.
+            match n {
+                0 => return None,
+                1 => (BtNodeKind::Decorator, Category::Decorator),
+                _ => (BtNodeKind::Control, Category::Control),
+            }
         } else {
             // Hints only for messages that will be shown (the rest are
             // counted): bounded work under a million unknown types.
@@ -1041,7 +1072,15 @@ impl Loader<'_> {
                 ),
             )
             .hint = Some(hint);
-            return None;
+            // A node with children is read on as a placeholder of its
+            // shape, so that the unknown types below it are reported in the
+            // same run (the file fails with these errors anyway); a leaf has
+            // nothing below it and costs nothing more.
+            match n {
+                0 => return None,
+                1 => (BtNodeKind::Decorator, Category::Decorator),
+                _ => (BtNodeKind::Control, Category::Control),
+            }
         };
         // Arity of the element (a SubTree child is one node).
         let bad = match cat {
@@ -1367,6 +1406,75 @@ mod tests {
 
     fn parse(text: &str) -> Result<Loaded, Vec<Diagnostic>> {
         parse_str("t.xml", text, Path::new("."), &Limits::default())
+    }
+
+    #[test]
+    fn every_unknown_type_is_reported_once_in_one_run() {
+        // An unknown control hides nothing below it; a type used twice is
+        // one error.
+        let text = r#"<root BTCPP_format="4" main_tree_to_execute="T">
+  <BehaviorTree ID="T">
+    <RecoveryNode>
+      <Sequence><Spin/><Wait/></Sequence>
+      <RateController><Spin/></RateController>
+    </RecoveryNode>
+  </BehaviorTree>
+</root>"#;
+        let e = parse(text).unwrap_err();
+        let msgs: Vec<&str> = e.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(
+            msgs,
+            [
+                "unknown node type `RecoveryNode` (2 children)",
+                "unknown node type `Spin` (0 children)",
+                "unknown node type `Wait` (0 children)",
+                "unknown node type `RateController` (1 child)",
+                "t.xml: 4 problems",
+            ][..msgs.len().min(5)],
+            "{msgs:#?}"
+        );
+        assert_eq!(
+            e.iter()
+                .filter(|d| d.message.starts_with("unknown"))
+                .count(),
+            4
+        );
+    }
+
+    #[test]
+    fn tree_chooses_among_several_trees_without_a_main_tree() {
+        let text = r#"<root BTCPP_format="4">
+  <BehaviorTree ID="Alpha"><AlwaysSuccess/></BehaviorTree>
+  <BehaviorTree ID="Beta"><Sequence><AlwaysSuccess/><SubTree ID="Alpha"/></Sequence></BehaviorTree>
+</root>"#;
+        let e = parse(text).unwrap_err();
+        assert!(
+            e[0].message
+                .contains("2 trees and no `main_tree_to_execute`")
+        );
+        let hint = e[0].hint.as_deref().unwrap();
+        assert!(hint.contains("--tree ID") && hint.contains("`Alpha`") && hint.contains("`Beta`"));
+        let with = |id: &str| Limits {
+            tree: Some(id.into()),
+            ..Limits::default()
+        };
+        let l = parse_str("t.xml", text, Path::new("."), &with("Beta")).unwrap();
+        assert_eq!(bt(&l).nodes.len(), 3, "Beta with Alpha expanded");
+        let e = parse_str("t.xml", text, Path::new("."), &with("Bta")).unwrap_err();
+        assert!(e[0].message.contains("--tree `Bta`"), "{}", e[0]);
+        assert!(
+            e[0].hint
+                .as_deref()
+                .unwrap()
+                .contains("did you mean `Beta`")
+        );
+        // --tree wins over main_tree_to_execute.
+        let named = text.replace(
+            "<root BTCPP_format=\"4\">",
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"Beta\">",
+        );
+        let l = parse_str("t.xml", &named, Path::new("."), &with("Alpha")).unwrap();
+        assert_eq!(bt(&l).nodes.len(), 1);
     }
 
     fn bt(l: &Loaded) -> &Bt {
