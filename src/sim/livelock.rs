@@ -59,7 +59,8 @@ impl Livelock {
 }
 
 /// The abstract state of the robot, hashed: where each object is (held, or
-/// its place to the centimetre) and whether it was seen, the arm, shut-down,
+/// its place on a surface or the floor to the centimetre), whether it was
+/// seen and where it is believed to be, the arm, shut-down,
 /// emergency, charging, the battery by tenths (and whether it is low),
 /// which leaf runs which skill, and which leaves started an action in the
 /// step (an action may start and finish within one step). The robot's position is left out: moving is
@@ -73,12 +74,17 @@ pub(super) fn abstract_state(r: &Robot) -> u64 {
     for o in &w.objects {
         match o.place {
             Place::Held => mix(u64::MAX),
-            Place::At(p) => {
+            Place::At(p) | Place::Floor(p) => {
+                mix(matches!(o.place, Place::Floor(_)) as u64);
                 mix((p.0 * 100.0).round() as i64 as u64);
                 mix((p.1 * 100.0).round() as i64 as u64);
             }
         }
         mix(o.found as u64);
+        // What the robot believes (to the centimetre): a belief that
+        // changes is progress of a kind.
+        mix((o.belief.0 * 100.0).round() as i64 as u64);
+        mix((o.belief.1 * 100.0).round() as i64 as u64);
     }
     mix(w.arm_tucked as u64
         | (w.shut_down as u64) << 1

@@ -7,6 +7,9 @@
 pub mod exec;
 mod livelock;
 pub mod monte_carlo;
+#[cfg(test)]
+mod physics_tests;
+pub mod planner;
 pub mod plot;
 pub mod report;
 pub mod rng;

@@ -10,7 +10,6 @@
 
 use super::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
 use super::livelock::{Livelock, abstract_state};
-use super::rng::SimRng;
 use super::robot::{Faults, MAX_EVENTS, MAX_SKILL_RECORDS, Robot, apply, round3};
 use super::scenario::{Afterwards, Disturbance, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Status};
@@ -164,29 +163,7 @@ pub fn run_policy_into(
     let goal_terms_n = s.goal.as_ref().map_or(0, Vec::len);
     let every = clock_every(p, disturbances, &world, goal_terms_n);
     let n = p.keys.len();
-    let mut robot = Robot {
-        world,
-        dt: s.dt,
-        live: vec![None; n],
-        ticked: vec![false; n],
-        touched: Vec::new(),
-        records: Vec::new(),
-        events: Vec::new(),
-        faults: Faults {
-            next: BTreeMap::new(),
-            rates,
-            rng: SimRng::named(seed, "skill-faults"),
-        },
-        log: opts.log,
-        failed_ends: 0,
-        started: Vec::new(),
-        failed_key: None,
-        failures: 0,
-        mark: 0,
-        low_at: None,
-        latencies: Vec::new(),
-        full: false,
-    };
+    let mut robot = Robot::new(world, s.dt, n, Faults::new(seed, rates), opts.log);
     enum Ex {
         Bt(BtExec),
         M(MachineExec),
@@ -328,6 +305,8 @@ pub fn run_policy_into(
                 .live
                 .iter()
                 .flatten()
+                // An outcome reached while moving is no longer running.
+                .filter(|r| r.result.is_none())
                 .map(|r| {
                     robot.records[r.record]
                         .text()

@@ -230,6 +230,23 @@ fn num(v: &DeValue<'_>) -> Option<f64> {
     }
 }
 
+/// The `[world] params` a scenario may set, with their ranges
+/// (docs/simulator-model.md gives their meaning and defaults).
+pub const PARAMS: &[(&str, f64, f64)] = &[
+    ("max_speed", 0.01, 10.0),
+    ("max_turn_rate", 0.01, 100.0),
+    ("drain_per_m", 0.0, 100.0),
+    ("drain_per_s", 0.0, 100.0),
+    ("charge_per_s", 0.01, 1000.0),
+    ("low_battery", 0.0, 100.0),
+    ("camera_range", 0.0, 100.0),
+    ("object_tolerance", 0.0, 1.0),
+    ("reach", 0.0, 1.0),
+    ("stall_s", 0.0, 1000.0),
+    ("manipulation_s", 0.0, 1000.0),
+    ("arm_s", 0.0, 1000.0),
+];
+
 /// Largest `max_steps`: a run records its trajectory (16 bytes a step).
 pub const MAX_STEPS: u64 = 1_000_000;
 
@@ -551,6 +568,7 @@ impl Reader {
         let mut robot = layout.station("start").expect("the paper room has a start");
         let mut objects = Vec::new();
         let mut battery = 100.0;
+        let mut placed: Vec<(Range<usize>, usize)> = Vec::new();
         let Some(v) = v else {
             return Some(World::new(layout, params, robot, objects));
         };
@@ -569,28 +587,45 @@ impl Reader {
         );
         if let Some(p) = t.get("params") {
             let pt = self.table(p, "`world.params`")?;
-            const PARAMS: &[&str] = &[
-                "max_speed",
-                "drain_per_m",
-                "drain_per_s",
-                "charge_per_s",
-                "low_battery",
-                "camera_range",
-                "manipulation_s",
-            ];
-            self.keys(pt, PARAMS, "world parameter");
+            self.keys(
+                pt,
+                &(PARAMS.iter().map(|p| p.0))
+                    .chain(["follow_belief"])
+                    .collect::<Vec<_>>(),
+                "world parameter",
+            );
             for (k, v) in pt.iter() {
-                let Some(x) = self.number(v, &format!("`{}`", k.get_ref()), 0.0, 1000.0) else {
+                if k.get_ref().as_ref() == "follow_belief" {
+                    match v.get_ref() {
+                        DeValue::Boolean(b) => params.follow_belief = *b,
+                        _ => self.err(
+                            v.span(),
+                            "`follow_belief` must be true or false",
+                            "write `follow_belief = true`",
+                        ),
+                    }
+                    continue;
+                }
+                let Some(&(name, lo, hi)) = PARAMS.iter().find(|p| p.0 == k.get_ref().as_ref())
+                else {
                     continue;
                 };
-                match k.get_ref().as_ref() {
-                    "max_speed" => params.max_speed = x.max(0.01),
+                let Some(x) = self.number(v, &format!("`{name}`"), lo, hi) else {
+                    continue;
+                };
+                match name {
+                    "max_speed" => params.max_speed = x,
+                    "max_turn_rate" => params.max_turn_rate = x,
                     "drain_per_m" => params.drain_per_m = x,
                     "drain_per_s" => params.drain_per_s = x,
-                    "charge_per_s" => params.charge_per_s = x.max(0.01),
+                    "charge_per_s" => params.charge_per_s = x,
                     "low_battery" => params.low_battery = x,
                     "camera_range" => params.camera_range = x,
+                    "object_tolerance" => params.object_tolerance = x,
+                    "reach" => params.reach = x,
+                    "stall_s" => params.stall_s = x,
                     "manipulation_s" => params.manipulation_s = x,
+                    "arm_s" => params.arm_s = x,
                     _ => {}
                 }
             }
@@ -602,6 +637,7 @@ impl Reader {
             }
             for ob in a.iter() {
                 if let Some(r) = self.rect(ob) {
+                    placed.push((ob.span(), layout.obstacles.len()));
                     layout.obstacles.push(r);
                 }
             }
@@ -630,6 +666,20 @@ impl Reader {
                     params.robot_radius,
                 );
             }
+        }
+        // The room's stations the scenario keeps where they are must stay
+        // free (those it sets were checked above, at their own position).
+        let set: Vec<&str> = match t.get("stations").and_then(|s| s.get_ref().as_table()) {
+            Some(st) => st.iter().map(|(k, _)| k.get_ref().as_ref()).collect(),
+            None => Vec::new(),
+        };
+        let kept: Vec<(String, P2)> = (layout.stations.iter())
+            .filter(|(n, _)| !set.contains(&n.as_str()))
+            .cloned()
+            .collect();
+        for (span, i) in placed {
+            let r = layout.obstacles[i].clone();
+            self.covers_no_station(span, &r, &kept, params.robot_radius, "obstacle");
         }
         if let Some(b) = t.get("battery")
             && let Some(x) = self.number(b, "`battery`", 0.0, 100.0)
@@ -678,16 +728,46 @@ impl Reader {
                     },
                     None => true,
                 };
-                objects.push(Object {
-                    name,
-                    place: Place::At(p),
-                    found,
-                });
+                // On the table in front of its pose, or on the floor.
+                let place = match layout.surface_near(p, params.robot_radius) {
+                    Some(_) => Place::At(p),
+                    None => Place::Floor(p),
+                };
+                objects.push(Object::new(&name, place, p, found));
             }
         }
         let mut w = World::new(layout, params, robot, objects);
         w.battery = battery;
         Some(w)
+    }
+
+    /// Refuses an obstacle or a `block` over a station (or the robot's
+    /// start): the robot must fit at every station. O(stations).
+    fn covers_no_station(
+        &mut self,
+        span: Range<usize>,
+        r: &Rect,
+        stations: &[(String, P2)],
+        radius: f64,
+        what: &str,
+    ) -> bool {
+        let hit = stations.iter().find(|(_, p)| r.distance(*p) < radius);
+        if let Some((n, p)) = hit {
+            self.err(
+                span,
+                format!(
+                    "{what} `{}` covers station `{n}` ({}, {})",
+                    r.name,
+                    show(p.0),
+                    show(p.1)
+                ),
+                format!(
+                    "keep it at least the robot's radius ({radius} m) away from every station, or move the station"
+                ),
+            );
+            return false;
+        }
+        true
     }
 
     fn rect(&mut self, v: &Val<'_>) -> Option<Rect> {
@@ -873,7 +953,25 @@ impl Reader {
                 )
             }
             "block" => {
-                let r = self.rect(t.get("block").expect("checked above"))?;
+                let bv = t.get("block").expect("checked above");
+                let r = self.rect(bv)?;
+                if !self.covers_no_station(
+                    bv.span(),
+                    &r,
+                    &world.layout.stations,
+                    world.params.robot_radius,
+                    "`block`",
+                ) {
+                    return None;
+                }
+                if r.distance(world.robot) < world.params.robot_radius {
+                    self.err(
+                        bv.span(),
+                        format!("`block` `{}` covers the robot's start ({}, {})", r.name, show(world.robot.0), show(world.robot.1)),
+                        "a box cannot land on the robot; move it (a block that would cover the robot during a run is refused, with an event)",
+                    );
+                    return None;
+                }
                 let text = format!("path blocked by {}", r.name);
                 (Effect::Block(r), text)
             }

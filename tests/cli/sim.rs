@@ -74,12 +74,82 @@ fn sim_only_the_bt_fetches_the_cube_again_after_the_task_is_done() {
         sim_policy(&v, BT1)["final_world"]["objects"]["cube2"]["at"],
         "delivery"
     );
+    // Left where it was moved, in view of the delivery station.
+    let cube = &sim_policy(&v, FSM4)["final_world"]["objects"]["cube2"];
     assert_eq!(
-        sim_policy(&v, FSM4)["final_world"]["objects"]["cube2"]["at"],
-        "west-table"
+        (cube["x"].as_f64(), cube["y"].as_f64()),
+        (Some(0.0), Some(1.3))
     );
+    assert_eq!(cube["at"], serde_json::Value::Null);
     assert!(!sim_verdict(&v, BT1, FSM4));
     assert!(sim_verdict(&v, HFSM1, FSM4));
+}
+
+/// The cube moved while the robot drives to it: Move-To goes to where the
+/// cube was believed to be when it started, so the grasp there fails; the
+/// reactive policies go to where the camera has since seen it, the
+/// sequential FSM stops. The BT halts its Pick as soon as Robot-At fails
+/// (cancelled) where the FSM waits for the Pick to fail: the same timeline.
+#[test]
+fn sim_a_cube_moved_during_the_task_defeats_only_the_sequential_fsm() {
+    let v = sim_json("policies/scenarios/exp1-cube-moved-during.toml");
+    for p in [BT1, HFSM1, FSM4] {
+        let r = sim_policy(&v, p);
+        assert_eq!(r["outcome"], "success", "{p}");
+        assert_eq!(r["goal_met"], true, "{p}");
+        let skills = r["skills"].as_array().unwrap();
+        assert_eq!(skills[1]["skill"], "Pick", "{p}");
+        assert_ne!(skills[1]["outcome"], "success", "{p}");
+        assert_eq!(skills[2]["skill"], "Move-To", "{p}");
+    }
+    let fsm2 = sim_policy(&v, FSM2);
+    assert_eq!(fsm2["outcome"], "failure");
+    assert_eq!(fsm2["goal_met"], false);
+    assert_eq!(fsm2["final_world"]["objects"]["cube2"]["y"], -0.8);
+}
+
+/// An injected navigation fault stops the base short of its goal: the
+/// sequential FSM is left part-way, the reactive policies drive on from
+/// there with a new Move-To.
+#[test]
+fn sim_a_navigation_fault_stops_the_robot_short_of_its_goal() {
+    let v = sim_json("tests/fixtures/sim/navigation-fault.toml");
+    let fsm2 = sim_policy(&v, FSM2);
+    assert_eq!(fsm2["outcome"], "failure");
+    assert_eq!(fsm2["final_world"]["robot_at"], serde_json::Value::Null);
+    let [x, y] = [0, 1].map(|i| fsm2["final_world"]["robot"][i].as_f64().unwrap());
+    // Part-way from the start (-2.0, -2.2) to the east table (1.7, 0.0).
+    assert!(x > -1.9 && x < 1.6, "{x}");
+    assert!(y > -2.2 && y < -0.05, "{y}");
+    for p in [BT1, FSM4] {
+        let r = sim_policy(&v, p);
+        assert_eq!(r["goal_met"], true, "{p}");
+        let s = r["skills"].as_array().unwrap();
+        assert_eq!(
+            (s[0]["skill"].as_str(), s[0]["outcome"].as_str()),
+            (Some("Move-To"), Some("failure"))
+        );
+        assert_eq!(s[1]["skill"], "Move-To", "{p}");
+        // Within a step of the failure (whether a representation restarts
+        // in the failing step is the executors' business, not the world's).
+        let gap = s[1]["start"].as_f64().unwrap() - s[0]["end"].as_f64().unwrap();
+        assert!((-1e-9..=0.1 + 1e-9).contains(&gap), "{p}: {gap}");
+    }
+}
+
+/// A cube moved out of the camera's view is seen by no policy: the BT
+/// tries where it believes the cube is and gives up.
+#[test]
+fn sim_no_policy_fetches_a_cube_it_cannot_see() {
+    let v = sim_json("tests/fixtures/sim/cube-moved-out-of-sight.toml");
+    let bt = sim_policy(&v, BT1);
+    assert_eq!(bt["outcome"], "failure");
+    assert!(
+        bt["reason"].as_str().unwrap().starts_with("gave up"),
+        "{bt}"
+    );
+    assert_eq!(bt["goal_met"], false);
+    assert_eq!(sim_policy(&v, FSM4)["goal_met"], false);
 }
 
 #[test]
@@ -764,13 +834,14 @@ mod hostile {
 
     /// 64 policies picking and placing a cube every step for 10^6 steps
     /// (a 400-byte scenario) recorded 2 million skills each: 3.3 GB per
-    /// policy. A run now records at most 1024 skills and 4096 events.
+    /// policy. A run now records at most 1024 skills and 4096 events (every
+    /// action takes at least one step: the tree picks or places every step).
     #[test]
     fn sim_hostile_endless_skills_fill_a_bounded_record() {
         let dir = scratch("endless-skills");
         std::fs::write(
             dir.join("pp.toml"),
-            "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
+            "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence_memory = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
         )
         .unwrap();
         let f = dir.join("pp-scenario.toml");
@@ -785,6 +856,7 @@ mod hostile {
         let (code, out, err, took) =
             btfsm_within(512, &["sim", f.to_str().unwrap(), "--format", "json"]);
         assert_eq!(code, 0, "{err}");
+        // About 2,100 steps per policy (every action takes a step).
         assert!(took < HANG_GUARD, "{took:?}");
         assert!(out.len() < 64 << 20, "{} bytes of JSON", out.len());
         let v: serde_json::Value = serde_json::from_str(&out).expect("json");

@@ -111,7 +111,7 @@ file = "../paper/fig01-bt.toml"
 [[disturbances]]
 after_done = 2.0
 move = "cube2"
-to = "west-table"
+to = [0.0, 1.3]
 "#,
     );
     let runs = run_scenario(&s, false);
@@ -121,11 +121,11 @@ to = "west-table"
     assert_eq!(runs[0].skills.len(), 4);
     assert_eq!(
         (runs[1].skills[4].skill.as_str(), runs[1].skills[4].start),
-        ("Move-To", 16.1)
+        ("Move-To", 16.5)
     );
     assert_eq!(
         (runs[1].skills[5].skill.as_str(), runs[1].skills[5].start),
-        ("Pick", 16.1)
+        ("Pick", 16.6)
     );
     let v = crate::sim::trace::verdicts(&runs, 300);
     assert!(v.iter().all(|v| !v.matches), "{v:?}");
@@ -321,7 +321,7 @@ fn a_spent_wall_clock_budget_stops_every_run_at_once() {
     );
 }
 
-/// A BT that picks and places the cube every step (both instantaneous)
+/// A BT that picks and places the cube every other step (both instantaneous)
 /// recorded two skills and four events a step, 3.3 GB over 10^6 steps:
 /// a run now ends once its records are full, and that is not taken for
 /// the wall-clock budget.
@@ -331,7 +331,7 @@ fn a_run_ends_when_its_records_are_full() {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(
         dir.join("pp.toml"),
-        "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
+        "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence_memory = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
     )
     .unwrap();
     let text = "max_steps = 1000000\nlivelock_repeats = 1000000\n[world]\nrobot = \"east-table\"\nparams = { manipulation_s = 0 }\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"pp.toml\"\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
@@ -348,7 +348,8 @@ fn a_run_ends_when_its_records_are_full() {
     );
     assert_eq!(r.skills.len(), MAX_SKILL_RECORDS);
     assert!(r.events.len() <= MAX_EVENTS);
-    assert!(r.steps < 1000, "{}", r.steps);
+    // Every action takes at least one step: two steps a record.
+    assert!(r.steps < 2100, "{}", r.steps);
     // Monte Carlo: a timeout of the episode, not a budget cut.
     let mc = monte_carlo_within(&s, 2, 1, 1, None);
     assert_eq!((mc.runs, mc.policies[0].timeouts), (2, 2));

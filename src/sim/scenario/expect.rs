@@ -428,7 +428,7 @@ match = [["Fig. 1 BT baseline", "Fig. 2 FSM sequential"]]
                 ),
             ]
         );
-        assert_eq!(r[3].found, "completed at 16.1 s");
+        assert_eq!(r[3].found, "completed at 16.5 s");
         // A run cut short: what names it is undecided (what names only the
         // other is still checked); no verdict: likewise.
         let r = check(&s.expect, &runs, &[], &[false, true]);
