@@ -147,7 +147,7 @@ pub(super) fn round3(x: f64) -> f64 {
 
 impl Leaves for Robot {
     #[inline]
-    fn condition(&mut self, call: &Call) -> bool {
+    fn condition(&mut self, _key: usize, call: &Call) -> bool {
         skills::condition(call, &self.world)
     }
 

@@ -88,8 +88,8 @@ impl MachineExec {
         }
     }
 
-    fn holds(terms: &GuardTerms, leaves: &mut impl Leaves) -> bool {
-        terms.iter().all(|(c, neg)| leaves.condition(c) != *neg)
+    fn holds(s: usize, terms: &GuardTerms, leaves: &mut impl Leaves) -> bool {
+        terms.iter().all(|(c, neg)| leaves.condition(s, c) != *neg)
     }
 
     fn follow(&self, from: usize, t: &Target) -> Flow {
@@ -131,7 +131,7 @@ impl MachineExec {
         let mut flow = Flow::Enter(self.current);
         'anc: for &a in anc.iter().rev() {
             for (g, t) in &c.guards[a] {
-                if Self::holds(g, leaves) {
+                if Self::holds(a, g, leaves) {
                     flow = self.follow(a, t);
                     break 'anc;
                 }
@@ -167,7 +167,9 @@ impl MachineExec {
                 Flow::Up(Some(container), o) => (container, o),
                 Flow::Enter(s) => {
                     // A state left by a guard runs nothing (and is not noted).
-                    if let Some((_, t)) = c.guards[s].iter().find(|(g, _)| Self::holds(g, leaves)) {
+                    if let Some((_, t)) =
+                        c.guards[s].iter().find(|(g, _)| Self::holds(s, g, leaves))
+                    {
                         flow = self.follow(s, t);
                         continue;
                     }
@@ -180,7 +182,7 @@ impl MachineExec {
                         StateBody::Task(_) => match &c.call[s] {
                             Some(call) if call.is_action() => leaves.action(s, call),
                             Some(call) => {
-                                if leaves.condition(call) {
+                                if leaves.condition(s, call) {
                                     Status::Success
                                 } else {
                                     Status::Failure

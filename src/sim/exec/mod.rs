@@ -38,15 +38,16 @@ mod machine;
 #[cfg(test)]
 mod tests;
 
-pub use bt::{BtExec, CompiledBt, XNode};
+pub use bt::{BtExec, CompiledBt, XNode, unsupported};
 pub use machine::{CompiledMachine, GuardTerms, MachineExec};
 
 use super::skills::{Call, Status};
 
 /// What an executor needs from the robot.
 pub trait Leaves {
-    /// Evaluates a condition.
-    fn condition(&mut self, call: &Call) -> bool;
+    /// Evaluates the condition of leaf `key` (a BT node, an FSM state; for
+    /// a guard, its state).
+    fn condition(&mut self, key: usize, call: &Call) -> bool;
     /// Ticks the action of leaf `key` (continuing its running instance).
     fn action(&mut self, key: usize, call: &Call) -> Status;
     /// Halts the running action of leaf `key` at once (BehaviorTree.CPP's
