@@ -127,6 +127,8 @@ pub enum Command {
     Edit(Box<EditArgs>),
     /// Runs policies in the planar robot simulator and compares their behavior
     Sim(super::sim::SimArgs),
+    /// Ticks a BT against scripted leaf outcomes (BehaviorTree.CPP 4 semantics)
+    Tick(super::tick::TickArgs),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

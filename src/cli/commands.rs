@@ -205,6 +205,7 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Paper(args) => super::paper::paper(&args),
         Command::Edit(args) => super::edit::edit(&args),
         Command::Sim(args) => super::sim::execute(args),
+        Command::Tick(args) => super::tick::execute(args),
     }
 }
 

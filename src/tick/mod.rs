@@ -1,0 +1,222 @@
+//! `btfsm tick`: ticks a BT against scripted leaf outcomes, without a world
+//! (docs/bt-semantics.md). Each tick is BehaviorTree.CPP 4's
+//! `tickExactlyOnce` on the shared executor ([`crate::sim::exec`]); the
+//! report lists, per tick, every leaf ticked with the status it returned and
+//! every running leaf halted, in the order they happened, and the root's
+//! status. tests/differential/ checks these against BehaviorTree.CPP.
+
+pub mod script;
+
+use crate::model::bt::Bt;
+use crate::sim::exec::{BtExec, CompiledBt, Leaves};
+use crate::sim::skills::{Call, Status};
+use script::Script;
+use serde::Serialize;
+use std::sync::Arc;
+
+/// Most events (leaf ticks and halts) of one run: the tick budget, whatever
+/// the tree does within a tick.
+pub const MAX_EVENTS: usize = 4_000_000;
+
+/// A leaf ticked or halted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Event {
+    Tick(usize, Status),
+    Halt(usize),
+}
+
+/// One tick of the tree.
+#[derive(Debug, Clone)]
+pub struct TickRecord {
+    pub root: Status,
+    pub events: Vec<Event>,
+}
+
+/// A run of a script on a tree.
+#[derive(Debug, Clone)]
+pub struct TickRun {
+    pub ticks: Vec<TickRecord>,
+    /// The leaves `halt = true` halted after the last tick.
+    pub halt: Option<Vec<usize>>,
+    /// Whether the run stopped at [`MAX_EVENTS`].
+    pub cut: bool,
+}
+
+/// The scripted leaves: answers by (leaf, how many times it was ticked).
+struct Scripted<'a> {
+    script: &'a Script,
+    action: Vec<bool>,
+    count: Vec<u64>,
+    events: Vec<Event>,
+    total: usize,
+}
+
+impl Scripted<'_> {
+    fn answer(&mut self, key: usize) -> Status {
+        let k = self.count[key];
+        self.count[key] += 1;
+        let s = self.script.answer(key, k, self.action[key]);
+        self.events.push(Event::Tick(key, s));
+        s
+    }
+}
+
+impl Leaves for Scripted<'_> {
+    fn condition(&mut self, key: usize, _: &Call) -> bool {
+        self.answer(key) == Status::Success
+    }
+    fn action(&mut self, key: usize, _: &Call) -> Status {
+        self.answer(key)
+    }
+    fn halt(&mut self, key: usize) {
+        self.events.push(Event::Halt(key));
+    }
+    fn now(&self) -> f64 {
+        0.0
+    }
+}
+
+/// Ticks `bt` as `script` says. The tree must have passed
+/// [`crate::sim::exec::unsupported`].
+pub fn run(bt: &Bt, script: &Script) -> TickRun {
+    let compiled = Arc::new(CompiledBt::scripted(bt));
+    let mut ex = BtExec::new(compiled, false);
+    let mut leaves = Scripted {
+        script,
+        action: (bt.nodes.iter())
+            .map(|n| n.kind == crate::model::BtNodeKind::Action)
+            .collect(),
+        count: vec![0; bt.nodes.len()],
+        events: Vec::new(),
+        total: 0,
+    };
+    let mut ticks = Vec::new();
+    let mut cut = false;
+    for _ in 0..script.ticks {
+        let root = ex.tick(&mut leaves);
+        let events = std::mem::take(&mut leaves.events);
+        leaves.total += events.len();
+        ticks.push(TickRecord { root, events });
+        if leaves.total > MAX_EVENTS {
+            cut = true;
+            break;
+        }
+    }
+    let halt = (script.halt && !cut).then(|| {
+        ex.halt(&mut leaves);
+        (leaves.events.iter())
+            .filter_map(|e| match e {
+                Event::Halt(n) => Some(*n),
+                Event::Tick(..) => None,
+            })
+            .collect()
+    });
+    TickRun { ticks, halt, cut }
+}
+
+#[derive(Serialize)]
+struct JsonEvent<'a> {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    leaf: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    status: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    halt: Option<&'a str>,
+}
+
+#[derive(Serialize)]
+struct JsonTick<'a> {
+    tick: usize,
+    root: &'static str,
+    events: Vec<JsonEvent<'a>>,
+}
+
+#[derive(Serialize)]
+struct JsonRun<'a> {
+    tree: &'a str,
+    script: &'a str,
+    ticks: Vec<JsonTick<'a>>,
+    halt: Option<Vec<&'a str>>,
+    cut: bool,
+}
+
+impl TickRun {
+    /// The JSON contract (docs/bt-semantics.md): one object, on one line.
+    pub fn json(&self, bt: &Bt, tree: &str, script: &str) -> String {
+        let id = |n: usize| bt.nodes[n].id.as_str();
+        let run = JsonRun {
+            tree,
+            script,
+            ticks: (self.ticks.iter().enumerate())
+                .map(|(i, t)| JsonTick {
+                    tick: i + 1,
+                    root: t.root.as_str(),
+                    events: (t.events.iter())
+                        .map(|e| match *e {
+                            Event::Tick(n, s) => JsonEvent {
+                                leaf: Some(id(n)),
+                                status: Some(s.as_str()),
+                                halt: None,
+                            },
+                            Event::Halt(n) => JsonEvent {
+                                leaf: None,
+                                status: None,
+                                halt: Some(id(n)),
+                            },
+                        })
+                        .collect(),
+                })
+                .collect(),
+            halt: self
+                .halt
+                .as_ref()
+                .map(|h| h.iter().map(|&n| id(n)).collect()),
+            cut: self.cut,
+        };
+        let mut s = crate::sanitize::json(serde_json::to_string(&run).expect("serializable"));
+        s.push('\n');
+        s
+    }
+
+    /// The table: a line per tick, its events in order.
+    pub fn table(&self, bt: &Bt, tree: &str, script: &str) -> String {
+        use crate::sanitize::shown;
+        let id = |n: usize| shown(&bt.nodes[n].id);
+        let mut out = format!(
+            "tree `{}`, script `{}`: {} tick{}\n\ntick  root     leaves ticked (status) and halted, in order\n",
+            shown(tree),
+            shown(script),
+            self.ticks.len(),
+            if self.ticks.len() == 1 { "" } else { "s" }
+        );
+        for (i, t) in self.ticks.iter().enumerate() {
+            let ev: Vec<String> = (t.events.iter())
+                .map(|e| match *e {
+                    Event::Tick(n, s) => format!("{} {}", id(n), s.as_str()),
+                    Event::Halt(n) => format!("halt {}", id(n)),
+                })
+                .collect();
+            let ev = if ev.is_empty() {
+                "-".to_string()
+            } else {
+                ev.join(", ")
+            };
+            out.push_str(&format!("{:<5} {:<8} {ev}\n", i + 1, t.root.as_str()));
+        }
+        if let Some(h) = &self.halt {
+            let ev: Vec<String> = h.iter().map(|&n| format!("halt {}", id(n))).collect();
+            let ev = if ev.is_empty() {
+                "-".to_string()
+            } else {
+                ev.join(", ")
+            };
+            out.push_str(&format!("{:<5} {:<8} {ev}\n", "halt", ""));
+        }
+        if self.cut {
+            out.push_str(&format!(
+                "\nstopped after {MAX_EVENTS} events (a fixed limit)\n"
+            ));
+        }
+        out
+    }
+}
