@@ -328,6 +328,18 @@ pub fn unsupported(bt: &Bt) -> Option<(usize, String)> {
                 "a `ParallelAll` whose `max_failures` is more than its children".into(),
             )),
             Ok((Op::Timeout, ..)) => Some((i, "`Timeout` (wall-clock time)".into())),
+            Ok((Op::Sequence, ..))
+                if (n.children.iter())
+                    .filter(|&&c| matches!(op_of(&bt.nodes[c]), Ok((Op::AsyncSequence, ..))))
+                    .count()
+                    > 1 =>
+            {
+                Some((
+                    i,
+                    "a `ReactiveSequence` with more than one `AsyncSequence` child (BehaviorTree.CPP 4 refuses it)"
+                        .into(),
+                ))
+            }
             _ => None,
         }
     })
@@ -531,7 +543,12 @@ impl BtExec {
             halts: &mut self.halts,
             now: 0.0,
         };
-        x.halt_child(root, leaves);
+        // Through the plan, the skeleton keeps no statuses: its one
+        // running slot is what is running.
+        match self.bt.plan.slots.get(self.running) {
+            Some(slot) if !self.stack_walk => x.halt_child(slot.node, leaves),
+            _ => x.halt_child(root, leaves),
+        }
         // Then every node is halted whatever its status (`haltTree`'s
         // recursive visitor): statuses IDLE, halt-time memory reset.
         for n in 0..self.node.len() {
