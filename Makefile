@@ -1,11 +1,13 @@
 # btfsm: `make run` runs the main job on the bundled policies and scenarios,
 # `make test` is what CI runs.
 CARGO ?= cargo
-BIN := target/release/btfsm
+TARGET_DIR := $(or $(CARGO_TARGET_DIR),target)
+BIN := $(TARGET_DIR)/release/btfsm
+VENV := .venv
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
-.PHONY: build run test bench bench-ged clean paper-docs fuzz
+.PHONY: build run test bench bench-ged clean paper-docs fuzz differential
 
 build:
 	$(CARGO) build --release --locked
@@ -34,6 +36,19 @@ test:
 	$(CARGO) test --locked
 	$(CARGO) test --locked --bench scale --bench ged --bench sim -- --test
 	$(CARGO) run --quiet --locked -- paper --check
+	$(MAKE) --no-print-directory differential
+
+# `btfsm tick` against BehaviorTree.CPP 4 (behaviortreepy, pinned in
+# tests/differential/requirements.txt, installed into .venv) on 3000 seeded
+# random trees (docs/bt-semantics.md).
+$(VENV)/.installed: tests/differential/requirements.txt
+	python3 -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
+	touch $@
+
+differential: $(VENV)/.installed
+	$(CARGO) build --quiet --locked
+	$(VENV)/bin/python tests/differential/differential.py $(TARGET_DIR)/debug/btfsm --trees 3000
 
 # Regenerates docs/paper-results.md (a test fails when it is stale).
 paper-docs:
