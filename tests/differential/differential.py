@@ -79,10 +79,14 @@ class Gen:
                 k = r.randint(1, self.max_kids)
             attrs = ""
             if ty == "Parallel":
-                s = r.choice([r.randint(1, k), -1])
-                f = r.choice([r.randint(1, k), -1])
-                attrs = ' success_count="%d" failure_count="%d"' % (s, f)
-            elif ty == "ParallelAll":
+                # Either threshold may be left to its default (-1, 1).
+                s = r.choice([r.randint(1, k), -1, None])
+                f = r.choice([r.randint(1, k), -1, None])
+                if s is not None:
+                    attrs += ' success_count="%d"' % s
+                if f is not None:
+                    attrs += ' failure_count="%d"' % f
+            elif ty == "ParallelAll" and r.random() < 0.8:
                 attrs = ' max_failures="%d"' % r.randint(1, k)
             me = {} if ty == "ReactiveSequence" else None
             kids = "".join(self.node(depth + 1, me) for _ in range(k))

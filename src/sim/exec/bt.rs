@@ -311,6 +311,12 @@ fn op_of(n: &BtNode) -> Result<(Op, i64, i64), String> {
     })
 }
 
+/// Why the executor cannot tick node `n` as BehaviorTree.CPP 4 does (its
+/// type, as written), if it cannot.
+pub fn refused(n: &BtNode) -> Option<String> {
+    op_of(n).err()
+}
+
 /// The first node (in pre-order) whose type the executor cannot tick as
 /// BehaviorTree.CPP 4 does, with what it is (`tick` refuses such a tree).
 pub fn unsupported(bt: &Bt) -> Option<(usize, String)> {

@@ -38,7 +38,7 @@ mod machine;
 #[cfg(test)]
 mod tests;
 
-pub use bt::{BtExec, CompiledBt, XNode, unsupported};
+pub use bt::{BtExec, CompiledBt, XNode, refused, unsupported};
 pub use machine::{CompiledMachine, GuardTerms, MachineExec};
 
 use super::skills::{Call, Status};
