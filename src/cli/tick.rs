@@ -97,7 +97,7 @@ fn one(
     if let Some((n, what)) = crate::sim::exec::unsupported(bt) {
         let node = &bt.nodes[n];
         let d = Diagnostic::error(format!(
-            "node `{}`: {what} is not ticked as BehaviorTree.CPP 4 ticks it",
+            "node `{}`: {what} cannot be ticked as BehaviorTree.CPP 4 ticks it",
             node.id
         ))
         .hint("`tick` runs the node types of docs/bt-semantics.md, not an approximation");
