@@ -3,8 +3,8 @@
 //! Several TREE / --script pairs run in one process (JSON: one object per
 //! line), which is how tests/differential/ drives it.
 
-use super::commands::{emit_text, print_diagnostics};
 use super::EXIT_BAD_INPUT;
+use super::commands::{emit_text, print_diagnostics};
 use crate::diagnostic::Diagnostic;
 use crate::format;
 use crate::model::PolicyBody;

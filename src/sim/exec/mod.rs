@@ -2,12 +2,14 @@
 //! (SPEC §6), against the shared skill library behind the [`Leaves`] trait.
 //!
 //! - BT (the paper's sec. II-A; Colledanchise & Ögren, "Behavior Trees in
-//!   Robotics and AI", ch. 1): the root is ticked once per step. Sequence and
-//!   Fallback are reactive (re-ticked from the first child), Sequence* and
-//!   Fallback* resume at the running child, Parallel succeeds when `success`
-//!   children succeed, decorators map their child's status. A node that was not
-//!   ticked on the previous step starts afresh (halting resets memory), and an
-//!   action not ticked in a step is cancelled by the caller.
+//!   Robotics and AI", ch. 1): the root is ticked once per step, every node
+//!   as BehaviorTree.CPP 4 ticks its type (docs/bt-semantics.md, checked
+//!   against the engine by tests/differential/): `sequence` and `fallback`
+//!   are ReactiveSequence and ReactiveFallback, `sequence_memory` and
+//!   `fallback_memory` BehaviorTree.CPP's Sequence and Fallback, and the
+//!   XML types keep their own semantics (SequenceWithMemory, Parallel with
+//!   per-child memory, IfThenElse, ...). A RUNNING leaf is halted
+//!   ([`Leaves::halt`]) at the moment BehaviorTree.CPP halts it.
 //! - FSM (sec. II-B, Algorithm 3): the current state's guards are checked, in
 //!   the order written, before its skill runs; the skill's outcome selects the
 //!   transition. A decision state (SELECTOR) only checks guards. Several states
@@ -30,8 +32,8 @@
 //! walk only for the subtrees below the skeleton. When every node's status is
 //! noted (`sim --trace`), the composites a status leaves are noted with it (a
 //! reactive composite returns the status of the child it stops at). A unit
-//! test checks plan and stack walk, noting or not, against a recursive
-//! reference on random trees of every node kind.
+//! test checks plan and stack walk, noting or not, halts included, on random
+//! trees of every node kind.
 
 mod bt;
 mod machine;

@@ -1,4 +1,4 @@
-//! The executors against a recursive reference and scripted leaves.
+//! The executors on scripted leaves: plan against stack walk (halts included), BehaviorTree.CPP semantics of single node types, BT against its converted HFSM.
 
 use super::*;
 use crate::format::{Limits, toml::parse_str};
