@@ -37,11 +37,14 @@
 
 mod bt;
 mod machine;
+mod ops;
+mod plan;
 #[cfg(test)]
 mod tests;
 
-pub use bt::{BtExec, CompiledBt, XNode, refused, unsupported};
+pub use bt::{BtExec, CompiledBt, XNode};
 pub use machine::{CompiledMachine, GuardTerms, MachineExec};
+pub use ops::{refused, unsupported};
 
 use super::skills::{Call, Status};
 

@@ -1,4 +1,6 @@
-//! The executors on scripted leaves: plan against stack walk (halts included), BehaviorTree.CPP semantics of single node types, BT against its converted HFSM.
+//! The executors on scripted leaves: plan against stack walk (halts
+//! included), BehaviorTree.CPP semantics of single node types, a BT against
+//! its converted HFSM.
 
 use super::*;
 use crate::format::{Limits, toml::parse_str};
