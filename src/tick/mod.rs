@@ -220,3 +220,71 @@ impl TickRun {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnostic::SourceFile;
+    use crate::format::Limits;
+    use crate::model::PolicyBody;
+    use std::path::Path;
+
+    fn bt_of(p: &crate::model::Policy) -> &Bt {
+        let PolicyBody::Bt(bt) = &p.body else {
+            panic!("a BT")
+        };
+        bt
+    }
+
+    fn events(bt: &Bt, script: &str) -> Vec<(Status, Vec<(String, Option<Status>)>)> {
+        let s = script::parse(&SourceFile::new("s.toml", script), bt).expect("script");
+        run(bt, &s)
+            .ticks
+            .iter()
+            .map(|t| {
+                let ev = (t.events.iter())
+                    .map(|e| match *e {
+                        Event::Tick(n, s) => (bt.nodes[n].id.clone(), Some(s)),
+                        Event::Halt(n) => (bt.nodes[n].id.clone(), None),
+                    })
+                    .collect();
+                (t.root, ev)
+            })
+            .collect()
+    }
+
+    /// docs/bt-semantics.md: a TOML `parallel` fails when it can no longer
+    /// succeed, and means the same once exported to BehaviorTree.CPP XML
+    /// (`failure_count = n - success + 1`); an XML `Parallel` without
+    /// `failure_count` fails at its first failure (BehaviorTree.CPP's default).
+    #[test]
+    fn parallel_failure_thresholds_survive_export_and_default_on_import() {
+        let text = "kind = \"bt\"\nroot = \"p\"\n[nodes]\np = { parallel = [\"a\", \"b\", \"c\"], success = 1 }\na = { action = \"A!\" }\nb = { action = \"B!\" }\nc = { action = \"C!\" }\n";
+        let lim = Limits::default();
+        let t = crate::format::toml::parse_str("t.toml", text, Path::new("."), &lim)
+            .unwrap()
+            .policy;
+        let xml = crate::format::btcpp_xml_write::write_policy(&t).unwrap();
+        assert!(xml.contains("failure_count=\"3\""), "{xml}");
+        let x = crate::format::btcpp_xml::parse_str("t.xml", &xml, Path::new("."), &lim)
+            .unwrap()
+            .policy;
+        let script =
+            "ticks = 2\ndefault = \"running\"\n[leaves]\na = [\"failure\"]\nb = [\"failure\"]\n";
+        let want = events(bt_of(&t), script);
+        assert_eq!(
+            want[0].0,
+            Status::Running,
+            "two failures of three: still running"
+        );
+        assert_eq!(events(bt_of(&x), script), want);
+        let imported = "<root BTCPP_format=\"4\"><BehaviorTree ID=\"T\"><Parallel success_count=\"1\"><AlwaysSuccess name=\"a\"/><AlwaysSuccess name=\"b\"/></Parallel></BehaviorTree></root>";
+        let x = crate::format::btcpp_xml::parse_str("i.xml", imported, Path::new("."), &lim)
+            .unwrap()
+            .policy;
+        let p = &bt_of(&x).nodes[bt_of(&x).root];
+        assert_eq!(p.ports.get("failure_count").map(String::as_str), Some("1"));
+        let e = events(bt_of(&x), "ticks = 1\n[leaves]\na = [\"failure\"]\n");
+        assert_eq!(e[0].0, Status::Failure, "{e:?}");
+    }
+}
