@@ -266,3 +266,48 @@ fn leaves(r: &mut Reader, lt: &DeTable<'_>, bt: &Bt, ids: &HashMap<&str, usize>,
         s.leaves.insert(n, LeafScript { statuses, then });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::Limits;
+    use crate::model::PolicyBody;
+    use std::path::Path;
+
+    /// No input panics: byte mutations of a valid script parse or give
+    /// positioned errors, and every script that parses runs.
+    #[test]
+    fn mutated_scripts_never_panic() {
+        let tree = "kind = \"bt\"\nroot = \"r\"\n[nodes]\nr = { sequence = [\"c\", \"a\"] }\nc = { condition = \"C?\" }\na = { action = \"A!\" }\n";
+        let l = crate::format::toml::parse_str("t.toml", tree, Path::new("."), &Limits::default())
+            .unwrap();
+        let PolicyBody::Bt(bt) = &l.policy.body else {
+            panic!()
+        };
+        let good = "ticks = 3\ndefault = \"running\"\ncondition_default = \"failure\"\nhalt = true\n[leaves]\nc = [\"success\", \"failure\"]\na = { statuses = [\"running\", \"success\"], then = \"cycle\" }\n";
+        let mut rng = crate::sim::rng::SimRng::named(3, "tick-script");
+        let alphabet = b"\"[]{}=,\n abcdefghilnrstuy0123456789-_#.";
+        for _ in 0..3000 {
+            let mut b = good.as_bytes().to_vec();
+            for _ in 0..1 + rng.next_u64() % 4 {
+                let i = (rng.next_u64() % b.len() as u64) as usize;
+                let c = alphabet[(rng.next_u64() % alphabet.len() as u64) as usize];
+                match rng.next_u64() % 3 {
+                    0 => b[i] = c,
+                    1 => b.insert(i, c),
+                    _ => {
+                        b.remove(i);
+                    }
+                }
+            }
+            let text = String::from_utf8_lossy(&b).into_owned();
+            match parse(&SourceFile::new("s.toml", text), bt) {
+                Ok(s) => {
+                    let r = crate::tick::run(bt, &s);
+                    assert_eq!(r.ticks.len() as u64, s.ticks);
+                }
+                Err(d) => assert!(d.iter().all(|d| d.span.is_some()), "{d:?}"),
+            }
+        }
+    }
+}
