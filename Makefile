@@ -7,7 +7,7 @@ VENV := .venv
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
-.PHONY: build run test bench bench-ged clean paper-docs fuzz differential
+.PHONY: build run test bench bench-ged clean paper-docs fuzz mermaid-oracle man differential
 
 build:
 	$(CARGO) build --release --locked
@@ -36,6 +36,7 @@ test:
 	$(CARGO) test --locked
 	$(CARGO) test --locked --bench scale --bench ged --bench sim -- --test
 	$(CARGO) run --quiet --locked -- paper --check
+	$(MAKE) --no-print-directory mermaid-oracle
 	$(MAKE) --no-print-directory differential
 
 # `btfsm tick` against BehaviorTree.CPP 4 (behaviortreepy, pinned in
@@ -49,6 +50,27 @@ $(VENV)/.installed: tests/differential/requirements.txt
 differential: $(VENV)/.installed
 	$(CARGO) build --quiet --locked
 	$(VENV)/bin/python tests/differential/differential.py $(TARGET_DIR)/debug/btfsm --trees 3000
+
+# `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
+# tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).
+NAV2 := tests/fixtures/corpus/bt-xml/nav2
+mermaid-oracle: build
+	cd tests/differential/mermaid && npm ci --silent --no-audit --no-fund
+	node tests/differential/mermaid/check.mjs $(BIN) -- tests/differential/mermaid/labels-*.toml \
+	  policies/paper/*.toml $$(find tests/fixtures/corpus -name '*.scxml') \
+	  $$(grep -L OrthogonalState $$(find tests/fixtures/corpus/yasmin -name '*.xml'))
+	node tests/differential/mermaid/check.mjs $(BIN) --nodes-model $(NAV2)/nav2_tree_nodes.xml -- \
+	  $$(ls $(NAV2)/*.xml | grep -v tree_nodes) tests/fixtures/corpus/bt-xml/btcpp/parent_include_child.xml
+
+# Man pages from the argument definitions: target/man/btfsm.1 and one
+# btfsm-SUBCOMMAND.1 per subcommand (`man -l target/man/btfsm.1`).
+man: build
+	@mkdir -p target/man
+	$(BIN) man > target/man/btfsm.1
+	@for c in $$($(BIN) --help | sed -n '/^Commands:/,/^$$/p' | awk 'NR>1 && $$1 != "help" {print $$1}'); do \
+	  $(BIN) man $$c > target/man/btfsm-$$c.1 || exit 2; \
+	done
+	@echo "wrote target/man/btfsm*.1"
 
 # Regenerates docs/paper-results.md (a test fails when it is stale).
 paper-docs:

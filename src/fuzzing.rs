@@ -96,6 +96,19 @@ pub fn scxml(data: &[u8]) {
     ));
 }
 
+/// Fuzz target `yasmin`: any bytes through the yasmin importer and
+/// downstream (a `file_path` resolves against the current directory).
+pub fn yasmin(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    accepted(crate::format::yasmin::parse_str(
+        "fuzz.xml",
+        text,
+        &limits(),
+    ));
+}
+
 /// Fuzz target `scenario`: any bytes as a simulator scenario (policies
 /// resolve against `policies/scenarios/`); an accepted one is run for at most
 /// 2000 steps per policy.

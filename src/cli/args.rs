@@ -20,9 +20,11 @@ pub struct Cli {
 pub enum Command {
     /// Counts, complexity and Table I estimates of each policy
     Analyze {
-        /// Policy files (TOML, BehaviorTree.CPP XML or SCXML)
+        /// Policy files (TOML, BehaviorTree.CPP XML, SCXML, yasmin XML), `-`
+        /// for stdin, or directories (every policy file below, sorted)
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Output format
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
         format: OutputFormat,
         /// Exit 1 when a policy's METRIC is above N, e.g. `--max cc=30`
@@ -43,6 +45,8 @@ pub enum Command {
     },
     /// Checks policy files and reports every problem with its position
     Validate {
+        /// Policy or scenario files, `-` for stdin, or directories (every
+        /// policy and scenario file below, sorted)
         #[arg(required = true)]
         files: Vec<PathBuf>,
         #[command(flatten)]
@@ -50,11 +54,13 @@ pub enum Command {
     },
     /// Draws a policy as Graphviz DOT (or SVG/PNG with --render)
     Dot {
+        /// Policy file (any format), or `-` for stdin
         file: PathBuf,
         /// Output file (default: stdout)
         #[arg(short, long)]
         output: Option<PathBuf>,
-        /// Render with Graphviz's `dot` instead of printing DOT
+        /// Render with Graphviz's `dot` instead of printing DOT (default: the
+        /// extension of -o when it is .svg, .png or .pdf, else DOT text)
         #[arg(long, value_enum)]
         render: Option<crate::render::dot::RenderFormat>,
         /// With --render: Graphviz's time budget; past it `dot` is killed
@@ -83,6 +89,7 @@ pub enum Command {
         /// `exact: false`
         #[arg(long, default_value_t = 2000, value_name = "MS")]
         timeout_ms: u64,
+        /// Output format
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
         format: CompareFormat,
         /// Also draw B with added elements red and A's removed ones dashed grey
@@ -90,7 +97,8 @@ pub enum Command {
         #[arg(long, value_name = "OUT")]
         dot: Option<PathBuf>,
         /// With --dot: render through Graphviz instead of writing DOT (under
-        /// the --timeout-ms budget of one mode: past it `dot` is killed)
+        /// the --timeout-ms budget of one mode: past it `dot` is killed);
+        /// default: the extension of --dot when it is .svg, .png or .pdf
         #[arg(long, value_enum, requires = "dot")]
         render: Option<crate::render::dot::RenderFormat>,
         #[command(flatten)]
@@ -98,6 +106,7 @@ pub enum Command {
     },
     /// Converts a policy into another representation
     Convert {
+        /// Policy file (any format), or `-` for stdin
         file: PathBuf,
         /// Target representation
         #[arg(long, value_enum)]
@@ -110,8 +119,10 @@ pub enum Command {
     },
     /// Effort (Eq. 4/5) to make an FSM reactive: formula and measured named GED
     Effort {
+        /// FSM files (any policy format), `-` for stdin, or directories
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Output format
         #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
         format: OutputFormat,
         /// Time budget of the structural GED per policy; when it runs out the
@@ -129,6 +140,19 @@ pub enum Command {
     Sim(super::sim::SimArgs),
     /// Ticks a BT against scripted leaf outcomes (BehaviorTree.CPP 4 semantics)
     Tick(super::tick::TickArgs),
+    /// Prints a shell completion script (e.g. `btfsm completions bash >
+    /// ~/.local/share/bash-completion/completions/btfsm`)
+    Completions {
+        /// The shell to complete in
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Prints the man page (roff; `make man` writes target/man/btfsm*.1)
+    #[command(hide = true)]
+    Man {
+        /// A subcommand's page instead of the main one (`btfsm-sim.1`)
+        subcommand: Option<String>,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -172,6 +196,8 @@ pub enum ConvertTarget {
     BtcppXml,
     /// SCXML (FSMs and HFSMs)
     Scxml,
+    /// Mermaid (flowchart for BTs, stateDiagram-v2 for FSMs and HFSMs), as GitHub renders in markdown
+    Mermaid,
 }
 
 /// `--assume-leaf`: how to read BehaviorTree.CPP leaves of unknown type.
@@ -201,6 +227,11 @@ pub struct LimitArgs {
     /// e.g. Nav2's nav2_tree_nodes.xml
     #[arg(long = "nodes-model", value_name = "FILE")]
     pub nodes_model: Vec<PathBuf>,
+    /// The BehaviorTree.CPP tree to read, by its `<BehaviorTree ID>` (over
+    /// `main_tree_to_execute`; needed when a file holds several trees and
+    /// names none, as a program names it to BT.CPP's factory)
+    #[arg(long, value_name = "ID")]
+    pub tree: Option<String>,
     /// Read BehaviorTree.CPP leaves of unknown type as actions or conditions
     /// (default: an error listing the known types)
     #[arg(long, value_enum, value_name = "KIND")]
@@ -239,6 +270,7 @@ impl LimitArgs {
             },
             read_budget: crate::format::source::Budget::new(self.max_total_bytes),
             expansion_budget: crate::format::source::Budget::new(self.max_nodes as u64),
+            tree: self.tree.clone(),
             ..Default::default()
         }
     }
@@ -247,6 +279,7 @@ impl LimitArgs {
 /// Flags of `btfsm paper`.
 #[derive(Debug, Clone, Args)]
 pub struct PaperArgs {
+    /// Output format
     #[arg(long, value_enum, default_value_t = crate::report::paper::PaperFormat::Table)]
     pub format: crate::report::paper::PaperFormat,
     /// Time budget of each exact GED; when it runs out the cell shows the
@@ -302,6 +335,7 @@ pub enum EditOp {
     },
     /// Puts a new control node above the root (the paper's Figs. 7c, 7d)
     WrapRoot {
+        /// Control node to put above the root
         #[arg(long, value_enum)]
         kind: WrapKind,
         /// Id of the new root
@@ -313,6 +347,7 @@ pub enum EditOp {
     },
     /// Adds an FSM state as the paper's sec. IV-A 1b does (Algorithm 1 for connected states)
     AddState {
+        /// How the new state is connected
         #[arg(long, value_enum)]
         kind: AddKind,
         /// Name of the new state
@@ -367,4 +402,42 @@ pub enum AddKind {
     Alternative,
     /// Reached from every other state (Algorithm 1, Fig. 8d)
     Connected,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    /// Every subcommand and every argument of every subcommand says what it
+    /// is for in `--help` (clap's own `--help`/`--version` aside).
+    #[test]
+    fn every_subcommand_and_argument_has_help() {
+        let mut missing = Vec::new();
+        let mut stack = vec![(String::from("btfsm"), Cli::command())];
+        while let Some((path, cmd)) = stack.pop() {
+            for a in cmd.get_arguments() {
+                let id = a.get_id().as_str();
+                if id == "help" || id == "version" || a.is_hide_set() {
+                    continue;
+                }
+                if a.get_help().is_none() && a.get_long_help().is_none() {
+                    missing.push(format!("{path} {id}"));
+                }
+            }
+            for sub in cmd.get_subcommands() {
+                if sub.get_about().is_none() && !sub.is_hide_set() {
+                    missing.push(format!("{path} {} (about)", sub.get_name()));
+                }
+                stack.push((format!("{path} {}", sub.get_name()), sub.clone()));
+            }
+        }
+        assert!(missing.is_empty(), "arguments without help: {missing:#?}");
+    }
+
+    /// Clap's own consistency checks (conflicting names, bad defaults).
+    #[test]
+    fn the_command_line_is_well_formed() {
+        Cli::command().debug_assert();
+    }
 }

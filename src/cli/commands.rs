@@ -24,11 +24,16 @@ pub fn execute(cli: Cli) -> u8 {
             let Some(gate) = gate(max, baseline.as_deref(), max_increase, &limits) else {
                 return EXIT_BAD_INPUT;
             };
-            let Some(loaded) = load_all(&files, &limits) else {
+            // A report for the files that load, an error for each that
+            // does not, and exit 2 at the end when any failed.
+            let Some((loaded, failed)) = load_inputs(&files, &limits) else {
                 return EXIT_BAD_INPUT;
             };
             let reports: Vec<_> = loaded.iter().map(analyze).collect();
             let code = emit_text(None, render_analysis(&reports, format));
+            if failed {
+                return EXIT_BAD_INPUT;
+            }
             if code != EXIT_OK || gate.is_empty() {
                 return code;
             }
@@ -39,11 +44,38 @@ pub fn execute(cli: Cli) -> u8 {
             let stderr = std::io::stderr();
             let mut err = stderr.lock();
             let mut failed = false;
-            for f in &files {
+            let inputs = match format::discover::expand(&files) {
+                Ok(i) => i,
+                Err(d) => {
+                    print_diagnostics(&mut err, &[d]);
+                    return EXIT_BAD_INPUT;
+                }
+            };
+            let mut skipped = 0usize;
+            for input in &inputs {
+                let f = &input.path;
                 // Read once; a scenario is validated as `sim` reads it (its
                 // policies included), without running it.
-                let (file, input) = match format::read_input(f, &limits) {
-                    Ok(r) => r,
+                let read = if input.found {
+                    format::discover::classify(f, &limits).map(|(file, holds)| {
+                        let kind = match holds {
+                            format::discover::Holds::Policy(fmt) => {
+                                Some(format::Input::Policy(fmt))
+                            }
+                            format::discover::Holds::Scenario => Some(format::Input::Scenario),
+                            format::discover::Holds::Other => None,
+                        };
+                        (file, kind)
+                    })
+                } else {
+                    format::read_input(f, &limits).map(|(file, i)| (file, Some(i)))
+                };
+                let (file, input) = match read {
+                    Ok((file, Some(i))) => (file, i),
+                    Ok((_, None)) => {
+                        skipped += 1;
+                        continue;
+                    }
                     Err(diags) => {
                         failed = true;
                         print_diagnostics(&mut err, &diags);
@@ -88,7 +120,18 @@ pub fn execute(cli: Cli) -> u8 {
                     None => failed = true,
                 }
             }
-            if failed { EXIT_BAD_INPUT } else { EXIT_OK }
+            note_skipped(&mut err, skipped);
+            if failed || inputs.len() == skipped {
+                if inputs.len() == skipped {
+                    let _ = writeln!(
+                        err,
+                        "error: no policy or scenario file below the directories given"
+                    );
+                }
+                EXIT_BAD_INPUT
+            } else {
+                EXIT_OK
+            }
         }
         Command::Dot {
             file,
@@ -141,6 +184,12 @@ pub fn execute(cli: Cli) -> u8 {
                 ConvertTarget::Toml => l.policy,
                 ConvertTarget::BtcppXml | ConvertTarget::Scxml => {
                     return super::convert::to_xml(&l.policy, to, output.as_deref());
+                }
+                ConvertTarget::Mermaid => {
+                    return emit_text(
+                        output.as_deref(),
+                        crate::render::mermaid::policy_mermaid(&l.policy),
+                    );
                 }
                 ConvertTarget::FaultTolerant => {
                     match crate::transform::fault_tolerant::fault_tolerant_policy(&l.policy) {
@@ -206,6 +255,37 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Edit(args) => super::edit::edit(&args),
         Command::Sim(args) => super::sim::execute(args),
         Command::Tick(args) => super::tick::execute(args),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            let mut out = Vec::new();
+            clap_complete::generate(shell, &mut super::args::Cli::command(), "btfsm", &mut out);
+            emit(None, &out)
+        }
+        Command::Man { subcommand } => {
+            use clap::CommandFactory;
+            let top = super::args::Cli::command();
+            let cmd = match subcommand.as_deref() {
+                None => top,
+                Some(name) => match top.find_subcommand(name) {
+                    Some(c) => c
+                        .clone()
+                        .name(format!("btfsm-{name}"))
+                        .version(env!("CARGO_PKG_VERSION")),
+                    None => {
+                        eprintln!("error: no subcommand `{}`", shown(name));
+                        return EXIT_BAD_INPUT;
+                    }
+                },
+            };
+            let mut out = Vec::new();
+            match clap_mangen::Man::new(cmd).render(&mut out) {
+                Ok(()) => emit(None, &out),
+                Err(e) => {
+                    eprintln!("error: cannot write the man page: {e}");
+                    EXIT_BAD_INPUT
+                }
+            }
+        }
     }
 }
 
@@ -220,6 +300,8 @@ pub(super) fn draw(
 ) -> u8 {
     use crate::render::dot::{self, RenderFormat};
     let text = dot::policy_dot(policy, opts);
+    // `-o x.png` means PNG: the format follows the extension unless given.
+    let render = render.or_else(|| output.and_then(RenderFormat::from_path));
     let Some(fmt) = render else {
         return emit_text(output, text);
     };
@@ -258,6 +340,60 @@ pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>
         }
     }
     (!failed).then_some(out)
+}
+
+/// Loads every input, directories expanded (`format::discover`), printing
+/// every file's diagnostics: the policies that loaded and whether any input
+/// failed; `None` when there is nothing to report (the walk failed, or no
+/// policy was found). Scenarios found below a directory are skipped.
+pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loaded>, bool)> {
+    use format::discover::{self, Holds};
+    let stderr = std::io::stderr();
+    let mut err = stderr.lock();
+    let inputs = match discover::expand(files) {
+        Ok(i) => i,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return None;
+        }
+    };
+    let (mut out, mut failed, mut skipped) = (Vec::new(), false, 0usize);
+    for input in &inputs {
+        let r = if input.found {
+            match discover::classify(&input.path, limits) {
+                Ok((file, Holds::Policy(fmt))) => format::load_read(file, &input.path, fmt, limits),
+                Ok(_) => {
+                    skipped += 1;
+                    continue;
+                }
+                Err(d) => Err(d),
+            }
+        } else {
+            format::load(&input.path, limits)
+        };
+        match reported(r, &mut err) {
+            Some(l) => out.push(l),
+            None => failed = true,
+        }
+    }
+    note_skipped(&mut err, skipped);
+    if out.is_empty() && !failed {
+        let _ = writeln!(err, "error: no policy file below the directories given");
+        return None;
+    }
+    Some((out, failed))
+}
+
+/// Says how many files found below directories held no policy.
+fn note_skipped(err: &mut impl Write, skipped: usize) {
+    if skipped > 0 {
+        let _ = writeln!(
+            err,
+            "note: skipped {skipped} file{} below the directories given that hold{} no policy",
+            if skipped == 1 { "" } else { "s" },
+            if skipped == 1 { "s" } else { "" },
+        );
+    }
 }
 
 /// Reads one policy, printing its warnings or its errors to `err`.

@@ -1,7 +1,7 @@
 //! `btfsm paper` and `btfsm effort`: load, compute through the library, print.
 
 use super::args::PaperArgs;
-use super::commands::{emit_text, load_all};
+use super::commands::emit_text;
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use crate::format::Limits;
 use crate::metrics::effort::effort as compute_effort;
@@ -21,7 +21,7 @@ fn ged_options(timeout_ms: u64) -> GedOptions {
 
 /// `btfsm effort FILE...`.
 pub fn effort(files: &[PathBuf], format: OutputFormat, timeout_ms: u64, limits: &Limits) -> u8 {
-    let Some(loaded) = load_all(files, limits) else {
+    let Some((loaded, failed)) = super::commands::load_inputs(files, limits) else {
         return EXIT_BAD_INPUT;
     };
     let opts = ged_options(timeout_ms);
@@ -29,7 +29,8 @@ pub fn effort(files: &[PathBuf], format: OutputFormat, timeout_ms: u64, limits: 
         .iter()
         .map(|l| EffortRow::new(&l.path, &l.policy.name, &compute_effort(&l.policy, &opts).0))
         .collect();
-    emit_text(None, render_effort(&rows, format))
+    let code = emit_text(None, render_effort(&rows, format));
+    if failed { EXIT_BAD_INPUT } else { code }
 }
 
 /// `btfsm paper`.

@@ -3,7 +3,7 @@
 //!
 //! - `<root>` holds `<BehaviorTree ID>` definitions, `<include path>` (relative to
 //!   the including file; cycles rejected) and `<TreeNodesModel>`; the tree run is
-//!   `main_tree_to_execute`, or the only tree of the main file.
+//!   `--tree ID`, else `main_tree_to_execute`, else the only tree of the main file.
 //! - Nodes in compact (`<Sequence>`) or explicit (`<Action ID="...">`) syntax.
 //!   `<SubTree ID>` (and format 3's `<SubTreePlus>`) is expanded in place: the
 //!   subtree's root takes the SubTree element's place, as TOML subtree includes
@@ -645,10 +645,30 @@ impl Loader<'_> {
         }
     }
 
-    /// The tree to run: `main_tree_to_execute`, or the only tree of the main file.
+    /// The tree to run: `--tree ID`, else `main_tree_to_execute`, else the
+    /// only tree of the main file.
     fn main_tree(&mut self) -> Option<(String, (usize, usize))> {
         let root = self.docs[0].root;
         let all: Vec<String> = self.trees.keys().cloned().collect();
+        if let Some(id) = self.limits.tree.clone() {
+            return match self.trees.get(&id) {
+                Some(&t) => Some((id, t)),
+                None => {
+                    let span = self.docs[0].elems[root].span.clone();
+                    let h = suggest(&id, all.iter().map(String::as_str));
+                    self.err(
+                        0,
+                        span,
+                        format!(
+                            "--tree `{}`: no `<BehaviorTree ID>` of that name",
+                            shown(&id)
+                        ),
+                    )
+                    .hint = Some(h);
+                    None
+                }
+            };
+        }
         if let Some(a) = self.docs[0].elems[root].attr_full("main_tree_to_execute") {
             let (v, span) = (a.value.clone(), a.span.clone());
             return match self.trees.get(&v) {
@@ -696,7 +716,7 @@ impl Loader<'_> {
                     format!("{} trees and no `main_tree_to_execute`", many.len()),
                 )
                 .hint = Some(format!(
-                    "add `main_tree_to_execute` with one of {}",
+                    "choose one with --tree ID, or add `main_tree_to_execute`: {}",
                     ids.join(", ")
                 ));
                 None
@@ -1380,6 +1400,42 @@ mod tests {
 
     fn parse(text: &str) -> Result<Loaded, Vec<Diagnostic>> {
         parse_str("t.xml", text, Path::new("."), &Limits::default())
+    }
+
+    #[test]
+    fn tree_chooses_among_several_trees_without_a_main_tree() {
+        let text = r#"<root BTCPP_format="4">
+  <BehaviorTree ID="Alpha"><AlwaysSuccess/></BehaviorTree>
+  <BehaviorTree ID="Beta"><Sequence><AlwaysSuccess/><SubTree ID="Alpha"/></Sequence></BehaviorTree>
+</root>"#;
+        let e = parse(text).unwrap_err();
+        assert!(
+            e[0].message
+                .contains("2 trees and no `main_tree_to_execute`")
+        );
+        let hint = e[0].hint.as_deref().unwrap();
+        assert!(hint.contains("--tree ID") && hint.contains("`Alpha`") && hint.contains("`Beta`"));
+        let with = |id: &str| Limits {
+            tree: Some(id.into()),
+            ..Limits::default()
+        };
+        let l = parse_str("t.xml", text, Path::new("."), &with("Beta")).unwrap();
+        assert_eq!(bt(&l).nodes.len(), 3, "Beta with Alpha expanded");
+        let e = parse_str("t.xml", text, Path::new("."), &with("Bta")).unwrap_err();
+        assert!(e[0].message.contains("--tree `Bta`"), "{}", e[0]);
+        assert!(
+            e[0].hint
+                .as_deref()
+                .unwrap()
+                .contains("did you mean `Beta`")
+        );
+        // --tree wins over main_tree_to_execute.
+        let named = text.replace(
+            "<root BTCPP_format=\"4\">",
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"Beta\">",
+        );
+        let l = parse_str("t.xml", &named, Path::new("."), &with("Alpha")).unwrap();
+        assert_eq!(bt(&l).nodes.len(), 1);
     }
 
     fn bt(l: &Loaded) -> &Bt {

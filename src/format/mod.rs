@@ -3,12 +3,14 @@
 
 pub mod btcpp_xml;
 pub mod btcpp_xml_write;
+pub mod discover;
 pub mod scxml;
 pub mod scxml_write;
 pub mod source;
 pub mod toml;
 pub mod toml_write;
 pub mod xml;
+pub mod yasmin;
 
 use crate::diagnostic::{Diagnostic, SourceFile};
 use crate::model::Policy;
@@ -56,6 +58,10 @@ pub struct Limits {
     /// `max_nodes` in all, so that a few kilobytes of files including each
     /// other twice per level cannot build millions of nodes per policy.
     pub expansion_budget: Arc<source::Budget>,
+    /// The BehaviorTree.CPP tree to read (`--tree ID`), as a program names
+    /// it to the factory; over `main_tree_to_execute`. Other formats
+    /// ignore it.
+    pub tree: Option<String>,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -87,6 +93,7 @@ impl Default for Limits {
             confinement: source::Confinement::Auto,
             read_budget: source::Budget::new(source::DEFAULT_MAX_TOTAL_BYTES),
             expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
+            tree: None,
         }
     }
 }
@@ -186,9 +193,11 @@ pub enum FileFormat {
     Toml,
     BtcppXml,
     Scxml,
+    /// yasmin (ROS 2) state machine XML.
+    Yasmin,
 }
 
-/// The format of a file: by extension (`.toml`, `.scxml`, `.xml`), else by its
+/// first bytes (`<scxml`, `<StateMachine` for yasmin, `<root`, ...); TOML otherwise.
 /// first bytes (`<scxml`, `<root`, ...); TOML otherwise.
 pub fn detect(path: &Path, text: &str) -> FileFormat {
     match path.extension().and_then(|e| e.to_str()) {
@@ -203,6 +212,8 @@ pub fn detect(path: &Path, text: &str) -> FileFormat {
         .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
     if head.contains("<scxml") {
         FileFormat::Scxml
+    } else if yasmin::looks_like_yasmin(head) {
+        FileFormat::Yasmin
     } else if is_xml_ext || head.trim_start().starts_with('<') {
         FileFormat::BtcppXml
     } else {
@@ -263,6 +274,7 @@ pub fn load_read(
         FileFormat::Toml => toml::load_read(&file, path, limits),
         FileFormat::BtcppXml => btcpp_xml::load_read(file, path, limits),
         FileFormat::Scxml => scxml::load_read(file, limits),
+        FileFormat::Yasmin => yasmin::load_read(file, path, limits),
     }?;
     // Every format: node count and nesting depth (the TOML reader has
     // already said where).

@@ -577,7 +577,9 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
             match (event, cond) {
                 (Some(ev), None)
                     if t.btfsm_attr("guard") != Some("true")
-                        && valid.contains(ev)
+                        && (valid.contains(ev)
+                            || (t.btfsm_attr("outcome") == Some("true")
+                                && matches!(m.states[si].body, StateBody::Task(None))))
                         && !used_outcomes.contains(ev) =>
                 {
                     used_outcomes.insert(ev);
@@ -926,6 +928,29 @@ mod tests {
         assert_eq!(l.warnings.len(), 1);
         assert!(l.warnings[0].message.contains("`z` is unreachable"));
         assert_eq!(l.warnings[0].location().unwrap().1, 3);
+    }
+
+    #[test]
+    fn a_transition_into_a_nested_state_reaches_its_containers() {
+        // `a` jumps straight into `c1` inside `outer/inner`: both containers
+        // are entered with it, so neither is unreachable; `lone` is.
+        let l = parse_str(
+            "t.scxml",
+            r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="a">
+  <state id="a"><transition event="go" target="c1"/></state>
+  <state id="outer"><state id="inner"><state id="c0"/><state id="c1"/></state></state>
+  <state id="lone"/>
+</scxml>"#,
+            &Limits::default(),
+        )
+        .unwrap();
+        let w: Vec<_> = l.warnings.iter().map(|d| d.message.clone()).collect();
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(w.iter().any(|m| m.contains("`c0` is unreachable")), "{w:?}");
+        assert!(
+            w.iter().any(|m| m.contains("`lone` is unreachable")),
+            "{w:?}"
+        );
     }
 
     const HEAD: &str = "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" xmlns:btfsm=\"urn:btfsm\" version=\"1.0\">\n";

@@ -273,6 +273,13 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
                     extra.push_str(" btfsm:guard=\"true\"");
                 }
             }
+            // An outcome the reader would take for an event (a state without
+            // a skill returns any outcome, as yasmin states do).
+            if let Trigger::Outcome(o) = &t.trigger
+                && !outcomes.contains(&o.as_str())
+            {
+                extra.push_str(" btfsm:outcome=\"true\"");
+            }
             let target = match &t.target {
                 Target::State(j) => state_id[*j].clone(),
                 Target::Outcome(o) => outcome_id(i, o),

@@ -1612,6 +1612,9 @@ impl Loader {
         // (state, transitions to resolve)
         type RawTr = (Trigger, String, Range<usize>);
         let mut raw_trs: Vec<Vec<RawTr>> = Vec::new();
+        // Per state (as `raw_trs`): whether it names a skill at all (a state
+        // whose skill is misspelled is not a state without one).
+        let mut names_skill: Vec<bool> = Vec::new();
         let mut qi = 0;
         while qi < queue.len() {
             let Pending {
@@ -1868,6 +1871,7 @@ impl Loader {
                     span: Some(k.span()),
                 });
                 raw_trs.push(trs);
+                names_skill.push(st.contains_key("skill"));
                 region.states.push(idx);
                 local.push((name, idx, k.span()));
             }
@@ -1935,8 +1939,28 @@ impl Loader {
                 StateBody::Decision => vec!["RUNNING".into()],
                 StateBody::Task(_) => TASK_OUTCOMES.iter().map(|s| s.to_string()).collect(),
             };
+            // A state without a skill (analysis only) returns whatever its
+            // code does, as yasmin and SMACH states do; a near miss of
+            // SUCCESS / FAILURE / RUNNING is worth a warning (yasmin's own
+            // `SUCCEED` is one).
+            let free = matches!(m.states[si].body, StateBody::Task(None))
+                && !names_skill.get(si).copied().unwrap_or(true);
             for (trigger, target, span) in trs {
-                if let Trigger::Outcome(o) = &trigger
+                if free
+                    && let Trigger::Outcome(o) = &trigger
+                    && !valid_outcomes.contains(o)
+                {
+                    let h = crate::diagnostic::suggest(o, TASK_OUTCOMES.iter().copied());
+                    if h.starts_with("did you mean") {
+                        self.warn(
+                            cx,
+                            span.clone(),
+                            format!(
+                                "state `{sname}` returns `{o}`: {h} (a state without a skill may return any outcome)"
+                            ),
+                        );
+                    }
+                } else if let Trigger::Outcome(o) = &trigger
                     && !valid_outcomes.contains(o)
                 {
                     let what = match &m.states[si].body {
@@ -2280,6 +2304,29 @@ mod tests {
     /// transforms, effort).
     fn exercise(l: &Loaded) {
         crate::fuzzing::exercise(l);
+    }
+
+    #[test]
+    fn a_state_without_a_skill_returns_any_outcome_a_near_miss_is_a_warning() {
+        let fsm = |on: &str, skill: &str| {
+            format!(
+                "name = \"m\"\nkind = \"fsm\"\ninitial = \"a\"\noutcomes = [\"done\"]\n\n[states.a]\n{skill}on = {{ {on} = \"done\" }}\n"
+            )
+        };
+        // yasmin-style outcomes on an unbound state: accepted, no warning.
+        let l = parse(&fsm("outcome1", "")).unwrap();
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        // A near miss of SUCCESS: accepted with a warning that says so.
+        let l = parse(&fsm("SUCCEED", "")).unwrap();
+        assert_eq!(l.warnings.len(), 1);
+        assert!(l.warnings[0].message.contains("did you mean `SUCCESS`"));
+        // A state bound to a skill returns SUCCESS, FAILURE or RUNNING only.
+        let e = parse(&fsm("outcome1", "skill = \"Tuck-Arm\"\n")).unwrap_err();
+        assert!(
+            e[0].message.contains("cannot return `outcome1`"),
+            "{}",
+            e[0]
+        );
     }
 
     #[test]

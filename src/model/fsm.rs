@@ -210,21 +210,39 @@ impl StateMachine {
     }
 
     /// Which states the initial state reaches through transitions and
-    /// containers' initial states (explicit stack).
+    /// containers' initial states (explicit stack). Entering a state enters
+    /// every container around it (an SCXML transition may target a state
+    /// inside another container, W3C SCXML 3.13), so those count as reached.
     pub fn reachable(&self) -> Vec<bool> {
         let mut seen = vec![false; self.states.len()];
-        let mut stack = vec![self.top.initial];
-        while let Some(s) = stack.pop() {
-            if s >= seen.len() || seen[s] {
+        // (state, entered at its default): a container entered because a
+        // transition targets a state inside it is not entered at its
+        // initial state.
+        let mut stack = vec![(self.top.initial, true)];
+        while let Some((s, default)) = stack.pop() {
+            if s >= seen.len() {
+                continue;
+            }
+            if seen[s] {
+                // Reached again at its default: its initial may be new.
+                if default
+                    && let StateBody::Container(r) = &self.states[s].body
+                    && !seen.get(r.initial).copied().unwrap_or(true)
+                {
+                    stack.push((r.initial, true));
+                }
                 continue;
             }
             seen[s] = true;
-            if let StateBody::Container(r) = &self.states[s].body {
-                stack.push(r.initial);
+            if let Some(p) = self.states[s].parent {
+                stack.push((p, false));
+            }
+            if default && let StateBody::Container(r) = &self.states[s].body {
+                stack.push((r.initial, true));
             }
             for t in &self.states[s].transitions {
                 if let Target::State(n) = t.target {
-                    stack.push(n);
+                    stack.push((n, true));
                 }
             }
         }

@@ -197,6 +197,16 @@ impl RenderFormat {
             RenderFormat::Pdf => "pdf",
         }
     }
+
+    /// The format an output file's extension asks for (`x.svg`, `x.PNG`,
+    /// `x.pdf`); `None` for anything else (`x.dot`, `x.gv`, no extension),
+    /// which gets DOT text.
+    pub fn from_path(path: &std::path::Path) -> Option<RenderFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        [RenderFormat::Svg, RenderFormat::Png, RenderFormat::Pdf]
+            .into_iter()
+            .find(|f| f.extension() == ext)
+    }
 }
 
 impl std::fmt::Display for RenderFormat {

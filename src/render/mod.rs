@@ -2,6 +2,7 @@
 //! and rendering it to SVG or PNG with Graphviz ([`dot::render`]).
 
 pub mod dot;
+pub mod mermaid;
 
 pub use dot::{
     DotOptions, Highlight, RenderError, RenderFormat, Status, policy_dot, render, render_with,

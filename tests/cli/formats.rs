@@ -165,8 +165,10 @@ fn count_tree_nodes(path: &Path) -> usize {
 /// Vertices and arcs of an SCXML file's HFSM graph by the test's own scanner:
 /// every `<state>` and `<history>`, plus the `<final>` states of the top level
 /// (the machine's outcomes; nested finals are their container's outcomes, not
-/// vertices); one arc per `<transition>` with a target, plus one per state
-/// holding states (to its initial child).
+/// vertices); one arc per `<transition>` with a target (not the one of an
+/// `<initial>`, which is the container's arc), plus one per state holding
+/// states (to its initial child). A machine embedded in `<invoke>` is
+/// another machine: not counted.
 fn count_scxml_graph(path: &Path) -> (usize, usize) {
     let text = std::fs::read_to_string(path).expect("read");
     // (element name, holds a state)
@@ -181,7 +183,15 @@ fn count_scxml_graph(path: &Path) -> (usize, usize) {
             }
             continue;
         }
+        let inside = |tag: &str| stack.iter().any(|(p, _)| p == tag);
+        if inside("invoke") {
+            if !self_closing {
+                stack.push((name, false));
+            }
+            continue;
+        }
         match name.as_str() {
+            "transition" if stack.last().map(|(p, _)| p.as_str()) == Some("initial") => {}
             "state" | "history" => {
                 n += 1;
                 if let Some(parent) = stack.last_mut().filter(|(p, _)| p == "state") {
@@ -518,4 +528,216 @@ fn compare_works_across_formats() {
     // SPEC §5: Fig. 1 -> Fig. 7c is 8 edits, whichever format B is in.
     assert_eq!(v["named"]["ged"], 8, "{stdout}");
     std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+/// Vertices and arcs of a yasmin file by the test's own tag scanner: every
+/// `<State>` and nested `<StateMachine>` is a vertex (an included file's
+/// states too), so is each top-level outcome; every `<Transition>` is an
+/// arc, and so is each container's arc to its start state.
+fn count_yasmin_graph(path: &Path) -> (usize, usize) {
+    let text = std::fs::read_to_string(path).expect("read");
+    let tags = scan_tags(&text);
+    let (mut v, mut e) = (0, 0);
+    let mut first = true;
+    for (name, attrs, _) in &tags {
+        match name.as_str() {
+            "StateMachine" if first => {
+                first = false;
+                v += attr(attrs, "outcomes").map_or(0, |o| o.split_whitespace().count());
+            }
+            "StateMachine" => {
+                v += 1;
+                e += 1;
+                if let Some(inc) = attr(attrs, "file_path") {
+                    let (iv, ie) = count_yasmin_graph(&path.parent().expect("dir").join(inc));
+                    let inner = std::fs::read_to_string(path.parent().expect("dir").join(inc))
+                        .expect("read");
+                    let top = scan_tags(&inner)
+                        .into_iter()
+                        .find(|t| t.0 == "StateMachine")
+                        .and_then(|t| attr(&t.1, "outcomes").map(|o| o.split_whitespace().count()))
+                        .unwrap_or(0);
+                    v += iv - top;
+                    e += ie;
+                }
+            }
+            "State" => v += 1,
+            "Transition" => e += 1,
+            _ => {}
+        }
+    }
+    (v, e)
+}
+
+#[test]
+fn corpus_yasmin_imports_analyzes_and_draws_orthogonal_states_are_refused() {
+    let files: Vec<PathBuf> = corpus_files("xml")
+        .into_iter()
+        .filter(|p| p.components().any(|c| c.as_os_str() == "yasmin"))
+        .collect();
+    assert!(files.len() >= 10, "{files:?}");
+    let mut loaded = 0;
+    for f in files {
+        let file = f.display().to_string();
+        let text = std::fs::read_to_string(&f).expect("read");
+        let (code, stdout, stderr) = btfsm(&["analyze", "--format", "json", &file]);
+        if text.contains("<OrthogonalState") {
+            assert_eq!(code, 2, "{file}");
+            assert!(
+                stderr.contains("`<OrthogonalState>` (concurrent regions) is not supported"),
+                "{stderr}"
+            );
+            continue;
+        }
+        assert_eq!(code, 0, "{file}: {stderr}");
+        let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+        let p = &v["policies"][0];
+        let (vertices, arcs) = count_yasmin_graph(&f);
+        assert_eq!(p["vertices"], vertices as u64, "{file}");
+        assert_eq!(p["edges"], arcs as u64, "{file}");
+        let nested = text.matches("<StateMachine").count() > 1;
+        assert_eq!(p["kind"], if nested { "hfsm" } else { "fsm" }, "{file}");
+        let (code, dot, stderr) = btfsm(&["dot", &file]);
+        assert_eq!(code, 0, "{file}: {stderr}");
+        assert!(dot.starts_with("digraph"));
+        loaded += 1;
+    }
+    assert!(loaded >= 8, "{loaded}");
+}
+
+#[test]
+fn yasmin_machines_round_trip_through_toml_and_scxml_at_named_ged_0() {
+    let dir = scratch("yasmin-rt");
+    for f in corpus_files("xml") {
+        let text = std::fs::read_to_string(&f).expect("read");
+        if f.components().any(|c| c.as_os_str() == "yasmin") && !text.contains("<OrthogonalState") {
+            round_trip(&f, "toml", "scxml", "toml", "scxml", &dir);
+        }
+    }
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn a_yasmin_file_path_outside_the_root_is_refused() {
+    let dir = scratch("yasmin-root");
+    std::fs::create_dir_all(dir.join("repo/.git")).expect("mkdir");
+    std::fs::write(
+        dir.join("outside.xml"),
+        "<StateMachine outcomes=\"end\"><State name=\"s\"><Transition from=\"ok\" to=\"end\"/></State></StateMachine>",
+    )
+    .expect("write");
+    let main = dir.join("repo/main.xml");
+    std::fs::write(
+        &main,
+        "<StateMachine outcomes=\"end\">\n  <StateMachine name=\"In\" file_path=\"../outside.xml\"><Transition from=\"end\" to=\"end\"/></StateMachine>\n</StateMachine>\n",
+    )
+    .expect("write");
+    let (code, _, stderr) = btfsm(&["analyze", &main.display().to_string()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("cannot include this file"), "{stderr}");
+    assert!(stderr.contains(":2:"), "positioned: {stderr}");
+    assert!(!stderr.contains("outside.xml\n"), "{stderr}");
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn the_render_format_follows_the_output_extension() {
+    let dir = scratch("render-ext");
+    let fig = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper/fig01-bt.toml");
+    let out = |name: &str| dir.join(name).display().to_string();
+    // `.dot`, `.gv` and no extension: DOT text.
+    for name in ["a.dot", "a.gv", "a"] {
+        let (code, _, stderr) = btfsm(&["dot", fig, "-o", &out(name)]);
+        assert_eq!(code, 0, "{stderr}");
+        let text = std::fs::read_to_string(dir.join(name)).expect("written");
+        assert!(text.starts_with("digraph"), "{name}");
+    }
+    // `.svg`, `.PNG`: rendered through Graphviz (make test installs it).
+    let (code, _, stderr) = btfsm(&["dot", fig, "-o", &out("a.svg")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read_to_string(dir.join("a.svg"))
+            .expect("svg")
+            .contains("<svg")
+    );
+    let (code, _, stderr) = btfsm(&["dot", fig, "-o", &out("a.PNG")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read(dir.join("a.PNG"))
+            .expect("png")
+            .starts_with(b"\x89PNG")
+    );
+    // An explicit --render wins over the extension.
+    let (code, _, stderr) = btfsm(&["dot", fig, "--render", "svg", "-o", &out("b.png")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read_to_string(dir.join("b.png"))
+            .expect("svg")
+            .contains("<svg")
+    );
+    // compare --dot follows its own extension the same way.
+    let fig3 = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper/fig03-bt.toml");
+    let (code, _, stderr) = btfsm(&["compare", fig, fig3, "--dot", &out("d.svg")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        std::fs::read_to_string(dir.join("d.svg"))
+            .expect("svg")
+            .contains("<svg")
+    );
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn a_directory_is_every_policy_below_it_and_a_bad_file_hides_no_report() {
+    let dir = scratch("dir-input");
+    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper");
+    std::fs::create_dir_all(dir.join("sub/.hidden")).expect("mkdir");
+    std::fs::copy(format!("{paper}/fig01-bt.toml"), dir.join("b-fig01.toml")).expect("copy");
+    std::fs::copy(
+        format!("{paper}/fig04-fsm.toml"),
+        dir.join("sub/a-fig04.toml"),
+    )
+    .expect("copy");
+    std::fs::copy(
+        format!("{paper}/fig02-fsm.toml"),
+        dir.join("sub/.hidden/x.toml"),
+    )
+    .expect("copy");
+    std::fs::write(dir.join("Cargo.toml"), "[package]\nname = \"x\"\n").expect("write");
+    std::fs::write(dir.join("package.xml"), "<package><name>x</name></package>").expect("write");
+    std::fs::write(
+        dir.join("bad.toml"),
+        "kind = \"bt\"\nroot = \"nope\"\n[nodes]\n",
+    )
+    .expect("write");
+    let d = dir.display().to_string();
+    let (code, stdout, stderr) = btfsm(&["analyze", &d, "--format", "json"]);
+    assert_eq!(code, 2, "a bad file makes exit 2: {stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("the good files' report");
+    let files: Vec<&str> = v["policies"]
+        .as_array()
+        .expect("policies")
+        .iter()
+        .map(|p| p["file"].as_str().expect("file"))
+        .collect();
+    assert_eq!(files.len(), 2, "{files:?}");
+    assert!(files[0].ends_with("b-fig01.toml") && files[1].ends_with("sub/a-fig04.toml"));
+    assert!(stderr.contains("bad.toml"), "{stderr}");
+    assert!(stderr.contains("skipped 2 files"), "{stderr}");
+    // Without the bad file: exit 0, and `validate` also checks scenarios.
+    std::fs::remove_file(dir.join("bad.toml")).expect("rm");
+    let (code, _, stderr) = btfsm(&["analyze", &d]);
+    assert_eq!(code, 0, "{stderr}");
+    let scen = concat!(env!("CARGO_MANIFEST_DIR"), "/policies");
+    let (code, _, stderr) = btfsm(&["validate", scen]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("ok (scenario `exp1-nominal`"), "{stderr}");
+    assert!(stderr.contains("fig01-bt.toml: ok (bt"), "{stderr}");
+    // A directory without policies is an error, not an empty report.
+    let empty = scratch("dir-empty");
+    let (code, _, stderr) = btfsm(&["analyze", &empty.display().to_string()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("no policy file"), "{stderr}");
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+    std::fs::remove_dir_all(&empty).expect("cleanup");
 }

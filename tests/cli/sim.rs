@@ -416,6 +416,10 @@ mod hostile {
 
     use crate::common::btfsm_capped as btfsm_within;
 
+    /// A hang guard, not a speed target (machines are shared and noisy;
+    /// speed lives in benches/): the refusals below take milliseconds.
+    const HANG_GUARD: Duration = Duration::from_secs(60);
+
     /// A scratch folder holding the Fig. 1 BT: a scenario's policies stay
     /// inside its root.
     fn scratch(tag: &str) -> std::path::PathBuf {
@@ -450,7 +454,7 @@ mod hostile {
                 && err.contains("stations.toml:3:1"),
             "{err}"
         );
-        assert!(took < Duration::from_secs(5), "{took:?}");
+        assert!(took < HANG_GUARD, "{took:?}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -483,7 +487,7 @@ mod hostile {
             ],
         );
         assert_eq!(code, 0, "{err}");
-        assert!(took < Duration::from_secs(5), "{took:?}");
+        assert!(took < HANG_GUARD, "{took:?}");
         let v: serde_json::Value = serde_json::from_str(&out).expect("json");
         let done = v["verdicts"].as_array().unwrap().len();
         let skipped = v["skipped_verdicts"]
@@ -536,7 +540,7 @@ mod hostile {
             ],
         );
         assert_eq!(code, 0, "{err}");
-        assert!(took < Duration::from_secs(20), "{took:?}");
+        assert!(took < HANG_GUARD, "{took:?}");
         let v: serde_json::Value = serde_json::from_str(&out).expect("json");
         assert_eq!(v["policies"][0]["steps"], 200_000);
         let bytes = std::fs::read(&trace).expect("trace written");
@@ -577,7 +581,7 @@ mod hostile {
         let (code, out, err, took) =
             btfsm_within(512, &["sim", f.to_str().unwrap(), "--format", "json"]);
         assert_eq!(code, 0, "{err}");
-        assert!(took < Duration::from_secs(20), "{took:?}");
+        assert!(took < HANG_GUARD, "{took:?}");
         assert!(out.len() < 64 << 20, "{} bytes of JSON", out.len());
         let v: serde_json::Value = serde_json::from_str(&out).expect("json");
         for p in v["policies"].as_array().unwrap() {
@@ -617,7 +621,7 @@ mod hostile {
                 && err.contains("--max-file-bytes"),
             "{err}"
         );
-        assert!(took < Duration::from_secs(5), "{took:?}");
+        assert!(took < HANG_GUARD, "{took:?}");
     }
 
     /// `--threads 100000` aborted (threads the system refused to create);

@@ -1,0 +1,661 @@
+//! yasmin XML (the state machine files of yasmin_factory, the ROS 2
+//! state-machine library of uleroboticsgroup/yasmin) read into the FSM/HFSM
+//! model.
+//!
+//! - `<StateMachine name outcomes start_state>` is the machine; a nested
+//!   `<StateMachine>` is a container (so a file with one is an HFSM), and a
+//!   nested `<StateMachine file_path="other.xml">` takes its states and
+//!   outcomes from that file (relative to the including file, kept inside the
+//!   root like every named file: `format::source::resolve`).
+//! - A machine's outcomes are its `outcomes` attribute plus its
+//!   `<FinalOutcome name>` children. Its start state is `start_state`, else
+//!   its first state in document order (the first one added, as yasmin's
+//!   `StateMachine.add_state` makes it).
+//! - `<State name>` is a task state without a skill binding (its `class` /
+//!   `module` is code the model does not run); `<Transition from="OUTCOME" to="TARGET">` is an outcome
+//!   transition. `to` is resolved as yasmin's `StateMachine.execute` does:
+//!   first an outcome of the enclosing machine, then a state of it; anything
+//!   else is an error at the attribute, as yasmin's `validate` refuses it.
+//! - A container's own `<Transition>` children map its outcomes in the
+//!   enclosing machine.
+//! - `<OrthogonalState>` (concurrent regions) is refused with its position:
+//!   the model runs one state per region. `<Param>`, `<Key>`, `<ParamRemap>`,
+//!   `<Remap>` and other elements (data flow, parameters, editor positions)
+//!   are ignored.
+//!
+//! The document is walked region by region with a queue (no recursion on
+//! nesting depth), and every element and included byte is charged to the
+//! command's limits.
+
+use super::xml::{self, XDoc, XElem, shown};
+use super::{Limits, Loaded};
+use crate::diagnostic::{Diagnostic, SourceFile};
+use crate::model::{
+    Policy, PolicyBody, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
+};
+use std::collections::{HashMap, VecDeque};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Does the text look like a yasmin file (its document element is
+/// `<StateMachine`)?
+pub fn looks_like_yasmin(head: &str) -> bool {
+    let mut rest = head.trim_start_matches('\u{feff}');
+    // Skip the XML declaration, comments and processing instructions.
+    loop {
+        rest = rest.trim_start();
+        if let Some(r) = rest.strip_prefix("<?") {
+            match r.find("?>") {
+                Some(i) => rest = &r[i + 2..],
+                None => return false,
+            }
+        } else if let Some(r) = rest.strip_prefix("<!--") {
+            match r.find("-->") {
+                Some(i) => rest = &r[i + 3..],
+                None => return false,
+            }
+        } else {
+            break;
+        }
+    }
+    rest.strip_prefix("<StateMachine")
+        .is_some_and(|r| r.starts_with(|c: char| c.is_whitespace() || c == '>' || c == '/'))
+}
+
+/// Reads yasmin XML already read from `path`.
+pub fn load_read(
+    file: Arc<SourceFile>,
+    path: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let main = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut r = Reader {
+        root: super::source::root_for(limits, &base),
+        elems_left: limits.max_nodes - main.elems.len(),
+        limits,
+        diags: xml::Sink::default(),
+        docs: vec![(main, base)],
+    };
+    let policy = r.read(path);
+    let diags = r.diags.into_vec(&file);
+    super::finish(&file, policy, diags, "state machine")
+}
+
+/// Reads yasmin XML from text (tests, fuzzing): includes are resolved
+/// against the current directory.
+pub fn parse_str(name: &str, text: &str, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    load_read(SourceFile::new(name, text), Path::new(name), limits)
+}
+
+/// A `<StateMachine>` element whose states are still to be read: in
+/// document `doc`, for container `state` (`None`: the top level).
+struct Pending {
+    doc: usize,
+    elem: usize,
+    state: Option<usize>,
+    depth: usize,
+    /// Canonical paths of the files included on the way here (cycles).
+    chain: Vec<PathBuf>,
+}
+
+struct Reader<'l> {
+    root: Option<PathBuf>,
+    elems_left: usize,
+    limits: &'l Limits,
+    diags: xml::Sink,
+    /// Documents read (the main file first) with their directories.
+    docs: Vec<(XDoc, PathBuf)>,
+}
+
+impl Reader<'_> {
+    fn err(&mut self, doc: usize, span: std::ops::Range<usize>, msg: String, hint: &str) {
+        let f = self.docs[doc].0.file.clone();
+        self.diags.push(Diagnostic::error(msg).at(&f, span)).hint = Some(hint.to_string());
+    }
+
+    fn read(&mut self, path: &Path) -> Option<Policy> {
+        let top = &self.docs[0].0.elems[self.docs[0].0.root];
+        if top.name != "StateMachine" {
+            let span = top.span.clone();
+            let msg = format!(
+                "expected `<StateMachine>` as the document element, found `<{}>`",
+                shown(&top.name)
+            );
+            self.err(
+                0,
+                span,
+                msg,
+                "a yasmin file is `<StateMachine outcomes=\"...\" start_state=\"...\">`",
+            );
+            return None;
+        }
+        let name = top.attr("name").map(str::to_string).unwrap_or_else(|| {
+            path.file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("machine")
+                .to_string()
+        });
+        let mut m = StateMachine {
+            hierarchical: false,
+            top: Region {
+                initial: usize::MAX,
+                outcomes: vec![],
+                states: vec![],
+            },
+            states: Vec::new(),
+        };
+        let mut queue = VecDeque::from([Pending {
+            doc: 0,
+            elem: self.docs[0].0.root,
+            state: None,
+            depth: 0,
+            chain: Vec::new(),
+        }]);
+        while let Some(p) = queue.pop_front() {
+            self.region(&mut m, p, &mut queue);
+            if !self.diags.room_for_errors() {
+                break;
+            }
+        }
+        if self.diags.has_errors() {
+            return None;
+        }
+        m.hierarchical = m
+            .states
+            .iter()
+            .any(|s| matches!(s.body, StateBody::Container(_)));
+        Some(Policy {
+            name,
+            description: top_description(&self.docs[0].0),
+            body: PolicyBody::Machine(m),
+        })
+    }
+
+    /// Reads the states of one machine element into region of `p.state`,
+    /// queueing its nested machines.
+    fn region(&mut self, m: &mut StateMachine, p: Pending, queue: &mut VecDeque<Pending>) {
+        let (doc, elem) = (p.doc, p.elem);
+        let machine_span = self.docs[doc].0.elems[elem].span.clone();
+        let outer_span = machine_span.clone();
+        // Outcomes: the attribute, then `<FinalOutcome>`s not already named.
+        // (A set beside the list: nothing is quadratic in the outcome count.)
+        let mut outcome_set: std::collections::HashSet<String> = Default::default();
+        let mut outcomes: Vec<String> = Vec::new();
+        for o in self.docs[doc].0.elems[elem]
+            .attr("outcomes")
+            .unwrap_or_default()
+            .split_whitespace()
+        {
+            if outcome_set.insert(o.to_string()) {
+                outcomes.push(o.to_string());
+            }
+        }
+        let kids: Vec<usize> = self.docs[doc].0.elems[elem].children.clone();
+        for &c in &kids {
+            let e = &self.docs[doc].0.elems[c];
+            if e.name == "FinalOutcome"
+                && let Some(n) = e.attr("name")
+                && outcome_set.insert(n.to_string())
+            {
+                outcomes.push(n.to_string());
+            }
+        }
+        // States, in document order.
+        let mut names: HashMap<String, usize> = HashMap::new();
+        let mut made: Vec<(usize, usize)> = Vec::new(); // (element, state)
+        // Unsupported states, reported once: transitions to them are not.
+        let mut skipped: std::collections::HashSet<String> = Default::default();
+        for &c in &kids {
+            let e = &self.docs[doc].0.elems[c];
+            let container = match e.name.as_str() {
+                "State" => false,
+                "StateMachine" => true,
+                "OrthogonalState" => {
+                    if let Some(n) = e.attr("name") {
+                        skipped.insert(n.to_string());
+                    }
+                    let span = e.span.clone();
+                    self.err(
+                        doc,
+                        span,
+                        "`<OrthogonalState>` (concurrent regions) is not supported".into(),
+                        "the FSM/HFSM model runs one state per region; model each region as its own machine",
+                    );
+                    continue;
+                }
+                _ => continue,
+            };
+            let Some(name) = e.attr("name").map(str::to_string) else {
+                let span = e.span.clone();
+                let what = e.name.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!("`<{what}>` needs a `name`"),
+                    "write `<State name=\"Foo\" ...>`",
+                );
+                continue;
+            };
+            if name.len() > self.limits.max_name_bytes {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!(
+                        "state name `{}` is {} bytes long, more than the limit of {} bytes",
+                        shown(&name),
+                        name.len(),
+                        self.limits.max_name_bytes
+                    ),
+                    "shorten it, or raise the limit with --max-name-bytes",
+                );
+                continue;
+            }
+            if names.contains_key(&name) {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!("duplicate state `{}` in this machine", shown(&name)),
+                    "state names are unique within their machine (yasmin's add_state refuses a second one)",
+                );
+                continue;
+            }
+            if m.states.len() >= self.limits.max_nodes {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!("more than {} states", self.limits.max_nodes),
+                    "raise the limit with --max-nodes",
+                );
+                return;
+            }
+            let span = (doc == 0).then(|| e.span.clone());
+            let body = if container {
+                StateBody::Container(Region {
+                    initial: usize::MAX,
+                    outcomes: vec![],
+                    states: vec![],
+                })
+            } else {
+                StateBody::Task(None)
+            };
+            let idx = m.states.len();
+            m.states.push(State {
+                name: name.clone(),
+                label: name.clone(),
+                parent: p.state,
+                body,
+                transitions: Vec::new(),
+                pseudo: None,
+                span,
+            });
+            names.insert(name, idx);
+            made.push((c, idx));
+        }
+        // The start state.
+        let start = match self.docs[doc].0.elems[elem].attr_full("start_state") {
+            Some(a) => match names.get(a.value.as_str()) {
+                Some(&s) => Some(s),
+                None => {
+                    let (v, span) = (a.value.clone(), a.span.clone());
+                    self.err(
+                        doc,
+                        span,
+                        format!("start state `{}` is not a state of this machine", shown(&v)),
+                        "name one of the machine's own `<State>` or `<StateMachine>` children",
+                    );
+                    None
+                }
+            },
+            None => made.first().map(|&(_, s)| s),
+        };
+        if made.is_empty() {
+            if !self.diags.has_errors() {
+                self.err(
+                    doc,
+                    outer_span,
+                    "this state machine has no states".into(),
+                    "add a `<State name=\"...\">` with its `<Transition from=\"...\" to=\"...\"/>`s",
+                );
+            }
+            return;
+        }
+        // Transitions of each state (a container's are its outcome map).
+        for &(c, s) in &made {
+            let tkids: Vec<usize> = self.docs[doc].0.elems[c].children.clone();
+            for t in tkids {
+                let te = &self.docs[doc].0.elems[t];
+                if te.name != "Transition" {
+                    continue;
+                }
+                let tspan = te.span.clone();
+                let (Some(from), Some(to)) = (te.attr("from"), te.attr_full("to")) else {
+                    self.err(
+                        doc,
+                        tspan,
+                        "`<Transition>` needs `from` and `to`".into(),
+                        "write `<Transition from=\"OUTCOME\" to=\"STATE_OR_OUTCOME\"/>`",
+                    );
+                    continue;
+                };
+                let (from, to_v, to_span) = (from.to_string(), to.value.clone(), to.span.clone());
+                let target = if outcome_set.contains(&to_v) {
+                    Target::Outcome(to_v)
+                } else if let Some(&n) = names.get(to_v.as_str()) {
+                    Target::State(n)
+                } else if skipped.contains(&to_v) {
+                    continue;
+                } else {
+                    self.err(
+                        doc,
+                        to_span,
+                        format!(
+                            "`{}` is neither a state nor an outcome of this machine",
+                            shown(&to_v)
+                        ),
+                        "`to` names a sibling state or one of the machine's `outcomes`",
+                    );
+                    continue;
+                };
+                m.states[s].transitions.push(Transition {
+                    trigger: Trigger::Outcome(from),
+                    target,
+                    span: (doc == 0).then_some(tspan),
+                });
+            }
+        }
+        // Install the region.
+        let Some(start) = start else {
+            return;
+        };
+        let states: Vec<usize> = made.iter().map(|&(_, s)| s).collect();
+        let region = Region {
+            initial: start,
+            outcomes,
+            states,
+        };
+        match p.state {
+            None => m.top = region,
+            Some(c) => m.states[c].body = StateBody::Container(region),
+        }
+        // Nested machines: their content, inline or from their file.
+        for &(c, s) in &made {
+            if self.docs[doc].0.elems[c].name != "StateMachine" {
+                continue;
+            }
+            if p.depth + 1 > self.limits.max_depth {
+                let span = self.docs[doc].0.elems[c].span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!(
+                        "state machines nested deeper than the limit of {} levels",
+                        self.limits.max_depth
+                    ),
+                    "raise the limit with --max-depth",
+                );
+                continue;
+            }
+            match self.docs[doc].0.elems[c].attr_full("file_path").cloned() {
+                None => queue.push_back(Pending {
+                    doc,
+                    elem: c,
+                    state: Some(s),
+                    depth: p.depth + 1,
+                    chain: p.chain.clone(),
+                }),
+                Some(fp) => {
+                    if let Some((nd, chain)) = self.include(doc, &fp, &p.chain) {
+                        let root = self.docs[nd].0.root;
+                        queue.push_back(Pending {
+                            doc: nd,
+                            elem: root,
+                            state: Some(s),
+                            depth: p.depth + 1,
+                            chain,
+                        });
+                    }
+                }
+            }
+        }
+        // A container's outcome map may name outcomes its content lacks:
+        // checked once its content is read (it is later in the queue).
+    }
+
+    /// Reads the file a `file_path` names: its document index, and the
+    /// include chain through it.
+    fn include(
+        &mut self,
+        doc: usize,
+        fp: &xml::XAttr,
+        chain: &[PathBuf],
+    ) -> Option<(usize, Vec<PathBuf>)> {
+        let full = match super::source::resolve(self.root.as_deref(), &self.docs[doc].1, &fp.value)
+        {
+            Ok(p) => p,
+            Err(r) => {
+                self.err(
+                    doc,
+                    fp.span.clone(),
+                    format!("cannot include this file: {}", r.message),
+                    &r.hint,
+                );
+                return None;
+            }
+        };
+        let canon = super::toml::canonical(&full);
+        if chain.contains(&canon) {
+            self.err(
+                doc,
+                fp.span.clone(),
+                "cyclic include: a machine includes itself through `file_path`".into(),
+                "a file must not include itself, directly or through others",
+            );
+            return None;
+        }
+        if chain.len() >= self.limits.max_include_depth {
+            self.err(
+                doc,
+                fp.span.clone(),
+                format!(
+                    "includes nested deeper than {}",
+                    self.limits.max_include_depth
+                ),
+                "raise the limit with --max-include-depth",
+            );
+            return None;
+        }
+        let shown_path = full.display().to_string();
+        let file = match super::toml::read_included(&full, &shown_path, self.limits) {
+            Ok(f) => f,
+            Err(mut ds) => {
+                let msg = ds.remove(0).message;
+                self.err(
+                    doc,
+                    fp.span.clone(),
+                    msg,
+                    "`file_path` is relative to the including file",
+                );
+                return None;
+            }
+        };
+        let parsed = match xml::parse(&file, self.elems_left, self.limits.max_nodes) {
+            Ok(d) => d,
+            Err(d) => {
+                self.diags.push(d);
+                return None;
+            }
+        };
+        self.elems_left -= parsed.elems.len().min(self.elems_left);
+        if parsed.elems[parsed.root].name != "StateMachine" {
+            self.err(
+                doc,
+                fp.span.clone(),
+                "the included file is not a yasmin state machine (its document element is not `<StateMachine>`)".into(),
+                "`file_path` names another yasmin XML file",
+            );
+            return None;
+        }
+        let dir = full.parent().map(Path::to_path_buf).unwrap_or_default();
+        self.docs.push((parsed, dir));
+        let mut chain = chain.to_vec();
+        chain.push(canon);
+        Some((self.docs.len() - 1, chain))
+    }
+}
+
+/// The machine's `description` attribute, if any.
+fn top_description(doc: &XDoc) -> Option<String> {
+    let e: &XElem = &doc.elems[doc.root];
+    e.attr("description").map(str::to_string)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::StateBody;
+
+    fn machine(text: &str) -> StateMachine {
+        match parse_str("t.xml", text, &Limits::default())
+            .unwrap()
+            .policy
+            .body
+        {
+            PolicyBody::Machine(m) => m,
+            _ => unreachable!(),
+        }
+    }
+
+    fn errors(text: &str) -> Vec<String> {
+        parse_str("t.xml", text, &Limits::default())
+            .unwrap_err()
+            .into_iter()
+            .filter(|d| d.is_error())
+            .map(|d| d.to_string())
+            .collect()
+    }
+
+    #[test]
+    fn a_flat_machine_with_its_start_state_and_final_outcomes() {
+        let m = machine(
+            r#"<?xml version="1.0"?>
+<StateMachine name="Demo" outcomes="outcome4" start_state="Foo">
+  <Param name="p" default_type="int" default_value="2"/>
+  <State name="Bar" type="py" class="BarState"><Transition from="outcome3" to="Foo"/></State>
+  <State name="Foo" type="cpp" class="FooState">
+    <Transition from="outcome1" to="Bar"/>
+    <Transition from="outcome2" to="outcome4"/>
+  </State>
+  <FinalOutcome name="outcome4"/>
+</StateMachine>"#,
+        );
+        assert!(!m.hierarchical);
+        assert_eq!(m.states[m.top.initial].name, "Foo");
+        assert_eq!(m.top.outcomes, vec!["outcome4"]);
+        let foo = &m.states[m.top.initial];
+        assert_eq!(foo.transitions.len(), 2);
+        assert_eq!(foo.transitions[0].target, Target::State(0));
+        assert_eq!(
+            foo.transitions[1].target,
+            Target::Outcome("outcome4".into())
+        );
+    }
+
+    #[test]
+    fn an_outcome_of_the_machine_wins_over_a_state_of_the_same_name() {
+        // yasmin's StateMachine.execute checks the machine's outcomes first.
+        let m = machine(
+            r#"<StateMachine outcomes="done">
+  <State name="a"><Transition from="ok" to="done"/></State>
+  <State name="done"><Transition from="ok" to="a"/></State>
+</StateMachine>"#,
+        );
+        assert_eq!(
+            m.states[0].transitions[0].target,
+            Target::Outcome("done".into())
+        );
+        assert_eq!(m.states[m.top.initial].name, "a", "the first state starts");
+    }
+
+    #[test]
+    fn nested_machines_are_containers_with_their_outcome_map() {
+        let m = machine(
+            r#"<StateMachine outcomes="final_outcome">
+    <StateMachine name="NestedSM" outcomes="outcome1 outcome2">
+        <State name="InnerState">
+            <Transition from="outcome1" to="outcome1"/>
+            <Transition from="outcome2" to="outcome2"/>
+        </State>
+        <Transition from="outcome1" to="NestedSM"/>
+        <Transition from="outcome2" to="final_outcome"/>
+    </StateMachine>
+</StateMachine>"#,
+        );
+        assert!(m.hierarchical);
+        let nested = &m.states[m.top.initial];
+        assert_eq!(nested.name, "NestedSM");
+        let StateBody::Container(r) = &nested.body else {
+            panic!("not a container")
+        };
+        assert_eq!(r.outcomes, vec!["outcome1", "outcome2"]);
+        assert_eq!(m.states[r.initial].name, "InnerState");
+        assert_eq!(m.states[r.initial].parent, Some(m.top.initial));
+        assert_eq!(nested.transitions.len(), 2);
+        assert_eq!(nested.transitions[0].target, Target::State(m.top.initial));
+    }
+
+    #[test]
+    fn bad_targets_start_states_and_orthogonal_states_are_errors_at_once() {
+        let e = errors(
+            r#"<StateMachine outcomes="end" start_state="nope">
+  <State name="a"><Transition from="x" to="nowhere"/></State>
+  <State name="a"/>
+  <OrthogonalState name="o"/>
+</StateMachine>"#,
+        );
+        assert_eq!(e.len(), 4, "{e:#?}");
+        assert!(e[0].contains("start state `nope`"), "{e:#?}");
+        assert!(
+            e.iter()
+                .any(|m| m.contains("`nowhere` is neither a state nor an outcome"))
+        );
+        assert!(e.iter().any(|m| m.contains("duplicate state `a`")));
+        assert!(e.iter().any(|m| m.contains("`<OrthogonalState>`")));
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
+
+        /// Cut and spliced yasmin files never panic: they load (and go
+        /// through graph, metrics, DOT, write-back) or give errors.
+        #[test]
+        fn mangled_files_never_panic(seed in 0..3usize, a in 0..2000usize, b in 0..2000usize, ins in "[<>/=\"a-zA-Z _]{0,12}") {
+            let seeds = [
+                include_str!("../../tests/fixtures/corpus/yasmin/yasmin_demos/state_machines/demo_fsm_metadata.xml"),
+                include_str!("../../tests/fixtures/corpus/yasmin/yasmin_factory/test/test_nested_sm.xml"),
+                include_str!("../../tests/fixtures/corpus/yasmin/yasmin_demos/state_machines/demo_orthogonal.xml"),
+            ];
+            let t = seeds[seed];
+            let (mut a, mut b) = (a.min(t.len()), b.min(t.len()));
+            if a > b {
+                std::mem::swap(&mut a, &mut b);
+            }
+            while !t.is_char_boundary(a) { a -= 1; }
+            while !t.is_char_boundary(b) { b -= 1; }
+            let text = format!("{}{ins}{}", &t[..a], &t[b..]);
+            crate::fuzzing::yasmin(text.as_bytes());
+        }
+    }
+
+    #[test]
+    fn sniffing_sees_the_document_element() {
+        assert!(looks_like_yasmin(
+            "<?xml version='1.0'?>\n<!-- c --><StateMachine outcomes=\"a\">"
+        ));
+        assert!(!looks_like_yasmin("<root BTCPP_format=\"4\">"));
+        assert!(!looks_like_yasmin("<StateMachineX/>"));
+    }
+}
