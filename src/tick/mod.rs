@@ -79,6 +79,11 @@ impl Leaves for Scripted<'_> {
 /// Ticks `bt` as `script` says. The tree must have passed
 /// [`crate::sim::exec::unsupported`].
 pub fn run(bt: &Bt, script: &Script) -> TickRun {
+    run_capped(bt, script, MAX_EVENTS)
+}
+
+/// [`run`] stopping after the tick that passes `cap` events.
+fn run_capped(bt: &Bt, script: &Script, cap: usize) -> TickRun {
     let compiled = Arc::new(CompiledBt::scripted(bt));
     let mut ex = BtExec::new(compiled, false);
     let mut leaves = Scripted {
@@ -97,7 +102,7 @@ pub fn run(bt: &Bt, script: &Script) -> TickRun {
         let events = std::mem::take(&mut leaves.events);
         leaves.total += events.len();
         ticks.push(TickRecord { root, events });
-        if leaves.total > MAX_EVENTS {
+        if leaves.total > cap {
             cut = true;
             break;
         }
@@ -251,6 +256,23 @@ mod tests {
                 (t.root, ev)
             })
             .collect()
+    }
+
+    /// docs/robustness.md: a run stops at its event cap, and says so.
+    #[test]
+    fn a_run_stops_at_its_event_cap() {
+        let text = "kind = \"bt\"\nroot = \"a\"\n[nodes]\na = { action = \"A!\" }\n";
+        let t = crate::format::toml::parse_str("t.toml", text, Path::new("."), &Limits::default())
+            .unwrap()
+            .policy;
+        let s = script::parse(
+            &SourceFile::new("s.toml", "ticks = 100000\nhalt = true\n"),
+            bt_of(&t),
+        )
+        .unwrap();
+        let r = run_capped(bt_of(&t), &s, 10);
+        assert!(r.cut && r.ticks.len() == 11 && r.halt.is_none());
+        assert!(r.table(bt_of(&t), "t", "s").contains("stopped after"));
     }
 
     /// docs/bt-semantics.md: a TOML `parallel` fails when it can no longer
