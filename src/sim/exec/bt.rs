@@ -482,7 +482,7 @@ impl Ticking<'_> {
                 unreachable!("the loop returns when the first frame is popped")
             };
             let n = f.node as usize;
-            let next = self.visit(n, f, ret.take(), leaves);
+            let next = self.visit::<REC>(n, f, ret.take(), leaves, rec);
             match next {
                 Next::Tick(i) => {
                     let c = bt.kids(n)[i] as usize;
@@ -523,12 +523,13 @@ impl Ticking<'_> {
 
     /// One step of node `n`'s `tick()`: entered (`ret` is `None`, `f.i` is
     /// 0) or resumed with the status of its child at `f.i`.
-    fn visit(
+    fn visit<const REC: bool>(
         &mut self,
         n: usize,
         f: &mut Frame,
         ret: Option<Status>,
         leaves: &mut impl Leaves,
+        rec: &mut Vec<(usize, Status)>,
     ) -> Next {
         use Status::{Failure as F, Running as R, Success as S};
         let node = &self.bt.nodes[n];
@@ -539,28 +540,36 @@ impl Ticking<'_> {
             Op::Sequence | Op::Fallback => {
                 let go_on = if op == Op::Sequence { S } else { F };
                 let mut i = i;
-                match ret {
-                    None => {}
-                    Some(R) => {
-                        for j in 0..len {
-                            if j != i {
-                                let c = self.bt.kids(n)[j] as usize;
-                                self.halt_child(c, leaves);
+                let mut ret = ret;
+                // Leaf children are ticked in place, without a frame.
+                loop {
+                    match ret {
+                        None => {}
+                        Some(R) => {
+                            for j in 0..len {
+                                if j != i {
+                                    let c = self.bt.kids(n)[j] as usize;
+                                    self.halt_child(c, leaves);
+                                }
                             }
+                            return Next::Done(R);
                         }
-                        return Next::Done(R);
+                        Some(s) if s == go_on => i += 1,
+                        Some(s) => {
+                            self.reset_children(n, 0, leaves);
+                            return Next::Done(s);
+                        }
                     }
-                    Some(s) if s == go_on => i += 1,
-                    Some(s) => {
+                    if i >= len {
                         self.reset_children(n, 0, leaves);
-                        return Next::Done(s);
+                        return Next::Done(go_on);
+                    }
+                    let c = self.bt.kids(n)[i] as usize;
+                    match self.leaf::<REC>(c, leaves, rec) {
+                        Some(s) => ret = Some(s),
+                        None => return Next::Tick(i),
                     }
                 }
-                if i >= len {
-                    self.reset_children(n, 0, leaves);
-                    return Next::Done(go_on);
-                }
-                Next::Tick(i)
             }
             Op::SequenceMemory
             | Op::FallbackMemory
@@ -576,35 +585,45 @@ impl Ticking<'_> {
                     op,
                     Op::SequenceWithMemory | Op::AsyncSequence | Op::AsyncFallback
                 );
-                match ret {
-                    None => {}
-                    Some(R) => return Next::Done(R),
-                    Some(s) if s == go_on => {
-                        self.st[n].idx += 1;
-                        if yields && f.prev == St::Idle && (self.st[n].idx as usize) < len {
-                            return Next::Done(R);
+                let mut ret = ret;
+                let mut prev = f.prev;
+                // Leaf children are ticked in place, without a frame.
+                loop {
+                    match ret {
+                        None => {}
+                        Some(R) => return Next::Done(R),
+                        Some(s) if s == go_on => {
+                            self.st[n].idx += 1;
+                            if yields && prev == St::Idle && (self.st[n].idx as usize) < len {
+                                return Next::Done(R);
+                            }
+                        }
+                        Some(s) => {
+                            if op == Op::SequenceWithMemory {
+                                // The index is kept: the failed child is
+                                // ticked again next time.
+                                let from = self.st[n].idx as usize;
+                                self.reset_children(n, from, leaves);
+                            } else {
+                                self.reset_children(n, 0, leaves);
+                                self.st[n].idx = 0;
+                            }
+                            return Next::Done(s);
                         }
                     }
-                    Some(s) => {
-                        if op == Op::SequenceWithMemory {
-                            // The index is kept: the failed child is ticked
-                            // again next time.
-                            let from = self.st[n].idx as usize;
-                            self.reset_children(n, from, leaves);
-                        } else {
-                            self.reset_children(n, 0, leaves);
-                            self.st[n].idx = 0;
-                        }
-                        return Next::Done(s);
+                    let idx = self.st[n].idx as usize;
+                    if idx >= len {
+                        self.reset_children(n, 0, leaves);
+                        self.st[n].idx = 0;
+                        return Next::Done(go_on);
+                    }
+                    let c = self.bt.kids(n)[idx] as usize;
+                    prev = self.st[c].st;
+                    match self.leaf::<REC>(c, leaves, rec) {
+                        Some(s) => ret = Some(s),
+                        None => return Next::Tick(idx),
                     }
                 }
-                let idx = self.st[n].idx as usize;
-                if idx >= len {
-                    self.reset_children(n, 0, leaves);
-                    self.st[n].idx = 0;
-                    return Next::Done(go_on);
-                }
-                Next::Tick(idx)
             }
             Op::Parallel | Op::ParallelAll => self.parallel(n, f, ret, leaves),
             Op::IfThenElse => {
