@@ -32,8 +32,8 @@
 //! walk only for the subtrees below the skeleton. When every node's status is
 //! noted (`sim --trace`), the composites a status leaves are noted with it (a
 //! reactive composite returns the status of the child it stops at). A unit
-//! test checks plan and stack walk, noting or not, halts included, on random
-//! trees of every node kind.
+//! test checks plan and stack walk, noting or not, halts included, against
+//! a recursive reference on random trees of every TOML node kind.
 
 mod bt;
 mod machine;

@@ -223,7 +223,7 @@ fn fsm_checks_guards_before_the_skill() {
 /// statuses, the same leaf calls in the same order, the same noted
 /// statuses.
 #[test]
-fn plan_and_stack_walk_agree_on_random_trees() {
+fn plan_stack_walk_and_recursive_reference_agree_on_random_trees() {
     use crate::sim::rng::SimRng;
     let mut rng = SimRng::named(11, "exec-differential");
     for case in 0..400 {
@@ -235,9 +235,10 @@ fn plan_and_stack_walk_agree_on_random_trees() {
         };
         let calls = oracle_calls(bt);
         let compiled = Arc::new(CompiledBt::new(bt, calls.clone()));
-        // The four ways to tick: plan or stack walk, noting or not; the
-        // stack walk noting is the reference (BehaviorTree.CPP's semantics,
-        // checked against the engine by tests/differential/).
+        // The four ways to tick: plan or stack walk, noting or not, against
+        // a recursive reference (BehaviorTree.CPP's semantics written as its
+        // sources are, node by node; the engine itself is the oracle of
+        // tests/differential/).
         let mut execs = [
             ("plan", BtExec::new(compiled.clone(), false)),
             ("plan noting", BtExec::new(compiled.clone(), true)),
@@ -247,24 +248,23 @@ fn plan_and_stack_walk_agree_on_random_trees() {
             ),
             ("walk noting", BtExec::new(compiled, true).with_stack_walk()),
         ];
+        let mut reference = Reference::new(bt, calls);
         let seed = rng.next_u64();
-        let mut oracles: Vec<Oracle> = (0..4).map(|_| Oracle::new(seed)).collect();
+        let mut oracles: Vec<Oracle> = (0..5).map(|_| Oracle::new(seed)).collect();
         for t in 0..30 {
             for o in &mut oracles {
                 o.step = t;
                 o.log.clear();
             }
-            let (ref_oracle, others) = oracles.split_last_mut().expect("four");
-            let (last, firsts) = execs.split_last_mut().expect("four");
-            let sr = last.1.tick(ref_oracle);
-            let noted = last.1.statuses.clone().expect("noting");
+            let (ref_oracle, others) = oracles.split_last_mut().expect("five");
+            let (sr, noted) = reference.tick(ref_oracle);
             let ctx = format!("case {case}, tick {t}\n{text}");
-            for ((name, ex), o) in firsts.iter_mut().zip(others) {
+            for ((name, ex), o) in execs.iter_mut().zip(others) {
                 let s = ex.tick(o);
                 assert_eq!(
                     (s, &o.log),
                     (sr, &ref_oracle.log),
-                    "{name} vs walk noting, {ctx}"
+                    "{name} vs reference, {ctx}"
                 );
                 if let Some(v) = &ex.statuses {
                     assert_eq!(v, &noted, "{name}: noted statuses, {ctx}");
@@ -454,4 +454,223 @@ fn random_tree(rng: &mut crate::sim::rng::SimRng, size: usize, kinds: &[usize]) 
         "kind = \"bt\"\nroot = \"n0\"\n[nodes]\n{}\n",
         lines.join("\n")
     )
+}
+
+/// BehaviorTree.CPP 4's semantics of the TOML kinds written recursively,
+/// one function per node type as in its sources (`executeTick`,
+/// `haltChild`, `resetChildren`), over the model (small trees only).
+struct Reference<'a> {
+    bt: &'a Bt,
+    calls: Vec<Option<Call>>,
+    st: Vec<Option<Status>>,
+    idx: Vec<usize>,
+    cnt: Vec<i64>,
+    ok: Vec<usize>,
+    bad: Vec<usize>,
+    t0: Vec<f64>,
+    now: f64,
+    noted: Vec<(usize, Status)>,
+}
+
+impl<'a> Reference<'a> {
+    fn new(bt: &'a Bt, calls: Vec<Option<Call>>) -> Self {
+        let n = bt.nodes.len();
+        Reference {
+            bt,
+            calls,
+            st: vec![None; n],
+            idx: vec![0; n],
+            cnt: vec![0; n],
+            ok: vec![0; n],
+            bad: vec![0; n],
+            t0: vec![0.0; n],
+            now: 0.0,
+            noted: vec![],
+        }
+    }
+
+    fn tick(&mut self, leaves: &mut impl Leaves) -> (Status, Vec<(usize, Status)>) {
+        self.now = leaves.now();
+        self.noted.clear();
+        let root = self.bt.root;
+        let s = self.exec(root, leaves);
+        if s != Status::Running {
+            self.st[root] = None;
+        }
+        (s, std::mem::take(&mut self.noted))
+    }
+
+    fn halt_child(&mut self, c: usize, leaves: &mut impl Leaves) {
+        if self.st[c] == Some(Status::Running) {
+            match self.bt.nodes[c].kind {
+                BtNodeKind::Action => leaves.halt(c),
+                BtNodeKind::SequenceMemory | BtNodeKind::FallbackMemory => self.idx[c] = 0,
+                BtNodeKind::Parallel { .. } => (self.ok[c], self.bad[c]) = (0, 0),
+                BtNodeKind::Repeat { .. } | BtNodeKind::Retry { .. } => self.cnt[c] = 0,
+                _ => {}
+            }
+            self.reset_children(c, leaves);
+        }
+        self.st[c] = None;
+    }
+
+    fn reset_children(&mut self, n: usize, leaves: &mut impl Leaves) {
+        for c in self.bt.nodes[n].children.clone() {
+            self.halt_child(c, leaves);
+        }
+    }
+
+    fn exec(&mut self, n: usize, leaves: &mut impl Leaves) -> Status {
+        use BtNodeKind as K;
+        use Status::{Failure as F, Running as R, Success as S};
+        let kind = self.bt.nodes[n].kind;
+        let kids = self.bt.nodes[n].children.clone();
+        let k = kids.len();
+        let s = match kind {
+            K::Condition => match &self.calls[n] {
+                Some(c) if leaves.condition(n, c) => S,
+                _ => F,
+            },
+            K::Action => match (self.st[n], &self.calls[n]) {
+                (Some(S), _) => S,
+                (Some(F), _) => F,
+                (_, Some(c)) => leaves.action(n, c),
+                (_, None) => F,
+            },
+            K::Sequence | K::Fallback => {
+                let go_on = if kind == K::Sequence { S } else { F };
+                let mut out = None;
+                for (i, &c) in kids.iter().enumerate() {
+                    match self.exec(c, leaves) {
+                        R => {
+                            for (j, &o) in kids.iter().enumerate() {
+                                if j != i {
+                                    self.halt_child(o, leaves);
+                                }
+                            }
+                            out = Some(R);
+                            break;
+                        }
+                        s if s == go_on => {}
+                        s => {
+                            self.reset_children(n, leaves);
+                            out = Some(s);
+                            break;
+                        }
+                    }
+                }
+                out.unwrap_or_else(|| {
+                    self.reset_children(n, leaves);
+                    go_on
+                })
+            }
+            K::SequenceMemory | K::FallbackMemory => {
+                let go_on = if kind == K::SequenceMemory { S } else { F };
+                let mut out = None;
+                while self.idx[n] < k {
+                    match self.exec(kids[self.idx[n]], leaves) {
+                        R => {
+                            out = Some(R);
+                            break;
+                        }
+                        s if s == go_on => self.idx[n] += 1,
+                        s => {
+                            self.reset_children(n, leaves);
+                            self.idx[n] = 0;
+                            out = Some(s);
+                            break;
+                        }
+                    }
+                }
+                out.unwrap_or_else(|| {
+                    self.reset_children(n, leaves);
+                    self.idx[n] = 0;
+                    go_on
+                })
+            }
+            K::Parallel { success } => {
+                let fail = k - success + 1;
+                let mut out = R;
+                for &c in &kids {
+                    if !matches!(self.st[c], Some(S | F)) {
+                        match self.exec(c, leaves) {
+                            S => self.ok[n] += 1,
+                            F => self.bad[n] += 1,
+                            R => {}
+                        }
+                    }
+                    let done = if self.ok[n] >= success {
+                        Some(S)
+                    } else if k - self.bad[n] < success || self.bad[n] == fail {
+                        Some(F)
+                    } else {
+                        None
+                    };
+                    if let Some(s) = done {
+                        (self.ok[n], self.bad[n]) = (0, 0);
+                        self.reset_children(n, leaves);
+                        out = s;
+                        break;
+                    }
+                }
+                out
+            }
+            K::Repeat { .. } | K::Retry { .. } => {
+                let (again, other, limit) = match kind {
+                    K::Repeat { times } => (S, F, times.map_or(-1, i64::from)),
+                    K::Retry { times } => (F, S, i64::from(times)),
+                    _ => unreachable!(),
+                };
+                let c = kids[0];
+                loop {
+                    if limit >= 0 && self.cnt[n] >= limit {
+                        self.cnt[n] = 0;
+                        break again;
+                    }
+                    let prev = self.st[c];
+                    match self.exec(c, leaves) {
+                        R => break R,
+                        s if s == again => {
+                            self.cnt[n] += 1;
+                            self.halt_child(c, leaves);
+                            if prev.is_none() && (limit < 0 || self.cnt[n] < limit) {
+                                break R;
+                            }
+                        }
+                        _ => {
+                            self.cnt[n] = 0;
+                            self.halt_child(c, leaves);
+                            break other;
+                        }
+                    }
+                }
+            }
+            K::Timeout { ms } => {
+                if self.st[n] != Some(R) {
+                    self.t0[n] = self.now;
+                }
+                if (self.now - self.t0[n]) * 1000.0 >= ms as f64 {
+                    self.halt_child(kids[0], leaves);
+                    F
+                } else {
+                    self.exec(kids[0], leaves)
+                }
+            }
+            _ => match (kind, self.exec(kids[0], leaves)) {
+                (_, R) => R,
+                (K::Inverter, S) => F,
+                (K::Inverter, _) => S,
+                (K::ForceSuccess, _) => S,
+                (K::ForceFailure, _) => F,
+                (_, s) => s,
+            },
+        };
+        // A decorator resets a child that finished.
+        if kind.is_decorator() && matches!(self.st[kids[0]], Some(S | F)) {
+            self.st[kids[0]] = None;
+        }
+        self.st[n] = Some(s);
+        self.noted.push((n, s));
+        s
+    }
 }
