@@ -125,6 +125,7 @@ impl CompiledBt {
         }
     }
 
+    #[inline(always)]
     fn kids(&self, n: usize) -> &[u32] {
         &self.kids[self.nodes[n].start as usize..self.nodes[n].end as usize]
     }
@@ -398,11 +399,18 @@ impl Ticking<'_> {
     /// BehaviorTree.CPP's `haltChild`: a RUNNING node is halted (its running
     /// leaves get [`Leaves::halt`] in depth-first order, its memory reset as
     /// its type's `halt()` does), then the node is IDLE.
+    #[inline(always)]
     fn halt_child(&mut self, c: usize, leaves: &mut impl Leaves) {
         if self.st[c].st != St::Running {
             self.st[c].st = St::Idle;
-            return;
+        } else {
+            self.halt_running(c, leaves);
         }
+    }
+
+    /// [`Ticking::halt_child`] of a RUNNING node: the depth-first walk.
+    #[inline(never)]
+    fn halt_running(&mut self, c: usize, leaves: &mut impl Leaves) {
         let bt = self.bt;
         let halts = &mut *self.halts;
         halts.clear();
@@ -449,8 +457,10 @@ impl Ticking<'_> {
     }
 
     /// BehaviorTree.CPP's `resetChildren`: every child halted or reset.
+    #[inline(always)]
     fn reset_children(&mut self, n: usize, from: usize, leaves: &mut impl Leaves) {
-        let kids = self.bt.kids(n);
+        let bt = self.bt;
+        let kids = bt.kids(n);
         for &c in &kids[from.min(kids.len())..] {
             self.halt_child(c as usize, leaves);
         }
@@ -546,10 +556,10 @@ impl Ticking<'_> {
                     match ret {
                         None => {}
                         Some(R) => {
-                            for j in 0..len {
+                            let bt = self.bt;
+                            for (j, &c) in bt.kids(n).iter().enumerate() {
                                 if j != i {
-                                    let c = self.bt.kids(n)[j] as usize;
-                                    self.halt_child(c, leaves);
+                                    self.halt_child(c as usize, leaves);
                                 }
                             }
                             return Next::Done(R);
