@@ -18,7 +18,7 @@
 
 use super::Leaves;
 use super::ops::{Op, op_of};
-use super::plan::{DONE_SUCCESS, NO_NODE, Plan};
+use super::plan::{DONE_FAILURE, DONE_SUCCESS, NO_NODE, Plan};
 use crate::model::BtNodeKind;
 use crate::model::bt::Bt;
 use crate::sim::skills::{Call, Status};
@@ -34,8 +34,6 @@ pub struct CompiledBt {
     plan: Plan,
     /// Each node's parent ([`NO_NODE`] for the root).
     parent: Vec<usize>,
-    /// Each node's pre-order number and the number after its subtree's last.
-    pre: Vec<(u32, u32)>,
 }
 
 /// A node of a [`CompiledBt`].
@@ -105,35 +103,18 @@ impl CompiledBt {
                 parent[c as usize] = p;
             }
         }
-        let order = bt.preorder();
-        let mut pre = vec![(0u32, 0u32); nodes.len()];
-        for (i, &n) in order.iter().enumerate() {
-            pre[n].0 = i as u32;
-        }
-        // Subtree ends, children before parents (reverse pre-order).
-        for &n in order.iter().rev() {
-            let end = (bt.nodes[n].children.last()).map_or(pre[n].0 + 1, |&c| pre[c].1);
-            pre[n].1 = end;
-        }
         CompiledBt {
             nodes,
             kids,
             root: bt.root,
             plan,
             parent,
-            pre,
         }
     }
 
     #[inline(always)]
     fn kids(&self, n: usize) -> &[u32] {
         &self.kids[self.nodes[n].start as usize..self.nodes[n].end as usize]
-    }
-
-    /// Whether `x` is in the subtree of `top`.
-    fn contains(&self, top: usize, x: usize) -> bool {
-        let (a, b) = self.pre[top];
-        (a..b).contains(&self.pre[x].0)
     }
 }
 
@@ -316,36 +297,71 @@ impl Ticking<'_> {
         let bt = self.bt;
         let plan = &bt.plan;
         let mut k = plan.first;
+        // A local copy: the loop keeps it in a register.
+        let mut run_slot = *running;
         loop {
             let Some(slot) = plan.slots.get(k) else {
+                *running = run_slot;
                 return if k == DONE_SUCCESS {
                     Status::Success
                 } else {
                     Status::Failure
                 };
             };
-            let s = match self.leaf::<REC>(slot.node, leaves, rec) {
-                Some(s) => s,
-                None => self.run::<REC>(slot.node, leaves, rec),
-            };
-            let (next, stop, left) = match s {
-                Status::Success => (slot.on_success, slot.stop_success, slot.left_success),
-                Status::Failure => (slot.on_failure, slot.stop_failure, slot.left_failure),
-                Status::Running => (DONE_SUCCESS, NO_NODE, bt.root),
-            };
-            if *running == k {
-                *running = NO_NODE;
-            } else if *running != NO_NODE {
-                let x = plan.slots[*running].node;
-                if bt.contains(left, x) {
-                    self.halt_child(x, leaves);
-                    *running = NO_NODE;
+            let n = slot.node;
+            let node = &bt.nodes[n];
+            // Leaf slots in place: through the plan a leaf's status is only
+            // read for an action (RUNNING or not), so only that is kept.
+            let s = match (node.op, &node.call) {
+                (Op::Condition, Some(call)) => {
+                    if leaves.condition(n, call) {
+                        Status::Success
+                    } else {
+                        Status::Failure
+                    }
                 }
+                (Op::Action, Some(call)) => {
+                    let s = leaves.action(n, call);
+                    self.st[n].st = if s == Status::Running {
+                        St::Running
+                    } else {
+                        St::Idle
+                    };
+                    s
+                }
+                (Op::Action | Op::Condition | Op::Unbound, _) => Status::Failure,
+                _ => {
+                    let s = self.run::<REC>(n, leaves, rec);
+                    if s != Status::Running {
+                        // The skeleton resets a finished slot.
+                        self.st[n].st = St::Idle;
+                    }
+                    s
+                }
+            };
+            if REC && matches!(node.op, Op::Condition | Op::Action | Op::Unbound) {
+                rec.push((n, s));
+            }
+            let (next, stop) = match s {
+                Status::Success => (slot.on_success, slot.stop_success),
+                Status::Failure => (slot.on_failure, slot.stop_failure),
+                Status::Running => (DONE_SUCCESS, NO_NODE),
+            };
+            // Slots are numbered in reverse tick order: a successor past the
+            // running slot means the skeleton left the composite holding
+            // it, which halts it now (BehaviorTree.CPP's `haltChild` /
+            // `resetChildren` of the reactive nodes).
+            if run_slot == k {
+                run_slot = NO_NODE;
+            } else if run_slot != NO_NODE && (next >= DONE_FAILURE || next < run_slot) {
+                let x = plan.slots[run_slot].node;
+                self.halt_child(x, leaves);
+                run_slot = NO_NODE;
             }
             if REC {
                 // The composites the status leaves return it (a reactive
                 // composite's status is that of the child it stops at).
-                let mut a = bt.parent[slot.node];
+                let mut a = bt.parent[n];
                 while a != stop && a != NO_NODE {
                     rec.push((a, s));
                     a = bt.parent[a];
@@ -355,8 +371,6 @@ impl Ticking<'_> {
                 *running = k;
                 return s;
             }
-            // The skeleton resets a finished slot before the tick ends.
-            self.st[slot.node].st = St::Idle;
             k = next;
         }
     }

@@ -40,8 +40,6 @@ pub(super) struct Slot {
     pub(super) on_failure: usize,
     pub(super) stop_success: usize,
     pub(super) stop_failure: usize,
-    pub(super) left_success: usize,
-    pub(super) left_failure: usize,
 }
 
 /// No node (above the root), no slot.
@@ -89,8 +87,6 @@ impl Plan {
                             on_failure: on_failure.0,
                             stop_success: on_success.1,
                             stop_failure: on_failure.1,
-                            left_success: on_success.2,
-                            left_failure: on_failure.2,
                         });
                         firsts.push(slots.len() - 1);
                     } else if kids_of(n).is_empty() {
