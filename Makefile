@@ -1,11 +1,13 @@
 # btfsm: `make run` runs the main job on the bundled policies and scenarios,
 # `make test` is what CI runs.
 CARGO ?= cargo
-BIN := $(or $(CARGO_TARGET_DIR),target)/release/btfsm
+TARGET_DIR := $(or $(CARGO_TARGET_DIR),target)
+BIN := $(TARGET_DIR)/release/btfsm
+VENV := .venv
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
-.PHONY: build run test bench bench-ged clean paper-docs fuzz mermaid-oracle man
+.PHONY: build run test bench bench-ged clean paper-docs fuzz mermaid-oracle man differential
 
 build:
 	$(CARGO) build --release --locked
@@ -35,6 +37,19 @@ test:
 	$(CARGO) test --locked --bench scale --bench ged --bench sim -- --test
 	$(CARGO) run --quiet --locked -- paper --check
 	$(MAKE) --no-print-directory mermaid-oracle
+	$(MAKE) --no-print-directory differential
+
+# `btfsm tick` against BehaviorTree.CPP 4 (behaviortreepy, pinned in
+# tests/differential/requirements.txt, installed into .venv) on 3000 seeded
+# random trees (docs/bt-semantics.md).
+$(VENV)/.installed: tests/differential/requirements.txt
+	python3 -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
+	touch $@
+
+differential: $(VENV)/.installed
+	$(CARGO) build --quiet --locked
+	$(VENV)/bin/python tests/differential/differential.py $(TARGET_DIR)/debug/btfsm --trees 3000
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).

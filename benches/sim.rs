@@ -25,7 +25,7 @@ struct Frozen(World);
 
 impl Leaves for Frozen {
     #[inline]
-    fn condition(&mut self, call: &Call) -> bool {
+    fn condition(&mut self, _key: usize, call: &Call) -> bool {
         condition(call, &self.0)
     }
     fn action(&mut self, _key: usize, _call: &Call) -> Status {

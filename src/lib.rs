@@ -18,6 +18,7 @@ pub mod render;
 pub mod report;
 pub mod sanitize;
 pub mod sim;
+pub mod tick;
 pub mod transform;
 
 pub use cli::run;

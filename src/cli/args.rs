@@ -139,6 +139,8 @@ pub enum Command {
     /// Runs policies in the planar robot simulator, compares their behavior
     /// and checks the scenario's [expect] (exit 1 when one fails)
     Sim(super::sim::SimArgs),
+    /// Ticks a BT against scripted leaf outcomes (BehaviorTree.CPP 4 semantics)
+    Tick(super::tick::TickArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
     Completions {

@@ -30,6 +30,7 @@ mod edit;
 pub mod out;
 mod paper;
 pub mod sim;
+mod tick;
 
 use clap::Parser;
 use std::ffi::OsString;

@@ -1126,6 +1126,19 @@ impl Loader<'_> {
             })
             .map(|a| (a.name.clone(), resolve(&a.value)))
             .collect();
+        // BehaviorTree.CPP 4's Parallel fails at its first failure unless
+        // told otherwise; the model's Parallel without `failure_count` is the
+        // paper's, which fails when it can no longer succeed
+        // (docs/bt-semantics.md).
+        if matches!(kind, BtNodeKind::Parallel { .. })
+            && ty == "Parallel"
+            && el.attr("success_threshold").is_none()
+            && el.attr("threshold").is_none()
+        {
+            ports
+                .entry("failure_count".into())
+                .or_insert_with(|| "1".into());
+        }
         // A leaf whose type is a skill of the shared library, with arguments
         // that fit the skill, is bound to it.
         let mut skill_call = None;

@@ -133,7 +133,12 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
         }
         match n.kind {
             BtNodeKind::Parallel { success } if n.type_name.is_none() => {
-                attrs.push(("success_count".into(), success.to_string()))
+                attrs.push(("success_count".into(), success.to_string()));
+                // The paper's Parallel fails when it can no longer succeed.
+                if !n.ports.contains_key("failure_count") {
+                    let fail = n.children.len().saturating_sub(success) + 1;
+                    attrs.push(("failure_count".into(), fail.to_string()));
+                }
             }
             BtNodeKind::Repeat { times } => attrs.push((
                 "num_cycles".into(),

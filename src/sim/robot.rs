@@ -3,7 +3,7 @@
 //! records of executed skills and events that a run reports.
 //!
 //! One base, one arm: an action that needs a resource held by another
-//! running action aborts it (its record ends as `failure` at once, and its
+//! running action aborts it (its record ends as `aborted` at once, and its
 //! leaf gets FAILURE at its next tick), as a navigation action server aborts
 //! its goal for a new one. A halted action ([`Leaves::halt`]) stops at once;
 //! at the end of a step the actions not ticked are cancelled, then the base
@@ -228,7 +228,7 @@ impl Robot {
             r.cancel(&mut self.world);
             r.result = Some(Status::Failure);
             let rec = r.record;
-            self.close(rec, "failure");
+            self.close(rec, "aborted");
             let text = format!("{} aborted by a new goal", self.records[rec].skill);
             self.event("aborted", text);
         }
@@ -302,7 +302,7 @@ pub(super) fn round3(x: f64) -> f64 {
 
 impl Leaves for Robot {
     #[inline]
-    fn condition(&mut self, call: &Call) -> bool {
+    fn condition(&mut self, _key: usize, call: &Call) -> bool {
         skills::condition(call, &self.world)
     }
 

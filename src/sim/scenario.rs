@@ -8,7 +8,7 @@ use super::skills::{self, Call, Unresolved};
 use super::world::{Layout, Object, P2, Params, Place, Rect, World};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
 use crate::format::{self, Limits};
-use crate::model::{BtNodeKind, Policy, PolicyBody, SkillCall, StateBody, skill::SKILLS};
+use crate::model::{Policy, PolicyBody, SkillCall, StateBody, skill::SKILLS};
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -1378,14 +1378,13 @@ pub fn check_bindings(
                     None => Pos::Span(n.span.clone()),
                     Some((inc, _)) => Pos::Include(inc.to_string()),
                 };
-                if matches!(n.kind, BtNodeKind::Control | BtNodeKind::Decorator) {
-                    let t = n.type_name.as_deref().unwrap_or(n.kind.keyword());
+                if let Some(t) = crate::sim::exec::refused(n) {
                     push(
                         format!("node `{}`", n.id),
                         span(),
                         Unresolved {
-                            message: format!("the simulator does not model the node type `{t}`"),
-                            hint: "it executes sequence, fallback, sequence_memory, fallback_memory, parallel, inverter, force_success, force_failure, repeat, retry and timeout nodes".into(),
+                            message: format!("the simulator does not model the node type {t}"),
+                            hint: "it executes the node types of docs/bt-semantics.md (sequence, fallback, sequence_memory, fallback_memory, parallel, inverter, force_success, force_failure, repeat, retry, timeout; IfThenElse, WhileDoElse, KeepRunningUntilFailure, ...)".into(),
                         },
                     );
                 }

@@ -17,7 +17,9 @@ use std::collections::BTreeMap;
 pub struct SkillRecord {
     pub skill: String,
     pub args: BTreeMap<String, String>,
-    /// `success`, `failure`, `cancelled` (preempted), or `running` at the end.
+    /// `success`, `failure`, `cancelled` (halted by the policy, or not
+    /// ticked), `aborted` (its base or arm taken by a new goal of the same
+    /// policy, as an action server aborts a goal), or `running` at the end.
     pub outcome: String,
     pub start: f64,
     pub end: Option<f64>,
@@ -30,8 +32,16 @@ impl SkillRecord {
         format!("{}({}) -> {}", self.skill, args.join(", "), self.outcome)
     }
 
+    /// The same skill, arguments and outcome; `cancelled` and `aborted` are
+    /// the same outcome here: the action ended because the policy started
+    /// another, and which came first, the halt or the new goal, is the
+    /// executor's order (BehaviorTree.CPP starts the new action before it
+    /// halts the old one; an FSM leaves its state first), not behavior.
     fn same(&self, o: &SkillRecord) -> bool {
-        self.skill == o.skill && self.args == o.args && self.outcome == o.outcome
+        fn class(x: &str) -> &str {
+            if x == "aborted" { "cancelled" } else { x }
+        }
+        self.skill == o.skill && self.args == o.args && class(&self.outcome) == class(&o.outcome)
     }
 }
 

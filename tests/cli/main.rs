@@ -11,6 +11,7 @@ mod gate;
 mod hostile;
 mod paper;
 mod sim;
+mod tick;
 mod untrusted;
 
 use common::btfsm;

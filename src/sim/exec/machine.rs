@@ -130,8 +130,8 @@ impl MachineExec {
         }
     }
 
-    fn holds(terms: &GuardTerms, leaves: &mut impl Leaves) -> bool {
-        terms.iter().all(|(c, neg)| leaves.condition(c) != *neg)
+    fn holds(s: usize, terms: &GuardTerms, leaves: &mut impl Leaves) -> bool {
+        terms.iter().all(|(c, neg)| leaves.condition(s, c) != *neg)
     }
 
     fn follow<'a>(c: &'a CompiledMachine, from: usize, t: &'a Target) -> Flow<'a> {
@@ -173,7 +173,7 @@ impl MachineExec {
         let mut flow = Flow::Enter(self.current);
         'anc: for &a in anc.iter().rev() {
             for (g, t) in &c.guards[a] {
-                if Self::holds(g, leaves) {
+                if Self::holds(a, g, leaves) {
                     // The running state is left: its action is halted now.
                     leaves.halt(self.current);
                     flow = Self::follow(&c, a, t);
@@ -216,7 +216,9 @@ impl MachineExec {
                 Flow::Up(Some(container), o) => (container, o),
                 Flow::Enter(s) => {
                     // A state left by a guard runs nothing (and is not noted).
-                    if let Some((_, t)) = c.guards[s].iter().find(|(g, _)| Self::holds(g, leaves)) {
+                    if let Some((_, t)) =
+                        c.guards[s].iter().find(|(g, _)| Self::holds(s, g, leaves))
+                    {
                         // Preempted: a running action of the state is halted
                         // at once (a state entered afresh has none).
                         leaves.halt(s);
@@ -232,7 +234,7 @@ impl MachineExec {
                         StateBody::Task(_) => match &c.call[s] {
                             Some(call) if call.is_action() => leaves.action(s, call),
                             Some(call) => {
-                                if leaves.condition(call) {
+                                if leaves.condition(s, call) {
                                     Status::Success
                                 } else {
                                     Status::Failure
@@ -296,7 +298,7 @@ mod tests {
     }
 
     impl Leaves for Log {
-        fn condition(&mut self, _: &Call) -> bool {
+        fn condition(&mut self, _: usize, _: &Call) -> bool {
             self.battery_ok
         }
         fn action(&mut self, key: usize, call: &Call) -> Status {

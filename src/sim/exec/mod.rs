@@ -2,12 +2,14 @@
 //! (SPEC §6), against the shared skill library behind the [`Leaves`] trait.
 //!
 //! - BT (the paper's sec. II-A; Colledanchise & Ögren, "Behavior Trees in
-//!   Robotics and AI", ch. 1): the root is ticked once per step. Sequence and
-//!   Fallback are reactive (re-ticked from the first child), Sequence* and
-//!   Fallback* resume at the running child, Parallel succeeds when `success`
-//!   children succeed, decorators map their child's status. A node that was not
-//!   ticked on the previous step starts afresh (halting resets memory), and an
-//!   action not ticked in a step is cancelled by the caller.
+//!   Robotics and AI", ch. 1): the root is ticked once per step, every node
+//!   as BehaviorTree.CPP 4 ticks its type (docs/bt-semantics.md, checked
+//!   against the engine by tests/differential/): `sequence` and `fallback`
+//!   are ReactiveSequence and ReactiveFallback, `sequence_memory` and
+//!   `fallback_memory` BehaviorTree.CPP's Sequence and Fallback, and the
+//!   XML types keep their own semantics (SequenceWithMemory, Parallel with
+//!   per-child memory, IfThenElse, ...). A RUNNING leaf is halted
+//!   ([`Leaves::halt`]) at the moment BehaviorTree.CPP halts it.
 //! - FSM (sec. II-B, Algorithm 3): the current state's guards are checked, in
 //!   the order written, before its skill runs; the skill's outcome selects the
 //!   transition. A decision state (SELECTOR) only checks guards. Several states
@@ -31,23 +33,27 @@
 //! walk only for the subtrees below the skeleton. When every node's status is
 //! noted (`sim --trace`), the composites a status leaves are noted with it (a
 //! reactive composite returns the status of the child it stops at). A unit
-//! test checks plan and stack walk, noting or not, against a recursive
-//! reference on random trees of every node kind.
+//! test checks plan and stack walk, noting or not, halts included, against
+//! a recursive reference on random trees of every TOML node kind.
 
 mod bt;
 mod machine;
+mod ops;
+mod plan;
 #[cfg(test)]
 mod tests;
 
 pub use bt::{BtExec, CompiledBt, XNode};
 pub use machine::{CompiledMachine, GuardTerms, MachineExec};
+pub use ops::{refused, unsupported};
 
 use super::skills::{Call, Status};
 
 /// What an executor needs from the robot.
 pub trait Leaves {
-    /// Evaluates a condition.
-    fn condition(&mut self, call: &Call) -> bool;
+    /// Evaluates the condition of leaf `key` (a BT node, an FSM state; for
+    /// a guard, its state).
+    fn condition(&mut self, key: usize, call: &Call) -> bool;
     /// Ticks the action of leaf `key` (continuing its running instance).
     fn action(&mut self, key: usize, call: &Call) -> Status;
     /// Halts the running action of leaf `key` at once (BehaviorTree.CPP's

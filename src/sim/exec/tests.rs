@@ -1,4 +1,6 @@
-//! The executors against a recursive reference and scripted leaves.
+//! The executors on scripted leaves: plan against stack walk (halts
+//! included), BehaviorTree.CPP semantics of single node types, a BT against
+//! its converted HFSM.
 
 use super::*;
 use crate::format::{Limits, toml::parse_str};
@@ -17,7 +19,7 @@ struct Script {
 }
 
 impl Leaves for Script {
-    fn condition(&mut self, call: &Call) -> bool {
+    fn condition(&mut self, _key: usize, call: &Call) -> bool {
         self.conds.get(call.name()).copied().unwrap_or(false)
     }
     fn action(&mut self, key: usize, call: &Call) -> Status {
@@ -105,8 +107,8 @@ const DECORATED: &str = r#"
 kind = "bt"
 root = "root"
 [nodes]
-root = { parallel = ["retry", "inv", "time"], success = 2 }
-retry = { retry = "dock", times = 1 }
+root = { parallel = ["retry", "inv", "time"], success = 3 }
+retry = { retry = "dock", times = 2 }
 dock = { action = "Dock!", skill = "Dock" }
 inv = { inverter = "tucked" }
 tucked = { condition = "Tucked?", skill = "Arm-Tucked" }
@@ -114,16 +116,16 @@ time = { timeout = "tuck", ms = 2500 }
 tuck = { action = "Tuck!", skill = "Tuck-Arm" }
 "#;
 
-/// Dock fails once then succeeds (Retry absorbs the failure), the
+/// Dock fails once then succeeds (the second of Retry's two attempts), the
 /// inverted condition succeeds, and Tuck-Arm never finishes, so Timeout
-/// fails it after 2.5 s of (scripted) time.
+/// fails it after 2.5 s of (scripted) time; Parallel needs all three.
 struct Decor {
     t: f64,
     docks: u32,
 }
 
 impl Leaves for Decor {
-    fn condition(&mut self, _: &Call) -> bool {
+    fn condition(&mut self, _: usize, _: &Call) -> bool {
         false
     }
     fn action(&mut self, _key: usize, call: &Call) -> Status {
@@ -159,17 +161,22 @@ fn parallel_retry_inverter_and_timeout() {
         .unwrap();
     let mut ex = BtExec::new(compiled, true);
     let mut d = Decor { t: 0.0, docks: 0 };
-    // Tick 1: Dock fails, Retry says RUNNING; inverter SUCCESS; tuck RUNNING.
+    // Tick 1: Dock fails, Retry yields (RUNNING); inverter SUCCESS; tuck
+    // RUNNING.
     assert_eq!(ex.tick(&mut d), Status::Running);
     d.t = 1.0;
-    // Tick 2: Dock succeeds: two successes reach the threshold.
-    assert_eq!(ex.tick(&mut d), Status::Success);
+    // Tick 2: Dock succeeds; the inverter finished on tick 1 and is not
+    // ticked again; the Timeout is still running.
+    assert_eq!(ex.tick(&mut d), Status::Running);
     let st = ex.statuses.clone().unwrap();
-    assert!(st.contains(&(time_node, Status::Running)));
+    assert!(st.contains(&(time_node, Status::Running)), "{st:?}");
+    assert_eq!(d.docks, 2);
     d.t = 3.0;
-    ex.tick(&mut d);
+    // Tick 3: the Timeout fails Tuck-Arm, so the Parallel fails.
+    assert_eq!(ex.tick(&mut d), Status::Failure);
     let st = ex.statuses.clone().unwrap();
     assert!(st.contains(&(time_node, Status::Failure)), "{st:?}");
+    assert_eq!(d.docks, 2);
 }
 
 const FSM: &str = r#"
@@ -228,7 +235,10 @@ fn plan_stack_walk_and_recursive_reference_agree_on_random_trees() {
         };
         let calls = oracle_calls(bt);
         let compiled = Arc::new(CompiledBt::new(bt, calls.clone()));
-        // The four ways to tick: plan or stack walk, noting or not.
+        // The four ways to tick: plan or stack walk, noting or not, against
+        // a recursive reference (BehaviorTree.CPP's semantics written as its
+        // sources are, node by node; the engine itself is the oracle of
+        // tests/differential/).
         let mut execs = [
             ("plan", BtExec::new(compiled.clone(), false)),
             ("plan noting", BtExec::new(compiled.clone(), true)),
@@ -296,6 +306,8 @@ fn hfsm_ticks_like_the_bt(kinds: &[usize], cases: usize) -> Result<(), String> {
             b.log.clear();
             let sa = bx.tick(&mut a);
             let sb = mx.step(&mut b);
+            // The HFSM's executor halts nothing: leaf calls are compared.
+            a.log.retain(|e| e.1 != 'h');
             if (sa, &a.log) != (sb, &b.log) {
                 return Err(format!(
                     "case {case}, tick {t}: BT {sa:?} {:?}, HFSM {sb:?} {:?}\n{text}",
@@ -356,7 +368,7 @@ impl Oracle {
 }
 
 impl Leaves for Oracle {
-    fn condition(&mut self, call: &Call) -> bool {
+    fn condition(&mut self, _key: usize, call: &Call) -> bool {
         let Call::InHand(i) = *call else { panic!() };
         self.log.push((i, 'c'));
         self.draw(i).is_multiple_of(2)
@@ -368,6 +380,9 @@ impl Leaves for Oracle {
         assert_eq!(key, object);
         self.log.push((key, 'a'));
         [Status::Running, Status::Success, Status::Failure][(self.draw(key) % 3) as usize]
+    }
+    fn halt(&mut self, key: usize) {
+        self.log.push((key, 'h'));
     }
     fn now(&self) -> f64 {
         self.step as f64 * 0.1
@@ -441,15 +456,18 @@ fn random_tree(rng: &mut crate::sim::rng::SimRng, size: usize, kinds: &[usize]) 
     )
 }
 
-/// The semantics of this file's header, written recursively over the
-/// model (small trees only).
+/// BehaviorTree.CPP 4's semantics of the TOML kinds written recursively,
+/// one function per node type as in its sources (`executeTick`,
+/// `haltChild`, `resetChildren`), over the model (small trees only).
 struct Reference<'a> {
     bt: &'a Bt,
     calls: Vec<Option<Call>>,
-    mem: Vec<u32>,
-    last: Vec<u64>,
+    st: Vec<Option<Status>>,
+    idx: Vec<usize>,
+    cnt: Vec<i64>,
+    ok: Vec<usize>,
+    bad: Vec<usize>,
     t0: Vec<f64>,
-    step: u64,
     now: f64,
     noted: Vec<(usize, Status)>,
 }
@@ -460,144 +478,198 @@ impl<'a> Reference<'a> {
         Reference {
             bt,
             calls,
-            mem: vec![0; n],
-            last: vec![0; n],
+            st: vec![None; n],
+            idx: vec![0; n],
+            cnt: vec![0; n],
+            ok: vec![0; n],
+            bad: vec![0; n],
             t0: vec![0.0; n],
-            step: 0,
             now: 0.0,
             noted: vec![],
         }
     }
 
     fn tick(&mut self, leaves: &mut impl Leaves) -> (Status, Vec<(usize, Status)>) {
-        self.step += 1;
         self.now = leaves.now();
         self.noted.clear();
-        let s = self.node(self.bt.root, leaves);
+        let root = self.bt.root;
+        let s = self.exec(root, leaves);
+        if s != Status::Running {
+            self.st[root] = None;
+        }
         (s, std::mem::take(&mut self.noted))
     }
 
-    fn node(&mut self, n: usize, leaves: &mut impl Leaves) -> Status {
+    fn halt_child(&mut self, c: usize, leaves: &mut impl Leaves) {
+        if self.st[c] == Some(Status::Running) {
+            match self.bt.nodes[c].kind {
+                BtNodeKind::Action => leaves.halt(c),
+                BtNodeKind::SequenceMemory | BtNodeKind::FallbackMemory => self.idx[c] = 0,
+                BtNodeKind::Parallel { .. } => (self.ok[c], self.bad[c]) = (0, 0),
+                BtNodeKind::Repeat { .. } | BtNodeKind::Retry { .. } => self.cnt[c] = 0,
+                _ => {}
+            }
+            self.reset_children(c, leaves);
+        }
+        self.st[c] = None;
+    }
+
+    fn reset_children(&mut self, n: usize, leaves: &mut impl Leaves) {
+        for c in self.bt.nodes[n].children.clone() {
+            self.halt_child(c, leaves);
+        }
+    }
+
+    fn exec(&mut self, n: usize, leaves: &mut impl Leaves) -> Status {
         use BtNodeKind as K;
         use Status::{Failure as F, Running as R, Success as S};
         let kind = self.bt.nodes[n].kind;
         let kids = self.bt.nodes[n].children.clone();
-        if matches!(
-            kind,
-            K::SequenceMemory
-                | K::FallbackMemory
-                | K::Repeat { .. }
-                | K::Retry { .. }
-                | K::Timeout { .. }
-        ) {
-            if self.last[n] + 1 != self.step {
-                self.mem[n] = 0;
-                self.t0[n] = self.now;
-            }
-            self.last[n] = self.step;
-        }
+        let k = kids.len();
         let s = match kind {
             K::Condition => match &self.calls[n] {
-                Some(c) if leaves.condition(c) => S,
+                Some(c) if leaves.condition(n, c) => S,
                 _ => F,
             },
-            K::Action => match &self.calls[n] {
-                Some(c) => leaves.action(n, c),
-                None => F,
+            K::Action => match (self.st[n], &self.calls[n]) {
+                (Some(S), _) => S,
+                (Some(F), _) => F,
+                (_, Some(c)) => leaves.action(n, c),
+                (_, None) => F,
             },
             K::Sequence | K::Fallback => {
                 let go_on = if kind == K::Sequence { S } else { F };
-                let mut out = go_on;
-                for c in kids {
-                    let s = self.node(c, leaves);
-                    if s != go_on {
-                        out = s;
-                        break;
+                let mut out = None;
+                for (i, &c) in kids.iter().enumerate() {
+                    match self.exec(c, leaves) {
+                        R => {
+                            for (j, &o) in kids.iter().enumerate() {
+                                if j != i {
+                                    self.halt_child(o, leaves);
+                                }
+                            }
+                            out = Some(R);
+                            break;
+                        }
+                        s if s == go_on => {}
+                        s => {
+                            self.reset_children(n, leaves);
+                            out = Some(s);
+                            break;
+                        }
                     }
                 }
-                out
+                out.unwrap_or_else(|| {
+                    self.reset_children(n, leaves);
+                    go_on
+                })
             }
             K::SequenceMemory | K::FallbackMemory => {
                 let go_on = if kind == K::SequenceMemory { S } else { F };
-                let mut out = go_on;
-                let start = self.mem[n] as usize;
-                for (i, &c) in kids.iter().enumerate().skip(start) {
-                    let s = self.node(c, leaves);
-                    if s == R {
-                        self.mem[n] = i as u32;
-                        return self.note(n, R);
+                let mut out = None;
+                while self.idx[n] < k {
+                    match self.exec(kids[self.idx[n]], leaves) {
+                        R => {
+                            out = Some(R);
+                            break;
+                        }
+                        s if s == go_on => self.idx[n] += 1,
+                        s => {
+                            self.reset_children(n, leaves);
+                            self.idx[n] = 0;
+                            out = Some(s);
+                            break;
+                        }
                     }
-                    if s != go_on {
+                }
+                out.unwrap_or_else(|| {
+                    self.reset_children(n, leaves);
+                    self.idx[n] = 0;
+                    go_on
+                })
+            }
+            K::Parallel { success } => {
+                let fail = k - success + 1;
+                let mut out = R;
+                for &c in &kids {
+                    if !matches!(self.st[c], Some(S | F)) {
+                        match self.exec(c, leaves) {
+                            S => self.ok[n] += 1,
+                            F => self.bad[n] += 1,
+                            R => {}
+                        }
+                    }
+                    let done = if self.ok[n] >= success {
+                        Some(S)
+                    } else if k - self.bad[n] < success || self.bad[n] == fail {
+                        Some(F)
+                    } else {
+                        None
+                    };
+                    if let Some(s) = done {
+                        (self.ok[n], self.bad[n]) = (0, 0);
+                        self.reset_children(n, leaves);
                         out = s;
                         break;
                     }
                 }
-                self.mem[n] = 0;
                 out
             }
-            K::Parallel { success } => {
-                let (mut ok, mut bad) = (0, 0);
-                for &c in &kids {
-                    match self.node(c, leaves) {
-                        S => ok += 1,
-                        F => bad += 1,
-                        R => {}
+            K::Repeat { .. } | K::Retry { .. } => {
+                let (again, other, limit) = match kind {
+                    K::Repeat { times } => (S, F, times.map_or(-1, i64::from)),
+                    K::Retry { times } => (F, S, i64::from(times)),
+                    _ => unreachable!(),
+                };
+                let c = kids[0];
+                loop {
+                    if limit >= 0 && self.cnt[n] >= limit {
+                        self.cnt[n] = 0;
+                        break again;
+                    }
+                    let prev = self.st[c];
+                    match self.exec(c, leaves) {
+                        R => break R,
+                        s if s == again => {
+                            self.cnt[n] += 1;
+                            self.halt_child(c, leaves);
+                            if prev.is_none() && (limit < 0 || self.cnt[n] < limit) {
+                                break R;
+                            }
+                        }
+                        _ => {
+                            self.cnt[n] = 0;
+                            self.halt_child(c, leaves);
+                            break other;
+                        }
                     }
                 }
-                if ok >= success {
-                    S
-                } else if bad > kids.len().saturating_sub(success) {
+            }
+            K::Timeout { ms } => {
+                if self.st[n] != Some(R) {
+                    self.t0[n] = self.now;
+                }
+                if (self.now - self.t0[n]) * 1000.0 >= ms as f64 {
+                    self.halt_child(kids[0], leaves);
                     F
                 } else {
-                    R
+                    self.exec(kids[0], leaves)
                 }
             }
-            K::Timeout { ms } if (self.now - self.t0[n]) * 1000.0 >= ms as f64 => {
-                self.last[n] = 0;
-                F
-            }
-            _ => {
-                let s = self.node(kids[0], leaves);
-                match (kind, s) {
-                    (_, R) => R,
-                    (K::Inverter, S) => F,
-                    (K::Inverter, _) => S,
-                    (K::ForceSuccess, _) => S,
-                    (K::ForceFailure, _) => F,
-                    (K::Repeat { times }, S) => {
-                        self.mem[n] += 1;
-                        if times.is_some_and(|t| self.mem[n] >= t) {
-                            self.mem[n] = 0;
-                            S
-                        } else {
-                            R
-                        }
-                    }
-                    (K::Retry { times }, F) => {
-                        self.mem[n] += 1;
-                        if self.mem[n] > times {
-                            self.mem[n] = 0;
-                            F
-                        } else {
-                            R
-                        }
-                    }
-                    (K::Repeat { .. } | K::Retry { .. }, s) => {
-                        self.mem[n] = 0;
-                        s
-                    }
-                    (K::Timeout { .. }, s) => {
-                        self.last[n] = 0;
-                        s
-                    }
-                    (_, s) => s,
-                }
-            }
+            _ => match (kind, self.exec(kids[0], leaves)) {
+                (_, R) => R,
+                (K::Inverter, S) => F,
+                (K::Inverter, _) => S,
+                (K::ForceSuccess, _) => S,
+                (K::ForceFailure, _) => F,
+                (_, s) => s,
+            },
         };
-        self.note(n, s)
-    }
-
-    fn note(&mut self, n: usize, s: Status) -> Status {
+        // A decorator resets a child that finished.
+        if kind.is_decorator() && matches!(self.st[kids[0]], Some(S | F)) {
+            self.st[kids[0]] = None;
+        }
+        self.st[n] = Some(s);
         self.noted.push((n, s));
         s
     }

@@ -1,0 +1,117 @@
+//! `btfsm tick TREE --script S`: ticks a BT against scripted leaf outcomes
+//! and prints every leaf ticked and halted per tick (docs/bt-semantics.md).
+//! Several TREE / --script pairs run in one process (JSON: one object per
+//! line), which is how tests/differential/ drives it.
+
+use super::EXIT_BAD_INPUT;
+use super::commands::{emit_text, print_diagnostics};
+use crate::diagnostic::Diagnostic;
+use crate::format;
+use crate::model::PolicyBody;
+use crate::report::OutputFormat;
+use crate::sanitize::shown;
+use crate::tick;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct TickArgs {
+    /// BT files (TOML or BehaviorTree.CPP XML), each with its --script
+    #[arg(required = true)]
+    pub trees: Vec<PathBuf>,
+    /// Leaf script (TOML), one per tree, in the same order
+    #[arg(long = "script", required = true, value_name = "S.toml")]
+    pub scripts: Vec<PathBuf>,
+    /// Output format (table or json)
+    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+    pub format: OutputFormat,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+pub fn execute(a: TickArgs) -> u8 {
+    if a.format == OutputFormat::Csv {
+        eprintln!("error: `tick` prints `table` or `json`, not `csv`");
+        return EXIT_BAD_INPUT;
+    }
+    if a.trees.len() != a.scripts.len() {
+        eprintln!(
+            "error: {} tree{} and {} script{}\n  = hint: give one --script per tree, in the same order",
+            a.trees.len(),
+            if a.trees.len() == 1 { "" } else { "s" },
+            a.scripts.len(),
+            if a.scripts.len() == 1 { "" } else { "s" },
+        );
+        return EXIT_BAD_INPUT;
+    }
+    let limits = a.limits.limits();
+    let mut out = String::new();
+    let stderr = std::io::stderr();
+    for (t, s) in a.trees.iter().zip(&a.scripts) {
+        let r = one(t, s, &limits, a.format);
+        match r {
+            Ok(text) => {
+                if a.format == OutputFormat::Table && !out.is_empty() {
+                    out.push('\n');
+                }
+                out.push_str(&text);
+            }
+            Err(d) => {
+                print_diagnostics(&mut stderr.lock(), &d);
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    emit_text(None, out)
+}
+
+/// One tree and its script: the report, or what is wrong with them.
+fn one(
+    tree: &std::path::Path,
+    script: &std::path::Path,
+    limits: &format::Limits,
+    fmt: OutputFormat,
+) -> Result<String, Vec<Diagnostic>> {
+    let (file, input) = format::read_input(tree, limits)?;
+    let f = match input {
+        format::Input::Policy(f) => f,
+        format::Input::Scenario => {
+            return Err(vec![
+                Diagnostic::error("a scenario, not a BT")
+                    .in_file(&file)
+                    .hint("`tick` runs a BT file (TOML or BehaviorTree.CPP XML); `sim` runs scenarios"),
+            ]);
+        }
+    };
+    let loaded = format::load_read(file.clone(), tree, f, limits)?;
+    let PolicyBody::Bt(bt) = &loaded.policy.body else {
+        return Err(vec![
+            Diagnostic::error(format!("a {}, not a BT", loaded.policy.kind()))
+                .in_file(&file)
+                .hint("`tick` runs Behavior Trees; `sim` runs FSMs and HFSMs in a world"),
+        ]);
+    };
+    if let Some((n, what)) = crate::sim::exec::unsupported(bt) {
+        let node = &bt.nodes[n];
+        let d = Diagnostic::error(format!(
+            "node `{}`: {what} cannot be ticked as BehaviorTree.CPP 4 ticks it",
+            node.id
+        ))
+        .hint("`tick` runs the node types of docs/bt-semantics.md, not an approximation");
+        let d = match &node.span {
+            Some(sp) if !node.id.contains('/') && sp.end <= file.text.len() => {
+                d.at(&file, sp.clone())
+            }
+            _ => d.in_file(&file),
+        };
+        return Err(vec![d]);
+    }
+    let sfile = format::source::read(script, &script.display().to_string(), limits, false)?;
+    let sc = tick::script::parse(&sfile, bt)?;
+    let run = tick::run(bt, &sc);
+    let (tn, sn) = (tree.display().to_string(), script.display().to_string());
+    Ok(match fmt {
+        OutputFormat::Json => run.json(bt, &tn, &sn),
+        _ => run.table(bt, &shown(&tn), &shown(&sn)),
+    })
+}
