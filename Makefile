@@ -41,7 +41,10 @@ test:
 
 # `btfsm tick` against BehaviorTree.CPP 4 (behaviortreepy, pinned in
 # tests/differential/requirements.txt, installed into .venv) on 3000 seeded
-# random trees (docs/bt-semantics.md).
+# random trees (docs/bt-semantics.md); then every BT XML fixture accepted or
+# rejected by both engines alike, and every export loading in BT.CPP with
+# the same shape (tests/differential/accept_btcpp.py; known, explained
+# mismatches in accept_btcpp_known.txt, which must not go stale).
 $(VENV)/.installed: tests/differential/requirements.txt
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
@@ -50,6 +53,10 @@ $(VENV)/.installed: tests/differential/requirements.txt
 differential: $(VENV)/.installed
 	$(CARGO) build --quiet --locked
 	$(VENV)/bin/python tests/differential/differential.py $(TARGET_DIR)/debug/btfsm --trees 3000
+	@mkdir -p $(TARGET_DIR)
+	$(VENV)/bin/python tests/differential/accept_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/accept_btcpp.txt 2>&1 \
+	  || { tail -40 $(TARGET_DIR)/accept_btcpp.txt; exit 1; }
+	@grep -m1 "fixture files" $(TARGET_DIR)/accept_btcpp.txt
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).

@@ -105,6 +105,58 @@ pub const BUILTINS: &[(&str, Category)] = &[
     ("WasEntryUpdated", Category::Action),
 ];
 
+/// The BehaviorTree.CPP 4 name of a format-3 built-in renamed in 4.
+pub fn v4_name(t: &str) -> &str {
+    match t {
+        "SequenceStar" => "SequenceWithMemory",
+        "RetryUntilSuccesful" => "RetryUntilSuccessful",
+        t => t,
+    }
+}
+
+/// A rule BehaviorTree.CPP 4 enforces on a built-in node with `n`
+/// children (at load or at its first tick): the message and a hint.
+fn builtin_rule(ty: &str, el: &XElem, n: usize) -> Option<(String, &'static str)> {
+    let int = |a: &str| el.attr(a).and_then(|v| v.trim().parse::<i64>().ok());
+    match ty {
+        "IfThenElse" | "WhileDoElse" if !(2..=3).contains(&n) => Some((
+            format!("`{ty}` takes 2 or 3 children, found {n}"),
+            "a condition, a branch and an optional else branch",
+        )),
+        "Switch2" | "Switch3" | "Switch4" | "Switch5" | "Switch6" => {
+            let cases: usize = ty[6..].parse().unwrap_or(0);
+            (n != cases + 1).then(|| {
+                (
+                    format!(
+                        "`{ty}` takes {} children ({cases} cases and a default), found {n}",
+                        cases + 1
+                    ),
+                    "one child per case, then the default",
+                )
+            })
+        }
+        "Parallel" => {
+            let over = |k: i64| k > 0 && k as usize > n;
+            match (int("success_count"), int("failure_count")) {
+                (Some(k), _) if over(k) => Some((
+                    format!("`Parallel` success_count={k} with {n} children can never succeed"),
+                    "at most the number of children (-1: all)",
+                )),
+                (_, Some(k)) if over(k) => Some((
+                    format!("`Parallel` failure_count={k} with {n} children can never fail"),
+                    "at most the number of children (-1: all)",
+                )),
+                _ => None,
+            }
+        }
+        "RetryUntilSuccessful" if el.attr("num_attempts").is_none() => Some((
+            "`RetryUntilSuccessful` needs `num_attempts`".into(),
+            "write num_attempts=\"3\" (-1: forever)",
+        )),
+        _ => None,
+    }
+}
+
 /// The category of a built-in type.
 pub fn builtin(name: &str) -> Option<Category> {
     BUILTINS.iter().find(|(n, _)| *n == name).map(|(_, c)| *c)
@@ -162,7 +214,7 @@ pub fn builtin_kind(
                     times: t.min(u32::MAX as i64) as u32,
                 },
                 &["num_attempts"],
-                name != "RetryUntilSuccessful",
+                false,
             ),
             _ => (BtNodeKind::Decorator, &[], true),
         },
@@ -1115,6 +1167,16 @@ impl Loader<'_> {
             });
             return None;
         }
+        // BehaviorTree.CPP's own rules for built-ins it checks when the
+        // tree is built or first ticked (a program that loads the file fails
+        // there): child counts, thresholds, required ports.
+        if builtin(&ty).is_some()
+            && !self.models.contains_key(&ty)
+            && let Some((msg, hint)) = builtin_rule(&ty, el, n)
+        {
+            self.err(d, el.span.clone(), msg).hint = Some(hint.into());
+            return None;
+        }
         let mut ports: BTreeMap<String, String> = el
             .attrs
             .iter()
@@ -1174,7 +1236,9 @@ impl Loader<'_> {
             kind,
             children: Vec::new(),
             skill: skill_call,
-            type_name: type_kept.then(|| ty.clone()),
+            // Format 3's names of built-ins are kept as format 4 names them
+            // (the same node; an export says BTCPP_format="4").
+            type_name: type_kept.then(|| v4_name(&ty).to_string()),
             ports,
             span: Some(el.span.clone()),
         })
@@ -1424,6 +1488,72 @@ mod tests {
 
     fn parse(text: &str) -> Result<Loaded, Vec<Diagnostic>> {
         parse_str("t.xml", text, Path::new("."), &Limits::default())
+    }
+
+    #[test]
+    fn behaviortree_cpp_child_count_and_port_rules_are_errors() {
+        let tree = |body: &str| {
+            format!(
+                "<root BTCPP_format=\"4\" main_tree_to_execute=\"T\"><BehaviorTree ID=\"T\">{body}</BehaviorTree></root>"
+            )
+        };
+        let s = "<AlwaysSuccess/>";
+        for (body, msg) in [
+            (
+                format!("<IfThenElse>{s}</IfThenElse>"),
+                "`IfThenElse` takes 2 or 3 children, found 1",
+            ),
+            (
+                format!("<WhileDoElse>{s}{s}{s}{s}</WhileDoElse>"),
+                "`WhileDoElse` takes 2 or 3 children, found 4",
+            ),
+            (
+                format!("<Switch2 variable=\"x\" case_1=\"a\" case_2=\"b\">{s}{s}</Switch2>"),
+                "`Switch2` takes 3 children",
+            ),
+            (
+                format!("<Parallel success_count=\"4\">{s}{s}{s}</Parallel>"),
+                "success_count=4 with 3 children can never succeed",
+            ),
+            (
+                format!("<RetryUntilSuccessful>{s}</RetryUntilSuccessful>"),
+                "needs `num_attempts`",
+            ),
+        ] {
+            let e = parse(&tree(&body)).unwrap_err();
+            assert!(e[0].message.contains(msg), "{body}: {}", e[0]);
+        }
+        for body in [
+            format!("<IfThenElse>{s}{s}</IfThenElse>"),
+            format!("<Switch2 variable=\"x\" case_1=\"a\" case_2=\"b\">{s}{s}{s}</Switch2>"),
+            format!("<Parallel success_count=\"-1\">{s}{s}</Parallel>"),
+        ] {
+            assert!(parse(&tree(&body)).is_ok(), "{body}");
+        }
+    }
+
+    #[test]
+    fn format_3_names_are_read_and_written_as_format_4_names_them() {
+        let text = r#"<root main_tree_to_execute="T"><BehaviorTree ID="T">
+  <SequenceStar><RetryUntilSuccesful num_attempts="2"><Action ID="Go" goal="${goal}"/></RetryUntilSuccesful></SequenceStar>
+</BehaviorTree><TreeNodesModel><Action ID="Go"/></TreeNodesModel></root>"#;
+        let l = parse(text).unwrap();
+        let b = bt(&l);
+        assert_eq!(
+            b.nodes[b.root].type_name.as_deref(),
+            Some("SequenceWithMemory")
+        );
+        let out = crate::format::btcpp_xml_write::write_policy(&l.policy).unwrap();
+        assert!(
+            out.contains("<SequenceWithMemory") && out.contains("<RetryUntilSuccessful"),
+            "{out}"
+        );
+        assert!(
+            out.contains(r#"goal="{goal}""#)
+                && !out.contains("<SequenceStar")
+                && !out.contains("<RetryUntilSuccesful"),
+            "{out}"
+        );
     }
 
     #[test]

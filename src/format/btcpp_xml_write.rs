@@ -47,6 +47,14 @@ fn is_xml_name(s: &str) -> bool {
 }
 
 /// The type a node is written as, and its category when it is not built in.
+/// A format-3 blackboard reference `${key}` as format 4 writes it, `{key}`.
+fn v4_port(v: &str) -> String {
+    match v.strip_prefix("${").and_then(|r| r.strip_suffix('}')) {
+        Some(key) if !key.is_empty() && !key.contains(['{', '}']) => format!("{{{key}}}"),
+        _ => v.to_string(),
+    }
+}
+
 fn node_type(n: &BtNode) -> (String, Category) {
     let cat = match n.kind {
         BtNodeKind::Action => Category::Action,
@@ -55,7 +63,7 @@ fn node_type(n: &BtNode) -> (String, Category) {
         _ => Category::Control,
     };
     let ty = if let Some(t) = &n.type_name {
-        t.clone()
+        btcpp_xml::v4_name(t).to_string()
     } else if let Some(call) = &n.skill {
         call.skill.clone()
     } else if let Some(t) = btcpp_xml::canonical_type(n.kind) {
@@ -154,7 +162,7 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
             }
         }
         for (k, v) in &n.ports {
-            attrs.push((k.clone(), v.clone()));
+            attrs.push((k.clone(), v4_port(v)));
         }
         let attr_text: String = attrs
             .iter()
