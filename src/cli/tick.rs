@@ -98,10 +98,17 @@ fn one(
             node.id
         ))
         .hint("`tick` runs the node types of docs/bt-semantics.md, not an approximation");
+        // A span is into the file the node was read from: shown when it
+        // is this file's (a node of an included file is named by its id).
+        let ty = node.type_name.as_deref().unwrap_or(node.kind.keyword());
+        let here = |sp: &std::ops::Range<usize>| {
+            file.text.get(sp.start..).is_some_and(|t| {
+                (!node.id.contains('/') && sp.end <= file.text.len())
+                    || t.starts_with(&format!("<{ty}"))
+            })
+        };
         let d = match &node.span {
-            Some(sp) if !node.id.contains('/') && sp.end <= file.text.len() => {
-                d.at(&file, sp.clone())
-            }
+            Some(sp) if here(sp) => d.at(&file, sp.clone()),
             _ => d.in_file(&file),
         };
         return Err(vec![d]);

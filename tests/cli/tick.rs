@@ -112,7 +112,7 @@ fn unsupported_types_are_refused_with_a_position() {
     assert!(out.is_empty());
     assert!(
         err.contains("tests/fixtures/tick/refused.xml:5:7")
-            && err.contains("`IfThenElse` with 4 children"),
+            && err.contains("`Delay` cannot be ticked"),
         "{err}"
     );
     let d = common::scratch("tick-refused");
