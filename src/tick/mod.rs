@@ -241,7 +241,11 @@ mod tests {
         bt
     }
 
-    fn events(bt: &Bt, script: &str) -> Vec<(Status, Vec<(String, Option<Status>)>)> {
+    /// Per tick: the root's status, and each leaf ticked (its status) or
+    /// halted (`None`).
+    type Trace = Vec<(Status, Vec<(String, Option<Status>)>)>;
+
+    fn events(bt: &Bt, script: &str) -> Trace {
         let s = script::parse(&SourceFile::new("s.toml", script), bt).expect("script");
         run(bt, &s)
             .ticks
