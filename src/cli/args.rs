@@ -136,7 +136,8 @@ pub enum Command {
     Paper(PaperArgs),
     /// The paper's edit operations: insert a BT subtree, add an (H)FSM state
     Edit(Box<EditArgs>),
-    /// Runs policies in the planar robot simulator and compares their behavior
+    /// Runs policies in the planar robot simulator, compares their behavior
+    /// and checks the scenario's [expect] (exit 1 when one fails)
     Sim(super::sim::SimArgs),
     /// Ticks a BT against scripted leaf outcomes (BehaviorTree.CPP 4 semantics)
     Tick(super::tick::TickArgs),

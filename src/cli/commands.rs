@@ -88,6 +88,7 @@ pub fn execute(cli: Cli) -> u8 {
                         let base = f.parent().unwrap_or(Path::new(""));
                         match crate::sim::scenario::parse(&file, base, &limits) {
                             Ok(s) => {
+                                print_diagnostics(&mut err, &s.warnings);
                                 let _ = writeln!(
                                     err,
                                     "{}: ok (scenario `{}`, {} polic{})",

@@ -3,8 +3,7 @@
 //! (SPEC §6, §7); `--runs N` runs seeded Monte Carlo episodes instead.
 
 use super::commands::{emit_text, print_diagnostics};
-use super::{EXIT_BAD_INPUT, EXIT_OK};
-use crate::report::OutputFormat;
+use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use crate::sim::report::{McReport, SimReport, TraceWriter};
 use crate::sim::{monte_carlo, plot, run, scenario};
 use clap::Args;
@@ -13,11 +12,23 @@ use std::path::PathBuf;
 /// `--threads` above this many per core are lowered to it.
 pub const MAX_THREADS_PER_CORE: usize = 4;
 
+/// What `sim` prints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutputFormat {
+    Table,
+    Json,
+    /// GitHub-flavoured markdown tables (with --runs)
+    Markdown,
+    /// Refused: `sim` has no CSV (kept for its message)
+    #[value(hide = true)]
+    Csv,
+}
+
 #[derive(Debug, Args)]
 pub struct SimArgs {
     /// Scenario file (TOML)
     pub scenario: PathBuf,
-    /// Output format (table or json)
+    /// Output format (table or json; markdown with --runs)
     #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
     pub format: OutputFormat,
     /// Write the full trace (every step of every run) as JSON
@@ -29,7 +40,10 @@ pub struct SimArgs {
     /// Run N seeded episodes with randomized disturbances and failure rates
     #[arg(long, value_name = "N")]
     pub runs: Option<u32>,
-    /// Seed of the episodes (default: the scenario's seed)
+    /// With --runs, the seed of the episodes (default: the scenario's
+    /// seed); without, run the one episode with seed S (the scenario's
+    /// disturbances jittered and the [monte_carlo] ones drawn as episode
+    /// S of --runs was: the seed a --runs report names replays it)
     #[arg(long, value_name = "S")]
     pub seed: Option<u64>,
     /// Worker threads for --runs (default: the number of cores; at least 1,
@@ -39,7 +53,8 @@ pub struct SimArgs {
     /// Wall-clock budget for all the simulation work, in ms: when it runs
     /// out, runs stop cleanly (outcome `timeout` at the step reached; with
     /// --runs, the figures cover the episodes completed) and the report
-    /// says so; the exit code stays 0. A budget too large for the clock
+    /// says so; the exit code stays 0, unless an expectation of the
+    /// scenario cannot be decided (exit 1). A budget too large for the clock
     /// (past the year 2^64 ns) is no budget
     #[arg(long, value_name = "MS")]
     pub timeout_ms: Option<u64>,
@@ -66,6 +81,9 @@ pub fn execute(a: SimArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    if !s.warnings.is_empty() {
+        print_diagnostics(&mut std::io::stderr().lock(), &s.warnings);
+    }
     let file = a.scenario.display().to_string();
     // The budget's clock starts once the scenario is read.
     let t0 = std::time::Instant::now();
@@ -89,7 +107,8 @@ pub fn execute(a: SimArgs) -> u8 {
             Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
             None => cores,
         };
-        let (stats, done) = monte_carlo::monte_carlo_within(&s, n, seed, threads, deadline);
+        let mc = monte_carlo::monte_carlo_within(&s, n, seed, threads, deadline);
+        let done = mc.runs;
         let rep = McReport {
             scenario: s.name.clone(),
             seed,
@@ -97,7 +116,8 @@ pub fn execute(a: SimArgs) -> u8 {
             runs: done,
             threads: threads.max(1).min(n.max(1) as usize),
             millis: t0.elapsed().as_millis(),
-            policies: stats,
+            policies: mc.policies,
+            pairs: mc.pairs,
         };
         let budget = a.timeout_ms.map(|ms| Budget {
             timeout_ms: ms,
@@ -111,14 +131,26 @@ pub fn execute(a: SimArgs) -> u8 {
             &rep,
             a.format,
             McReport::json,
-            McReport::table,
+            if a.format == OutputFormat::Markdown {
+                McReport::markdown
+            } else {
+                McReport::table
+            },
             &budget,
             &note,
         );
         return emit_text(None, text);
     }
+    if a.format == OutputFormat::Markdown {
+        eprintln!("error: `sim` prints markdown with --runs; use `table` or `json` for one run");
+        return EXIT_BAD_INPUT;
+    }
     if let Some(seed) = a.seed {
+        // The episode with this seed, as `--runs` draws it.
+        let (ds, rates) = monte_carlo::episode(&s, seed);
         s.seed = seed;
+        s.disturbances = ds;
+        s.rates = rates;
     }
     // The runs stop 5% early, leaving the verdicts time to compare them.
     let runs_deadline = a
@@ -156,7 +188,9 @@ pub fn execute(a: SimArgs) -> u8 {
         )
     });
     // The verdicts stop at the deadline too; the pairs left are reported.
-    let rep = SimReport::within(&s.name, &file, s.seed, s.dt, runs, points, deadline);
+    let cut_runs: Vec<bool> = runs.iter().map(|r| run::cut_short(&s, r)).collect();
+    let mut rep = SimReport::within(&s.name, &file, s.seed, s.dt, runs, points, deadline);
+    rep.check(&s.expect, &cut_runs);
     let millis = t0.elapsed().as_millis();
     let budget = a.timeout_ms.map(|ms| Budget {
         timeout_ms: ms,
@@ -187,7 +221,25 @@ pub fn execute(a: SimArgs) -> u8 {
         &budget,
         note,
     );
-    emit_text(None, text)
+    let code = emit_text(None, text);
+    if code != EXIT_OK {
+        return code;
+    }
+    if rep.expectations_failed > 0 {
+        eprintln!(
+            "error: {} of {} expectations of the scenario failed: {}",
+            rep.expectations_failed,
+            rep.expectations.len(),
+            (rep.expectations.iter())
+                .filter(|e| e.status != crate::sim::scenario::expect::Status::Pass)
+                .map(|e| crate::sanitize::shown(&e.name).into_owned())
+                .take(10)
+                .collect::<Vec<_>>()
+                .join("; ")
+        );
+        return EXIT_CHECK_FAILED;
+    }
+    EXIT_OK
 }
 
 /// What `--timeout-ms` adds to a JSON report.

@@ -90,7 +90,7 @@ pub const BUILTINS: &[(&str, Category)] = &[
     ("LoopBool", Category::Decorator),
     ("EntryUpdated", Category::Decorator),
     ("SkipUnlessUpdated", Category::Decorator),
-    ("WaitValueUpdated", Category::Decorator),
+    ("WaitValueUpdate", Category::Decorator),
     ("BlackboardCheckInt", Category::Decorator),
     ("BlackboardCheckDouble", Category::Decorator),
     ("BlackboardCheckString", Category::Decorator),
@@ -102,7 +102,7 @@ pub const BUILTINS: &[(&str, Category)] = &[
     ("UnsetBlackboard", Category::Action),
     ("Sleep", Category::Action),
     ("ScriptCondition", Category::Condition),
-    ("WasEntryUpdated", Category::Condition),
+    ("WasEntryUpdated", Category::Action),
 ];
 
 /// The category of a built-in type.
@@ -256,6 +256,9 @@ struct Loader<'l> {
     /// What remains of `--max-nodes` for the elements of the files still to
     /// read: every element of every file counts, used or not.
     elems_left: usize,
+    /// Unknown node types already reported: each is an error once, at its
+    /// first use, however often it is used.
+    unknown: std::collections::HashSet<String>,
 }
 
 fn load(
@@ -264,7 +267,10 @@ fn load(
     base: PathBuf,
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let main = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    // BehaviorTree.CPP reads with tinyxml2, which is lenient: so is this
+    // reader, with a warning at each place (`xml_lenient`).
+    let (main, repaired) =
+        xml::parse_lenient(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
     let elems_left = limits.max_nodes - main.elems.len();
     let root = super::source::root_for(limits, &base);
     let mut l = Loader {
@@ -276,7 +282,9 @@ fn load(
         dirs: vec![base],
         trees: BTreeMap::new(),
         models: BTreeMap::new(),
+        unknown: Default::default(),
     };
+    l.diags.extend(repaired);
     let policy = l.run(identity);
     super::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")
 }
@@ -290,7 +298,8 @@ impl Loader<'_> {
     /// Parses a file read for this policy, charging its elements to the
     /// shared element budget.
     fn parse_charged(&mut self, file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
-        let doc = xml::parse(file, self.elems_left, self.limits.max_nodes)?;
+        let (doc, repaired) = xml::parse_lenient(file, self.elems_left, self.limits.max_nodes)?;
+        self.diags.extend(repaired);
         self.elems_left -= doc.elems.len();
         Ok(doc)
     }
@@ -1025,6 +1034,13 @@ impl Loader<'_> {
                 AssumeLeaf::Action => (BtNodeKind::Action, Category::Action),
                 AssumeLeaf::Condition => (BtNodeKind::Condition, Category::Condition),
             }
+        } else if !self.unknown.insert(ty.clone()) {
+            // Reported at its first use already.
+            match n {
+                0 => return None,
+                1 => (BtNodeKind::Decorator, Category::Decorator),
+                _ => (BtNodeKind::Control, Category::Control),
+            }
         } else {
             // Hints only for messages that will be shown (the rest are
             // counted): bounded work under a million unknown types.
@@ -1061,7 +1077,15 @@ impl Loader<'_> {
                 ),
             )
             .hint = Some(hint);
-            return None;
+            // A node with children is read on as a placeholder of its
+            // shape, so that the unknown types below it are reported in the
+            // same run (the file fails with these errors anyway); a leaf has
+            // nothing below it and costs nothing more.
+            match n {
+                0 => return None,
+                1 => (BtNodeKind::Decorator, Category::Decorator),
+                _ => (BtNodeKind::Control, Category::Control),
+            }
         };
         // Arity of the element (a SubTree child is one node).
         let bad = match cat {
@@ -1400,6 +1424,39 @@ mod tests {
 
     fn parse(text: &str) -> Result<Loaded, Vec<Diagnostic>> {
         parse_str("t.xml", text, Path::new("."), &Limits::default())
+    }
+
+    #[test]
+    fn every_unknown_type_is_reported_once_in_one_run() {
+        // An unknown control hides nothing below it; a type used twice is
+        // one error.
+        let text = r#"<root BTCPP_format="4" main_tree_to_execute="T">
+  <BehaviorTree ID="T">
+    <RecoveryNode>
+      <Sequence><Spin/><Wait/></Sequence>
+      <RateController><Spin/></RateController>
+    </RecoveryNode>
+  </BehaviorTree>
+</root>"#;
+        let e = parse(text).unwrap_err();
+        let msgs: Vec<&str> = e.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(
+            msgs,
+            [
+                "unknown node type `RecoveryNode` (2 children)",
+                "unknown node type `Spin` (0 children)",
+                "unknown node type `Wait` (0 children)",
+                "unknown node type `RateController` (1 child)",
+                "t.xml: 4 problems",
+            ][..msgs.len().min(5)],
+            "{msgs:#?}"
+        );
+        assert_eq!(
+            e.iter()
+                .filter(|d| d.message.starts_with("unknown"))
+                .count(),
+            4
+        );
     }
 
     #[test]

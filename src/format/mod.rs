@@ -10,6 +10,7 @@ pub mod source;
 pub mod toml;
 pub mod toml_write;
 pub mod xml;
+pub mod xml_lenient;
 pub mod yasmin;
 
 use crate::diagnostic::{Diagnostic, SourceFile};

@@ -3,7 +3,8 @@
 //! - `<scxml initial>` and nested `<state>`: a state holding states is a container,
 //!   so a machine with any is an HFSM, else an FSM. A region's initial state is
 //!   its `initial` attribute, its `<initial><transition target>`, or its first
-//!   child state in document order (SCXML 3.3).
+//!   child state in document order (SCXML 3.3); an `initial` naming a state
+//!   deeper inside enters each container on the way at the next one.
 //! - `<final>` states are the outcomes of their region (top level: the machine's
 //!   outcomes, vertices of the graph; inside a container: the container's).
 //! - `<transition event cond target>`: an event that is an outcome the source
@@ -374,8 +375,30 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
             }
         }
     }
+    // `initial` naming a state deeper inside the region (SCXML 3.3 allows
+    // any descendant): (container, chain from the named state up to the
+    // region's child, span), applied once every explicit initial is set.
+    let mut deep: Vec<(Option<usize>, Vec<usize>, std::ops::Range<usize>)> = Vec::new();
     for (container, target, span) in initial_of {
         let tid = target.trim();
+        if let Some(s) = by_id.get(tid).and_then(|&k| state_of[k])
+            && m.states[s].parent != container
+        {
+            // Walk up (at most --max-depth levels) to the region's child.
+            let mut chain = vec![s];
+            let mut cur = m.states[s].parent;
+            while let Some(p) = cur {
+                if Some(p) == container {
+                    break;
+                }
+                chain.push(p);
+                cur = m.states[p].parent;
+            }
+            if cur == container && container.is_none_or(|c| chain.last() != Some(&c)) {
+                deep.push((container, chain, span));
+                continue;
+            }
+        }
         if tid.split_whitespace().count() > 1 {
             diags.push(
                 Diagnostic::error(format!("initial `{}` names several states", shown(tid)))
@@ -423,6 +446,44 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
                         h
                     }),
                 );
+            }
+        }
+    }
+    for (container, chain, span) in deep {
+        let top_child = *chain.last().expect("a chain has a state");
+        fn region_initial(m: &mut StateMachine, c: Option<usize>) -> Option<&mut usize> {
+            match c {
+                None => Some(&mut m.top.initial),
+                Some(c) => match &mut m.states[c].body {
+                    StateBody::Container(r) => Some(&mut r.initial),
+                    _ => None,
+                },
+            }
+        }
+        if let Some(slot) = region_initial(&mut m, container) {
+            *slot = top_child;
+        }
+        // Each container on the way is entered at the next state of the
+        // chain, unless its own `initial` says otherwise: then the model
+        // (one initial state per container) cannot say both.
+        for w in chain.windows(2) {
+            let (inner, outer) = (w[0], w[1]);
+            let Some(slot) = region_initial(&mut m, Some(outer)) else {
+                continue;
+            };
+            if *slot == usize::MAX {
+                *slot = inner;
+            } else if *slot != inner {
+                diags.push(
+                    Diagnostic::error(format!(
+                        "initial `{}` is inside `{}`, whose own initial state is another one",
+                        shown(&ids[entry_of[chain[0]]]),
+                        shown(&ids[entry_of[outer]])
+                    ))
+                    .at(f, span.clone())
+                    .hint("the model enters a container at one state: name a state directly inside this region, or drop the inner `initial`"),
+                );
+                break;
             }
         }
     }
@@ -950,6 +1011,45 @@ mod tests {
         assert!(
             w.iter().any(|m| m.contains("`lone` is unreachable")),
             "{w:?}"
+        );
+    }
+
+    #[test]
+    fn an_initial_state_deeper_in_the_region_enters_the_containers_on_the_way() {
+        // SCXML 3.3: `initial` may name any descendant. The machine starts in
+        // `outer`, entered at `inner`, entered at `deep`.
+        let l = parse_str(
+            "t.scxml",
+            r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="deep">
+  <state id="x"/>
+  <state id="outer"><state id="o1"/><state id="inner"><state id="i1"/><state id="deep"/></state></state>
+</scxml>"#,
+            &Limits::default(),
+        )
+        .unwrap();
+        let m = machine(&l);
+        let name = |i: usize| m.states[i].name.as_str();
+        assert_eq!(name(m.top.initial), "outer");
+        let init = |i: usize| match &m.states[i].body {
+            StateBody::Container(r) => r.initial,
+            _ => panic!(),
+        };
+        assert_eq!(name(init(m.top.initial)), "inner");
+        assert_eq!(name(init(init(m.top.initial))), "deep");
+        // A container whose own initial says otherwise: the model cannot say both.
+        let e = parse_str(
+            "t.scxml",
+            r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="deep">
+  <state id="outer" initial="o1"><state id="o1"/><state id="deep"/></state>
+</scxml>"#,
+            &Limits::default(),
+        )
+        .unwrap_err();
+        assert!(
+            e[0].message
+                .contains("whose own initial state is another one"),
+            "{}",
+            e[0]
         );
     }
 

@@ -226,6 +226,45 @@ impl Sink {
 /// hold more than `limit` elements (`--max-nodes`; `left` is what remains of
 /// it after the files read before).
 pub fn parse(file: &Arc<SourceFile>, left: usize, limit: usize) -> Result<XDoc, Diagnostic> {
+    parse_text(file, &file.text, None, left, limit)
+}
+
+/// [`parse`], reading what BehaviorTree.CPP's tinyxml2 reads although it is
+/// not well-formed ([`super::xml_lenient`]): the document, and a warning per
+/// place repaired. Anything else is the strict parser's error.
+pub fn parse_lenient(
+    file: &Arc<SourceFile>,
+    left: usize,
+    limit: usize,
+) -> Result<(XDoc, Vec<Diagnostic>), Diagnostic> {
+    match parse(file, left, limit) {
+        Ok(d) => Ok((d, Vec::new())),
+        Err(strict) if strict.message.starts_with("malformed XML") => {
+            let Some((text, map, fixes)) = super::xml_lenient::repair(&file.text) else {
+                return Err(strict);
+            };
+            match parse_text(file, &text, Some(&map), left, limit) {
+                Ok(d) => Ok((d, super::xml_lenient::warnings(file, &fixes))),
+                Err(_) => Err(strict),
+            }
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Parses `text` (the file's text, or a repair of it whose offsets `map`
+/// takes back to the file's).
+fn parse_text(
+    file: &Arc<SourceFile>,
+    text: &str,
+    map: Option<&super::xml_lenient::OffsetMap>,
+    left: usize,
+    limit: usize,
+) -> Result<XDoc, Diagnostic> {
+    let back = |r: std::ops::Range<usize>| match map {
+        Some(m) => m.range(r),
+        None => r,
+    };
     let max_elems = left;
     if let Some(at) = nth_start_tag(&file.text, max_elems) {
         let end = at + 1 + qname_len(&file.text[at..]);
@@ -244,7 +283,7 @@ pub fn parse(file: &Arc<SourceFile>, left: usize, limit: usize) -> Result<XDoc, 
         nodes_limit,
         ..Default::default()
     };
-    let doc = roxmltree::Document::parse_with_options(&file.text, opts).map_err(|e| {
+    let doc = roxmltree::Document::parse_with_options(text, opts).map_err(|e| {
         if matches!(e, roxmltree::Error::NodesLimitReached) {
             return Diagnostic::error(format!(
                 "more than {nodes_limit} XML nodes (elements, text, comments) in this file"
@@ -293,11 +332,11 @@ pub fn parse(file: &Arc<SourceFile>, left: usize, limit: usize) -> Result<XDoc, 
                     name: a.name().to_string(),
                     ns: intern(a.namespace()),
                     value: a.value().to_string(),
-                    span: a.range(),
+                    span: back(a.range()),
                 })
                 .collect(),
             children: Vec::new(),
-            span: start..(start + 1 + qname_len(&file.text[start..])),
+            span: back(start..(start + 1 + qname_len(&text[start..]))),
         });
         if let Some(p) = n.parent_element()
             && let Some(&pi) = index.get(p.id().get_usize())

@@ -174,7 +174,14 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
                         None => continue,
                     },
                 };
-                let _ = writeln!(out, "{pad}s{s} --> {to} : {}", label(&t.trigger.label()));
+                match label(&t.trigger.label()) {
+                    l if l.trim().is_empty() => {
+                        let _ = writeln!(out, "{pad}s{s} --> {to}");
+                    }
+                    l => {
+                        let _ = writeln!(out, "{pad}s{s} --> {to} : {l}");
+                    }
+                }
             }
         }
         if owner.is_some() {

@@ -5,7 +5,11 @@
 //! Monte Carlo episodes.
 
 pub mod exec;
+mod livelock;
 pub mod monte_carlo;
+#[cfg(test)]
+mod physics_tests;
+pub mod planner;
 pub mod plot;
 pub mod report;
 pub mod rng;

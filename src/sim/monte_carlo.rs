@@ -5,8 +5,8 @@
 use super::rng::SimRng;
 use super::robot::round3;
 use super::run::{RunOptions, cut_short, prepare, run_policy};
-use super::scenario::{Disturbance, Effect, Scenario, When};
-use super::trace::Outcome;
+use super::scenario::{Disturbance, Scenario, mc};
+use super::trace::{Outcome, behavior_matches};
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -18,51 +18,92 @@ pub struct McStats {
     pub runs: u32,
     pub successes: u32,
     pub success_rate: f64,
+    /// 95 % Wilson score interval of the success rate.
+    pub success_ci95: [f64; 2],
     pub chattering: u32,
     pub timeouts: u32,
     pub failures: u32,
     /// Mean completion time of the successful episodes, s.
     pub mean_completion_s: Option<f64>,
+    /// Completion-time quantiles of the successful episodes (10 %, 50 %,
+    /// 90 %, nearest rank), s.
+    pub completion_quantiles_s: Option<[f64; 3]>,
     /// Mean latency from a battery-low event to the start of Recharge, s.
     pub mean_recharge_latency_s: Option<f64>,
     pub recharges: u32,
 }
 
-/// The disturbances and failure rates of episode `i`: the scenario's, with
-/// timed ones jittered, plus the `monte_carlo` battery drop and rates.
-pub fn episode(s: &Scenario, seed: u64, i: u32) -> (u64, Vec<Disturbance>, BTreeMap<String, f64>) {
-    let ep_seed = SimRng::named(seed, &format!("episode-{i}")).next_u64();
-    let mut rng = SimRng::named(ep_seed, "disturbances");
-    let mut ds = s.disturbances.clone();
-    // Timed disturbances happen anywhere from half to one and a half times
-    // their scenario time.
-    for d in &mut ds {
-        if let When::At(t) = &mut d.when {
-            *t = (*t * rng.range(0.5, 1.5) * 10.0).round() / 10.0;
-        }
+/// Per-pair figures of `--runs N`: how often the two policies' behavior
+/// matched (the verdict of a single run, episode by episode).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PairStats {
+    pub a: String,
+    pub b: String,
+    pub runs: u32,
+    pub matches: u32,
+    pub match_rate: f64,
+    /// 95 % Wilson score interval of the match rate.
+    pub match_ci95: [f64; 2],
+    /// The first episode whose behavior differs: its index and its seed
+    /// (`btfsm sim SCENARIO --seed SEED` replays it).
+    pub first_divergence: Option<Diverged>,
+}
+
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Diverged {
+    pub episode: u32,
+    pub seed: u64,
+}
+
+/// What `--runs N` computes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct McResult {
+    pub policies: Vec<McStats>,
+    pub pairs: Vec<PairStats>,
+    /// Episodes the figures cover.
+    pub runs: u32,
+}
+
+/// 95 % Wilson score interval of `k` successes in `n` trials
+/// (`[0, 1]` when `n` is 0), rounded to 4 decimals (10,000 successes in
+/// 10,000 give `[0.9996, 1]`).
+pub fn wilson(k: u32, n: u32) -> [f64; 2] {
+    if n == 0 {
+        return [0.0, 1.0];
     }
-    if let Some((p, (lo, hi), (t0, t1))) = s.monte_carlo.battery_drop
-        && rng.chance(p)
-    {
-        let level = rng.range(lo, hi).round();
-        let at = (rng.range(t0, t1) * 10.0).round() / 10.0;
-        ds.push(Disturbance {
-            when: When::At(at),
-            effect: Effect::Battery(level),
-            text: format!("battery set to {level}%"),
-        });
+    let (z, n, p) = (1.959964f64, n as f64, k as f64 / n as f64);
+    let z2 = z * z;
+    let centre = (p + z2 / (2.0 * n)) / (1.0 + z2 / n);
+    let half = z / (1.0 + z2 / n) * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
+    let r4 = |x: f64| (x * 10_000.0).round() / 10_000.0;
+    [r4((centre - half).max(0.0)), r4((centre + half).min(1.0))]
+}
+
+/// Nearest-rank quantiles 10 %, 50 %, 90 % of `v` (sorted here).
+fn quantiles(v: &mut [f64]) -> Option<[f64; 3]> {
+    if v.is_empty() {
+        return None;
     }
-    let mut rates = s.rates.clone();
-    for (k, v) in &s.monte_carlo.rates {
-        let e = rates.entry(k.clone()).or_insert(0.0);
-        *e = 1.0 - (1.0 - *e) * (1.0 - v);
-    }
-    (ep_seed, ds, rates)
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+    Some([q(0.1), q(0.5), q(0.9)])
+}
+
+/// The seed of episode `i` of a Monte Carlo run with seed `seed`.
+pub fn episode_seed(seed: u64, i: u32) -> u64 {
+    SimRng::named(seed, &format!("episode-{i}")).next_u64()
+}
+
+/// The disturbances and failure rates of the episode with seed `ep_seed`
+/// (a function of the scenario and `ep_seed` alone: `sim --seed ep_seed`
+/// runs this episode).
+pub fn episode(s: &Scenario, ep_seed: u64) -> (Vec<Disturbance>, BTreeMap<String, f64>) {
+    (mc::draw(s, ep_seed), mc::rates(s))
 }
 
 /// Runs `runs` seeded episodes of every policy on `threads` threads.
-pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> Vec<McStats> {
-    monte_carlo_within(s, runs, seed, threads, None).0
+pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> McResult {
+    monte_carlo_within(s, runs, seed, threads, None)
 }
 
 /// [`monte_carlo`] under a wall-clock deadline: once it passes, every
@@ -77,26 +118,37 @@ pub fn monte_carlo_within(
     seed: u64,
     threads: usize,
     deadline: Option<Instant>,
-) -> (Vec<McStats>, u32) {
+) -> McResult {
     let prepared = prepare(s);
+    let np = prepared.len();
+    let pairs: Vec<(usize, usize)> = (0..np)
+        .flat_map(|a| (a + 1..np).map(move |b| (a, b)))
+        .collect();
+    let pairs = &pairs;
     let threads = threads.max(1).min(runs.max(1) as usize);
     let stop = AtomicBool::new(false);
     // results[policy][episode] = (outcome, goal, completion, latencies)
     type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
-    let mut per_thread: Vec<Vec<(u32, usize, Res)>> = Vec::new();
+    // Per episode: its seed and, per pair, whether the behavior matched.
+    type Agree = (u32, u64, Vec<bool>);
+    type Results = (Vec<(u32, usize, Res)>, Vec<Agree>);
+    let mut per_thread: Vec<Results> = Vec::new();
     std::thread::scope(|sc| {
         let prepared = &prepared;
         let stop = &stop;
         // One worker's episodes: t, t + threads, ...
         let work = move |t: usize| {
             let mut out = Vec::new();
+            let mut agree = Vec::new();
             let mut i = t as u32;
             'episodes: while i < runs {
                 if stop.load(Ordering::Relaxed) {
                     break;
                 }
-                let (ep_seed, ds, rates) = episode(s, seed, i);
+                let ep_seed = episode_seed(seed, i);
+                let (ds, rates) = episode(s, ep_seed);
                 let first = out.len();
+                let mut ep_runs = Vec::with_capacity(prepared.len());
                 for (k, p) in prepared.iter().enumerate() {
                     let r = run_policy(
                         s,
@@ -119,12 +171,22 @@ pub fn monte_carlo_within(
                     out.push((
                         i,
                         k,
-                        (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s),
+                        (
+                            r.outcome,
+                            r.goal_met,
+                            r.completion_s,
+                            r.recharge_latency_s.clone(),
+                        ),
                     ));
+                    ep_runs.push(r);
                 }
+                let same = (pairs.iter())
+                    .map(|&(a, b)| behavior_matches(&ep_runs[a], &ep_runs[b]))
+                    .collect();
+                agree.push((i, ep_seed, same));
                 i += threads as u32;
             }
-            out
+            (out, agree)
         };
         let mut handles = Vec::new();
         for t in 0..threads {
@@ -139,7 +201,12 @@ pub fn monte_carlo_within(
             per_thread.push(h.join().expect("episode thread"));
         }
     });
-    let mut all: Vec<(u32, usize, Res)> = per_thread.into_iter().flatten().collect();
+    let mut all: Vec<(u32, usize, Res)> = Vec::new();
+    let mut agree: Vec<Agree> = Vec::new();
+    for (o, a) in per_thread {
+        all.extend(o);
+        agree.extend(a);
+    }
     // Episodes come whole (all policies) or not at all: keep the prefix of
     // consecutive completed ones.
     let mut complete = vec![false; runs as usize];
@@ -149,6 +216,29 @@ pub fn monte_carlo_within(
     let runs = complete.iter().position(|c| !c).unwrap_or(complete.len()) as u32;
     all.retain(|(i, _, _)| *i < runs);
     all.sort_by_key(|(i, k, _)| (*k, *i));
+    agree.retain(|(i, _, _)| *i < runs);
+    agree.sort_by_key(|(i, _, _)| *i);
+    let pair_stats = (pairs.iter().enumerate())
+        .map(|(x, &(a, b))| {
+            let matches = agree.iter().filter(|e| e.2[x]).count() as u32;
+            PairStats {
+                a: prepared[a].name.clone(),
+                b: prepared[b].name.clone(),
+                runs,
+                matches,
+                match_rate: if runs == 0 {
+                    0.0
+                } else {
+                    round3(matches as f64 / runs as f64)
+                },
+                match_ci95: wilson(matches, runs),
+                first_divergence: (agree.iter().find(|e| !e.2[x])).map(|e| Diverged {
+                    episode: e.0,
+                    seed: e.1,
+                }),
+            }
+        })
+        .collect();
     let stats = prepared
         .iter()
         .enumerate()
@@ -162,7 +252,7 @@ pub fn monte_carlo_within(
                 .iter()
                 .filter(|r| r.0 == Outcome::Success && r.1 != Some(false))
                 .collect();
-            let comp: Vec<f64> = ok.iter().filter_map(|r| r.2).collect();
+            let mut comp: Vec<f64> = ok.iter().filter_map(|r| r.2).collect();
             let lat: Vec<f64> = mine.iter().flat_map(|r| r.3.iter().copied()).collect();
             let mean =
                 |v: &[f64]| (!v.is_empty()).then(|| round3(v.iter().sum::<f64>() / v.len() as f64));
@@ -182,11 +272,17 @@ pub fn monte_carlo_within(
                     - ok.len() as u32
                     - count(Outcome::Chattering)
                     - count(Outcome::Timeout),
+                success_ci95: wilson(ok.len() as u32, runs),
                 mean_completion_s: mean(&comp),
+                completion_quantiles_s: quantiles(&mut comp),
                 mean_recharge_latency_s: mean(&lat),
                 recharges: lat.len() as u32,
             }
         })
         .collect();
-    (stats, runs)
+    McResult {
+        policies: stats,
+        pairs: pair_stats,
+        runs,
+    }
 }

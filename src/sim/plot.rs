@@ -116,7 +116,7 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
     }
     // Objects at the start.
     for ob in &s.world.objects {
-        if let Place::At(p) = ob.place {
+        if let Place::At(p) | Place::Floor(p) = ob.place {
             let _ = writeln!(
                 o,
                 r##"<rect x="{:.1}" y="{:.1}" width="10" height="10" fill="#f2c200" stroke="#7a6200"/><text x="{:.1}" y="{:.1}" font-size="10">{}</text>"##,

@@ -3,7 +3,8 @@
 //! as a table or as JSON (a stable contract documented in the README). Also the
 //! `--runs` summary and the `--trace` file.
 
-use super::monte_carlo::McStats;
+use super::monte_carlo::{McStats, PairStats};
+use super::scenario::expect::{ExpectResult, Status};
 use super::trace::{FRECHET_POINTS, Run, Verdict, verdicts_within};
 use crate::report::table::Table;
 use serde::Serialize;
@@ -21,6 +22,11 @@ pub struct SimReport {
     /// (`--timeout-ms`) ran out first.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub skipped_verdicts: Vec<[String; 2]>,
+    /// The scenario's `[expect]`, checked (empty when it has none).
+    pub expectations: Vec<ExpectResult>,
+    /// How many expectations failed or could not be decided (`sim` exits 1
+    /// when this is not 0).
+    pub expectations_failed: usize,
 }
 
 impl SimReport {
@@ -61,7 +67,19 @@ impl SimReport {
             policies: runs,
             verdicts,
             skipped_verdicts,
+            expectations: Vec::new(),
+            expectations_failed: 0,
         }
+    }
+
+    /// Checks the scenario's expectations against the runs and verdicts;
+    /// `cut[i]`: the wall-clock budget cut run `i` short.
+    pub fn check(&mut self, expect: &[super::scenario::expect::Expectation], cut: &[bool]) {
+        self.expectations =
+            super::scenario::expect::check(expect, &self.policies, &self.verdicts, cut);
+        self.expectations_failed = (self.expectations.iter())
+            .filter(|e| e.status != Status::Pass)
+            .count();
     }
 
     pub fn json(&self) -> String {
@@ -189,7 +207,7 @@ impl SimReport {
             ));
         }
         if !self.verdicts.is_empty() {
-            out.push_str("\nbehavior match (same executed skills with arguments and outcomes, same final world):\n");
+            out.push_str("\nbehavior match (same executed skills with arguments, outcomes and start times within a step, same goal outcome, same final world):\n");
             for v in &self.verdicts {
                 let what = if v.matches {
                     "MATCH".to_string()
@@ -198,22 +216,20 @@ impl SimReport {
                     if !v.same_skills {
                         why.push("skills differ");
                     }
+                    if !v.same_outcome {
+                        why.push("outcomes differ");
+                    }
                     if !v.same_final_world {
                         why.push("final worlds differ");
                     }
                     format!("DIFFER ({})", why.join(", "))
                 };
                 out.push_str(&format!(
-                    "  {} vs {}: {what}, trajectory distance {:.3} m\n",
-                    v.a, v.b, v.trajectory_distance_m
+                    "  {} vs {}: {what}, trajectory distance {:.3} m at equal times ({:.3} m between the paths)\n",
+                    v.a, v.b, v.trajectory_distance_m, v.path_distance_m
                 ));
                 if let Some(d) = &v.first_divergence {
-                    out.push_str(&format!(
-                        "    first divergence at skill {}: {} | {}\n",
-                        d.index + 1,
-                        d.a.as_deref().unwrap_or("(none)"),
-                        d.b.as_deref().unwrap_or("(none)")
-                    ));
+                    out.push_str(&format!("    first divergence {}\n", d.summary()));
                 }
             }
         }
@@ -233,6 +249,21 @@ impl SimReport {
                 }
             ));
         }
+        if !self.expectations.is_empty() {
+            out.push_str(&format!(
+                "\nexpectations: {} of {} hold\n",
+                self.expectations.len() - self.expectations_failed,
+                self.expectations.len()
+            ));
+            for e in &self.expectations {
+                let st = match e.status {
+                    Status::Pass => "ok  ",
+                    Status::Fail => "FAIL",
+                    Status::Undecided => "UNDECIDED",
+                };
+                out.push_str(&format!("  {st} {} ({})\n", e.name, e.found));
+            }
+        }
         out
     }
 }
@@ -246,6 +277,8 @@ pub struct McReport {
     pub threads: usize,
     pub millis: u128,
     pub policies: Vec<McStats>,
+    /// Per pair of policies, the rate of episodes whose behavior matched.
+    pub pairs: Vec<PairStats>,
 }
 
 impl McReport {
@@ -257,35 +290,93 @@ impl McReport {
     }
 
     pub fn table(&self) -> String {
+        self.render(false)
+    }
+
+    /// The same tables in GitHub-flavoured markdown (a paper's or a pull
+    /// request's table).
+    pub fn markdown(&self) -> String {
+        self.render(true)
+    }
+
+    fn render(&self, md: bool) -> String {
         let mut out = format!(
             "scenario `{}`: {} episodes (seed {}) on {} threads in {} ms\n\n",
             self.scenario, self.runs, self.seed, self.threads, self.millis
         );
-        let mut t = Table::new(&[
+        let head = [
             "policy",
             "success rate",
+            "95% CI",
             "failures",
             "chattering",
             "timeouts",
-            "mean completion s",
+            "completion s (p10 / p50 / p90)",
             "recharges",
             "mean low-battery latency s",
-        ]);
+        ];
         let f = |x: Option<f64>| x.map_or("-".into(), |v| format!("{v:.2}"));
-        for p in &self.policies {
-            t.row(vec![
-                p.policy.clone(),
-                format!("{:.3}", p.success_rate),
-                p.failures.to_string(),
-                p.chattering.to_string(),
-                p.timeouts.to_string(),
-                f(p.mean_completion_s),
-                p.recharges.to_string(),
-                f(p.mean_recharge_latency_s),
-            ]);
+        let rows: Vec<Vec<String>> = (self.policies.iter())
+            .map(|p| {
+                vec![
+                    p.policy.clone(),
+                    format!("{:.3}", p.success_rate),
+                    format!("[{:.4}, {:.4}]", p.success_ci95[0], p.success_ci95[1]),
+                    p.failures.to_string(),
+                    p.chattering.to_string(),
+                    p.timeouts.to_string(),
+                    p.completion_quantiles_s.map_or("-".into(), |q| {
+                        format!("{:.1} / {:.1} / {:.1}", q[0], q[1], q[2])
+                    }),
+                    p.recharges.to_string(),
+                    f(p.mean_recharge_latency_s),
+                ]
+            })
+            .collect();
+        out.push_str(&table(md, &head, rows));
+        if !self.pairs.is_empty() {
+            out.push('\n');
+            let head = [
+                "pair",
+                "behavior match rate",
+                "95% CI",
+                "first diverging episode (seed)",
+            ];
+            let rows = (self.pairs.iter())
+                .map(|p| {
+                    vec![
+                        format!("{} vs {}", p.a, p.b),
+                        format!("{:.3}", p.match_rate),
+                        format!("[{:.4}, {:.4}]", p.match_ci95[0], p.match_ci95[1]),
+                        p.first_divergence
+                            .as_ref()
+                            .map_or("-".into(), |d| format!("{} (--seed {})", d.episode, d.seed)),
+                    ]
+                })
+                .collect();
+            out.push_str(&table(md, &head, rows));
         }
-        out.push_str(&t.render());
         out
+    }
+}
+
+/// A table as text, or as markdown with every cell escaped.
+fn table(md: bool, head: &[&str], rows: Vec<Vec<String>>) -> String {
+    if md {
+        let cell = |c: &str| crate::sanitize::markdown_cell(c);
+        let mut out = format!("| {} |\n", head.join(" | "));
+        out.push_str(&format!("|{}\n", "---|".repeat(head.len())));
+        for r in rows {
+            let cells: Vec<String> = r.iter().map(|c| cell(c)).collect();
+            out.push_str(&format!("| {} |\n", cells.join(" | ")));
+        }
+        out
+    } else {
+        let mut t = Table::new(head);
+        for r in rows {
+            t.row(r);
+        }
+        t.render()
     }
 }
 
@@ -449,7 +540,24 @@ mod tests {
         ] {
             assert!(p.get(k).is_some(), "{k}");
         }
+        assert!(p.get("after_success").is_some());
         assert!(p.get("trace").is_none() && p.get("trajectory").is_none());
+        for k in [
+            "a",
+            "b",
+            "match",
+            "same_skills",
+            "same_outcome",
+            "same_final_world",
+            "tolerance_s",
+            "first_divergence",
+            "trajectory_distance_m",
+            "path_distance_m",
+        ] {
+            assert!(v["verdicts"][0].get(k).is_some(), "{k}");
+        }
+        assert!(v["expectations"].as_array().unwrap().is_empty());
+        assert_eq!(v["expectations_failed"], 0);
         let t: serde_json::Value = serde_json::from_str(&r.trace_json()).unwrap();
         assert!(t["policies"][0]["trace"].as_array().unwrap().is_empty());
         assert!(

@@ -1,11 +1,18 @@
 //! The robot as the executors see it (SPEC §6): the world, the actions
 //! running on it (one [`Running`] per leaf), injected faults, and the
 //! records of executed skills and events that a run reports.
+//!
+//! One base, one arm: an action that needs a resource held by another
+//! running action aborts it (its record ends as `aborted` at once, and its
+//! leaf gets FAILURE at its next tick), as a navigation action server aborts
+//! its goal for a new one. A halted action ([`Leaves::halt`]) stops at once;
+//! at the end of a step the actions not ticked are cancelled, then the base
+//! moves for the one action holding it, then the camera looks.
 
 use super::exec::Leaves;
 use super::rng::SimRng;
 use super::scenario::{Disturbance, Effect};
-use super::skills::{self, Call, Running, Status, Target};
+use super::skills::{self, Call, Resource, Running, Status, Target};
 use super::trace::{Event, SkillRecord};
 use super::world::{Place, World};
 use std::collections::BTreeMap;
@@ -16,20 +23,36 @@ pub(super) struct Faults {
     pub(super) next: BTreeMap<String, u32>,
     pub(super) rates: BTreeMap<String, f64>,
     pub(super) rng: SimRng,
+    /// Where in its execution a doomed action aborts (its own stream, so
+    /// that which starts are doomed does not depend on it).
+    pub(super) points: SimRng,
 }
 
 impl Faults {
-    fn doomed(&mut self, skill: &str) -> bool {
-        if let Some(n) = self.next.get_mut(skill)
+    pub(super) fn new(seed: u64, rates: BTreeMap<String, f64>) -> Self {
+        Faults {
+            next: BTreeMap::new(),
+            rates,
+            rng: SimRng::named(seed, "skill-faults"),
+            points: SimRng::named(seed, "fault-points"),
+        }
+    }
+
+    /// `Some(f)`: this start of `skill` aborts at the fraction `f` (drawn
+    /// uniformly from [0.05, 0.95]) of its execution.
+    fn doomed(&mut self, skill: &str) -> Option<f64> {
+        let doomed = if let Some(n) = self.next.get_mut(skill)
             && *n > 0
         {
             *n -= 1;
-            return true;
-        }
-        match self.rates.get(skill) {
-            Some(&p) => self.rng.chance(p),
-            None => false,
-        }
+            true
+        } else {
+            match self.rates.get(skill) {
+                Some(&p) => self.rng.chance(p),
+                None => false,
+            }
+        };
+        doomed.then(|| self.points.range(0.05, 0.95))
     }
 }
 
@@ -40,12 +63,22 @@ pub(super) struct Robot {
     pub(super) dt: f64,
     pub(super) live: Vec<Option<Running>>,
     pub(super) ticked: Vec<bool>,
+    /// The keys ticked in this step or live, so that a step's bookkeeping
+    /// costs what it touched, not the size of the policy; after
+    /// [`Robot::end_step`], the live keys in ascending order.
+    pub(super) touched: Vec<usize>,
     pub(super) records: Vec<SkillRecord>,
     pub(super) events: Vec<Event>,
     pub(super) faults: Faults,
     pub(super) log: bool,
-    pub(super) last_failed: Option<Call>,
-    pub(super) switches: u32,
+    /// Actions that ended in FAILURE so far (the run loop re-ticks a policy
+    /// whose root failed because one did, within the same step).
+    pub(super) failed_ends: u64,
+    /// Leaves whose action started in this step, a retry of the action that
+    /// just failed excepted (livelock detection; cleared by the run loop).
+    pub(super) started: Vec<usize>,
+    /// The leaf whose action failed last, until the next start.
+    pub(super) failed_key: Option<usize>,
     pub(super) failures: u32,
     pub(super) mark: u64,
     pub(super) low_at: Option<f64>,
@@ -53,6 +86,9 @@ pub(super) struct Robot {
     /// An action start or an event was refused: the run's records are full
     /// ([`MAX_SKILL_RECORDS`], [`MAX_EVENTS`]); the run ends after the step.
     pub(super) full: bool,
+    /// The leaf whose action holds the base, and the arm.
+    pub(super) base: Option<usize>,
+    pub(super) arm: Option<usize>,
 }
 
 /// Executed skills a run records at most: a policy that picks and places
@@ -92,6 +128,31 @@ pub fn call_args(c: &Call, w: &World) -> BTreeMap<String, String> {
 }
 
 impl Robot {
+    /// A robot in `world` for a policy of `leaves` leaf keys.
+    pub(super) fn new(world: World, dt: f64, leaves: usize, faults: Faults, log: bool) -> Self {
+        Robot {
+            world,
+            dt,
+            live: vec![None; leaves],
+            ticked: vec![false; leaves],
+            records: Vec::new(),
+            events: Vec::new(),
+            faults,
+            log,
+            touched: Vec::new(),
+            failed_ends: 0,
+            started: Vec::new(),
+            failed_key: None,
+            failures: 0,
+            mark: 0,
+            low_at: None,
+            latencies: Vec::new(),
+            full: false,
+            base: None,
+            arm: None,
+        }
+    }
+
     pub(super) fn event(&mut self, kind: &str, text: String) {
         if self.events.len() >= MAX_EVENTS {
             self.full = true;
@@ -111,13 +172,16 @@ impl Robot {
     fn sync_progress(&mut self) {
         if self.world.progress != self.mark {
             self.mark = self.world.progress;
-            self.switches = 0;
             self.failures = 0;
         }
     }
 
     fn close(&mut self, rec: usize, outcome: &str) {
-        let t = round3(self.world.time);
+        self.close_at(rec, outcome, self.world.time);
+    }
+
+    fn close_at(&mut self, rec: usize, outcome: &str, t: f64) {
+        let t = round3(t);
         let r = &mut self.records[rec];
         r.outcome = outcome.into();
         r.end = Some(t);
@@ -127,17 +191,108 @@ impl Robot {
         }
     }
 
-    /// Cancels the actions that were not ticked in this step.
-    pub(super) fn end_step(&mut self) {
-        for k in 0..self.live.len() {
-            if !self.ticked[k]
-                && let Some(mut r) = self.live[k].take()
-            {
-                r.cancel(&mut self.world);
+    /// Frees the resources leaf `key` holds.
+    fn release(&mut self, key: usize) {
+        if self.base == Some(key) {
+            self.base = None;
+        }
+        if self.arm == Some(key) {
+            self.arm = None;
+        }
+    }
+
+    /// Stops the action of leaf `key` now: `cancelled` unless its outcome
+    /// was already reached (then its record stands).
+    fn stop(&mut self, key: usize) {
+        if let Some(mut r) = self.live[key].take() {
+            r.cancel(&mut self.world);
+            if r.result.is_none() {
                 self.close(r.record, "cancelled");
+            }
+        }
+        self.release(key);
+    }
+
+    /// Gives `res` to leaf `key`, aborting the action that held it.
+    fn claim(&mut self, key: usize, res: Resource) {
+        let holder = match res {
+            Resource::Base => self.base.replace(key),
+            Resource::Arm => self.arm.replace(key),
+        };
+        let Some(j) = holder.filter(|&j| j != key) else {
+            return;
+        };
+        if let Some(r) = self.live[j].as_mut()
+            && r.result.is_none()
+        {
+            r.cancel(&mut self.world);
+            r.result = Some(Status::Failure);
+            let rec = r.record;
+            self.close(rec, "aborted");
+            let text = format!("{} aborted by a new goal", self.records[rec].skill);
+            self.event("aborted", text);
+        }
+        // It holds nothing any more.
+        if self.base == Some(j) {
+            self.base = None;
+        }
+        if self.arm == Some(j) {
+            self.arm = None;
+        }
+    }
+
+    /// Ends a step: cancels the actions that were not ticked, moves the base
+    /// for the action holding it (once), lets the camera look, and records
+    /// the outcomes reached.
+    pub(super) fn end_step(&mut self) {
+        // Only the keys touched since the last step can hold a live action;
+        // in key order, as a walk over every key would stop them.
+        let mut keys = std::mem::take(&mut self.touched);
+        keys.sort_unstable();
+        keys.dedup();
+        for &k in &keys {
+            if !self.ticked[k] && self.live[k].is_some() {
+                self.stop(k);
             }
             self.ticked[k] = false;
         }
+        keys.retain(|&k| self.live[k].is_some());
+        self.touched = keys;
+        let dt = self.dt;
+        let end = self.world.time + dt;
+        if let Some(k) = self.base
+            && let Some(r) = self.live[k].as_mut()
+            && let Some(s) = r.drive(&mut self.world, dt)
+        {
+            let rec = r.record;
+            self.close_at(rec, outcome(s), end);
+        }
+        if self.world.sense() > 0 {
+            self.world.progress += 1;
+        }
+        if let Some(k) = self.base
+            && let Some(r) = self.live[k].as_mut()
+            && let Some(s) = r.settle(&self.world)
+        {
+            let rec = r.record;
+            self.close_at(rec, outcome(s), end);
+        }
+    }
+
+    /// Forgets which keys were ticked in this step (the run loop ticks the
+    /// policy again: its last tick says which actions go on).
+    pub(super) fn untick(&mut self) {
+        for &k in &self.touched {
+            self.ticked[k] = false;
+        }
+    }
+}
+
+fn outcome(s: Status) -> &'static str {
+    match s {
+        Status::Success => "success",
+        Status::Failure => "failure",
+        Status::Running => "running",
     }
 }
 
@@ -152,24 +307,25 @@ impl Leaves for Robot {
     }
 
     fn action(&mut self, key: usize, call: &Call) -> Status {
-        self.ticked[key] = true;
+        if !self.ticked[key] {
+            self.ticked[key] = true;
+            self.touched.push(key);
+        }
         if self.live[key].as_ref().is_none_or(|r| r.call != *call) {
             if self.records.len() >= MAX_SKILL_RECORDS {
                 // Not started: the run ends after this step.
                 self.full = true;
                 return Status::Failure;
             }
-            if let Some(mut old) = self.live[key].take() {
-                old.cancel(&mut self.world);
-                self.close(old.record, "cancelled");
+            if self.live[key].is_some() {
+                self.stop(key);
             }
             self.sync_progress();
-            // Every start counts, except a retry of the action that just failed.
-            if self.last_failed != Some(*call) {
-                self.switches += 1;
+            if self.failed_key != Some(key) && self.started.len() < 64 {
+                self.started.push(key);
             }
-            self.last_failed = None;
-            let doomed = self.faults.doomed(call.name());
+            self.failed_key = None;
+            let fault_at = self.faults.doomed(call.name());
             if *call == Call::Recharge
                 && let Some(t) = self.low_at.take()
             {
@@ -186,35 +342,33 @@ impl Leaves for Robot {
                 let text = self.records.last().expect("pushed").text();
                 self.event("start", text.trim_end_matches(" -> running").to_string());
             }
-            self.live[key] = Some(Running::new(*call, doomed, self.records.len() - 1));
+            for &res in call.resources() {
+                self.claim(key, res);
+            }
+            self.live[key] = Some(Running::new(*call, fault_at, self.records.len() - 1));
         }
         let r = self.live[key].as_mut().expect("started above");
+        let known = r.result.is_some();
         let s = r.tick(&mut self.world, self.dt);
         if s != Status::Running {
             let rec = r.record;
             self.live[key] = None;
-            self.close(
-                rec,
-                if s == Status::Success {
-                    "success"
-                } else {
-                    "failure"
-                },
-            );
+            self.release(key);
+            if !known {
+                self.close(rec, outcome(s));
+            }
             if s == Status::Failure {
                 self.sync_progress();
                 self.failures += 1;
-                self.last_failed = Some(*call);
+                self.failed_ends += 1;
+                self.failed_key = Some(key);
             }
         }
         s
     }
 
     fn halt(&mut self, key: usize) {
-        if let Some(mut r) = self.live[key].take() {
-            r.cancel(&mut self.world);
-            self.close(r.record, "cancelled");
-        }
+        self.stop(key);
     }
 
     fn now(&self) -> f64 {
@@ -227,15 +381,30 @@ pub(super) fn apply(d: &Disturbance, r: &mut Robot) {
     let w = &mut r.world;
     match &d.effect {
         Effect::Battery(b) => w.battery = *b,
-        Effect::Move { object, to } => w.objects[*object].place = Place::At(*to),
+        Effect::Move { object, to } => w.objects[*object].place = w.rest_at(*to),
         Effect::Drop { object } => {
             if w.objects[*object].place == Place::Held {
-                w.objects[*object].place = Place::At(w.robot);
+                // It lies on the floor where it fell.
+                w.objects[*object].place = Place::Floor(w.robot);
             }
         }
         Effect::Fail { skill, times } => *r.faults.next.entry(skill.clone()).or_insert(0) += times,
-        Effect::Block(rect) => w.block(rect.clone()),
-        Effect::Emergency(b) => w.emergency = *b,
+        Effect::Block(rect) => {
+            if rect.distance(w.robot) < w.params.robot_radius {
+                // A box cannot land on the robot: refused, and said so.
+                let text = format!("{} refused: it would cover the robot", d.text);
+                r.event("disturbance", text);
+                return;
+            }
+            w.block(rect.clone())
+        }
+        Effect::Emergency(b) => {
+            w.emergency = *b;
+            if !*b {
+                // Shut-Down holds until the emergency clears.
+                w.shut_down = false;
+            }
+        }
     }
     r.world.progress += 1;
     r.event("disturbance", d.text.clone());

@@ -9,12 +9,12 @@
 //! the first k whole episodes.
 
 use super::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
-use super::rng::SimRng;
+use super::livelock::{Livelock, abstract_state};
 use super::robot::{Faults, MAX_EVENTS, MAX_SKILL_RECORDS, Robot, apply, round3};
-use super::scenario::{Disturbance, PolicyEntry, Scenario, When};
+use super::scenario::{Afterwards, Disturbance, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Status};
-use super::trace::{FinalWorld, Outcome, Run, Step, compact_trajectory};
-use super::world::{P2, World};
+use super::trace::{FinalWorld, Outcome, Run, Step, compact_track, compact_trajectory};
+use super::world::{P2, World, dist};
 use crate::model::PolicyBody;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -27,6 +27,10 @@ pub struct Prepared {
     pub file: String,
     pub kind: String,
     pub convert: Option<String>,
+    /// What the policy does after it reports SUCCESS.
+    pub after_success: Afterwards,
+    /// What the policy does after it reports FAILURE.
+    pub after_failure: Afterwards,
     pub exec: Compiled,
     /// Node id / state path per key (for statuses).
     pub keys: Arc<Vec<String>>,
@@ -81,6 +85,8 @@ fn prepare_one(e: &PolicyEntry, w: &World) -> Prepared {
         file: e.file.display().to_string(),
         kind: e.policy.kind().to_string(),
         convert: e.convert.clone(),
+        after_success: e.after_success,
+        after_failure: e.after_failure,
         exec,
         keys: Arc::new(keys),
     }
@@ -112,14 +118,14 @@ fn holds(terms: &[(Call, bool)], w: &World) -> bool {
 /// nodes, a thousand disturbances with conditions), so that the clock is
 /// read about every 64k units of work (node ticks, conditions) whatever
 /// the input.
-pub fn clock_every(p: &Prepared, disturbances: &[Disturbance], w: &World) -> u64 {
+pub fn clock_every(p: &Prepared, disturbances: &[Disturbance], w: &World, goal: usize) -> u64 {
     let terms: usize = (disturbances.iter())
         .map(|d| match &d.when {
             When::Holds(t) => t.len(),
             _ => 1,
         })
         .sum();
-    let work = (p.keys.len() + terms + w.objects.len()).max(1) as u64;
+    let work = (p.keys.len() + terms + goal + w.objects.len()).max(1) as u64;
     (65_536 / work).clamp(1, CLOCK_EVERY)
 }
 
@@ -153,37 +159,31 @@ pub fn run_policy_into(
     opts: RunOptions,
     mut sink: Option<StepSink<'_>>,
 ) -> Run {
-    let every = clock_every(p, disturbances, &world);
+    // The goal's terms are evaluated every step too (progress toward it).
+    let goal_terms_n = s.goal.as_ref().map_or(0, Vec::len);
+    let every = clock_every(p, disturbances, &world, goal_terms_n);
     let n = p.keys.len();
-    let mut robot = Robot {
-        world,
-        dt: s.dt,
-        live: vec![None; n],
-        ticked: vec![false; n],
-        records: Vec::new(),
-        events: Vec::new(),
-        faults: Faults {
-            next: BTreeMap::new(),
-            rates,
-            rng: SimRng::named(seed, "skill-faults"),
-        },
-        log: opts.log,
-        last_failed: None,
-        switches: 0,
-        failures: 0,
-        mark: 0,
-        low_at: None,
-        latencies: Vec::new(),
-        full: false,
-    };
+    let mut robot = Robot::new(world, s.dt, n, Faults::new(seed, rates), opts.log);
     enum Ex {
         Bt(BtExec),
         M(MachineExec),
     }
+    let keep_ticking = p.after_success == Afterwards::KeepTicking;
     let mut ex = match &p.exec {
         Compiled::Bt(b) => Ex::Bt(BtExec::new(b.clone(), opts.trace)),
-        Compiled::Machine(m) => Ex::M(MachineExec::new(m.clone(), opts.trace)),
+        Compiled::Machine(m) => {
+            let mut m = MachineExec::new(m.clone(), opts.trace);
+            m.keep_ticking = keep_ticking;
+            m.reenter_on_failure = p.after_failure == Afterwards::KeepTicking;
+            Ex::M(m)
+        }
     };
+    // `after_success = "stop"`: the policy is no longer ticked once it has
+    // reported SUCCESS (a machine ends at its outcome by itself).
+    let mut stopped = false;
+    let mut livelock = Livelock::new(s.livelock_repeats);
+    let goal_terms: &[(Call, bool)] = s.goal.as_deref().unwrap_or(&[]);
+    let mut track: Vec<(u64, P2)> = Vec::new();
     let mut fired = vec![false; disturbances.len()];
     // Timed disturbances not yet fired (a run is not over while one is).
     let mut pending_timed = (disturbances.iter())
@@ -199,6 +199,7 @@ pub fn run_policy_into(
     let mut last = Status::Running;
     if opts.log {
         trajectory.push(robot.world.robot);
+        track.push((0, robot.world.robot));
     }
     while steps < s.max_steps {
         if let Some(d) = opts.deadline
@@ -213,6 +214,7 @@ pub fn run_policy_into(
         }
         steps += 1;
         let now = robot.world.time + 1e-9;
+        let mut disturbed = false;
         for (i, d) in disturbances.iter().enumerate() {
             if fired[i] {
                 continue;
@@ -228,6 +230,7 @@ pub fn run_policy_into(
                     pending_timed -= 1;
                 }
                 apply(d, &mut robot);
+                disturbed = true;
             }
         }
         let lowb = robot.world.battery <= robot.world.params.low_battery;
@@ -237,14 +240,61 @@ pub fn run_policy_into(
             robot.event("battery-low", format!("battery at {b:.1}%"));
         }
         low = lowb;
-        last = match &mut ex {
-            Ex::Bt(b) => b.tick(&mut robot),
-            Ex::M(m) => m.step(&mut robot),
-        };
+        if !stopped {
+            // A policy whose root failed because an action failed, and
+            // which goes on (a BT, a machine re-entered after FAILURE), is
+            // ticked again in the same step, as an FSM's failure arc starts
+            // its next action in the step of the failure: no representation
+            // gets a step for free. Bounded: MAX_TICKS_PER_STEP ticks.
+            let mut ticks = 0;
+            loop {
+                ticks += 1;
+                let failed = robot.failed_ends;
+                last = match &mut ex {
+                    Ex::Bt(b) => b.tick(&mut robot),
+                    Ex::M(m) => m.step(&mut robot),
+                };
+                let goes_on = match &ex {
+                    Ex::Bt(_) => p.after_failure == Afterwards::KeepTicking,
+                    Ex::M(m) => m.finished.is_none(),
+                };
+                if last != Status::Failure
+                    || !goes_on
+                    || robot.failed_ends == failed
+                    || ticks >= MAX_TICKS_PER_STEP
+                {
+                    break;
+                }
+                // The last tick of the step says which actions go on.
+                robot.untick();
+            }
+            if last == Status::Success && !keep_ticking && matches!(ex, Ex::Bt(_)) {
+                stopped = true;
+            }
+            // `after_failure = "stop"` for a BT: its root's FAILURE ends the
+            // run (a machine ends at its outcome by itself).
+            if last == Status::Failure
+                && p.after_failure == Afterwards::Stop
+                && matches!(ex, Ex::Bt(_))
+            {
+                robot.end_step();
+                ended = Some((
+                    Outcome::Failure,
+                    "the root returned FAILURE (after_failure = \"stop\")".into(),
+                ));
+                break;
+            }
+        }
         robot.end_step();
         robot.world.advance(s.dt);
         if opts.log {
             trajectory.push(robot.world.robot);
+            if track
+                .last()
+                .is_none_or(|&(_, q)| dist(q, robot.world.robot) > 1e-6)
+            {
+                track.push((steps, robot.world.robot));
+            }
         }
         if opts.trace {
             let st = match &ex {
@@ -255,6 +305,8 @@ pub fn run_policy_into(
                 .live
                 .iter()
                 .flatten()
+                // An outcome reached while moving is no longer running.
+                .filter(|r| r.result.is_none())
                 .map(|r| {
                     robot.records[r.record]
                         .text()
@@ -306,8 +358,17 @@ pub fn run_policy_into(
             ));
             break;
         }
-        if robot.switches > s.chatter_switches {
-            let text = format!("{} actions started without progress", robot.switches);
+        let measure = (goal_terms.iter())
+            .filter(|(c, neg)| skills::condition(c, &robot.world) != *neg)
+            .count()
+            + usize::from(done);
+        let fresh = !robot.started.is_empty();
+        let state = abstract_state(&robot);
+        robot.started.clear();
+        if let Some(n) = livelock.step(state, fresh, measure, disturbed) {
+            let text = format!(
+                "livelock: an abstract state (world facts, running skills) entered {n} times without progress toward the goal"
+            );
             robot.event("chattering", text.clone());
             ended = Some((Outcome::Chattering, text));
             break;
@@ -332,7 +393,13 @@ pub fn run_policy_into(
     let (outcome, reason) = ended.unwrap_or_else(|| match finished {
         Some((o, why)) if o == "SUCCESS" => (Outcome::Success, why),
         Some((_, why)) => (Outcome::Failure, why),
-        None if last == Status::Success => (Outcome::Success, "the root returned SUCCESS".into()),
+        None if last == Status::Success => (
+            Outcome::Success,
+            match &ex {
+                Ex::Bt(_) => "the root returned SUCCESS".into(),
+                Ex::M(_) => "reached the outcome SUCCESS (and ticks on)".into(),
+            },
+        ),
         None => (
             Outcome::Timeout,
             format!("step budget of {} steps exhausted", s.max_steps),
@@ -348,6 +415,9 @@ pub fn run_policy_into(
         reason,
         goal_met,
         steps,
+        dt: s.dt,
+        after_success: p.after_success.as_str(),
+        after_failure: p.after_failure.as_str(),
         completion_s: completion.map(round3),
         duration_s: round3(robot.world.time),
         distance_m: round3(robot.world.odometer),
@@ -356,13 +426,18 @@ pub fn run_policy_into(
         final_world: FinalWorld::of(&robot.world),
         recharge_latency_s: robot.latencies,
         trajectory,
+        track,
         trace,
     }
 }
 
+/// Ticks of a policy in one step at most: the first, and the re-ticks after
+/// a FAILURE caused by a failed action.
+pub const MAX_TICKS_PER_STEP: u32 = 4;
+
 /// Whether the wall-clock budget cut `r` short: a timeout before the step
 /// budget was used up (the clock is read only while steps remain).
-pub(super) fn cut_short(s: &Scenario, r: &Run) -> bool {
+pub fn cut_short(s: &Scenario, r: &Run) -> bool {
     r.outcome == Outcome::Timeout
         && r.steps < s.max_steps
         && r.reason.starts_with("wall-clock budget")
@@ -437,6 +512,7 @@ fn run_scenario_out(
             // Kept for the verdicts and the plot: the points where the
             // robot moved, at most TRAJECTORY_POINTS of them.
             run.trajectory = compact_trajectory(std::mem::take(&mut run.trajectory));
+            run.track = compact_track(std::mem::take(&mut run.track));
             any_cut |= cut_short(s, &run);
             run
         })
@@ -445,218 +521,4 @@ fn run_scenario_out(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::diagnostic::SourceFile;
-    use crate::format::Limits;
-    use crate::sim::monte_carlo::{monte_carlo, monte_carlo_within};
-    use std::path::Path;
-
-    fn scenario(text: &str) -> Scenario {
-        let f = SourceFile::new("t.toml", text);
-        super::super::scenario::parse(&f, Path::new("policies/scenarios"), &Limits::default())
-            .expect("valid scenario")
-    }
-
-    const FLAKY: &str = r#"
-seed = 11
-goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
-[world]
-objects = { cube2 = { at = "east-table" } }
-[rates]
-Pick = 0.5
-[[policies]]
-file = "../paper/fig01-bt.toml"
-[[policies]]
-file = "../paper/fig04-fsm.toml"
-[monte_carlo]
-battery_drop = { probability = 1.0, level = [10, 15], window = [1.0, 5.0] }
-"#;
-
-    #[test]
-    fn runs_are_deterministic_given_the_seed() {
-        let s = scenario(FLAKY);
-        let a = run_scenario(&s, false);
-        let b = run_scenario(&s, false);
-        assert_eq!(a[0].skills, b[0].skills);
-        assert_eq!(a[0].trajectory, b[0].trajectory);
-        // With a 50% grasp failure rate some seed makes a Pick fail.
-        let failed = (0..10u64).any(|seed| {
-            let mut s = s.clone();
-            s.seed = seed;
-            run_scenario(&s, false)[0]
-                .skills
-                .iter()
-                .any(|r| r.skill == "Pick" && r.outcome == "failure")
-        });
-        assert!(failed);
-    }
-
-    #[test]
-    fn monte_carlo_does_not_depend_on_the_number_of_threads() {
-        let s = scenario(FLAKY);
-        let one = monte_carlo(&s, 6, 3, 1);
-        let two = monte_carlo(&s, 6, 3, 2);
-        assert_eq!(one, two);
-        assert_eq!(one.len(), 2);
-        assert_eq!(one[0].runs, 6);
-        // Every episode drops the battery, so every policy recharges.
-        assert!(
-            one.iter()
-                .all(|p| p.recharges == 0 || p.mean_recharge_latency_s.is_some())
-        );
-        assert!(one.iter().all(|p| p.success_rate > 0.0));
-    }
-
-    #[test]
-    fn a_spent_wall_clock_budget_stops_every_run_at_once() {
-        let s = scenario(FLAKY);
-        // No deadline: the same figures as without the budget.
-        let (stats, done) = monte_carlo_within(&s, 6, 3, 2, None);
-        assert_eq!((stats, done), (monte_carlo(&s, 6, 3, 2), 6));
-        // A deadline already past: no episode completes, no figure is made up.
-        let (stats, done) = monte_carlo_within(&s, 6, 3, 2, Some(Instant::now()));
-        assert_eq!(done, 0);
-        assert!(stats.iter().all(|p| p.runs == 0 && p.successes == 0));
-        let (runs, cut) = run_scenario_within(&s, false, Some(Instant::now()));
-        assert!(cut);
-        for r in &runs {
-            assert_eq!(r.outcome, Outcome::Timeout);
-            assert_eq!(
-                (r.steps, r.reason.as_str()),
-                (0, "wall-clock budget exhausted at step 0")
-            );
-        }
-        let (free, cut) = run_scenario_within(&s, false, None);
-        assert!(!cut);
-        let plain = run_scenario(&s, false);
-        let key = |r: &Run| (r.outcome, r.steps, r.reason.clone());
-        assert_eq!(
-            free.iter().map(key).collect::<Vec<_>>(),
-            plain.iter().map(key).collect::<Vec<_>>()
-        );
-    }
-
-    /// A BT that picks and places the cube every step (both instantaneous)
-    /// recorded two skills and four events a step, 3.3 GB over 10^6 steps:
-    /// a run now ends once its records are full, and that is not taken for
-    /// the wall-clock budget.
-    #[test]
-    fn a_run_ends_when_its_records_are_full() {
-        let dir = std::env::temp_dir().join(format!("btfsm-records-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(
-            dir.join("pp.toml"),
-            "kind = \"bt\"\nroot = \"root\"\n[nodes]\nroot = { sequence = [\"pick\", \"place\"] }\npick = { action = \"Pick\", skill = \"Pick\", args = { object = \"cube2\" } }\nplace = { action = \"Place\", skill = \"Place\", args = { object = \"cube2\", at = \"east-table\" } }\n",
-        )
-        .unwrap();
-        let text = "max_steps = 1000000\n[world]\nrobot = \"east-table\"\nparams = { manipulation_s = 0 }\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"pp.toml\"\n[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n";
-        let f = SourceFile::new("pp-scenario.toml", text);
-        let s = super::super::scenario::parse(&f, &dir, &Limits::default()).expect("valid");
-        let (runs, cut) = run_scenario_within(&s, false, None);
-        assert!(!cut);
-        let r = &runs[0];
-        assert_eq!(r.outcome, Outcome::Timeout);
-        assert!(
-            r.reason.starts_with("record budget exhausted at step"),
-            "{}",
-            r.reason
-        );
-        assert_eq!(r.skills.len(), MAX_SKILL_RECORDS);
-        assert!(r.events.len() <= MAX_EVENTS);
-        assert!(r.steps < 1000, "{}", r.steps);
-        // Monte Carlo: a timeout of the episode, not a budget cut.
-        let (stats, done) = monte_carlo_within(&s, 2, 1, 1, None);
-        assert_eq!((done, stats[0].timeouts), (2, 2));
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn a_sequential_policy_without_a_failure_arc_fails() {
-        let s = scenario(
-            r#"
-[world]
-objects = { cube2 = { at = "east-table" } }
-[[policies]]
-file = "../paper/fig02-fsm.toml"
-[[disturbances]]
-at = 0.0
-fail = "Move-To"
-"#,
-        );
-        let r = &run_scenario(&s, true)[0];
-        assert_eq!(r.outcome, Outcome::Failure);
-        assert_eq!(r.skills.len(), 1);
-        assert!(!r.trace.is_empty());
-        assert!(
-            r.trace[0]
-                .statuses
-                .iter()
-                .any(|(k, st)| k == "Move-To cube2" && st == "RUNNING")
-        );
-    }
-
-    #[test]
-    fn a_dropped_cube_is_picked_again_and_a_blocked_goal_gives_up() {
-        let s = scenario(
-            r#"
-goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
-[world]
-objects = { cube2 = { at = "east-table" } }
-[[policies]]
-file = "../paper/fig01-bt.toml"
-[[policies]]
-file = "../paper/fig04-fsm.toml"
-[[disturbances]]
-when = [{ if = "In-Hand", args = { object = "cube2" } }]
-drop = "cube2"
-"#,
-        );
-        let runs = run_scenario(&s, false);
-        for r in &runs {
-            assert_eq!(r.goal_met, Some(true), "{}", r.policy);
-            let picks = r
-                .skills
-                .iter()
-                .filter(|x| x.skill == "Pick" && x.outcome == "success");
-            assert_eq!(picks.count(), 2, "{}", r.policy);
-        }
-        // The BT notices the drop at once; the FSM only when Place fails.
-        assert!(
-            !runs[0]
-                .skills
-                .iter()
-                .any(|x| x.skill == "Place" && x.outcome == "failure")
-        );
-        assert!(
-            runs[1]
-                .skills
-                .iter()
-                .any(|x| x.skill == "Place" && x.outcome == "failure")
-        );
-
-        let s = scenario(
-            r#"
-[world]
-objects = { cube2 = { at = "east-table" } }
-[[policies]]
-file = "../paper/fig01-bt.toml"
-[[policies]]
-file = "../paper/fig04-fsm.toml"
-[[disturbances]]
-at = 0.0
-block = { name = "fence", rect = [-0.5, 1.4, 1.5, 1.5] }
-[[disturbances]]
-at = 0.0
-block = { name = "fence2", rect = [-0.5, 1.4, -0.4, 2.99] }
-[[disturbances]]
-at = 0.0
-block = { name = "fence3", rect = [1.4, 1.4, 1.5, 2.99] }
-"#,
-        );
-        for r in run_scenario(&s, false) {
-            assert_eq!(r.outcome, Outcome::Failure, "{}", r.policy);
-            assert!(r.reason.starts_with("gave up"), "{}", r.reason);
-        }
-    }
-}
+mod tests;

@@ -16,7 +16,33 @@ use std::sync::Arc;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
+pub mod expect;
+pub mod mc;
+
 type Val<'i> = Spanned<DeValue<'i>>;
+
+/// What a policy does once it has reported SUCCESS, or FAILURE (a property
+/// of the run, written per policy in the scenario: `after_success`,
+/// `after_failure`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Afterwards {
+    /// No longer ticked: the robot stands idle (SMACH's final state; the
+    /// default for FSMs and HFSMs).
+    Stop,
+    /// Ticked again every step: a BT from its root, a machine re-entered at
+    /// its initial state (the default for BTs, as the paper describes).
+    KeepTicking,
+}
+
+impl Afterwards {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Afterwards::Stop => "stop",
+            Afterwards::KeepTicking => "keep-ticking",
+        }
+    }
+}
 
 /// A policy of a scenario.
 #[derive(Debug, Clone)]
@@ -25,8 +51,13 @@ pub struct PolicyEntry {
     pub file: PathBuf,
     /// `Some("hfsm")` when the scenario asks to convert the BT to an HFSM.
     pub convert: Option<String>,
-    /// The policy as run (converted when asked).
+    /// The policy as run (converted when asked; named by the entry's
+    /// `name` when it has one).
     pub policy: Policy,
+    /// What the policy does after SUCCESS.
+    pub after_success: Afterwards,
+    /// What the policy does after FAILURE.
+    pub after_failure: Afterwards,
 }
 
 /// When a disturbance fires.
@@ -59,18 +90,7 @@ pub struct Disturbance {
     pub text: String,
 }
 
-/// `(probability, level range in percent, time window in s)` of a random
-/// battery drop.
-pub type BatteryDrop = (f64, (f64, f64), (f64, f64));
-
-/// Randomisation of `--runs` episodes.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct MonteCarlo {
-    /// Extra failure probability per start of a skill.
-    pub rates: BTreeMap<String, f64>,
-    /// `(probability, level range, time window)` of a battery drop.
-    pub battery_drop: Option<BatteryDrop>,
-}
+pub use mc::{BatteryDrop, MonteCarlo};
 
 #[derive(Debug, Clone)]
 pub struct Scenario {
@@ -80,9 +100,10 @@ pub struct Scenario {
     /// Step length, s.
     pub dt: f64,
     pub max_steps: u64,
-    /// Action starts (retries of a failed action excepted) without progress
-    /// in the world that count as chattering.
-    pub chatter_switches: u32,
+    /// Times an abstract state (world facts, running skills) may be entered
+    /// without progress toward the goal before the run is a livelock
+    /// (outcome `chattering`): entered this many times, it ends the run.
+    pub livelock_repeats: u32,
     /// Action failures without progress after which a run gives up.
     pub max_failures: u32,
     pub world: World,
@@ -92,6 +113,10 @@ pub struct Scenario {
     /// The task's goal (all terms hold at the end), if given.
     pub goal: Option<Vec<(Call, bool)>>,
     pub monte_carlo: MonteCarlo,
+    /// The `[expect]` table, in the order written.
+    pub expect: Vec<expect::Expectation>,
+    /// Warnings (positioned) about a scenario that is valid.
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// Reads and validates a scenario and the policies it names.
@@ -140,7 +165,10 @@ pub fn parse(
     };
     let s = r.scenario(doc.get_ref(), base, limits);
     match s {
-        Some(s) if r.diags.iter().all(|d| !d.is_error()) => Ok(s),
+        Some(mut s) if r.diags.iter().all(|d| !d.is_error()) => {
+            s.warnings = r.diags;
+            Ok(s)
+        }
         _ => {
             if r.diags.is_empty() {
                 r.diags
@@ -202,6 +230,23 @@ fn num(v: &DeValue<'_>) -> Option<f64> {
     }
 }
 
+/// The `[world] params` a scenario may set, with their ranges
+/// (docs/simulator-model.md gives their meaning and defaults).
+pub const PARAMS: &[(&str, f64, f64)] = &[
+    ("max_speed", 0.01, 10.0),
+    ("max_turn_rate", 0.01, 100.0),
+    ("drain_per_m", 0.0, 100.0),
+    ("drain_per_s", 0.0, 100.0),
+    ("charge_per_s", 0.01, 1000.0),
+    ("low_battery", 0.0, 100.0),
+    ("camera_range", 0.0, 100.0),
+    ("object_tolerance", 0.0, 1.0),
+    ("reach", 0.0, 1.0),
+    ("stall_s", 0.0, 1000.0),
+    ("manipulation_s", 0.0, 1000.0),
+    ("arm_s", 0.0, 1000.0),
+];
+
 /// Largest `max_steps`: a run records its trajectory (16 bytes a step).
 pub const MAX_STEPS: u64 = 1_000_000;
 
@@ -212,7 +257,9 @@ const TOP_KEYS: &[&str] = &[
     "dt",
     "max_steps",
     "chatter_switches",
+    "livelock_repeats",
     "max_failures",
+    "expect",
     "goal",
     "world",
     "policies",
@@ -521,6 +568,7 @@ impl Reader {
         let mut robot = layout.station("start").expect("the paper room has a start");
         let mut objects = Vec::new();
         let mut battery = 100.0;
+        let mut placed: Vec<(Range<usize>, usize)> = Vec::new();
         let Some(v) = v else {
             return Some(World::new(layout, params, robot, objects));
         };
@@ -539,28 +587,45 @@ impl Reader {
         );
         if let Some(p) = t.get("params") {
             let pt = self.table(p, "`world.params`")?;
-            const PARAMS: &[&str] = &[
-                "max_speed",
-                "drain_per_m",
-                "drain_per_s",
-                "charge_per_s",
-                "low_battery",
-                "camera_range",
-                "manipulation_s",
-            ];
-            self.keys(pt, PARAMS, "world parameter");
+            self.keys(
+                pt,
+                &(PARAMS.iter().map(|p| p.0))
+                    .chain(["follow_belief"])
+                    .collect::<Vec<_>>(),
+                "world parameter",
+            );
             for (k, v) in pt.iter() {
-                let Some(x) = self.number(v, &format!("`{}`", k.get_ref()), 0.0, 1000.0) else {
+                if k.get_ref().as_ref() == "follow_belief" {
+                    match v.get_ref() {
+                        DeValue::Boolean(b) => params.follow_belief = *b,
+                        _ => self.err(
+                            v.span(),
+                            "`follow_belief` must be true or false",
+                            "write `follow_belief = true`",
+                        ),
+                    }
+                    continue;
+                }
+                let Some(&(name, lo, hi)) = PARAMS.iter().find(|p| p.0 == k.get_ref().as_ref())
+                else {
                     continue;
                 };
-                match k.get_ref().as_ref() {
-                    "max_speed" => params.max_speed = x.max(0.01),
+                let Some(x) = self.number(v, &format!("`{name}`"), lo, hi) else {
+                    continue;
+                };
+                match name {
+                    "max_speed" => params.max_speed = x,
+                    "max_turn_rate" => params.max_turn_rate = x,
                     "drain_per_m" => params.drain_per_m = x,
                     "drain_per_s" => params.drain_per_s = x,
-                    "charge_per_s" => params.charge_per_s = x.max(0.01),
+                    "charge_per_s" => params.charge_per_s = x,
                     "low_battery" => params.low_battery = x,
                     "camera_range" => params.camera_range = x,
+                    "object_tolerance" => params.object_tolerance = x,
+                    "reach" => params.reach = x,
+                    "stall_s" => params.stall_s = x,
                     "manipulation_s" => params.manipulation_s = x,
+                    "arm_s" => params.arm_s = x,
                     _ => {}
                 }
             }
@@ -572,6 +637,7 @@ impl Reader {
             }
             for ob in a.iter() {
                 if let Some(r) = self.rect(ob) {
+                    placed.push((ob.span(), layout.obstacles.len()));
                     layout.obstacles.push(r);
                 }
             }
@@ -600,6 +666,20 @@ impl Reader {
                     params.robot_radius,
                 );
             }
+        }
+        // The room's stations the scenario keeps where they are must stay
+        // free (those it sets were checked above, at their own position).
+        let set: Vec<&str> = match t.get("stations").and_then(|s| s.get_ref().as_table()) {
+            Some(st) => st.iter().map(|(k, _)| k.get_ref().as_ref()).collect(),
+            None => Vec::new(),
+        };
+        let kept: Vec<(String, P2)> = (layout.stations.iter())
+            .filter(|(n, _)| !set.contains(&n.as_str()))
+            .cloned()
+            .collect();
+        for (span, i) in placed {
+            let r = layout.obstacles[i].clone();
+            self.covers_no_station(span, &r, &kept, params.robot_radius, "obstacle");
         }
         if let Some(b) = t.get("battery")
             && let Some(x) = self.number(b, "`battery`", 0.0, 100.0)
@@ -648,16 +728,46 @@ impl Reader {
                     },
                     None => true,
                 };
-                objects.push(Object {
-                    name,
-                    place: Place::At(p),
-                    found,
-                });
+                // On the table in front of its pose, or on the floor.
+                let place = match layout.surface_near(p, params.robot_radius) {
+                    Some(_) => Place::At(p),
+                    None => Place::Floor(p),
+                };
+                objects.push(Object::new(&name, place, p, found));
             }
         }
         let mut w = World::new(layout, params, robot, objects);
         w.battery = battery;
         Some(w)
+    }
+
+    /// Refuses an obstacle or a `block` over a station (or the robot's
+    /// start): the robot must fit at every station. O(stations).
+    fn covers_no_station(
+        &mut self,
+        span: Range<usize>,
+        r: &Rect,
+        stations: &[(String, P2)],
+        radius: f64,
+        what: &str,
+    ) -> bool {
+        let hit = stations.iter().find(|(_, p)| r.distance(*p) < radius);
+        if let Some((n, p)) = hit {
+            self.err(
+                span,
+                format!(
+                    "{what} `{}` covers station `{n}` ({}, {})",
+                    r.name,
+                    show(p.0),
+                    show(p.1)
+                ),
+                format!(
+                    "keep it at least the robot's radius ({radius} m) away from every station, or move the station"
+                ),
+            );
+            return false;
+        }
+        true
     }
 
     fn rect(&mut self, v: &Val<'_>) -> Option<Rect> {
@@ -843,7 +953,25 @@ impl Reader {
                 )
             }
             "block" => {
-                let r = self.rect(t.get("block").expect("checked above"))?;
+                let bv = t.get("block").expect("checked above");
+                let r = self.rect(bv)?;
+                if !self.covers_no_station(
+                    bv.span(),
+                    &r,
+                    &world.layout.stations,
+                    world.params.robot_radius,
+                    "`block`",
+                ) {
+                    return None;
+                }
+                if r.distance(world.robot) < world.params.robot_radius {
+                    self.err(
+                        bv.span(),
+                        format!("`block` `{}` covers the robot's start ({}, {})", r.name, show(world.robot.0), show(world.robot.1)),
+                        "a box cannot land on the robot; move it (a block that would cover the robot during a run is refused, with an event)",
+                    );
+                    return None;
+                }
                 let text = format!("path blocked by {}", r.name);
                 (Effect::Block(r), text)
             }
@@ -894,10 +1022,21 @@ impl Reader {
             .get("max_steps")
             .and_then(|v| self.integer(v, "`max_steps`", 1, MAX_STEPS))
             .unwrap_or(20_000);
-        let chatter_switches = t
-            .get("chatter_switches")
-            .and_then(|v| self.integer(v, "`chatter_switches`", 2, 1_000_000))
-            .unwrap_or(12) as u32;
+        if let Some(v) = t.get("chatter_switches")
+            && self
+                .integer(v, "`chatter_switches`", 2, 1_000_000)
+                .is_some()
+        {
+            self.diags.push(
+                Diagnostic::warning("`chatter_switches` is no longer used: a livelock is a recurring abstract state without progress toward the goal")
+                    .at(&self.file, v.span())
+                    .hint("remove it; `livelock_repeats` (default 3) sets how often a state may recur"),
+            );
+        }
+        let livelock_repeats = t
+            .get("livelock_repeats")
+            .and_then(|v| self.integer(v, "`livelock_repeats`", 2, 1_000_000))
+            .unwrap_or(3) as u32;
         let max_failures = t
             .get("max_failures")
             .and_then(|v| self.integer(v, "`max_failures`", 1, 1_000_000))
@@ -940,35 +1079,10 @@ impl Reader {
                 }
             }
         }
-        let mut monte_carlo = MonteCarlo::default();
-        if let Some(m) = t.get("monte_carlo") {
-            let mt = self.table(m, "`monte_carlo`")?;
-            self.keys(mt, &["rates", "battery_drop"], "field of `monte_carlo`");
-            if let Some(r) = mt.get("rates") {
-                monte_carlo.rates = self.rates(r)?;
-            }
-            if let Some(b) = mt.get("battery_drop") {
-                let bt = self.table(b, "`battery_drop`")?;
-                self.keys(
-                    bt,
-                    &["probability", "level", "window"],
-                    "field of `battery_drop`",
-                );
-                let p = bt
-                    .get("probability")
-                    .and_then(|v| self.number(v, "`probability`", 0.0, 1.0))
-                    .unwrap_or(0.5);
-                let level = bt
-                    .get("level")
-                    .and_then(|v| self.range(v, "`level`", 0.0, 100.0))
-                    .unwrap_or((5.0, 19.0));
-                let window = bt
-                    .get("window")
-                    .and_then(|v| self.range(v, "`window`", 0.0, 1e9))
-                    .unwrap_or((5.0, 60.0));
-                monte_carlo.battery_drop = Some((p, level, window));
-            }
-        }
+        let monte_carlo = match t.get("monte_carlo") {
+            Some(m) => self.monte_carlo(m, &world)?,
+            None => MonteCarlo::default(),
+        };
         let mut policies = Vec::new();
         match t.get("policies") {
             None => self.err(
@@ -988,13 +1102,22 @@ impl Reader {
                 }
             }
         }
+        let expect = match t.get("expect") {
+            Some(e) => {
+                let names: Vec<String> = policies.iter().map(|p| p.policy.name.clone()).collect();
+                self.expect(e, &names, goal.is_some())
+            }
+            None => Vec::new(),
+        };
         Some(Scenario {
+            expect,
+            warnings: Vec::new(),
             name,
             description,
             seed,
             dt,
             max_steps,
-            chatter_switches,
+            livelock_repeats,
             max_failures,
             world,
             policies,
@@ -1005,6 +1128,29 @@ impl Reader {
         })
     }
 
+    /// `after_success` / `after_failure`: `"stop"` or `"keep-ticking"`.
+    fn afterwards(&mut self, v: Option<&Val<'_>>, key: &str, keep: bool) -> Option<Afterwards> {
+        let Some(a) = v else {
+            return Some(if keep {
+                Afterwards::KeepTicking
+            } else {
+                Afterwards::Stop
+            });
+        };
+        match a.get_ref().as_str() {
+            Some("stop") => Some(Afterwards::Stop),
+            Some("keep-ticking") => Some(Afterwards::KeepTicking),
+            _ => {
+                self.err(
+                    a.span(),
+                    format!("`{key}` must be \"stop\" or \"keep-ticking\""),
+                    format!("write `{key} = \"keep-ticking\"` to tick the policy again (a BT's default), `\"stop\"` to end it (an FSM's and an HFSM's)"),
+                );
+                None
+            }
+        }
+    }
+
     fn policy(
         &mut self,
         v: &Val<'_>,
@@ -1013,7 +1159,11 @@ impl Reader {
         world: &World,
     ) -> Option<PolicyEntry> {
         let t = self.table(v, "a policy entry")?;
-        self.keys(t, &["file", "convert"], "field of a policy entry");
+        self.keys(
+            t,
+            &["file", "convert", "name", "after_success", "after_failure"],
+            "field of a policy entry",
+        );
         let Some(f) = t.get("file") else {
             self.err(
                 v.span(),
@@ -1101,10 +1251,43 @@ impl Reader {
             }
         }
         check_bindings(&policy, &loaded.path, limits, world, &mut self.diags);
+        if convert.is_none()
+            && let PolicyBody::Machine(m) = &policy.body
+            && m.top.outcomes.iter().any(|o| o == "RUNNING")
+            && let Some(st) = (m.states.iter()).find(|st| {
+                matches!(st.body, StateBody::Container(_))
+                    && (st.label == "Sequence*" || st.label == "Fallback*")
+            })
+        {
+            self.diags.push(
+                Diagnostic::warning(format!(
+                    "`{rel}` looks converted from a BT with memory: its container `{}` ({}) is re-entered at its first state every tick, so it forgets the running child and does not behave as the BT",
+                    st.name, st.label
+                ))
+                .at(&self.file, f.span())
+                .hint("run the BT itself, or convert a BT whose composites are reactive (sequence / fallback)"),
+            );
+        }
+        if let Some(n) = t.get("name") {
+            policy.name = self.string(n, "`name`")?;
+        }
+        // Defaults: a BT keeps ticking after both (its root is ticked every
+        // step); a machine stops, unless its top-level outcomes include
+        // RUNNING (the Fig. 6 construction says it is ticked), which keeps
+        // ticking after FAILURE.
+        let (bt, tick_driven) = match &policy.body {
+            PolicyBody::Bt(_) => (true, true),
+            PolicyBody::Machine(m) => (false, m.top.outcomes.iter().any(|o| o == "RUNNING")),
+        };
+        let after_success = self.afterwards(t.get("after_success"), "after_success", bt)?;
+        let after_failure =
+            self.afterwards(t.get("after_failure"), "after_failure", tick_driven)?;
         Some(PolicyEntry {
             file: path,
             convert,
             policy,
+            after_success,
+            after_failure,
         })
     }
 }

@@ -1,9 +1,12 @@
 //! What a run records (SPEC §6): per step the time, pose, battery, running skills
 //! and node/state statuses; the executed skills with arguments and outcomes;
 //! events; the final world; the outcome. Also the behavior-match verdict between
-//! two runs: equal ordered sequence of executed skills (with arguments and
-//! outcomes) and equal final world, with the first divergence and the trajectory
-//! distance (discrete Fréchet distance, Eiter and Mannila 1994).
+//! two runs: the same executed skills in the same order (arguments, outcomes,
+//! start times within a tolerance, one step by default), the same goal
+//! outcome and the same final world, with the first divergence and its time,
+//! the distance between the robot's positions at the same times (time-aligned)
+//! and, beside it, the time-free discrete Fréchet distance between the paths
+//! (Eiter and Mannila 1994).
 
 use super::world::{P2, Place, World, dist};
 use serde::Serialize;
@@ -14,7 +17,9 @@ use std::collections::BTreeMap;
 pub struct SkillRecord {
     pub skill: String,
     pub args: BTreeMap<String, String>,
-    /// `success`, `failure`, `cancelled` (preempted), or `running` at the end.
+    /// `success`, `failure`, `cancelled` (halted by the policy, or not
+    /// ticked), `aborted` (its base or arm taken by a new goal of the same
+    /// policy, as an action server aborts a goal), or `running` at the end.
     pub outcome: String,
     pub start: f64,
     pub end: Option<f64>,
@@ -27,8 +32,16 @@ impl SkillRecord {
         format!("{}({}) -> {}", self.skill, args.join(", "), self.outcome)
     }
 
+    /// The same skill, arguments and outcome; `cancelled` and `aborted` are
+    /// the same outcome here: the action ended because the policy started
+    /// another, and which came first, the halt or the new goal, is the
+    /// executor's order (BehaviorTree.CPP starts the new action before it
+    /// halts the old one; an FSM leaves its state first), not behavior.
     fn same(&self, o: &SkillRecord) -> bool {
-        self.skill == o.skill && self.args == o.args && self.outcome == o.outcome
+        fn class(x: &str) -> &str {
+            if x == "aborted" { "cancelled" } else { x }
+        }
+        self.skill == o.skill && self.args == o.args && class(&self.outcome) == class(&o.outcome)
     }
 }
 
@@ -184,6 +197,13 @@ pub struct Run {
     /// Whether the scenario's goal holds at the end (`None`: no goal given).
     pub goal_met: Option<bool>,
     pub steps: u64,
+    /// Step length, s (the verdicts' default start-time tolerance).
+    #[serde(skip)]
+    pub dt: f64,
+    /// What the policy did after SUCCESS (`stop` or `keep-ticking`).
+    pub after_success: &'static str,
+    /// What the policy did after FAILURE (`stop` or `keep-ticking`).
+    pub after_failure: &'static str,
     /// Time at which the policy last reported it was done, s.
     pub completion_s: Option<f64>,
     pub duration_s: f64,
@@ -195,6 +215,11 @@ pub struct Run {
     pub recharge_latency_s: Vec<f64>,
     #[serde(skip)]
     pub trajectory: Vec<P2>,
+    /// The positions with the step at which the robot reached each: the
+    /// steps where it moved (and the start), at most [`TRAJECTORY_POINTS`];
+    /// between two, it stood still. For the time-aligned distance.
+    #[serde(skip)]
+    pub track: Vec<(u64, P2)>,
     #[serde(skip)]
     pub trace: Vec<Step>,
 }
@@ -206,6 +231,33 @@ pub struct Divergence {
     pub index: usize,
     pub a: Option<String>,
     pub b: Option<String>,
+    /// When: the earlier start of the two skills, s (the end of the shorter
+    /// run when one has no skill there).
+    pub t: f64,
+    /// `skill` (skill, arguments or outcome differ), `start` (the same skill
+    /// started more than the tolerance apart) or `missing` (one run has no
+    /// skill there).
+    pub kind: &'static str,
+    /// The two start times, s, for `start`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub starts: Option<[f64; 2]>,
+}
+
+impl Divergence {
+    /// `at 10.0 s, skill 3: Pick(object=cube2) -> success | (none)`.
+    pub fn summary(&self) -> String {
+        let what = match (self.kind, self.starts) {
+            ("start", Some([a, b])) => format!(" (started at {a} s | {b} s)"),
+            _ => String::new(),
+        };
+        format!(
+            "at {} s, skill {}: {} | {}{what}",
+            self.t,
+            self.index + 1,
+            self.a.as_deref().unwrap_or("(none)"),
+            self.b.as_deref().unwrap_or("(none)")
+        )
+    }
 }
 
 /// The behavior-match verdict between two runs.
@@ -213,15 +265,24 @@ pub struct Divergence {
 pub struct Verdict {
     pub a: String,
     pub b: String,
+    /// Same skills, same outcome and goal, same final world.
     #[serde(rename = "match")]
     pub matches: bool,
+    /// The same executed skills in order: skill, arguments, outcome, and
+    /// start times at most `tolerance_s` apart.
     pub same_skills: bool,
+    /// The same run outcome and the same goal result.
+    pub same_outcome: bool,
     pub same_final_world: bool,
+    pub tolerance_s: f64,
     pub first_divergence: Option<Divergence>,
-    /// Discrete Fréchet distance between the two trajectories, m.
+    /// The largest distance between the two robots at the same time, m
+    /// (after its run ended, a robot stands where it stopped).
     pub trajectory_distance_m: f64,
+    /// Discrete Fréchet distance between the two paths, m: how far apart
+    /// the paths are, whatever the time each took.
+    pub path_distance_m: f64,
 }
-
 /// The verdict of every pair of runs, in pair order, their trajectories
 /// thinned once to at most `points` points each for the Fréchet distance.
 pub fn verdicts(runs: &[Run], points: usize) -> Vec<Verdict> {
@@ -273,26 +334,97 @@ pub fn verdict(a: &Run, b: &Run) -> Verdict {
     )
 }
 
+/// Whether two runs' behavior matches (the verdict without its distances).
+pub fn behavior_matches(a: &Run, b: &Run) -> bool {
+    verdict_on(a, b, &[], &[]).matches
+}
+
 fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
+    let tol = a.dt.max(b.dt) + 1e-6;
     let n = a.skills.len().max(b.skills.len());
-    let first = (0..n).find(|&i| match (a.skills.get(i), b.skills.get(i)) {
-        (Some(x), Some(y)) => !x.same(y),
-        _ => true,
+    let end = |r: &Run| r.duration_s;
+    let first = (0..n).find_map(|i| {
+        let (x, y) = (a.skills.get(i), b.skills.get(i));
+        let (kind, t, starts) = match (x, y) {
+            (Some(x), Some(y)) if !x.same(y) => ("skill", x.start.min(y.start), None),
+            (Some(x), Some(y)) if (x.start - y.start).abs() > tol => {
+                ("start", x.start.min(y.start), Some([x.start, y.start]))
+            }
+            (Some(_), Some(_)) => return None,
+            (Some(x), None) => ("missing", x.start.min(end(b)), None),
+            (None, Some(y)) => ("missing", y.start.min(end(a)), None),
+            (None, None) => return None,
+        };
+        Some(Divergence {
+            index: i,
+            a: x.map(SkillRecord::text),
+            b: y.map(SkillRecord::text),
+            t,
+            kind,
+            starts,
+        })
     });
     let same_world = a.final_world.same_state(&b.final_world);
+    let same_outcome = a.outcome == b.outcome && a.goal_met == b.goal_met;
     Verdict {
         a: a.policy.clone(),
         b: b.policy.clone(),
-        matches: first.is_none() && same_world,
+        matches: first.is_none() && same_world && same_outcome,
         same_skills: first.is_none(),
+        same_outcome,
         same_final_world: same_world,
-        first_divergence: first.map(|i| Divergence {
-            index: i,
-            a: a.skills.get(i).map(SkillRecord::text),
-            b: b.skills.get(i).map(SkillRecord::text),
-        }),
-        trajectory_distance_m: (frechet_thinned(ta, tb) * 1000.0).round() / 1000.0,
+        tolerance_s: (tol * 1000.0).round() / 1000.0,
+        first_divergence: first,
+        trajectory_distance_m: (aligned_distance(&a.track, &b.track) * 1000.0).round() / 1000.0,
+        path_distance_m: (frechet_thinned(ta, tb) * 1000.0).round() / 1000.0,
     }
+}
+
+/// The largest distance between two tracks at the same step: each holds its
+/// position between two points and after its last. Linear in the points.
+pub fn aligned_distance(a: &[(u64, P2)], b: &[(u64, P2)]) -> f64 {
+    let (Some(&(_, mut pa)), Some(&(_, mut pb))) = (a.first(), b.first()) else {
+        return 0.0;
+    };
+    let (mut i, mut j) = (0, 0);
+    let mut best = dist(pa, pb);
+    while i < a.len() || j < b.len() {
+        let next = match (a.get(i), b.get(j)) {
+            (Some(x), Some(y)) => x.0.min(y.0),
+            (Some(x), None) => x.0,
+            (None, Some(y)) => y.0,
+            (None, None) => break,
+        };
+        while let Some(&(k, p)) = a.get(i)
+            && k == next
+        {
+            pa = p;
+            i += 1;
+        }
+        while let Some(&(k, p)) = b.get(j)
+            && k == next
+        {
+            pb = p;
+            j += 1;
+        }
+        best = best.max(dist(pa, pb));
+    }
+    best
+}
+
+/// A run's track as kept: every k-th point when there are more than
+/// [`TRAJECTORY_POINTS`], and the last.
+pub fn compact_track(t: Vec<(u64, P2)>) -> Vec<(u64, P2)> {
+    if t.len() <= TRAJECTORY_POINTS {
+        return t;
+    }
+    let last = *t.last().expect("non-empty");
+    let stride = t.len().div_ceil(TRAJECTORY_POINTS);
+    let mut out: Vec<(u64, P2)> = t.into_iter().step_by(stride).collect();
+    if out.last() != Some(&last) {
+        out.push(last);
+    }
+    out
 }
 
 /// Trajectory points a run keeps once it has ended (for the verdicts and

@@ -241,11 +241,10 @@ mod tests {
         bt
     }
 
-    /// Per tick: the root's status, and each leaf ticked (its status) or
-    /// halted (`None`).
-    type Trace = Vec<(Status, Vec<(String, Option<Status>)>)>;
+    /// Per tick: the root status and each leaf event (node, status or halt).
+    type Ticks = Vec<(Status, Vec<(String, Option<Status>)>)>;
 
-    fn events(bt: &Bt, script: &str) -> Trace {
+    fn events(bt: &Bt, script: &str) -> Ticks {
         let s = script::parse(&SourceFile::new("s.toml", script), bt).expect("script");
         run(bt, &s)
             .ticks

@@ -81,6 +81,28 @@ fn unreachable_state_is_a_warning_not_an_error() {
     assert!(stderr.contains("unreachable-state.toml:10:9"), "{stderr}");
 }
 
+/// What BehaviorTree.CPP's tinyxml2 reads although it is not well-formed
+/// XML (text before `<root>`, `--` in a comment, a bare `&` or `<` in an
+/// attribute, attributes without a space) loads with a warning at each place;
+/// the values are read as tinyxml2 reads them.
+#[test]
+fn xml_that_behaviortree_cpp_tolerates_loads_with_warnings() {
+    let f = "tests/fixtures/valid/tinyxml2-lenient.xml";
+    let (code, _, stderr) = btfsm(&["validate", f]);
+    assert_eq!(code, 0, "{stderr}");
+    let expected =
+        std::fs::read_to_string("tests/fixtures/valid/tinyxml2-lenient.stderr").unwrap_or_default();
+    if std::env::var_os("BLESS").is_some() {
+        std::fs::write("tests/fixtures/valid/tinyxml2-lenient.stderr", &stderr).expect("bless");
+    } else {
+        assert_eq!(stderr, expected);
+    }
+    let (code, toml, stderr) = btfsm(&["convert", f, "--to", "toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(toml.contains(r#"code = "ok := 1 && 2 < 3""#), "{toml}");
+    assert!(toml.contains(r#""fish & chips""#), "{toml}");
+}
+
 #[test]
 fn missing_file_and_bad_usage_exit_2() {
     let (code, _, stderr) = btfsm(&["analyze", "no/such/file.toml"]);

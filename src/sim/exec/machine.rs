@@ -17,6 +17,21 @@ pub struct CompiledMachine {
     pub call: Vec<Option<Call>>,
     /// Per state: its guards in order, with their targets.
     pub guards: Vec<Vec<(GuardTerms, Target)>>,
+    /// Per state, the index of its transition on RUNNING, SUCCESS and
+    /// FAILURE (the first written), so a step compares no strings.
+    pub on_status: Vec<[Option<u32>; 3]>,
+    /// The top-level outcomes include `RUNNING` (the Fig. 6 construction):
+    /// the machine is re-entered after FAILURE.
+    pub tick_driven: bool,
+}
+
+fn status_index(o: &str) -> Option<usize> {
+    match o {
+        "RUNNING" => Some(0),
+        "SUCCESS" => Some(1),
+        "FAILURE" => Some(2),
+        _ => None,
+    }
 }
 
 impl CompiledMachine {
@@ -49,10 +64,25 @@ impl CompiledMachine {
             }
         }
         if errs.is_empty() {
+            let on_status = (m.states.iter())
+                .map(|s| {
+                    let mut on = [None; 3];
+                    for (i, t) in s.transitions.iter().enumerate() {
+                        if let Trigger::Outcome(o) = &t.trigger
+                            && let Some(k) = status_index(o)
+                        {
+                            on[k].get_or_insert(i as u32);
+                        }
+                    }
+                    on
+                })
+                .collect();
             Ok(CompiledMachine {
                 m: m.clone(),
                 call,
                 guards,
+                on_status,
+                tick_driven: m.top.outcomes.iter().any(|x| x == "RUNNING"),
             })
         } else {
             Err(errs)
@@ -69,22 +99,34 @@ pub struct MachineExec {
     pub finished: Option<(String, String)>,
     /// When `Some`, every state run in the last step with its status.
     pub statuses: Option<Vec<(usize, Status)>>,
+    /// `after_success = "keep-ticking"`: reaching the top-level outcome
+    /// SUCCESS returns SUCCESS and the next step re-enters the machine at
+    /// its initial state, instead of ending it.
+    pub keep_ticking: bool,
+    /// `after_failure = "keep-ticking"`: reaching FAILURE (a top-level
+    /// outcome other than SUCCESS, or a state's outcome with no transition)
+    /// returns FAILURE and the next tick re-enters the machine at its
+    /// initial state (a task reset), instead of ending it. Set by default
+    /// for a machine whose top-level outcomes include RUNNING.
+    pub reenter_on_failure: bool,
 }
 
-enum Flow {
+enum Flow<'a> {
     Enter(usize),
     /// An outcome of the region of the state's parent (`None`: top level).
-    Up(Option<usize>, String),
+    Up(Option<usize>, &'a str),
 }
 
 impl MachineExec {
     pub fn new(c: Arc<CompiledMachine>, record: bool) -> Self {
         let current = c.m.top.initial;
         MachineExec {
-            c,
             current,
             finished: None,
             statuses: record.then(Vec::new),
+            keep_ticking: false,
+            reenter_on_failure: c.tick_driven,
+            c,
         }
     }
 
@@ -92,10 +134,10 @@ impl MachineExec {
         terms.iter().all(|(c, neg)| leaves.condition(s, c) != *neg)
     }
 
-    fn follow(&self, from: usize, t: &Target) -> Flow {
+    fn follow<'a>(c: &'a CompiledMachine, from: usize, t: &'a Target) -> Flow<'a> {
         match t {
             Target::State(s) => Flow::Enter(*s),
-            Target::Outcome(o) => Flow::Up(self.c.m.states[from].parent, o.clone()),
+            Target::Outcome(o) => Flow::Up(c.m.states[from].parent, o),
         }
     }
 
@@ -132,7 +174,9 @@ impl MachineExec {
         'anc: for &a in anc.iter().rev() {
             for (g, t) in &c.guards[a] {
                 if Self::holds(a, g, leaves) {
-                    flow = self.follow(a, t);
+                    // The running state is left: its action is halted now.
+                    leaves.halt(self.current);
+                    flow = Self::follow(&c, a, t);
                     break 'anc;
                 }
             }
@@ -149,10 +193,15 @@ impl MachineExec {
                         self.current = c.m.top.initial;
                         return Status::Running;
                     }
-                    // A tick-driven machine (top-level outcome RUNNING, as the
-                    // BT -> HFSM construction makes) is re-entered after a
+                    if o == "SUCCESS" && self.keep_ticking {
+                        self.current = c.m.top.initial;
+                        return Status::Success;
+                    }
+                    // `after_failure = "keep-ticking"` (the default of a
+                    // tick-driven machine, top-level outcome RUNNING, as the
+                    // BT -> HFSM construction makes): re-entered after a
                     // failure, as a BT's root is ticked again.
-                    if o != "SUCCESS" && c.m.top.outcomes.iter().any(|x| x == "RUNNING") {
+                    if o != "SUCCESS" && self.reenter_on_failure {
                         self.current = c.m.top.initial;
                         return Status::Failure;
                     }
@@ -161,7 +210,7 @@ impl MachineExec {
                     } else {
                         Status::Failure
                     };
-                    self.finished = Some((o.clone(), format!("reached the outcome {o}")));
+                    self.finished = Some((o.to_string(), format!("reached the outcome {o}")));
                     return st;
                 }
                 Flow::Up(Some(container), o) => (container, o),
@@ -170,7 +219,10 @@ impl MachineExec {
                     if let Some((_, t)) =
                         c.guards[s].iter().find(|(g, _)| Self::holds(s, g, leaves))
                     {
-                        flow = self.follow(s, t);
+                        // Preempted: a running action of the state is halted
+                        // at once (a state entered afresh has none).
+                        leaves.halt(s);
+                        flow = Self::follow(&c, s, t);
                         continue;
                     }
                     let st = match &c.m.states[s].body {
@@ -192,15 +244,17 @@ impl MachineExec {
                         },
                     };
                     self.note(s, st);
-                    (s, st.as_str().to_string())
+                    (s, st.as_str())
                 }
             };
-            let tr = c.m.states[from]
-                .transitions
-                .iter()
-                .find(|t| matches!(&t.trigger, Trigger::Outcome(o) if *o == outcome));
+            let transitions = &c.m.states[from].transitions;
+            let tr = match status_index(outcome) {
+                Some(k) => c.on_status[from][k].map(|i| &transitions[i as usize]),
+                None => (transitions.iter())
+                    .find(|t| matches!(&t.trigger, Trigger::Outcome(o) if *o == outcome)),
+            };
             match tr {
-                Some(t) => match self.follow(from, &t.target) {
+                Some(t) => match Self::follow(&c, from, &t.target) {
                     Flow::Enter(next) if outcome == "RUNNING" => {
                         self.current = next;
                         return Status::Running;
@@ -210,6 +264,10 @@ impl MachineExec {
                 None if outcome == "RUNNING" => {
                     self.current = from;
                     return Status::Running;
+                }
+                None if self.reenter_on_failure && outcome != "SUCCESS" => {
+                    self.current = c.m.top.initial;
+                    return Status::Failure;
                 }
                 None => {
                     self.finished = Some((
@@ -223,5 +281,84 @@ impl MachineExec {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::{Limits, toml::parse_str};
+    use crate::model::PolicyBody;
+    use std::path::Path;
+
+    /// Leaves that log what the executor does: ticks and halts, in order.
+    struct Log {
+        battery_ok: bool,
+        log: Vec<String>,
+    }
+
+    impl Leaves for Log {
+        fn condition(&mut self, _: usize, _: &Call) -> bool {
+            self.battery_ok
+        }
+        fn action(&mut self, key: usize, call: &Call) -> Status {
+            self.log.push(format!("tick {key} {}", call.name()));
+            Status::Running
+        }
+        fn halt(&mut self, key: usize) {
+            self.log.push(format!("halt {key}"));
+        }
+        fn now(&self) -> f64 {
+            0.0
+        }
+    }
+
+    /// A guard that preempts a state whose action is running halts that
+    /// action at once, before the next state's action is ticked; with
+    /// `keep_ticking`, SUCCESS re-enters the machine instead of ending it.
+    #[test]
+    fn a_preempting_guard_halts_the_running_action_first() {
+        let text = r#"
+kind = "fsm"
+initial = "A"
+outcomes = ["SUCCESS"]
+[states.A]
+skill = "Tuck-Arm"
+guards = [{ unless = "Battery-Level", args = { min = 20 }, to = "R" }]
+on = { SUCCESS = "SUCCESS" }
+[states.R]
+skill = "Recharge"
+on = { SUCCESS = "A" }
+"#;
+        let l = parse_str("f.toml", text, Path::new("."), &Limits::default()).unwrap();
+        let PolicyBody::Machine(m) = &l.policy.body else {
+            panic!("an FSM")
+        };
+        let cm = CompiledMachine::new(m, |c| {
+            Ok::<_, ()>(match c.skill.as_str() {
+                "Battery-Level" => Call::BatteryLevel(20.0),
+                "Recharge" => Call::Recharge,
+                _ => Call::TuckArm,
+            })
+        })
+        .unwrap();
+        let a = m.states.iter().position(|s| s.name == "A").unwrap();
+        let r = m.states.iter().position(|s| s.name == "R").unwrap();
+        let mut ex = MachineExec::new(Arc::new(cm), false);
+        let mut leaves = Log {
+            battery_ok: true,
+            log: vec![],
+        };
+        assert_eq!(ex.step(&mut leaves), Status::Running);
+        leaves.battery_ok = false;
+        assert_eq!(ex.step(&mut leaves), Status::Running);
+        assert_eq!(
+            leaves.log,
+            vec![
+                format!("tick {a} Tuck-Arm"),
+                format!("halt {a}"),
+                format!("tick {r} Recharge"),
+            ]
+        );
     }
 }

@@ -20,9 +20,10 @@
 //!   transition on that outcome; the guards of the enclosing containers are
 //!   checked first, outermost first. Reaching the top-level outcome `RUNNING`
 //!   ends the step and the next step re-enters the machine (the construction of
-//!   Fig. 6, which makes an HFSM tick like a BT); such a tick-driven machine is
-//!   also re-entered after reaching FAILURE, as a BT's root is ticked again,
-//!   and ends at SUCCESS.
+//!   Fig. 6, which makes an HFSM tick like a BT). What a machine does at
+//!   SUCCESS and at FAILURE (end, or be re-entered at its initial state) is
+//!   set by the run (`after_success`, `after_failure` in the scenario;
+//!   [`MachineExec::keep_ticking`], [`MachineExec::reenter_on_failure`]).
 //!
 //! Both executors walk their structure with explicit stacks, never recursion.
 //! A BT's reactive skeleton (its Sequence and Fallback nodes from the root
