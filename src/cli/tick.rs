@@ -98,17 +98,8 @@ fn one(
             node.id
         ))
         .hint("`tick` runs the node types of docs/bt-semantics.md, not an approximation");
-        // A span is into the file the node was read from: shown when it
-        // is this file's (a node of an included file is named by its id).
-        let ty = node.type_name.as_deref().unwrap_or(node.kind.keyword());
-        let here = |sp: &std::ops::Range<usize>| {
-            file.text.get(sp.start..).is_some_and(|t| {
-                (!node.id.contains('/') && sp.end <= file.text.len())
-                    || t.starts_with(&format!("<{ty}"))
-            })
-        };
         let d = match &node.span {
-            Some(sp) if here(sp) => d.at(&file, sp.clone()),
+            Some(sp) if in_this_file(&file.text, f, node, sp) => d.at(&file, sp.clone()),
             _ => d.in_file(&file),
         };
         return Err(vec![d]);
@@ -121,4 +112,31 @@ fn one(
         OutputFormat::Json => run.json(bt, &tn, &sn),
         _ => run.table(bt, &shown(&tn), &shown(&sn)),
     })
+}
+
+/// Whether a node's span is in the file given on the command line (not in
+/// an included one): a TOML node not from a subtree (`include/id`); an XML
+/// element whose tag, at the span, is the node's type.
+fn in_this_file(
+    text: &str,
+    f: format::FileFormat,
+    node: &crate::model::bt::BtNode,
+    sp: &std::ops::Range<usize>,
+) -> bool {
+    let Some(at) = text.get(sp.clone()) else {
+        return false;
+    };
+    if f != format::FileFormat::BtcppXml {
+        return !node.id.contains('/');
+    }
+    let tag: &str = at
+        .strip_prefix('<')
+        .unwrap_or("")
+        .split(|c: char| c.is_whitespace() || c == '/' || c == '>')
+        .next()
+        .unwrap_or("");
+    !tag.is_empty()
+        && (node.type_name.as_deref() == Some(tag)
+            || format::btcpp_xml::canonical_type(node.kind) == Some(tag)
+            || node.skill.as_ref().is_some_and(|c| c.skill == tag))
 }

@@ -128,6 +128,19 @@ fn unsupported_types_are_refused_with_a_position() {
         err.contains("`Timeout` (wall-clock time)") && err.contains("t.toml:4:"),
         "{err}"
     );
+    // A pre/post-condition script is not modelled: refused, not ignored.
+    let x = d.join("p.xml");
+    std::fs::write(
+        &x,
+        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"T\">\n<Sequence>\n<AlwaysSuccess _skipIf=\"x\"/>\n</Sequence></BehaviorTree></root>\n",
+    )
+    .unwrap();
+    let (code, _, err) = btfsm(&["tick", x.to_str().unwrap(), "--script", SCRIPT]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("`_skipIf`") && err.contains("p.xml:3:1"),
+        "{err}"
+    );
 }
 
 #[test]

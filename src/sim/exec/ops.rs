@@ -141,9 +141,25 @@ pub(super) fn op_of(n: &BtNode) -> Result<(Op, i64, i64), String> {
     })
 }
 
+/// BehaviorTree.CPP 4's pre- and post-condition ports (scripts run around
+/// a node's tick), which the executor does not model.
+const PRE_POST: &[&str] = &[
+    "_skipIf",
+    "_failureIf",
+    "_successIf",
+    "_while",
+    "_onSuccess",
+    "_onFailure",
+    "_onHalted",
+    "_post",
+];
+
 /// Why the executor cannot tick node `n` as BehaviorTree.CPP 4 does (its
-/// type, as written), if it cannot.
+/// type, as written, or a pre/post condition), if it cannot.
 pub fn refused(n: &BtNode) -> Option<String> {
+    if let Some(p) = n.ports.keys().find(|p| PRE_POST.contains(&p.as_str())) {
+        return Some(format!("`{p}` (a pre/post-condition script)"));
+    }
     op_of(n).err()
 }
 
@@ -153,6 +169,9 @@ pub fn unsupported(bt: &Bt) -> Option<(usize, String)> {
     let k = |i: usize| bt.nodes[i].children.len() as i64;
     bt.preorder().into_iter().find_map(|i| {
         let n = &bt.nodes[i];
+        if let Some(what) = refused(n) {
+            return Some((i, what));
+        }
         match op_of(n) {
             Err(what) => Some((i, what)),
             Ok((Op::Parallel, s, f)) if s < 1 || f < 1 || s > k(i) || f > k(i) => Some((
