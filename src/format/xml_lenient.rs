@@ -118,28 +118,20 @@ pub fn repair(text: &str) -> Option<(String, OffsetMap, Vec<Repair>)> {
                         }
                         continue;
                     }
-                    Some(_) if c == b'<' => {
+                    Some(_) if c == b'<' || (c == b'&' && !entity_at(&text[i..])) => {
+                        let (what, escape) = if c == b'<' {
+                            ("a bare `<` in an attribute value", "&lt;")
+                        } else {
+                            ("a bare `&` in an attribute value", "&amp;")
+                        };
                         if !fixed_here {
                             fixes.push(Repair {
                                 span: i..i + 1,
-                                what: "a bare `<` in an attribute value",
+                                what,
                             });
                             fixed_here = true;
                         }
-                        out.push_str("&lt;");
-                        i += 1;
-                        map.marks.push((out.len(), i));
-                        continue;
-                    }
-                    Some(_) if c == b'&' && !entity_at(&text[i..]) => {
-                        if !fixed_here {
-                            fixes.push(Repair {
-                                span: i..i + 1,
-                                what: "a bare `&` in an attribute value",
-                            });
-                            fixed_here = true;
-                        }
-                        out.push_str("&amp;");
+                        out.push_str(escape);
                         i += 1;
                         map.marks.push((out.len(), i));
                         continue;

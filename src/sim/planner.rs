@@ -323,12 +323,7 @@ mod tests {
     use crate::sim::world::World;
 
     fn world() -> World {
-        World::new(
-            Layout::paper_room(),
-            Params::default(),
-            (-2.0, -2.2),
-            vec![],
-        )
+        crate::sim::world::empty_paper_room()
     }
 
     #[test]

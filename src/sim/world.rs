@@ -567,17 +567,23 @@ impl World {
     }
 }
 
+/// The paper's room with the robot at the start and no objects (tests).
+#[cfg(test)]
+pub fn empty_paper_room() -> World {
+    World::new(
+        Layout::paper_room(),
+        Params::default(),
+        (-2.0, -2.2),
+        vec![],
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn world() -> World {
-        World::new(
-            Layout::paper_room(),
-            Params::default(),
-            (-2.0, -2.2),
-            vec![],
-        )
+        empty_paper_room()
     }
 
     #[test]

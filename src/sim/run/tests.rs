@@ -7,6 +7,22 @@ use crate::sim::livelock::{LIVELOCK_STATES, Livelock};
 use crate::sim::monte_carlo::{monte_carlo, monte_carlo_within};
 use std::path::Path;
 
+/// Fig. 1's BT and Fig. 4's FSM fetching cube2 to the delivery station,
+/// with `rest` (disturbances, more policies) after them.
+fn fig1_fig4(rest: &str) -> String {
+    format!(
+        "{}{rest}",
+        r#"goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig04-fsm.toml"
+"#
+    )
+}
+
 fn scenario(text: &str) -> Scenario {
     let f = SourceFile::new("t.toml", text);
     super::super::scenario::parse(&f, Path::new("policies/scenarios"), &Limits::default())
@@ -60,21 +76,13 @@ fn equivalent_bt_and_fsm_produce_equal_timelines() {
 /// `max_failures` bounds): five failed grasps in a row, then success.
 #[test]
 fn retries_of_a_failing_action_are_not_a_livelock() {
-    let s = scenario(
-        r#"
-goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
-[world]
-objects = { cube2 = { at = "east-table" } }
-[[policies]]
-file = "../paper/fig01-bt.toml"
-[[policies]]
-file = "../paper/fig04-fsm.toml"
-[[disturbances]]
+    let s = scenario(&fig1_fig4(
+        r#"[[disturbances]]
 at = 0.0
 fail = "Pick"
 times = 5
 "#,
-    );
+    ));
     for r in run_scenario(&s, false) {
         assert_eq!(
             (r.outcome, r.goal_met),
@@ -383,20 +391,12 @@ fail = "Move-To"
 
 #[test]
 fn a_dropped_cube_is_picked_again_and_a_blocked_goal_gives_up() {
-    let s = scenario(
-        r#"
-goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
-[world]
-objects = { cube2 = { at = "east-table" } }
-[[policies]]
-file = "../paper/fig01-bt.toml"
-[[policies]]
-file = "../paper/fig04-fsm.toml"
-[[disturbances]]
+    let s = scenario(&fig1_fig4(
+        r#"[[disturbances]]
 when = [{ if = "In-Hand", args = { object = "cube2" } }]
 drop = "cube2"
 "#,
-    );
+    ));
     let runs = run_scenario(&s, false);
     for r in &runs {
         assert_eq!(r.goal_met, Some(true), "{}", r.policy);
