@@ -360,6 +360,7 @@ mod tests {
                 Some("compare") => compare(&data),
                 Some("btcpp_xml") => btcpp_xml(&data),
                 Some("scxml") => scxml(&data),
+                Some("yasmin") => yasmin(&data),
                 Some("scenario") => scenario(&data),
                 Some("project") => project(&data),
                 other => panic!("{}: no fuzz target `{other:?}`", f.display()),

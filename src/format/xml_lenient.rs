@@ -59,17 +59,20 @@ pub fn repair(text: &str) -> Option<(String, OffsetMap, Vec<Repair>)> {
     let copy = |out: &mut String, from: usize, to: usize| out.push_str(&text[from..to]);
     while i < b.len() {
         if text[i..].starts_with("<!--") {
-            let end = text[i + 4..].find("-->").map_or(b.len(), |e| i + 4 + e + 3);
-            let body = &text[i..end];
-            let inner = &body[4..body.len().saturating_sub(3).max(4)];
+            // The comment's content ends at `-->` (or at the end of an
+            // unterminated comment, which stays an error): ASCII boundaries.
+            let close = text[i + 4..].find("-->").map(|e| i + 4 + e);
+            let inner_end = close.unwrap_or(b.len());
+            let end = close.map_or(b.len(), |c| c + 3);
+            let inner = &text[i + 4..inner_end];
             if inner.contains("--") {
                 fixes.push(Repair {
-                    span: i..end.min(i + 4),
+                    span: i..i + 4,
                     what: "`--` inside a comment",
                 });
                 out.push_str("<!--");
                 out.push_str(&inner.replace("--", "~~"));
-                out.push_str(&body[4 + inner.len()..]);
+                out.push_str(&text[inner_end..end]);
             } else {
                 copy(&mut out, i, end);
             }

@@ -326,6 +326,9 @@ impl Reader<'_> {
         // Transitions of each state (a container's are its outcome map).
         for &(c, s) in &made {
             let tkids: Vec<usize> = self.docs[doc].0.elems[c].children.clone();
+            // An outcome maps to one target (yasmin keeps transitions in a
+            // dict): a second one is an error, not a silent overwrite.
+            let mut mapped: std::collections::HashSet<String> = Default::default();
             for t in tkids {
                 let te = &self.docs[doc].0.elems[t];
                 if te.name != "Transition" {
@@ -342,6 +345,15 @@ impl Reader<'_> {
                     continue;
                 };
                 let (from, to_v, to_span) = (from.to_string(), to.value.clone(), to.span.clone());
+                if !mapped.insert(from.clone()) {
+                    self.err(
+                        doc,
+                        tspan,
+                        format!("a second transition from outcome `{}`", shown(&from)),
+                        "each outcome of a state has one transition; remove one",
+                    );
+                    continue;
+                }
                 let target = if outcome_set.contains(&to_v) {
                     Target::Outcome(to_v)
                 } else if let Some(&n) = names.get(to_v.as_str()) {
