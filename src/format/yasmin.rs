@@ -76,6 +76,7 @@ pub fn load_read(
         limits,
         diags: xml::Sink::default(),
         docs: vec![(main, base)],
+        maps: Vec::new(),
     };
     let policy = r.read(path);
     let diags = r.diags.into_vec(&file);
@@ -106,6 +107,9 @@ struct Reader<'l> {
     diags: xml::Sink,
     /// Documents read (the main file first) with their directories.
     docs: Vec<(XDoc, PathBuf)>,
+    /// A container's transitions, checked against its outcomes once its
+    /// content is read: (state, document, `<Transition>` span, outcome).
+    maps: Vec<(usize, usize, std::ops::Range<usize>, String)>,
 }
 
 impl Reader<'_> {
@@ -156,6 +160,24 @@ impl Reader<'_> {
             self.region(&mut m, p, &mut queue);
             if !self.diags.room_for_errors() {
                 break;
+            }
+        }
+        // A container maps only the outcomes it has (its content is read).
+        for (s, doc, span, from) in std::mem::take(&mut self.maps) {
+            if let StateBody::Container(r) = &m.states[s].body
+                && !r.outcomes.contains(&from)
+            {
+                let msg = format!(
+                    "`{}` has no outcome `{}`",
+                    shown(&m.states[s].name),
+                    shown(&from)
+                );
+                self.err(
+                    doc,
+                    span,
+                    msg,
+                    "a nested machine's `<Transition from>` names one of its `outcomes`",
+                );
             }
         }
         if self.diags.has_errors() {
@@ -372,6 +394,9 @@ impl Reader<'_> {
                     );
                     continue;
                 };
+                if container_state(&self.docs[doc].0.elems[c]) {
+                    self.maps.push((s, doc, tspan.clone(), from.clone()));
+                }
                 m.states[s].transitions.push(Transition {
                     trigger: Trigger::Outcome(from),
                     target,
@@ -519,6 +544,11 @@ impl Reader<'_> {
     }
 }
 
+/// Is the element a nested machine (a container)?
+fn container_state(e: &XElem) -> bool {
+    e.name == "StateMachine"
+}
+
 /// The machine's `description` attribute, if any.
 fn top_description(doc: &XDoc) -> Option<String> {
     let e: &XElem = &doc.elems[doc.root];
@@ -660,6 +690,28 @@ mod tests {
             let text = format!("{}{ins}{}", &t[..a], &t[b..]);
             crate::fuzzing::yasmin(text.as_bytes());
         }
+    }
+
+    #[test]
+    fn a_container_maps_only_its_outcomes_and_each_outcome_once() {
+        let e = errors(
+            r#"<StateMachine outcomes="end">
+  <StateMachine name="In" outcomes="done">
+    <State name="s"><Transition from="ok" to="done"/><Transition from="ok" to="s"/></State>
+    <Transition from="done" to="end"/>
+    <Transition from="nope" to="end"/>
+  </StateMachine>
+</StateMachine>"#,
+        );
+        assert!(
+            e.iter()
+                .any(|m| m.contains("a second transition from outcome `ok`")),
+            "{e:#?}"
+        );
+        assert!(
+            e.iter().any(|m| m.contains("`In` has no outcome `nope`")),
+            "{e:#?}"
+        );
     }
 
     #[test]
