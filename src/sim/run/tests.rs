@@ -7,20 +7,29 @@ use crate::sim::livelock::{LIVELOCK_STATES, Livelock};
 use crate::sim::monte_carlo::{monte_carlo, monte_carlo_within};
 use std::path::Path;
 
-/// Fig. 1's BT and Fig. 4's FSM fetching cube2 to the delivery station,
-/// with `rest` (disturbances, more policies) after them.
-fn fig1_fig4(rest: &str) -> String {
+/// The goal of Experiment 1 (cube2 from the east table to the delivery
+/// station) and its world, with `rest` (policies, disturbances) after them.
+fn deliver(rest: &str) -> String {
     format!(
         "{}{rest}",
         r#"goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
 [world]
 objects = { cube2 = { at = "east-table" } }
-[[policies]]
+"#
+    )
+}
+
+/// Fig. 1's BT and Fig. 4's FSM fetching cube2 to the delivery station,
+/// with `rest` (disturbances, more policies) after them.
+fn fig1_fig4(rest: &str) -> String {
+    deliver(&format!(
+        "{}{rest}",
+        r#"[[policies]]
 file = "../paper/fig01-bt.toml"
 [[policies]]
 file = "../paper/fig04-fsm.toml"
 "#
-    )
+    ))
 }
 
 fn scenario(text: &str) -> Scenario {
@@ -101,12 +110,8 @@ times = 5
 /// ends with the cube delivered, by other skills than the BT's.
 #[test]
 fn after_success_is_a_property_of_the_run() {
-    let s = scenario(
-        r#"
-goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
-[world]
-objects = { cube2 = { at = "east-table" } }
-[[policies]]
+    let s = scenario(&deliver(
+        r#"[[policies]]
 file = "../paper/fig01-bt.toml"
 name = "BT stop"
 after_success = "stop"
@@ -121,7 +126,7 @@ after_done = 2.0
 move = "cube2"
 to = [0.0, 1.3]
 "#,
-    );
+    ));
     let runs = run_scenario(&s, false);
     assert_eq!(runs[0].goal_met, Some(false));
     assert_eq!(runs[1].goal_met, Some(true));
@@ -146,12 +151,8 @@ to = [0.0, 1.3]
 /// (FSM stops, BT and its HFSM keep ticking) are as before.
 #[test]
 fn after_failure_is_a_property_of_the_run() {
-    let s = scenario(
-        r#"
-goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
-[world]
-objects = { cube2 = { at = "east-table" } }
-[[policies]]
+    let s = scenario(&deliver(
+        r#"[[policies]]
 file = "../paper/fig02-fsm.toml"
 name = "FSM reset"
 after_failure = "keep-ticking"
@@ -168,7 +169,7 @@ convert = "hfsm"
 at = 0.0
 fail = "Pick"
 "#,
-    );
+    ));
     let runs = run_scenario(&s, false);
     let got: Vec<(Outcome, Option<bool>, &str)> = (runs.iter())
         .map(|r| (r.outcome, r.goal_met, r.after_failure))
