@@ -56,20 +56,7 @@ pub fn execute(cli: Cli) -> u8 {
                 let f = &input.path;
                 // Read once; a scenario is validated as `sim` reads it (its
                 // policies included), without running it.
-                let read = if input.found {
-                    format::discover::classify(f, &limits).map(|(file, holds)| {
-                        let kind = match holds {
-                            format::discover::Holds::Policy(fmt) => {
-                                Some(format::Input::Policy(fmt))
-                            }
-                            format::discover::Holds::Scenario => Some(format::Input::Scenario),
-                            format::discover::Holds::Other => None,
-                        };
-                        (file, kind)
-                    })
-                } else {
-                    format::read_input(f, &limits).map(|(file, i)| (file, Some(i)))
-                };
+                let read = format::discover::read(input, &limits);
                 let (file, input) = match read {
                     Ok((file, Some(i))) => (file, i),
                     Ok((_, None)) => {
@@ -348,7 +335,7 @@ pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>
 /// failed; `None` when there is nothing to report (the walk failed, or no
 /// policy was found). Scenarios found below a directory are skipped.
 pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loaded>, bool)> {
-    use format::discover::{self, Holds};
+    use format::discover;
     let stderr = std::io::stderr();
     let mut err = stderr.lock();
     let inputs = match discover::expand(files) {
@@ -360,17 +347,20 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
     };
     let (mut out, mut failed, mut skipped) = (Vec::new(), false, 0usize);
     for input in &inputs {
-        let r = if input.found {
-            match discover::classify(&input.path, limits) {
-                Ok((file, Holds::Policy(fmt))) => format::load_read(file, &input.path, fmt, limits),
-                Ok(_) => {
-                    skipped += 1;
-                    continue;
-                }
-                Err(d) => Err(d),
+        let r = match discover::read(input, limits) {
+            Ok((file, Some(format::Input::Policy(fmt)))) => {
+                format::load_read(file, &input.path, fmt, limits)
             }
-        } else {
-            format::load(&input.path, limits)
+            // A scenario named on the command line is read as the policy
+            // it is not (its errors say so); one found below is skipped.
+            Ok((file, Some(format::Input::Scenario))) if !input.found => {
+                format::load_read(file, &input.path, format::FileFormat::Toml, limits)
+            }
+            Ok(_) => {
+                skipped += 1;
+                continue;
+            }
+            Err(d) => Err(d),
         };
         match reported(r, &mut err) {
             Some(l) => out.push(l),

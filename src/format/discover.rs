@@ -100,37 +100,27 @@ fn walk(dir: &Path, visited: &mut usize, out: &mut Vec<Input>) -> Result<(), Dia
     Ok(())
 }
 
-/// What a file found below a directory holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Holds {
-    Policy(FileFormat),
-    Scenario,
-    /// Something else (skipped).
-    Other,
-}
-
-/// Reads a found file once and says what it holds (by [`super::detect`]
-/// and the marks above).
-pub fn classify(path: &Path, limits: &Limits) -> Result<(Arc<SourceFile>, Holds), Vec<Diagnostic>> {
-    let shown = path.display().to_string();
-    let file = source::read(path, &shown, limits, true)?;
+/// Reads an input once and says what it holds: a file named on the command
+/// line is whatever [`super::read_input`] makes of it; a file found below a
+/// directory is a policy or a scenario by the marks above, else `None`
+/// (skipped).
+pub fn read(
+    input: &Input,
+    limits: &Limits,
+) -> Result<(Arc<SourceFile>, Option<super::Input>), Vec<Diagnostic>> {
+    if !input.found {
+        return super::read_input(&input.path, limits).map(|(f, i)| (f, Some(i)));
+    }
+    let path = &input.path;
+    let file = source::read(path, &path.display().to_string(), limits, true)?;
     let text = &file.text;
     let holds = match super::detect(path, text) {
-        FileFormat::Toml => {
-            if crate::sim::scenario::looks_like_scenario(super::head(text)) {
-                Holds::Scenario
-            } else if has_top_level_kind(text) {
-                Holds::Policy(FileFormat::Toml)
-            } else {
-                Holds::Other
-            }
+        FileFormat::Toml if crate::sim::scenario::looks_like_scenario(super::head(text)) => {
+            Some(super::Input::Scenario)
         }
-        FileFormat::Scxml => Holds::Policy(FileFormat::Scxml),
-        FileFormat::Yasmin => Holds::Policy(FileFormat::Yasmin),
-        FileFormat::BtcppXml if text.contains("<BehaviorTree") => {
-            Holds::Policy(FileFormat::BtcppXml)
-        }
-        FileFormat::BtcppXml => Holds::Other,
+        FileFormat::Toml if !has_top_level_kind(text) => None,
+        FileFormat::BtcppXml if !text.contains("<BehaviorTree") => None,
+        f => Some(super::Input::Policy(f)),
     };
     Ok((file, holds))
 }

@@ -237,15 +237,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
         }
     }
     // Model states (not finals), in document order.
-    let mut m = StateMachine {
-        hierarchical: false,
-        top: Region {
-            initial: usize::MAX,
-            outcomes: vec![],
-            states: vec![],
-        },
-        states: Vec::new(),
-    };
+    let mut m = StateMachine::unset();
     let mut state_of: Vec<Option<usize>> = vec![None; found.len()];
     for (k, (e, kind, parent)) in found.iter().enumerate() {
         let el = &doc.elems[*e];
@@ -258,11 +250,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
                     if let StateBody::Container(r) = &mut m.states[p].body {
                         r.outcomes.push(name);
                     } else {
-                        m.states[p].body = StateBody::Container(Region {
-                            initial: usize::MAX,
-                            outcomes: vec![name],
-                            states: vec![],
-                        });
+                        m.states[p].body = StateBody::Container(Region::unset(vec![name]));
                     }
                 }
             }

@@ -140,15 +140,7 @@ impl Reader<'_> {
                 .unwrap_or("machine")
                 .to_string()
         });
-        let mut m = StateMachine {
-            hierarchical: false,
-            top: Region {
-                initial: usize::MAX,
-                outcomes: vec![],
-                states: vec![],
-            },
-            states: Vec::new(),
-        };
+        let mut m = StateMachine::unset();
         let mut queue = VecDeque::from([Pending {
             doc: 0,
             elem: self.docs[0].0.root,
@@ -296,11 +288,7 @@ impl Reader<'_> {
             }
             let span = (doc == 0).then(|| e.span.clone());
             let body = if container {
-                StateBody::Container(Region {
-                    initial: usize::MAX,
-                    outcomes: vec![],
-                    states: vec![],
-                })
+                StateBody::Container(Region::unset(vec![]))
             } else {
                 StateBody::Task(None)
             };

@@ -103,7 +103,28 @@ pub enum Target {
 /// Longest key made of a path of names (see [`StateMachine::keys`]).
 pub const MAX_PATH_KEY_BYTES: usize = 256;
 
+impl Region {
+    /// A region with `outcomes` whose states and initial state a reader has
+    /// still to set (`initial` is `usize::MAX` until then).
+    pub fn unset(outcomes: Vec<String>) -> Region {
+        Region {
+            initial: usize::MAX,
+            outcomes,
+            states: vec![],
+        }
+    }
+}
+
 impl StateMachine {
+    /// A flat machine with nothing in it yet, for a reader to fill.
+    pub fn unset() -> StateMachine {
+        StateMachine {
+            hierarchical: false,
+            top: Region::unset(vec![]),
+            states: Vec::new(),
+        }
+    }
+
     /// The region a state is in.
     pub fn region_of(&self, s: StateIdx) -> &Region {
         match self.states[s].parent {

@@ -9,7 +9,7 @@ use super::robot::{Faults, Robot, apply};
 use super::run::run_scenario;
 use super::scenario::{self, Disturbance, Effect, Scenario, When};
 use super::skills::{Call, Status, Target};
-use super::world::{Layout, Object, Params, Place, World, dist};
+use super::world::{Object, Place, World, dist};
 use crate::diagnostic::SourceFile;
 use crate::format::Limits;
 use std::collections::BTreeMap;
@@ -17,12 +17,7 @@ use std::path::Path;
 
 fn world() -> World {
     let cube = Object::new("cube2", Place::At((1.7, 0.0)), (1.7, 0.0), true);
-    World::new(
-        Layout::paper_room(),
-        Params::default(),
-        (-2.0, -2.2),
-        vec![cube],
-    )
+    crate::sim::world::paper_room_with(vec![cube])
 }
 
 fn robot(w: World, leaves: usize) -> Robot {

@@ -611,17 +611,12 @@ impl Running {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::world::{Layout, Object, Params};
+    use crate::sim::world::Object;
     use std::collections::BTreeMap;
 
     fn world() -> World {
         let cube = Object::new("cube2", Place::At((1.7, 0.0)), (1.7, 0.0), true);
-        World::new(
-            Layout::paper_room(),
-            Params::default(),
-            (-2.0, -2.2),
-            vec![cube],
-        )
+        crate::sim::world::paper_room_with(vec![cube])
     }
 
     fn call(skill: &str, args: &[(&str, &str)]) -> SkillCall {

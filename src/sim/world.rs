@@ -567,15 +567,21 @@ impl World {
     }
 }
 
-/// The paper's room with the robot at the start and no objects (tests).
+/// The paper's room with the robot at the start and `objects` (tests).
 #[cfg(test)]
-pub fn empty_paper_room() -> World {
+pub fn paper_room_with(objects: Vec<Object>) -> World {
     World::new(
         Layout::paper_room(),
         Params::default(),
         (-2.0, -2.2),
-        vec![],
+        objects,
     )
+}
+
+/// The paper's room with the robot at the start and no objects (tests).
+#[cfg(test)]
+pub fn empty_paper_room() -> World {
+    paper_room_with(vec![])
 }
 
 #[cfg(test)]

@@ -78,11 +78,7 @@ impl Loader {
                 ok = false;
                 continue;
             };
-            let mut region = Region {
-                initial: usize::MAX,
-                outcomes: outcomes.clone(),
-                states: vec![],
-            };
+            let mut region = Region::unset(outcomes.clone());
             let mut local: Vec<(String, usize, Range<usize>)> = Vec::new();
             for (k, v) in states.iter() {
                 let name = k.get_ref().to_string();
@@ -188,11 +184,7 @@ impl Loader {
                         span: v.span(),
                         container: Some(idx),
                     });
-                    StateBody::Container(Region {
-                        initial: usize::MAX,
-                        outcomes: vec![],
-                        states: vec![],
-                    })
+                    StateBody::Container(Region::unset(vec![]))
                 } else if decision {
                     if st.contains_key("skill") {
                         self.err(

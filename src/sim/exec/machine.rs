@@ -334,14 +334,7 @@ on = { SUCCESS = "A" }
         let PolicyBody::Machine(m) = &l.policy.body else {
             panic!("an FSM")
         };
-        let cm = CompiledMachine::new(m, |c| {
-            Ok::<_, ()>(match c.skill.as_str() {
-                "Battery-Level" => Call::BatteryLevel(20.0),
-                "Recharge" => Call::Recharge,
-                _ => Call::TuckArm,
-            })
-        })
-        .unwrap();
+        let cm = super::super::tests::recharge_machine(m);
         let a = m.states.iter().position(|s| s.name == "A").unwrap();
         let r = m.states.iter().position(|s| s.name == "R").unwrap();
         let mut ex = MachineExec::new(Arc::new(cm), false);

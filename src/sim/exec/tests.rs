@@ -198,14 +198,7 @@ fn fsm_checks_guards_before_the_skill() {
     let PolicyBody::Machine(m) = &l.policy.body else {
         panic!()
     };
-    let cm = CompiledMachine::new(m, |c| {
-        Ok::<_, ()>(match c.skill.as_str() {
-            "Battery-Level" => Call::BatteryLevel(20.0),
-            "Recharge" => Call::Recharge,
-            _ => Call::TuckArm,
-        })
-    })
-    .unwrap();
+    let cm = recharge_machine(m);
     let mut ex = MachineExec::new(Arc::new(cm), false);
     let mut s = script();
     let out: Vec<Status> = (0..5).map(|_| ex.step(&mut s)).collect();
@@ -673,4 +666,17 @@ impl<'a> Reference<'a> {
         self.noted.push((n, s));
         s
     }
+}
+
+/// A machine whose Battery-Level guards need 20 %, whose Recharge recharges
+/// and whose other states tuck the arm (also for `machine.rs`'s tests).
+pub(super) fn recharge_machine(m: &crate::model::StateMachine) -> CompiledMachine {
+    CompiledMachine::new(m, |c| {
+        Ok::<_, ()>(match c.skill.as_str() {
+            "Battery-Level" => Call::BatteryLevel(20.0),
+            "Recharge" => Call::Recharge,
+            _ => Call::TuckArm,
+        })
+    })
+    .expect("infallible")
 }
