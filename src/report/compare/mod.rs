@@ -1,0 +1,274 @@
+//! `btfsm compare`: graph edit distance between two policies (paper sec. IV-A 2,
+//! Eq. 2; SPEC §3) in the `structural`, `labeled` and `named` modes, each with
+//! the edit script of its mapping told in the policies' own terms (vertex
+//! names and types, transition labels), and the diff drawing of the paper's
+//! Figs. 7 and 8 (the new policy with added elements red and the old one's
+//! removed elements dashed grey).
+//!
+//! The GED engine (`metrics::ged`) works on unlabeled arcs, so a mapping says
+//! only how many arcs between two vertices are kept. Which of several
+//! parallel transitions those are is decided here, label by label: arcs whose
+//! labels agree are kept first, so a re-routed `FAILURE` arc shows up as one
+//! `FAILURE` arc removed and one added, not as an arbitrary pair.
+
+mod diff_dot;
+mod render;
+mod script;
+#[cfg(test)]
+mod tests;
+mod text;
+
+pub use render::{render_json, render_markdown, render_table};
+use script::{ScriptIndex, key_ids};
+pub use text::Text;
+
+use crate::graph::{PolicyGraph, VertexType, policy_graph};
+use crate::metrics::ged::{
+    GedMode, GedOptions, Shape, keep_same_labels, mapping_cost, named_mapping_of_ids,
+    search_mapping,
+};
+use crate::model::{Policy, PolicyBody, PolicyKind};
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+/// One policy being compared.
+#[derive(Debug, Clone, Copy)]
+pub struct Side<'a> {
+    /// The file it came from, as given.
+    pub file: &'a str,
+    pub policy: &'a Policy,
+}
+
+/// The modes `compare` computes, in report order.
+pub fn modes_of(selection: Option<GedMode>) -> Vec<GedMode> {
+    match selection {
+        Some(m) => vec![m],
+        None => vec![GedMode::Structural, GedMode::Labeled, GedMode::Named],
+    }
+}
+
+/// A vertex named in an edit script.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct VertexRef {
+    /// Identity (BT node id, state path, outcome name).
+    pub key: Text,
+    /// Display name.
+    pub name: Text,
+    #[serde(rename = "type")]
+    pub vtype: VertexType,
+}
+
+/// A vertex of a kept (substituted at cost 0) as the vertex of b it maps to.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct KeptVertex {
+    pub a: Text,
+    pub b: Text,
+}
+
+/// Arcs between two vertices with one label.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+pub struct ArcRef {
+    /// Tail key (of b for added and kept arcs, of a for removed ones).
+    pub from: Text,
+    /// Head key, likewise.
+    pub to: Text,
+    /// Outcome or guard label; `initial` for an HFSM container's arc to its
+    /// initial state; empty for a BT edge.
+    pub label: Text,
+    /// How many such parallel arcs.
+    pub count: u32,
+    /// For a kept arc whose label differs in a: a's label (unit-cost GED does
+    /// not charge for it, a reviewer wants to see it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub label_in_a: Option<Text>,
+}
+
+/// The edit script of one mode's mapping, a → b.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Script {
+    pub vertices_added: Vec<VertexRef>,
+    pub vertices_removed: Vec<VertexRef>,
+    pub vertices_kept: Vec<KeptVertex>,
+    pub arcs_added: Vec<ArcRef>,
+    pub arcs_removed: Vec<ArcRef>,
+    pub arcs_kept: Vec<ArcRef>,
+}
+
+impl Script {
+    /// Unit edit operations: vertices and arcs added and removed.
+    pub fn cost(&self) -> u64 {
+        let arcs = |l: &[ArcRef]| l.iter().map(|a| u64::from(a.count)).sum::<u64>();
+        (self.vertices_added.len() + self.vertices_removed.len()) as u64
+            + arcs(&self.arcs_added)
+            + arcs(&self.arcs_removed)
+    }
+
+    /// Kept vertices whose key changes (only `structural` and `labeled`
+    /// mappings have them).
+    pub fn rematched(&self) -> impl Iterator<Item = &KeptVertex> {
+        self.vertices_kept.iter().filter(|k| k.a != k.b)
+    }
+}
+
+/// One mode's result (SPEC §7: `ged`, `exact`, `lower_bound`, `upper_bound`,
+/// `millis`, `edit_script`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ModeReport {
+    #[serde(skip)]
+    pub mode: GedMode,
+    pub ged: u64,
+    pub exact: bool,
+    pub lower_bound: u64,
+    pub upper_bound: u64,
+    pub millis: u64,
+    pub edit_script: Script,
+}
+
+/// Size and kind of one side, for the table header.
+#[derive(Debug, Clone)]
+pub struct SideSummary {
+    pub file: String,
+    pub name: String,
+    pub kind: PolicyKind,
+    pub vertices: usize,
+    pub arcs: usize,
+}
+
+/// `btfsm compare A B`.
+#[derive(Debug, Clone)]
+pub struct CompareReport {
+    pub a: SideSummary,
+    pub b: SideSummary,
+    pub modes: Vec<ModeReport>,
+}
+
+impl CompareReport {
+    /// The result of one mode, if computed.
+    pub fn mode(&self, mode: GedMode) -> Option<&ModeReport> {
+        self.modes.iter().find(|m| m.mode == mode)
+    }
+
+    /// The mode whose edit script the table prints and `--dot` draws: the
+    /// only one computed, or `named` (the engineer's own edits) when all are.
+    pub fn primary(&self) -> Option<&ModeReport> {
+        self.mode(GedMode::Named).or(self.modes.first())
+    }
+}
+
+/// The two graphs of a comparison, built once and reused by every mode.
+pub struct Pair<'a> {
+    a: Side<'a>,
+    b: Side<'a>,
+    ga: PolicyGraph,
+    gb: PolicyGraph,
+    ia: ScriptIndex,
+    ib: ScriptIndex,
+    /// Each vertex's key as an id shared by both graphs (equal keys, equal
+    /// ids), so that the mapping by name costs no string work per mode.
+    ids_a: Vec<u32>,
+    ids_b: Vec<u32>,
+    /// HFSM containment in a: state key -> its container's key.
+    parent_a: BTreeMap<String, String>,
+}
+
+/// State key -> container key, for every nested state of an HFSM.
+fn containers(p: &Policy) -> BTreeMap<String, String> {
+    let PolicyBody::Machine(m) = &p.body else {
+        return BTreeMap::new();
+    };
+    let keys = m.keys();
+    m.states
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.parent.map(|q| (keys[i].clone(), keys[q].clone())))
+        .collect()
+}
+
+impl<'a> Pair<'a> {
+    pub fn new(a: Side<'a>, b: Side<'a>) -> Self {
+        let (ga, gb) = (policy_graph(a.policy), policy_graph(b.policy));
+        let (ia, ib) = (ScriptIndex::new(&ga), ScriptIndex::new(&gb));
+        let (ids_a, ids_b) = key_ids(&ia, &ib);
+        Pair {
+            ia,
+            ib,
+            ids_a,
+            ids_b,
+            ga,
+            gb,
+            parent_a: containers(a.policy),
+            a,
+            b,
+        }
+    }
+
+    /// GED in one mode, with its labelled edit script, within
+    /// `opts.timeout` for the whole of it: the clock starts before the
+    /// compact graphs are built, the mapping by name and its script come
+    /// next, and the search gets what remains minus twice the time that
+    /// script took (the script of the search's mapping, if better, costs
+    /// about as much, and the unused one must be freed: 1.3 to 1.6 times
+    /// the first on 100k-vertex BTs). `millis` is the time of all of it.
+    pub fn run(&self, mode: GedMode, opts: &GedOptions) -> ModeReport {
+        let start = Instant::now();
+        let (sa, sb) = (Shape::from(&self.ga), Shape::from(&self.gb));
+        let mut by_name = named_mapping_of_ids(&self.ids_a, &self.ids_b);
+        if mode == GedMode::Labeled {
+            keep_same_labels(&sa, &sb, &mut by_name);
+        }
+        let named_cost = mapping_cost(&sa, &sb, &by_name);
+        let before_script = Instant::now();
+        let named = self.script(&by_name);
+        let (lower, upper, edit_script) = if mode == GedMode::Named {
+            (named_cost, named_cost, named)
+        } else {
+            let reserve = before_script.elapsed() * 2;
+            // Checked: a budget past the clock's range means no deadline.
+            let deadline = start
+                .checked_add(opts.timeout)
+                .unwrap_or_else(|| start + Duration::from_secs(1 << 32))
+                .checked_sub(reserve)
+                .map_or(start, |d| d.max(start));
+            let found = search_mapping(
+                &sa,
+                &sb,
+                mode == GedMode::Labeled,
+                deadline,
+                opts.max_expansions,
+            );
+            // Among mappings of equal cost, prefer the one by name: its
+            // script reads as the engineer's own edits.
+            if named_cost <= found.upper_bound {
+                (found.lower_bound, named_cost, named)
+            } else {
+                let s = self.script(&found.map);
+                (found.lower_bound, found.upper_bound, s)
+            }
+        };
+        debug_assert_eq!(edit_script.cost(), upper);
+        ModeReport {
+            mode,
+            ged: upper,
+            exact: lower >= upper,
+            lower_bound: lower.min(upper),
+            upper_bound: upper,
+            millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
+            edit_script,
+        }
+    }
+
+    pub fn report(&self, modes: Vec<ModeReport>) -> CompareReport {
+        let summary = |s: &Side, g: &PolicyGraph| SideSummary {
+            file: s.file.to_string(),
+            name: s.policy.name.clone(),
+            kind: s.policy.kind(),
+            vertices: g.vertex_count(),
+            arcs: g.arc_count(),
+        };
+        CompareReport {
+            a: summary(&self.a, &self.ga),
+            b: summary(&self.b, &self.gb),
+            modes,
+        }
+    }
+}

@@ -1,0 +1,195 @@
+//! `compare`'s output formats: JSON (SPEC §7), the table with the edit
+//! script, and GitHub markdown for a pull-request comment.
+
+use super::{ArcRef, CompareReport, ModeReport, VertexRef};
+use crate::metrics::ged::GedMode;
+
+/// SPEC §7: `{"a", "b", "structural": {...}, "labeled": {...}, "named": {...}}`
+/// (only the modes computed), in that field order.
+pub fn render_json(r: &CompareReport) -> String {
+    #[derive(serde::Serialize)]
+    struct Out<'a> {
+        a: &'a str,
+        b: &'a str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        structural: Option<&'a ModeReport>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        labeled: Option<&'a ModeReport>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        named: Option<&'a ModeReport>,
+    }
+    let out = Out {
+        a: &r.a.file,
+        b: &r.b.file,
+        structural: r.mode(GedMode::Structural),
+        labeled: r.mode(GedMode::Labeled),
+        named: r.mode(GedMode::Named),
+    };
+    let mut s = crate::sanitize::json(serde_json::to_string_pretty(&out).expect("serializable"));
+    s.push('\n');
+    s
+}
+
+/// The human-readable report: both policies, one row per mode, and the edit
+/// script of the primary mode.
+pub fn render_table(r: &CompareReport) -> String {
+    let mut out = String::new();
+    for (tag, s) in [("a", &r.a), ("b", &r.b)] {
+        out.push_str(&format!(
+            "{tag}: {} ({} `{}`, {} vertices, {} arcs)\n",
+            s.file, s.kind, s.name, s.vertices, s.arcs
+        ));
+    }
+    if r.a.kind != r.b.kind {
+        out.push_str(&format!(
+            "note: comparing a {} with a {}: labeled and named GED count every vertex of a differing type or name as replaced\n",
+            r.a.kind, r.b.kind
+        ));
+    }
+    out.push('\n');
+    let mut t = crate::report::table::Table::new(&["mode", "GED", "exact", "interval", "ms"]);
+    for m in &r.modes {
+        t.row(vec![
+            m.mode.as_str().to_string(),
+            m.ged.to_string(),
+            if m.exact { "yes" } else { "no" }.to_string(),
+            format!("[{}, {}]", m.lower_bound, m.upper_bound),
+            m.millis.to_string(),
+        ]);
+    }
+    out.push_str(&t.render());
+    if r.modes.iter().any(|m| !m.exact) {
+        out.push_str(
+            "note: the search hit its budget; the distance lies in the certified interval (raise --timeout-ms to narrow it)\n",
+        );
+    }
+    if let Some(p) = r.primary() {
+        out.push('\n');
+        out.push_str(&render_script(p));
+    }
+    out
+}
+
+/// The report as GitHub-flavoured markdown, for a pull-request comment: the
+/// two policies and the modes as tables, the primary edit script as a
+/// `diff` block (added lines green, removed red) in a collapsible section.
+pub fn render_markdown(r: &CompareReport) -> String {
+    let cell = crate::sanitize::markdown_cell;
+    let code = crate::sanitize::markdown_code;
+    let mut out = format!(
+        "### btfsm compare: {} → {}\n\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
+        code(&r.a.file),
+        code(&r.b.file)
+    );
+    for (tag, s) in [("a", &r.a), ("b", &r.b)] {
+        out.push_str(&format!(
+            "| {tag} | {} | {} | {} | {} | {} |\n",
+            code(&s.file),
+            s.kind,
+            cell(&s.name),
+            s.vertices,
+            s.arcs
+        ));
+    }
+    out.push_str("\n| mode | GED | exact | interval | ms |\n|---|---:|---|---|---:|\n");
+    for m in &r.modes {
+        out.push_str(&format!(
+            "| {} | {} | {} | [{}, {}] | {} |\n",
+            m.mode.as_str(),
+            m.ged,
+            if m.exact { "yes" } else { "no" },
+            m.lower_bound,
+            m.upper_bound,
+            m.millis
+        ));
+    }
+    if r.modes.iter().any(|m| !m.exact) {
+        out.push_str("\nThe search hit its budget: the distance lies in the certified interval.\n");
+    }
+    if let Some(p) = r.primary() {
+        let script = render_script(p);
+        let mut lines = script.lines();
+        let title = lines.next().unwrap_or_default().trim_end_matches(':');
+        let body: String = lines
+            .map(|l| format!("{}\n", l.strip_prefix("  ").unwrap_or(l)))
+            .collect();
+        // Names are escaped onto one line each and every line starts with
+        // its sign; the fence is longer than any run of backticks anyway.
+        let fence = crate::sanitize::code_fence(&body);
+        out.push_str(&format!(
+            "\n<details><summary>{}</summary>\n\n{fence}diff\n{body}{fence}\n\n</details>\n",
+            cell(title)
+        ));
+    }
+    out
+}
+
+/// One line per edit: `+` added, `-` removed, `~` rematched or relabelled.
+fn render_script(m: &ModeReport) -> String {
+    use crate::sanitize::shown;
+    let s = &m.edit_script;
+    let cost = s.cost();
+    let mut out = format!(
+        "{} edit script ({} edit{}):\n",
+        m.mode.as_str(),
+        cost,
+        if cost == 1 { "" } else { "s" }
+    );
+    let vertex = |sign: char, v: &VertexRef| {
+        let name = if v.name == v.key {
+            String::new()
+        } else {
+            format!(" \"{}\"", shown(&v.name))
+        };
+        format!("  {sign} {} `{}`{name}\n", v.vtype.as_str(), shown(&v.key))
+    };
+    let arc = |sign: char, a: &ArcRef| {
+        let label = if a.label.is_empty() {
+            String::new()
+        } else {
+            format!(" [{}]", shown(&a.label))
+        };
+        let times = if a.count > 1 {
+            format!(" ×{}", a.count)
+        } else {
+            String::new()
+        };
+        format!(
+            "  {sign} arc `{}` -> `{}`{label}{times}\n",
+            shown(&a.from),
+            shown(&a.to)
+        )
+    };
+    for v in &s.vertices_removed {
+        out.push_str(&vertex('-', v));
+    }
+    for v in &s.vertices_added {
+        out.push_str(&vertex('+', v));
+    }
+    for a in &s.arcs_removed {
+        out.push_str(&arc('-', a));
+    }
+    for a in &s.arcs_added {
+        out.push_str(&arc('+', a));
+    }
+    for k in s.rematched() {
+        out.push_str(&format!(
+            "  ~ `{}` matched to `{}`\n",
+            shown(&k.a),
+            shown(&k.b)
+        ));
+    }
+    for a in s.arcs_kept.iter().filter(|a| a.label_in_a.is_some()) {
+        out.push_str(&format!(
+            "  ~ arc `{}` -> `{}` relabelled [{}] -> [{}]\n",
+            shown(&a.from),
+            shown(&a.to),
+            shown(a.label_in_a.as_deref().unwrap_or_default()),
+            shown(&a.label)
+        ));
+    }
+    if cost == 0 && s.rematched().next().is_none() {
+        out.push_str("  (none: the graphs are identical under this mapping)\n");
+    }
+    out
+}
