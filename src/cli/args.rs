@@ -230,7 +230,8 @@ pub struct LimitArgs {
     pub nodes_model: Vec<PathBuf>,
     /// The BehaviorTree.CPP tree to read, by its `<BehaviorTree ID>` (over
     /// `main_tree_to_execute`; needed when a file holds several trees and
-    /// names none, as a program names it to BT.CPP's factory)
+    /// names none, as a program names it to BT.CPP's factory); among
+    /// several BehaviorTree.CPP files given together, the files that define it
     #[arg(long, value_name = "ID")]
     pub tree: Option<String>,
     /// Read BehaviorTree.CPP leaves of unknown type as actions or conditions

@@ -345,8 +345,22 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
             return None;
         }
     };
+    let (limits, only) = match with_companions(&inputs, limits) {
+        Ok(x) => x,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return None;
+        }
+    };
+    let limits = &limits;
     let (mut out, mut failed, mut skipped) = (Vec::new(), false, 0usize);
     for input in &inputs {
+        if let Some(only) = &only
+            && is_btcpp_candidate(&input.path)
+            && !only.contains(&input.path)
+        {
+            continue; // a companion of the files that define `--tree`
+        }
         let r = match discover::read(input, limits) {
             Ok((file, Some(format::Input::Policy(fmt)))) => {
                 format::load_read(file, &input.path, fmt, limits)
@@ -373,6 +387,58 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
         return None;
     }
     Some((out, failed))
+}
+
+/// May `path` be a BehaviorTree.CPP file given together with others (a
+/// regular `.xml` or Groot2 `.btproj` file; a pipe is read once, as the
+/// input it is)?
+fn is_btcpp_candidate(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("btproj"))
+        && std::fs::metadata(path).is_ok_and(|m| m.is_file())
+}
+
+/// The limits with the BehaviorTree.CPP files given together as each
+/// other's companions (SubTrees one defines and another uses are found, as
+/// BehaviorTree.CPP's factory registers every file it loads), and, with
+/// `--tree ID` and several such files, the files that define `ID` (the
+/// others are read only as companions). No file defining `ID`: an error
+/// listing the trees there are.
+fn with_companions(
+    inputs: &[format::discover::Input],
+    limits: &Limits,
+) -> Result<(Limits, Option<Vec<PathBuf>>), Diagnostic> {
+    let files: Vec<PathBuf> = inputs
+        .iter()
+        .filter(|i| is_btcpp_candidate(&i.path))
+        .map(|i| i.path.clone())
+        .collect();
+    if files.len() < 2 {
+        return Ok((limits.clone(), None));
+    }
+    let comp = std::sync::Arc::new(format::btcpp_xml::Companions::new(files));
+    let mut limits = limits.clone();
+    limits.companions = Some(comp.clone());
+    let Some(id) = limits.tree.clone() else {
+        return Ok((limits, None));
+    };
+    let only: Vec<PathBuf> = comp
+        .defining(&id, &limits)
+        .into_iter()
+        .map(Path::to_path_buf)
+        .collect();
+    if only.is_empty() {
+        let trees = comp.tree_ids(&limits);
+        let hint = crate::diagnostic::suggest(&id, trees.iter().copied());
+        return Err(Diagnostic::error(format!(
+            "--tree `{}`: none of the {} BehaviorTree.CPP files given defines it",
+            crate::sanitize::shown(&id),
+            comp.len()
+        ))
+        .hint(hint));
+    }
+    Ok((limits, Some(only)))
 }
 
 /// Says how many files found below directories held no policy.

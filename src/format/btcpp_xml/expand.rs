@@ -82,6 +82,23 @@ impl Loader<'_> {
                     continue;
                 };
                 let Some(&(sd, se)) = self.trees.get(&id) else {
+                    if let Some(files) = self.ambiguous.get(&id) {
+                        let files = files.join(", ");
+                        self.err(
+                            it.d,
+                            el.span.clone(),
+                            format!(
+                                "tree `{}` in `<SubTree>` is defined by several files given together: {files}",
+                                shown(&id)
+                            ),
+                        )
+                        .hint = Some(
+                            "`<include path>` the one you mean, or give only that file with this one"
+                                .into(),
+                        );
+                        failed = true;
+                        continue;
+                    }
                     let h = if self.hinting() {
                         suggest(&id, self.trees.keys().map(String::as_str))
                     } else {
@@ -92,7 +109,9 @@ impl Loader<'_> {
                         el.span.clone(),
                         format!("unknown tree `{}` in `<SubTree>`", shown(&id)),
                     )
-                    .hint = Some(h);
+                    .hint = Some(format!(
+                        "{h}; a tree of another file is found when that file is `<include>`d, or given with this one (`btfsm analyze main.xml subtrees/`)"
+                    ));
                     failed = true;
                     continue;
                 };

@@ -35,6 +35,13 @@ pub(super) struct Loader<'l> {
     /// Unknown node types already reported: each is an error once, at its
     /// first use, however often it is used.
     pub(super) unknown: std::collections::HashSet<String>,
+    /// Files read so far (canonical paths): each is read once.
+    pub(super) seen: HashSet<PathBuf>,
+    /// The first document read as a companion (a file given together with
+    /// this one that defines a missing SubTree); `usize::MAX` before any.
+    pub(super) first_companion: usize,
+    /// Tree IDs no file read defines and several companions do: the files.
+    pub(super) ambiguous: BTreeMap<String, Vec<String>>,
 }
 
 pub(super) fn load(
@@ -59,6 +66,9 @@ pub(super) fn load(
         trees: BTreeMap::new(),
         models: BTreeMap::new(),
         unknown: Default::default(),
+        seen: HashSet::new(),
+        first_companion: usize::MAX,
+        ambiguous: BTreeMap::new(),
     };
     l.diags.extend(repaired);
     let policy = l.run(identity);
@@ -120,7 +130,7 @@ impl Loader<'_> {
             );
             return None;
         }
-        self.includes(identity);
+        self.includes(0, identity);
         let extra = self.limits.nodes_models.clone();
         for m in &extra {
             self.nodes_model_file(m);
@@ -132,6 +142,10 @@ impl Loader<'_> {
             return None;
         }
         let (tree_id, (d, e)) = self.main_tree()?;
+        self.companion_trees();
+        if self.diags.has_errors() {
+            return None;
+        }
         let bt = self.expand(&tree_id, d, e)?;
         Some(Policy {
             name: tree_id,
@@ -142,12 +156,12 @@ impl Loader<'_> {
 
     /// Loads `<include path>` files depth-first with an explicit stack; a file
     /// including one of its includers is a cycle.
-    pub(super) fn includes(&mut self, identity: PathBuf) {
+    pub(super) fn includes(&mut self, start: usize, identity: PathBuf) {
+        self.seen.insert(identity.clone());
         let mut chain: Vec<PathBuf> = vec![identity];
         // The same chain as the user sees the paths (canonical ones differ by machine).
-        let mut shown_chain: Vec<String> = vec![self.docs[0].file.path.clone()];
-        let mut loaded: HashSet<PathBuf> = chain.iter().cloned().collect();
-        let mut work: Vec<(usize, usize)> = vec![(0, 0)];
+        let mut shown_chain: Vec<String> = vec![self.docs[start].file.path.clone()];
+        let mut work: Vec<(usize, usize)> = vec![(start, 0)];
         while let Some(&mut (d, ref mut pos)) = work.last_mut() {
             let root = self.docs[d].root;
             let kids = &self.docs[d].elems[root].children;
@@ -199,7 +213,7 @@ impl Loader<'_> {
                     Some("a file must not include itself, directly or through others".into());
                 continue;
             }
-            if loaded.contains(&canon) {
+            if self.seen.contains(&canon) {
                 continue; // already read through another include
             }
             if chain.len() > self.limits.max_include_depth {
@@ -242,7 +256,7 @@ impl Loader<'_> {
                 self.docs.pop();
                 continue;
             }
-            loaded.insert(canon.clone());
+            self.seen.insert(canon.clone());
             self.docs.push(doc);
             self.dirs
                 .push(full.parent().unwrap_or(Path::new("")).to_path_buf());
@@ -394,6 +408,9 @@ impl Loader<'_> {
                     let id = el.attr("ID").unwrap_or("MainTree").to_string();
                     if self.too_long(d, &el, "tree ID", &id) {
                         continue;
+                    }
+                    if d >= self.first_companion && self.trees.contains_key(&id) {
+                        continue; // the files read first define it (docs: companions)
                     }
                     if let Some(&(pd, pe)) = self.trees.get(&id) {
                         let (l, c) = {

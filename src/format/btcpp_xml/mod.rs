@@ -21,6 +21,7 @@
 //!
 //! The expansion walks an explicit stack (no recursion on input depth).
 
+mod companions;
 mod expand;
 mod ids;
 mod loader;
@@ -28,6 +29,7 @@ mod node;
 #[cfg(test)]
 mod tests;
 
+pub use companions::Companions;
 pub use ids::derive_ids;
 use loader::load;
 
