@@ -150,6 +150,10 @@ impl Loader<'_> {
                 // Its ports remap the subtree's blackboard entries: a
                 // reference is resolved in the enclosing expansion now, so
                 // that the subtree's nodes get the value or the outer entry.
+                // Format 3's `<SubTree>` (not `<SubTreePlus>`) maps an
+                // entry to an outer entry by its bare name: `target="goal"`
+                // is format 4's `target="{goal}"`.
+                let keys_by_name = tag == "SubTree" && self.format_3(it.d);
                 let remap = el
                     .attrs
                     .iter()
@@ -157,6 +161,8 @@ impl Loader<'_> {
                     .map(|a| {
                         let v = if a.value == "{=}" {
                             format!("{{{}}}", a.name)
+                        } else if keys_by_name && port_key(&a.value).is_none() {
+                            format!("{{{}}}", a.value)
                         } else {
                             a.value.clone()
                         };
@@ -227,6 +233,15 @@ impl Loader<'_> {
             n.id = id;
         }
         Some(Bt { nodes, root: 0 })
+    }
+}
+
+impl Loader<'_> {
+    /// Does document `d` say `BTCPP_format="3"`? (Without the attribute,
+    /// BehaviorTree.CPP 4 reads a file as format 4, with a warning.)
+    fn format_3(&self, d: usize) -> bool {
+        let doc = &self.docs[d];
+        doc.elems[doc.root].attr("BTCPP_format") == Some("3")
     }
 }
 

@@ -10,7 +10,12 @@
 //!   do, so counts are those of the expanded tree; recursion is rejected. Its
 //!   ports remap the subtree's blackboard entries, so inside the expansion a
 //!   port `{key}` becomes the value or outer entry the SubTree maps `key` to
-//!   (BehaviorTree.CPP 4 "Remapping ports between Trees and SubTrees").
+//!   (BehaviorTree.CPP 4 "Remapping ports between Trees and SubTrees"); in a
+//!   `BTCPP_format="3"` file a `<SubTree>` port names the outer entry by its
+//!   bare name, as BehaviorTree.CPP 3 reads it.
+//! - A `<SubTree ID>` that neither the file nor its includes define is read
+//!   from the other BehaviorTree.CPP files given together ([`Companions`]),
+//!   as BehaviorTree.CPP's factory registers every file of a project.
 //! - Built-in types map onto the model (see [`BUILTINS`] and the README table);
 //!   other types are resolved through a `<TreeNodesModel>` (in the files read or
 //!   given with `--nodes-model`), or `--assume-leaf` decides for leaves.

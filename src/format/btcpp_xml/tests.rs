@@ -563,3 +563,47 @@ fn port_resolution_through_nested_expansions() {
     assert_eq!(chain.frames, [0, 1]);
     assert_eq!(chain.resolve(&frames, "{x}"), "{x}");
 }
+
+#[test]
+fn format_3_subtree_ports_name_outer_entries() {
+    // BehaviorTree.CPP 3: `<SubTree>` maps an entry to an outer entry by its
+    // bare name; `<SubTreePlus>` takes `{key}` or a literal, as format 4's
+    // `<SubTree>` does. Without `BTCPP_format="3"` the file is format 4.
+    let text = |format: &str| {
+        format!(
+            r#"<root BTCPP_format="{format}" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main"><Sequence>
+    <SubTree ID="Go" target="move_goal"/>
+    <SubTreePlus ID="Go" target="cube2"/>
+    <SubTreePlus ID="Go" target="{{move_goal}}"/>
+  </Sequence></BehaviorTree>
+  <BehaviorTree ID="Go"><Action ID="Move-To" target="{{target}}"/></BehaviorTree>
+</root>"#
+        )
+    };
+    let targets = |format: &str| -> Vec<String> {
+        let l = parse(&text(format)).unwrap();
+        bt(&l)
+            .nodes
+            .iter()
+            .filter_map(|n| n.skill.as_ref())
+            .map(|c| format!("{:?}", c.args["target"]))
+            .collect()
+    };
+    assert_eq!(
+        targets("3"),
+        [
+            r#"Str("{move_goal}")"#,
+            r#"Str("cube2")"#,
+            r#"Str("{move_goal}")"#
+        ]
+    );
+    assert_eq!(
+        targets("4"),
+        [
+            r#"Str("move_goal")"#,
+            r#"Str("cube2")"#,
+            r#"Str("{move_goal}")"#
+        ]
+    );
+}
