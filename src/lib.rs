@@ -14,6 +14,7 @@ pub mod fuzzing;
 pub mod graph;
 pub mod metrics;
 pub mod model;
+pub mod plan;
 pub mod render;
 pub mod report;
 pub mod sanitize;
