@@ -141,6 +141,10 @@ pub enum Command {
     Sim(super::sim::SimArgs),
     /// Ticks a BT against scripted leaf outcomes (BehaviorTree.CPP 4 semantics)
     Tick(super::tick::TickArgs),
+    /// Backchains an action domain's goal into a BT, and derives the
+    /// fault-tolerant FSM and the HFSM of the same plan (exit 1 when a
+    /// precondition conflict no order resolves is left)
+    Plan(super::plan::PlanArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
     Completions {

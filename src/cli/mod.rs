@@ -29,6 +29,7 @@ mod convert;
 mod edit;
 pub mod out;
 mod paper;
+mod plan;
 pub mod sim;
 mod tick;
 

@@ -621,3 +621,41 @@ fn empty(name: String) -> Domain {
         },
     }
 }
+
+impl Domain {
+    /// Replaces the goal by `facts` (`--goal`), each checked as a goal fact
+    /// of the domain is; the errors say what is wrong with each.
+    pub fn set_goal(&mut self, facts: &[String]) -> Result<(), Vec<String>> {
+        let mut errors = Vec::new();
+        let mut goal = Vec::new();
+        let file = SourceFile::new("--goal", String::new());
+        for text in facts {
+            let mut v = Validator {
+                file: file.clone(),
+                diags: Vec::new(),
+            };
+            let raw = [Spanned::new(0..0, text.clone())];
+            let found = v.patterns(&raw, &[], self);
+            errors.extend(v.diags.into_iter().map(|d| match d.hint {
+                Some(h) => format!(
+                    "--goal `{}`: {} ({h})",
+                    crate::sanitize::shown(text),
+                    d.message
+                ),
+                None => format!("--goal `{}`: {}", crate::sanitize::shown(text), d.message),
+            }));
+            goal.extend(found.into_iter().map(|p| p.ground(&|_| None)));
+        }
+        if goal.len() > MAX_SIBLINGS {
+            errors.push(format!(
+                "{} goal facts, more than {MAX_SIBLINGS}",
+                goal.len()
+            ));
+        }
+        if !errors.is_empty() {
+            return Err(errors);
+        }
+        self.goal.facts = goal;
+        Ok(())
+    }
+}

@@ -10,6 +10,7 @@ mod formats;
 mod gate;
 mod hostile;
 mod paper;
+mod plan;
 mod sim;
 mod tick;
 mod untrusted;

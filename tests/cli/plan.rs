@@ -1,0 +1,106 @@
+//! `btfsm plan` on the paper's domain (policies/domains/moma.toml): Fig. 1,
+//! Fig. 3 with its conflict, Fig. 4, checked with `compare` against the
+//! hand-written figures.
+
+use super::*;
+use common::scratch;
+
+const MOMA: &str = "policies/domains/moma.toml";
+
+/// Named GED between two policy files, by `compare --mode named`.
+fn named_ged(a: &str, b: &str) -> u64 {
+    let (code, out, err) = btfsm(&["compare", a, b, "--mode", "named", "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    v["named"]["ged"].as_u64().expect("ged")
+}
+
+#[test]
+fn plan_reproduces_fig_1_and_the_structure_of_fig_4() {
+    let d = scratch("plan-moma");
+    let dir = d.to_str().expect("utf-8");
+    let (code, out, err) = btfsm(&["plan", MOMA, "-o", dir]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("conflicts: none"), "{out}");
+    let bt = format!("{dir}/moma-bt.toml");
+    let fsm = format!("{dir}/moma-fsm.toml");
+    assert_eq!(named_ged("policies/paper/fig01-bt.toml", &bt), 0);
+    assert_eq!(named_ged("policies/paper/fig04-fsm.toml", &fsm), 0);
+    // The metrics side by side: Fig. 1's 14/13 and Fig. 4's 6/18.
+    let row = |tag: &str| {
+        out.lines()
+            .find(|l| l.contains(&format!("moma-{tag}.toml")))
+            .unwrap_or_else(|| panic!("{tag} row in {out}"))
+            .split_whitespace()
+            .skip(1)
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    assert_eq!(row("bt"), "bt 14 13");
+    assert_eq!(row("fsm"), "fsm 6 18");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn plan_without_reordering_gives_fig_3_and_says_why_it_chatters() {
+    let d = scratch("plan-fig03");
+    let swapped = std::fs::read_to_string(MOMA).expect("domain").replace(
+        r#"pre = ["In-Hand(object)", "Robot-At(at)"]"#,
+        r#"pre = ["Robot-At(at)", "In-Hand(object)"]"#,
+    );
+    let domain = d.join("moma.toml");
+    std::fs::write(&domain, swapped).expect("write");
+    let domain = domain.to_str().expect("utf-8");
+    let (code, out, err) = btfsm(&["plan", domain, "--to", "bt", "--no-reorder", "-o", "-"]);
+    assert_eq!(code, 0, "{err}");
+    let bt = d.join("fig03.toml");
+    std::fs::write(&bt, out).expect("write");
+    assert_eq!(
+        named_ged("policies/paper/fig03-bt.toml", bt.to_str().expect("utf-8")),
+        0
+    );
+    let (code, out, _) = btfsm(&["plan", domain, "--no-reorder"]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("`held` undoes Robot-At(delivery), which `reached-delivery` ensures: left after it (--no-reorder)"),
+        "{out}"
+    );
+    // Reordered (the default), the same domain gives Fig. 1 and says what moved.
+    let (code, out, _) = btfsm(&["plan", domain]);
+    assert_eq!(code, 0);
+    assert!(out.contains("moved before it"), "{out}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn plan_reports_every_domain_error_with_its_position() {
+    let d = scratch("plan-bad");
+    let bad = std::fs::read_to_string(MOMA)
+        .expect("domain")
+        .replace(
+            r#"pre = ["Robot-At(object)"]"#,
+            r#"pre = ["Robot-Art(object)"]"#,
+        )
+        .replace(
+            r#"params = ["target:location"]"#,
+            r#"params = ["target:place"]"#,
+        );
+    let domain = d.join("bad.toml");
+    std::fs::write(&domain, bad).expect("write");
+    let (code, _, err) = btfsm(&["plan", domain.to_str().expect("utf-8")]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("unknown predicate `Robot-Art`") && err.contains("did you mean `Robot-At`?"),
+        "{err}"
+    );
+    assert!(err.contains("no object has type `place`"), "{err}");
+    assert!(err.contains("bad.toml:"), "{err}");
+    let (code, _, err) = btfsm(&["plan", MOMA, "--goal", "Object-At(cube9, delivery)"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("`cube9` is neither a parameter nor an object"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
