@@ -114,6 +114,11 @@ pub enum Command {
         /// Output file (default: stdout)
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// With --to fault-tolerant: the action domain giving the skills'
+        /// preconditions and effects (default: the built-in
+        /// policies/domains/moma.toml)
+        #[arg(long, value_name = "DOMAIN.toml")]
+        domain: Option<PathBuf>,
         #[command(flatten)]
         limits: LimitArgs,
     },

@@ -163,8 +163,20 @@ pub fn execute(cli: Cli) -> u8 {
             file,
             to,
             output,
+            domain,
             limits,
         } => {
+            if domain.is_some() && to != ConvertTarget::FaultTolerant {
+                eprintln!("error: --domain applies to --to fault-tolerant only");
+                return EXIT_BAD_INPUT;
+            }
+            let domain = match &domain {
+                None => None,
+                Some(path) => match super::plan::read_domain(path, &limits.limits()) {
+                    Some(d) => Some(d),
+                    None => return EXIT_BAD_INPUT,
+                },
+            };
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
@@ -180,12 +192,14 @@ pub fn execute(cli: Cli) -> u8 {
                     );
                 }
                 ConvertTarget::FaultTolerant => {
-                    match crate::transform::fault_tolerant::fault_tolerant_policy(&l.policy) {
+                    use crate::transform::fault_tolerant as ft;
+                    let d = domain.as_ref().unwrap_or_else(|| ft::builtin_domain());
+                    match ft::fault_tolerant_policy_with(&l.policy, d) {
                         Ok(p) => p,
                         Err(errs) => {
                             for e in errs {
                                 eprintln!(
-                                    "error: {}: {}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
+                                    "error: {}: {}\n  = hint: the construction needs a flat FSM whose action states run skills the domain has actions for (--domain; built in: policies/domains/moma.toml)",
                                     shown(&l.path),
                                     crate::sanitize::shown_max(&e.to_string(), 1000)
                                 );

@@ -54,27 +54,35 @@ pub struct PlanArgs {
     pub limits: super::args::LimitArgs,
 }
 
+/// Reads and validates a domain file, printing its errors.
+pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> {
+    let stderr = std::io::stderr();
+    let shown = path.display().to_string();
+    let file = match crate::format::source::read(path, &shown, limits, true) {
+        Ok(f) => f,
+        Err(d) => {
+            print_diagnostics(&mut stderr.lock(), &d);
+            return None;
+        }
+    };
+    match plan::load(&file) {
+        Ok(d) => Some(d),
+        Err(d) => {
+            print_diagnostics(&mut stderr.lock(), &d);
+            None
+        }
+    }
+}
+
 pub fn execute(a: PlanArgs) -> u8 {
     if a.format == OutputFormat::Csv {
         eprintln!("error: `plan` prints `table` or `json`, not `csv`");
         return EXIT_BAD_INPUT;
     }
     let limits = a.limits.limits();
-    let stderr = std::io::stderr();
     let shown = a.domain.display().to_string();
-    let file = match crate::format::source::read(&a.domain, &shown, &limits, true) {
-        Ok(f) => f,
-        Err(d) => {
-            print_diagnostics(&mut stderr.lock(), &d);
-            return EXIT_BAD_INPUT;
-        }
-    };
-    let mut domain = match plan::load(&file) {
-        Ok(d) => d,
-        Err(d) => {
-            print_diagnostics(&mut stderr.lock(), &d);
-            return EXIT_BAD_INPUT;
-        }
+    let Some(mut domain) = read_domain(&a.domain, &limits) else {
+        return EXIT_BAD_INPUT;
     };
     if !a.goals.is_empty()
         && let Err(es) = domain.set_goal(&a.goals)

@@ -17,7 +17,7 @@
 use super::conflicts::{self, Conflict};
 use super::domain::{Action, Domain};
 use super::fact::Fact;
-use crate::model::skill::{ArgValue, SkillCall};
+use crate::model::skill::SkillCall;
 use crate::model::{Bt, BtNode, BtNodeKind};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
@@ -234,7 +234,7 @@ impl<'d> Planner<'d, '_> {
             skill: s.clone(),
             args: bind
                 .iter()
-                .map(|(k, v)| (k.clone(), ArgValue::Str(v.clone())))
+                .map(|(k, v)| (k.clone(), crate::format::btcpp_xml::arg_value(v)))
                 .collect(),
         })
     }
@@ -343,6 +343,11 @@ impl<'d> Planner<'d, '_> {
         order.sort_by_key(|&i| self.d.actions[i].cost);
         for i in order {
             let a = &self.d.actions[i];
+            if let Some(allowed) = &self.d.goal.actions
+                && !allowed.contains(&a.name)
+            {
+                continue;
+            }
             for add in &a.add {
                 if add.pred != f.pred {
                     continue;

@@ -133,6 +133,8 @@ fn one() -> u32 {
 struct RawGoal {
     #[serde(default)]
     id: Option<String>,
+    #[serde(default, rename = "use")]
+    use_actions: Option<Vec<Spanned<String>>>,
     facts: Vec<Spanned<String>>,
     #[serde(default)]
     ids: BTreeMap<String, String>,
@@ -186,6 +188,8 @@ pub struct Action {
 #[derive(Debug, Clone)]
 pub struct Goal {
     pub id: String,
+    /// The actions the planner may use for this goal (`use`; `None`: all).
+    pub actions: Option<Vec<String>>,
     pub facts: Vec<Fact>,
     /// Node id of a goal fact's condition, by its text (`Object-At(cube2, delivery)`).
     pub ids: BTreeMap<String, String>,
@@ -331,6 +335,7 @@ impl Validator {
             actions: Vec::new(),
             goal: Goal {
                 id: String::new(),
+                actions: None,
                 facts: Vec::new(),
                 ids: BTreeMap::new(),
                 labels: BTreeMap::new(),
@@ -440,6 +445,25 @@ impl Validator {
         let empty_params: Vec<Param> = Vec::new();
         for f in self.patterns(&g.facts, &empty_params, &d) {
             d.goal.facts.push(f.ground(&|_| None));
+        }
+        if let Some(names) = &g.use_actions {
+            let mut ok = Vec::new();
+            for n in names {
+                if d.actions.iter().any(|a| &a.name == n.get_ref()) {
+                    ok.push(n.get_ref().clone());
+                } else {
+                    let h = suggest(n.get_ref(), d.actions.iter().map(|a| a.name.as_str()));
+                    self.err(
+                        n.span(),
+                        format!(
+                            "`use` names `{}`, not an action",
+                            crate::sanitize::shown(n.get_ref())
+                        ),
+                        h,
+                    );
+                }
+            }
+            d.goal.actions = Some(ok);
         }
         d.goal.id = g.id.clone().unwrap_or_else(|| d.name.clone());
         d.goal.ids = g.ids.clone();
@@ -615,6 +639,7 @@ fn empty(name: String) -> Domain {
         actions: Vec::new(),
         goal: Goal {
             id: String::new(),
+            actions: None,
             facts: Vec::new(),
             ids: BTreeMap::new(),
             labels: BTreeMap::new(),
@@ -657,5 +682,24 @@ impl Domain {
         }
         self.goal.facts = goal;
         Ok(())
+    }
+}
+
+impl Domain {
+    /// The skill call of `skill` with `params` bound to `objects` (numbers
+    /// and booleans as such: `Battery-Level(20)` is `min = 20`).
+    pub fn skill_call(
+        skill: &str,
+        params: &[Param],
+        objects: &[String],
+    ) -> crate::model::skill::SkillCall {
+        crate::model::skill::SkillCall {
+            skill: skill.to_string(),
+            args: params
+                .iter()
+                .zip(objects)
+                .map(|(p, o)| (p.name.clone(), crate::format::btcpp_xml::arg_value(o)))
+                .collect(),
+        }
     }
 }

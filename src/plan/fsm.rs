@@ -18,7 +18,7 @@
 use super::backchain::{Planned, Step};
 use super::domain::Domain;
 use super::fact::Fact;
-use crate::model::skill::{ArgValue, Guard, GuardTerm, SkillCall};
+use crate::model::skill::{Guard, GuardTerm};
 use crate::model::{
     BtNodeKind, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
@@ -92,15 +92,7 @@ fn term(d: &Domain, f: &Fact, negate: bool) -> Result<GuardTerm, FsmError> {
         .clone()
         .ok_or_else(|| FsmError::NoSkill(pred.name.clone()))?;
     Ok(GuardTerm {
-        condition: SkillCall {
-            skill,
-            args: pred
-                .params
-                .iter()
-                .zip(&f.args)
-                .map(|(p, a)| (p.name.clone(), ArgValue::Str(a.clone())))
-                .collect(),
-        },
+        condition: Domain::skill_call(&skill, &pred.params, &f.args),
         negate,
     })
 }
@@ -144,14 +136,13 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             label: names[i].clone(),
             parent: None,
             body: StateBody::Task(s.action.skill.as_ref().map(|skill| {
-                SkillCall {
-                    skill: skill.clone(),
-                    args: s
-                        .bind
-                        .iter()
-                        .map(|(k, v)| (k.clone(), ArgValue::Str(v.clone())))
-                        .collect(),
-                }
+                let objs: Vec<String> = s
+                    .action
+                    .params
+                    .iter()
+                    .map(|p| s.bind[&p.name].clone())
+                    .collect();
+                Domain::skill_call(skill, &s.action.params, &objs)
             })),
             transitions: vec![
                 outcome("SUCCESS", next),

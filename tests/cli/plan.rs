@@ -104,3 +104,76 @@ fn plan_reports_every_domain_error_with_its_position() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn convert_to_fault_tolerant_recovers_from_a_dropped_cube_like_fig_4() {
+    // Fig. 2 converted with the built-in domain's kernels, beside Fig. 1,
+    // Fig. 4 and the previous construction (a fixture): the cube is dropped
+    // at a random time in half of the episodes.
+    let d = scratch("convert-drop");
+    let dir = d.to_str().expect("utf-8");
+    for f in ["fig01-bt.toml", "fig04-fsm.toml"] {
+        std::fs::copy(format!("policies/paper/{f}"), d.join(f)).expect("copy");
+    }
+    std::fs::copy(
+        "tests/fixtures/sim/fig02-ft-postcondition-guards.toml",
+        d.join("control.toml"),
+    )
+    .expect("copy");
+    let converted = format!("{dir}/fig02-ft.toml");
+    let (code, _, err) = btfsm(&[
+        "convert",
+        "policies/paper/fig02-fsm.toml",
+        "--to",
+        "fault-tolerant",
+        "-o",
+        &converted,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(
+        d.join("drop.toml"),
+        r#"name = "drop"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+robot = "start"
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "fig01-bt.toml"
+[[policies]]
+file = "fig04-fsm.toml"
+[[policies]]
+file = "fig02-ft.toml"
+[[policies]]
+file = "control.toml"
+[monte_carlo]
+drop = { probability = 0.5, window = [5.0, 20.0] }
+"#,
+    )
+    .expect("write");
+    let scenario = format!("{dir}/drop.toml");
+    let (code, out, err) = btfsm(&[
+        "sim", &scenario, "--runs", "200", "--seed", "3", "--format", "json",
+    ]);
+    assert!(code == 0 || code == 1, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    let rate = |name: &str| {
+        v["policies"]
+            .as_array()
+            .expect("policies")
+            .iter()
+            .find(|p| p["policy"].as_str().is_some_and(|n| n.starts_with(name)))
+            .unwrap_or_else(|| panic!("{name} in {out}"))["success_rate"]
+            .as_f64()
+            .expect("rate")
+    };
+    assert_eq!(rate("Fig. 1"), 1.0);
+    assert_eq!(rate("Fig. 4"), 1.0);
+    assert_eq!(rate("Fig. 2 FSM sequential (fault tolerant)"), 1.0);
+    // The scenario tells the constructions apart: the previous one resumes
+    // at Place without the cube.
+    assert!(
+        rate("Fig. 2 fault tolerant, postcondition guards") < 0.9,
+        "{out}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
