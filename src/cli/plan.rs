@@ -29,6 +29,9 @@ pub enum PlanTarget {
 pub struct PlanArgs {
     /// Action domain (TOML; README "Action domains"), e.g. policies/domains/moma.toml
     pub domain: PathBuf,
+    /// A task of the domain (`[tasks.NAME]`) instead of its `[goal]`
+    #[arg(long, value_name = "NAME")]
+    pub task: Option<String>,
     /// Goal fact replacing the domain's goal, e.g. "Object-At(cube2, delivery)"
     /// (repeat for several, in order)
     #[arg(long = "goal", value_name = "FACT")]
@@ -84,6 +87,12 @@ pub fn execute(a: PlanArgs) -> u8 {
     let Some(mut domain) = read_domain(&a.domain, &limits) else {
         return EXIT_BAD_INPUT;
     };
+    if let Some(t) = &a.task
+        && let Err(e) = domain.select_task(t)
+    {
+        eprintln!("error: {e}");
+        return EXIT_BAD_INPUT;
+    }
     if !a.goals.is_empty()
         && let Err(es) = domain.set_goal(&a.goals)
     {

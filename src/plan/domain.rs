@@ -37,6 +37,8 @@ struct RawDomain {
     #[serde(default)]
     actions: Ordered<Spanned<RawAction>>,
     goal: Spanned<RawGoal>,
+    #[serde(default)]
+    tasks: Ordered<Spanned<RawGoal>>,
 }
 
 /// A table read in file order (the domain's order breaks cost ties).
@@ -99,6 +101,8 @@ struct RawPredicate {
     label: Option<String>,
     #[serde(default)]
     achieved_id: Option<String>,
+    #[serde(default)]
+    volatile: bool,
 }
 
 #[derive(Deserialize)]
@@ -169,6 +173,9 @@ pub struct Predicate {
     pub id: String,
     pub label: String,
     pub achieved_id: String,
+    /// The world makes its facts false at any time (a battery drains): in
+    /// an FSM, the action restoring one is a connected state.
+    pub volatile: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -205,6 +212,8 @@ pub struct Domain {
     pub predicates: Vec<Predicate>,
     pub actions: Vec<Action>,
     pub goal: Goal,
+    /// Other goals by name (`[tasks.NAME]`), for `plan --task NAME`.
+    pub tasks: Vec<(String, Goal)>,
 }
 
 impl Domain {
@@ -340,6 +349,7 @@ impl Validator {
                 ids: BTreeMap::new(),
                 labels: BTreeMap::new(),
             },
+            tasks: Vec::new(),
         };
         for (name, p) in raw.predicates.0 {
             let p = p.into_inner();
@@ -371,6 +381,7 @@ impl Validator {
                 exclusive,
                 id: p.id.unwrap_or_else(|| default_id(&name, &params)),
                 label: p.label.unwrap_or_else(|| format!("{shown_fact}?")),
+                volatile: p.volatile,
                 achieved_id: p
                     .achieved_id
                     .unwrap_or_else(|| format!("ensure-{}", default_id(&name, &params))),
@@ -423,28 +434,48 @@ impl Validator {
                 params,
             });
         }
-        let g = raw.goal.get_ref();
+        d.goal = self.goal(&raw.goal, &d);
+        for (name, t) in &raw.tasks.0 {
+            let mut g = self.goal(t, &d);
+            if t.get_ref().id.is_none() {
+                g.id = name.clone();
+            }
+            d.tasks.push((name.clone(), g));
+        }
+        d
+    }
+
+    /// A goal (`[goal]` or `[tasks.NAME]`): facts, `use`, names.
+    fn goal(&mut self, raw: &Spanned<RawGoal>, d: &Domain) -> Goal {
+        let g = raw.get_ref();
+        let mut out = Goal {
+            id: g.id.clone().unwrap_or_else(|| d.name.clone()),
+            actions: None,
+            facts: Vec::new(),
+            ids: g.ids.clone(),
+            labels: g.labels.clone(),
+        };
         if g.facts.len() > MAX_SIBLINGS {
             self.err(
-                raw.goal.span(),
+                raw.span(),
                 format!(
                     "the goal has {} facts, more than {MAX_SIBLINGS}",
                     g.facts.len()
                 ),
                 "split the goal",
             );
-            return d;
+            return out;
         }
         if g.facts.is_empty() {
             self.err(
-                raw.goal.span(),
+                raw.span(),
                 "the goal has no facts",
                 "write `facts = [\"Object-At(cube2, delivery)\"]`",
             );
         }
         let empty_params: Vec<Param> = Vec::new();
-        for f in self.patterns(&g.facts, &empty_params, &d) {
-            d.goal.facts.push(f.ground(&|_| None));
+        for f in self.patterns(&g.facts, &empty_params, d) {
+            out.facts.push(f.ground(&|_| None));
         }
         if let Some(names) = &g.use_actions {
             let mut ok = Vec::new();
@@ -463,12 +494,9 @@ impl Validator {
                     );
                 }
             }
-            d.goal.actions = Some(ok);
+            out.actions = Some(ok);
         }
-        d.goal.id = g.id.clone().unwrap_or_else(|| d.name.clone());
-        d.goal.ids = g.ids.clone();
-        d.goal.labels = g.labels.clone();
-        d
+        out
     }
 
     /// `["name:type", ...]`, types checked against the objects.
@@ -644,10 +672,28 @@ fn empty(name: String) -> Domain {
             ids: BTreeMap::new(),
             labels: BTreeMap::new(),
         },
+        tasks: Vec::new(),
     }
 }
 
 impl Domain {
+    /// Makes task `name` the goal (`plan --task`); the error lists the tasks.
+    pub fn select_task(&mut self, name: &str) -> Result<(), String> {
+        match self.tasks.iter().find(|(n, _)| n == name) {
+            Some((_, g)) => {
+                self.goal = g.clone();
+                Ok(())
+            }
+            None => Err(format!(
+                "--task `{}`: no `[tasks.{}]` in domain `{}`; {}",
+                crate::sanitize::shown(name),
+                crate::sanitize::shown(name),
+                crate::sanitize::shown(&self.name),
+                suggest(name, self.tasks.iter().map(|(n, _)| n.as_str()))
+            )),
+        }
+    }
+
     /// Replaces the goal by `facts` (`--goal`), each checked as a goal fact
     /// of the domain is; the errors say what is wrong with each.
     pub fn set_goal(&mut self, facts: &[String]) -> Result<(), Vec<String>> {

@@ -13,7 +13,12 @@
 //! is what the SELECTOR already knows there, as Fig. 4 writes it.
 //!
 //! The plan is the BT's nominal execution: at each Fallback its first
-//! (cheapest) achiever, each Sequence in order.
+//! (cheapest) achiever, each Sequence in order. A step restoring a goal fact
+//! of a `volatile` predicate (one the world makes false at any time, the
+//! battery level) is not a step of the chain but a *connected* state, as
+//! the paper builds Recharge (Figs. 8d, 16b): every other state and the
+//! SELECTOR go to it when the fact does not hold (checked first), it
+//! returns to the SELECTOR on `SUCCESS` and stays on `RUNNING`.
 
 use super::backchain::{Planned, Step};
 use super::domain::Domain;
@@ -107,15 +112,33 @@ fn outcome(o: &str, target: Target) -> Transition {
 
 /// The fault-tolerant FSM of the planned tree (see the module docs).
 pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
-    let steps = steps(d, p);
+    let all = steps(d, p);
+    // Steps restoring a volatile goal fact (a battery level) are connected
+    // states; the others are the task's chain.
+    let volatile: Vec<&Fact> = d
+        .goal
+        .facts
+        .iter()
+        .filter(|f| d.predicate(&f.pred).is_some_and(|q| q.volatile))
+        .collect();
+    let (connected, steps): (Vec<Step<'_>>, Vec<Step<'_>>) = all
+        .into_iter()
+        .partition(|s| s.adds().iter().any(|f| volatile.contains(&f)));
     if steps.is_empty() {
         return Err(FsmError::NoStep);
     }
-    let ks = kernels(&steps, &d.goal.facts);
+    let goal: Vec<Fact> = d
+        .goal
+        .facts
+        .iter()
+        .filter(|f| !volatile.contains(f))
+        .cloned()
+        .collect();
+    let ks = kernels(&steps, &goal);
     let n = steps.len();
     let sel = n;
     let mut names: Vec<String> = Vec::new();
-    for s in &steps {
+    for s in steps.iter().chain(&connected) {
         let mut name = state_name(d, s);
         let mut k = 2;
         while names.contains(&name) || name == "SELECTOR" {
@@ -124,6 +147,35 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         }
         names.push(name);
     }
+    // Entering a connected state: the guard "its fact does not hold".
+    let mut to_connected: Vec<Transition> = Vec::new();
+    for (c, s) in connected.iter().enumerate() {
+        let f = s
+            .adds()
+            .into_iter()
+            .find(|f| volatile.contains(&f))
+            .expect("partitioned on it");
+        let t = term(d, &f, true)?;
+        to_connected.push(Transition {
+            trigger: Trigger::Guard(Guard {
+                label: t.to_string(),
+                all: vec![t],
+            }),
+            target: Target::State(n + 1 + c),
+            span: None,
+        });
+    }
+    let task = |s: &Step<'_>| {
+        StateBody::Task(s.action.skill.as_ref().map(|skill| {
+            let objs: Vec<String> = s
+                .action
+                .params
+                .iter()
+                .map(|p| s.bind[&p.name].clone())
+                .collect();
+            Domain::skill_call(skill, &s.action.params, &objs)
+        }))
+    };
     let mut states: Vec<State> = Vec::new();
     for (i, s) in steps.iter().enumerate() {
         let next = if i + 1 < n {
@@ -131,24 +183,18 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         } else {
             Target::Outcome("SUCCESS".into())
         };
+        let mut transitions = to_connected.clone();
+        transitions.extend([
+            outcome("SUCCESS", next),
+            outcome("FAILURE", Target::State(sel)),
+            outcome("RUNNING", Target::State(i)),
+        ]);
         states.push(State {
             name: names[i].clone(),
             label: names[i].clone(),
             parent: None,
-            body: StateBody::Task(s.action.skill.as_ref().map(|skill| {
-                let objs: Vec<String> = s
-                    .action
-                    .params
-                    .iter()
-                    .map(|p| s.bind[&p.name].clone())
-                    .collect();
-                Domain::skill_call(skill, &s.action.params, &objs)
-            })),
-            transitions: vec![
-                outcome("SUCCESS", next),
-                outcome("FAILURE", Target::State(sel)),
-                outcome("RUNNING", Target::State(i)),
-            ],
+            body: task(s),
+            transitions,
             pseudo: None,
             span: None,
         });
@@ -159,7 +205,7 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             .collect::<Vec<_>>()
             .join(" and ")
     };
-    let mut guards = Vec::new();
+    let mut guards = to_connected.clone();
     for k in (0..=n).rev() {
         let target = if k == n {
             Target::Outcome("SUCCESS".into())
@@ -204,12 +250,28 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         pseudo: None,
         span: None,
     });
+    for (c, s) in connected.iter().enumerate() {
+        let i = n + 1 + c;
+        states.push(State {
+            name: names[n + c].clone(),
+            label: names[n + c].clone(),
+            parent: None,
+            body: task(s),
+            transitions: vec![
+                outcome("SUCCESS", Target::State(sel)),
+                outcome("RUNNING", Target::State(i)),
+            ],
+            pseudo: None,
+            span: None,
+        });
+    }
+    let count = states.len();
     Ok(StateMachine {
         hierarchical: false,
         top: Region {
             initial: 0,
             outcomes: vec!["SUCCESS".into()],
-            states: (0..=n).collect(),
+            states: (0..count).collect(),
         },
         states,
     })

@@ -177,3 +177,41 @@ drop = { probability = 0.5, window = [5.0, 20.0] }
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// (kind, V, E, cc) of each row of an `analyze`-style table.
+fn counts(table: &str) -> Vec<String> {
+    table
+        .lines()
+        .skip_while(|l| !l.starts_with("file"))
+        .skip(1)
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            format!("{} {} {} {}", f[1], f[2], f[3], f[6])
+        })
+        .collect()
+}
+
+#[test]
+fn plan_five_cubes_gives_the_counts_of_the_scalability_experiment() {
+    for (task, bt, fsm) in [
+        ("five-cubes-baseline", "scal-bt", "scal-fsm"),
+        ("five-cubes", "fig16a-bt", "fig16b-fsm"),
+    ] {
+        let (code, planned, err) = btfsm(&["plan", MOMA, "--task", task, "--to", "all"]);
+        assert_eq!(code, 0, "{err}");
+        let (code, paper, err) = btfsm(&[
+            "analyze",
+            &format!("policies/paper/{bt}.toml"),
+            &format!("policies/paper/{fsm}.toml"),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        assert_eq!(counts(&planned)[..2], counts(&paper)[..], "{task}");
+    }
+    let (code, _, err) = btfsm(&["plan", MOMA, "--task", "five-cube"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("no `[tasks.five-cube]`") && err.contains("five-cubes"),
+        "{err}"
+    );
+}
