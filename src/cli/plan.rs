@@ -47,9 +47,9 @@ pub struct PlanArgs {
     /// (a later sibling undoing an earlier one's condition: the robot chatters)
     #[arg(long)]
     pub no_reorder: bool,
-    /// Deepest nesting of achievers below a goal condition
-    #[arg(long, default_value_t = 16, value_name = "N")]
-    pub max_plan_depth: usize,
+    /// Deepest nesting of achievers below a goal condition (1 to 256)
+    #[arg(long, default_value_t = 16, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+    pub max_plan_depth: u16,
     /// Output format of the report (table or json)
     #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
     pub format: OutputFormat,
@@ -103,7 +103,7 @@ pub fn execute(a: PlanArgs) -> u8 {
     }
     let opts = Options {
         reorder: !a.no_reorder,
-        max_depth: a.max_plan_depth,
+        max_depth: usize::from(a.max_plan_depth),
         max_nodes: limits.max_nodes,
         ..Options::default()
     };

@@ -11,6 +11,7 @@
 
 use super::fact::{self, Fact, Pattern};
 use crate::diagnostic::{Diagnostic, SourceFile, suggest};
+use crate::model::skill::{self, SkillKind};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -92,7 +93,7 @@ struct RawPredicate {
     #[serde(default)]
     params: Vec<Spanned<String>>,
     #[serde(default)]
-    skill: Option<String>,
+    skill: Option<Spanned<String>>,
     #[serde(default)]
     exclusive: Option<Spanned<String>>,
     #[serde(default)]
@@ -119,7 +120,7 @@ struct RawAction {
     #[serde(default = "one")]
     cost: u32,
     #[serde(default)]
-    skill: Option<String>,
+    skill: Option<Spanned<String>>,
     #[serde(default)]
     id: Option<String>,
     #[serde(default)]
@@ -375,9 +376,10 @@ impl Validator {
             } else {
                 format!("{name} {}", args.join(" "))
             };
+            let skill = self.skill(p.skill.as_ref(), SkillKind::Condition, &params);
             d.predicates.push(Predicate {
                 name: name.clone(),
-                skill: p.skill,
+                skill,
                 exclusive,
                 id: p.id.unwrap_or_else(|| default_id(&name, &params)),
                 label: p.label.unwrap_or_else(|| format!("{shown_fact}?")),
@@ -427,7 +429,7 @@ impl Validator {
                 add,
                 del,
                 cost: a.cost,
-                skill: a.skill,
+                skill: self.skill(a.skill.as_ref(), SkillKind::Action, &params),
                 label: a.label.unwrap_or_else(|| format!("{shown_call}!")),
                 sequence_id: a.sequence_id.unwrap_or_else(|| format!("do-{id}")),
                 id,
@@ -497,6 +499,74 @@ impl Validator {
             out.actions = Some(ok);
         }
         out
+    }
+
+    /// A `skill` of the shared library of `kind` whose arguments are the
+    /// parameters (every required one given, none it does not take).
+    fn skill(
+        &mut self,
+        raw: Option<&Spanned<String>>,
+        kind: SkillKind,
+        params: &[Param],
+    ) -> Option<String> {
+        let raw = raw?;
+        let name = raw.get_ref();
+        let word = match kind {
+            SkillKind::Action => "an action",
+            SkillKind::Condition => "a condition",
+        };
+        match skill::skill_kind(name) {
+            Some(k) if k == kind => {}
+            _ => {
+                let h = suggest(name, skill::skill_names(kind));
+                self.err(
+                    raw.span(),
+                    format!(
+                        "`{}` is not {word} skill of the shared library",
+                        crate::sanitize::shown(name)
+                    ),
+                    h,
+                );
+                return None;
+            }
+        }
+        let takes = skill::skill_params(name).unwrap_or(&[]);
+        let mut ok = true;
+        for (arg, required) in takes {
+            if *required && !params.iter().any(|p| p.name == *arg) {
+                self.err(
+                    raw.span(),
+                    format!("skill `{name}` needs argument `{arg}`, which is not a parameter here"),
+                    format!("name a parameter `{arg}`: its object is the argument"),
+                );
+                ok = false;
+            }
+        }
+        for p in params {
+            if !takes.iter().any(|(arg, _)| *arg == p.name) {
+                self.err(
+                    raw.span(),
+                    format!(
+                        "skill `{name}` has no argument `{}`",
+                        crate::sanitize::shown(&p.name)
+                    ),
+                    format!(
+                        "the parameters are the skill's arguments: {}",
+                        if takes.is_empty() {
+                            "none".to_string()
+                        } else {
+                            takes
+                                .iter()
+                                .map(|(a, _)| format!("`{a}`"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        }
+                    ),
+                );
+                ok = false;
+            }
+        }
+        ok.then(|| name.clone())
     }
 
     /// `["name:type", ...]`, types checked against the objects.

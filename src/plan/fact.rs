@@ -21,7 +21,11 @@ pub struct Fact {
 
 impl fmt::Display for Fact {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}({})", self.pred, self.args.join(", "))
+        if self.args.is_empty() {
+            write!(f, "{}", self.pred)
+        } else {
+            write!(f, "{}({})", self.pred, self.args.join(", "))
+        }
     }
 }
 

@@ -171,3 +171,39 @@ fn the_moma_plan_gives_the_fault_tolerant_fsm_of_fig_4() {
     };
     assert_eq!(machine_shape(&m), machine_shape(fig04));
 }
+
+#[test]
+fn mutated_domains_never_panic() {
+    // Seeded byte and line mutations of the paper's domain through the fuzz
+    // target's body (which plans and exercises what it accepts).
+    let mut rng = crate::sim::rng::SimRng::named(0x5eed_d0a1, "domain-mutations");
+    let mut below = move |n: u64| rng.next_u64() % n.max(1);
+    let lines: Vec<&str> = MOMA.lines().collect();
+    for _ in 0..300 {
+        let mut text: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        for _ in 0..1 + below(3) {
+            let i = below(text.len() as u64) as usize;
+            match below(4) {
+                0 => {
+                    text.remove(i);
+                }
+                1 => {
+                    let j = below(text.len() as u64) as usize;
+                    let l = text[j].clone();
+                    text.insert(i, l);
+                }
+                2 if !text[i].is_empty() => {
+                    let mut b = text[i].clone().into_bytes();
+                    let k = below(b.len() as u64) as usize;
+                    b[k] = b"()[]{},=\"x1 \\"[below(13) as usize];
+                    text[i] = String::from_utf8_lossy(&b).into_owned();
+                }
+                _ => {
+                    let j = below(text.len() as u64) as usize;
+                    text.swap(i, j);
+                }
+            }
+        }
+        crate::fuzzing::domain(text.join("\n").as_bytes());
+    }
+}
