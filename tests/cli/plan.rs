@@ -215,3 +215,36 @@ fn plan_five_cubes_gives_the_counts_of_the_scalability_experiment() {
         "{err}"
     );
 }
+
+#[test]
+fn plan_work_is_bounded_by_max_nodes_and_the_depth_limit() {
+    // Every X(i) and Y(i) needs both X(i+1) and Y(i+1): a tree of 2^20
+    // nodes, refused at --max-nodes; the depth is capped at 256.
+    let d = scratch("plan-bounded");
+    let mut text = String::from("name = \"blowup\"\n[objects]\no = { types = [\"t\"] }\n");
+    for i in 0..=20 {
+        for p in ["X", "Y"] {
+            text.push_str(&format!("[predicates.{p}{i}]\n"));
+        }
+    }
+    for i in 0..20 {
+        for p in ["X", "Y"] {
+            text.push_str(&format!(
+                "[actions.make-{p}{i}]\npre = [\"X{}\", \"Y{}\"]\nadd = [\"{p}{i}\"]\n",
+                i + 1,
+                i + 1
+            ));
+        }
+    }
+    text.push_str("[goal]\nfacts = [\"X0\"]\n");
+    let f = d.join("blowup.toml");
+    std::fs::write(&f, text).expect("write");
+    let f = f.to_str().expect("utf-8");
+    let (code, _, err) = btfsm(&["plan", f, "--max-plan-depth", "256", "--max-nodes", "5000"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("more than 5000 nodes"), "{err}");
+    let (code, _, err) = btfsm(&["plan", f, "--max-plan-depth", "257"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("257"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
