@@ -107,9 +107,9 @@ fn plan_reports_every_domain_error_with_its_position() {
 
 #[test]
 fn convert_to_fault_tolerant_recovers_from_a_dropped_cube_like_fig_4() {
-    // Fig. 2 converted with the built-in domain's kernels, beside Fig. 1,
-    // Fig. 4 and the previous construction (a fixture): the cube is dropped
-    // at a random time in half of the episodes.
+    // Fig. 2 converted with the built-in domain's kernels and the FSM `plan`
+    // derives, beside Fig. 1, Fig. 4 and the previous construction (a
+    // fixture): the cube is dropped at a random time in half of the episodes.
     let d = scratch("convert-drop");
     let dir = d.to_str().expect("utf-8");
     for f in ["fig01-bt.toml", "fig04-fsm.toml"] {
@@ -130,6 +130,9 @@ fn convert_to_fault_tolerant_recovers_from_a_dropped_cube_like_fig_4() {
         &converted,
     ]);
     assert_eq!(code, 0, "{err}");
+    // And the FSM `plan` derives from the domain.
+    let (code, _, err) = btfsm(&["plan", MOMA, "-o", dir]);
+    assert_eq!(code, 0, "{err}");
     std::fs::write(
         d.join("drop.toml"),
         r#"name = "drop"
@@ -145,6 +148,8 @@ file = "fig04-fsm.toml"
 file = "fig02-ft.toml"
 [[policies]]
 file = "control.toml"
+[[policies]]
+file = "moma-fsm.toml"
 [monte_carlo]
 drop = { probability = 0.5, window = [5.0, 20.0] }
 "#,
@@ -169,6 +174,7 @@ drop = { probability = 0.5, window = [5.0, 20.0] }
     assert_eq!(rate("Fig. 1"), 1.0);
     assert_eq!(rate("Fig. 4"), 1.0);
     assert_eq!(rate("Fig. 2 FSM sequential (fault tolerant)"), 1.0);
+    assert_eq!(rate("moma (planned fault-tolerant FSM)"), 1.0);
     // The scenario tells the constructions apart: the previous one resumes
     // at Place without the cube.
     assert!(
