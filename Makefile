@@ -27,8 +27,10 @@ run: build
 	  $(BIN) sim $$s --format json --plot out/sim-$$b.svg > out/sim-$$b.json || exit 2; \
 	done
 	$(BIN) sim policies/scenarios/exp1-pick-fails.toml
-	@if command -v dot >/dev/null 2>&1; then echo "wrote out/analysis.json, out/*.dot, out/*.svg and out/sim-*.json"; \
-	 else echo "wrote out/analysis.json, out/*.dot, out/sim-*.json and out/sim-*.svg (install Graphviz for the policy SVGs)"; fi
+	$(BIN) plan policies/domains/moma.toml -o out/planned
+	$(BIN) sim policies/domains/moma-sim.toml --runs 300
+	@if command -v dot >/dev/null 2>&1; then echo "wrote out/analysis.json, out/*.dot, out/*.svg, out/sim-*.json and out/planned/"; \
+	 else echo "wrote out/analysis.json, out/*.dot, out/sim-*.json, out/sim-*.svg and out/planned/ (install Graphviz for the policy SVGs)"; fi
 
 test:
 	$(CARGO) fmt --check

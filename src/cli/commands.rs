@@ -71,6 +71,27 @@ pub fn execute(cli: Cli) -> u8 {
                 };
                 let fmt = match input {
                     format::Input::Policy(fmt) => fmt,
+                    format::Input::Scenario if crate::sim::symbolic::looks_symbolic(&file.text) => {
+                        let base = f.parent().unwrap_or(Path::new(""));
+                        match crate::sim::symbolic::scenario::parse(&file, base, &limits) {
+                            Ok(s) => {
+                                let _ = writeln!(
+                                    err,
+                                    "{}: ok (symbolic scenario `{}`, domain `{}`, {} polic{})",
+                                    shown(&f.display().to_string()),
+                                    shown(&s.name),
+                                    shown(&s.domain.name),
+                                    s.policies.len(),
+                                    if s.policies.len() == 1 { "y" } else { "ies" }
+                                );
+                            }
+                            Err(diags) => {
+                                failed = true;
+                                print_diagnostics(&mut err, &diags);
+                            }
+                        }
+                        continue;
+                    }
                     format::Input::Scenario => {
                         let base = f.parent().unwrap_or(Path::new(""));
                         match crate::sim::scenario::parse(&file, base, &limits) {

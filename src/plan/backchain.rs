@@ -311,10 +311,7 @@ impl<'d> Planner<'d, '_> {
             seq.push(act);
             let s = self.push(
                 self.d.fill(&a.sequence_id, &step.bind),
-                self.d
-                    .fill(&a.label, &step.bind)
-                    .trim_end_matches('!')
-                    .to_string(),
+                BtNodeKind::Sequence.default_label().into(),
                 BtNodeKind::Sequence,
                 seq,
                 None,

@@ -337,6 +337,13 @@ impl Validator {
                 return empty(raw.name.into_inner());
             }
         }
+        if !fact::is_name(raw.name.get_ref()) {
+            self.err(
+                raw.name.span(),
+                format!("domain name `{}` is not a name", crate::sanitize::shown(raw.name.get_ref())),
+                "letters, digits, `-` and `_`: it prefixes the domain's own skills (`moma:Open-Door`)",
+            );
+        }
         let mut d = Domain {
             name: raw.name.get_ref().clone(),
             description: raw.description.clone(),
@@ -376,7 +383,8 @@ impl Validator {
             } else {
                 format!("{name} {}", args.join(" "))
             };
-            let skill = self.skill(p.skill.as_ref(), SkillKind::Condition, &params);
+            let custom = format!("{}:{name}", d.name);
+            let skill = self.skill(p.skill.as_ref(), SkillKind::Condition, &params, custom);
             d.predicates.push(Predicate {
                 name: name.clone(),
                 skill,
@@ -429,7 +437,12 @@ impl Validator {
                 add,
                 del,
                 cost: a.cost,
-                skill: self.skill(a.skill.as_ref(), SkillKind::Action, &params),
+                skill: self.skill(
+                    a.skill.as_ref(),
+                    SkillKind::Action,
+                    &params,
+                    format!("{}:{name}", d.name),
+                ),
                 label: a.label.unwrap_or_else(|| format!("{shown_call}!")),
                 sequence_id: a.sequence_id.unwrap_or_else(|| format!("do-{id}")),
                 id,
@@ -502,14 +515,20 @@ impl Validator {
     }
 
     /// A `skill` of the shared library of `kind` whose arguments are the
-    /// parameters (every required one given, none it does not take).
+    /// parameters (every required one given, none it does not take); without
+    /// one, `custom` (the domain's own skill `domain:Name`).
     fn skill(
         &mut self,
         raw: Option<&Spanned<String>>,
         kind: SkillKind,
         params: &[Param],
+        custom: String,
     ) -> Option<String> {
-        let raw = raw?;
+        // Without `skill`: a skill of the domain's own, `domain:Name`, which
+        // runs in symbolic simulation.
+        let Some(raw) = raw else {
+            return Some(custom);
+        };
         let name = raw.get_ref();
         let word = match kind {
             SkillKind::Action => "an action",

@@ -254,3 +254,71 @@ fn plan_work_is_bounded_by_max_nodes_and_the_depth_limit() {
     assert!(err.contains("257"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn plan_and_simulate_a_domain_of_its_own_skills() {
+    // tests/fixtures/domains/kitchen.toml names no library skill: its
+    // actions and predicates are its own skills (`kitchen:Go`, ...). The
+    // planned BT and FSM load, and in the symbolic world both reach the goal
+    // when the door closes and the cup slips, and under Monte Carlo.
+    let d = scratch("plan-kitchen");
+    let dir = d.to_str().expect("utf-8");
+    std::fs::copy(
+        "tests/fixtures/domains/kitchen.toml",
+        d.join("kitchen.toml"),
+    )
+    .expect("copy");
+    let (code, _, err) = btfsm(&["plan", "tests/fixtures/domains/kitchen.toml", "-o", dir]);
+    assert_eq!(code, 0, "{err}");
+    let bt = format!("{dir}/kitchen-bt.toml");
+    let fsm = format!("{dir}/kitchen-fsm.toml");
+    let (code, _, err) = btfsm(&["validate", &bt, &fsm]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(
+        d.join("sim.toml"),
+        r#"name = "kitchen"
+domain = "kitchen.toml"
+durations = { Go = 3, Take = 2 }
+[[policies]]
+file = "kitchen-bt.toml"
+[[policies]]
+file = "kitchen-fsm.toml"
+[[disturbances]]
+at = 3
+unset = ["Door-Open(door)"]
+[[disturbances]]
+at = 6
+unset = ["Holding(cup)"]
+[monte_carlo]
+rates = { Take = 0.2, Go = 0.1 }
+unset = { probability = 0.6, facts = ["Door-Open(door)", "Holding(cup)"], window = [1, 15] }
+"#,
+    )
+    .expect("write");
+    let sim = format!("{dir}/sim.toml");
+    let (code, out, err) = btfsm(&["sim", &sim, "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    for r in v["runs"].as_array().expect("runs") {
+        assert_eq!(r["outcome"], "success", "{out}");
+    }
+    let (code, out, err) = btfsm(&["sim", &sim, "--runs", "300", "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    for p in v["policies"].as_array().expect("policies") {
+        assert_eq!(p["success_rate"], 1.0, "{out}");
+    }
+    // In the planar room these skills do not exist: a clear error.
+    std::fs::write(
+        d.join("planar.toml"),
+        "name = \"p\"\n[world]\nrobot = \"start\"\n[[policies]]\nfile = \"kitchen-bt.toml\"\n",
+    )
+    .expect("write");
+    let (code, _, err) = btfsm(&["sim", &format!("{dir}/planar.toml")]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("unknown skill `kitchen:Item-In` (a skill of an action domain: it runs in symbolic scenarios"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
