@@ -48,7 +48,8 @@ test:
 # the same shape (tests/differential/accept_btcpp.py; known, explained
 # mismatches in accept_btcpp_known.txt, which must not go stale); then the
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
-# SubTrees are spread over files given together (projects_btcpp.py).
+# SubTrees are spread over files given together (projects_btcpp.py); and
+# every SARIF log of `lint` against the official schema (sarif_check.py).
 $(VENV)/.installed: tests/differential/requirements.txt
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
@@ -64,6 +65,7 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/projects_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/projects_btcpp.txt 2>&1 \
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
+	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).

@@ -12,6 +12,7 @@ pub mod format;
 #[doc(hidden)]
 pub mod fuzzing;
 pub mod graph;
+pub mod lint;
 pub mod metrics;
 pub mod model;
 pub mod plan;

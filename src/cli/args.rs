@@ -150,6 +150,10 @@ pub enum Command {
     /// fault-tolerant FSM and the HFSM of the same plan (exit 1 when a
     /// precondition conflict no order resolves is left)
     Plan(super::plan::PlanArgs),
+    /// Checks policies against coded rules (structure, the paper's
+    /// smells); text, JSON or SARIF; exit 1 when an error-level finding
+    /// remains
+    Lint(super::lint::LintArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
     Completions {

@@ -279,6 +279,7 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Sim(args) => super::sim::execute(args),
         Command::Tick(args) => super::tick::execute(args),
         Command::Plan(args) => super::plan::execute(args),
+        Command::Lint(args) => super::lint::execute(args),
         Command::Completions { shell } => {
             use clap::CommandFactory;
             let mut out = Vec::new();

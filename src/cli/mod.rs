@@ -27,6 +27,7 @@ mod commands;
 mod compare;
 mod convert;
 mod edit;
+mod lint;
 pub mod out;
 mod paper;
 mod plan;

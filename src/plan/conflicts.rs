@@ -62,8 +62,9 @@ impl std::fmt::Display for Conflict {
     }
 }
 
-/// The facts of `ensured` that `step` deletes.
-pub(super) fn undone_by(d: &Domain, step: &Step<'_>, ensured: &[Option<Fact>]) -> Vec<Fact> {
+/// The facts of `ensured` that `step` deletes (explicitly, or by adding a
+/// fact of an `exclusive` predicate that excludes them).
+pub fn undone_by(d: &Domain, step: &Step<'_>, ensured: &[Option<Fact>]) -> Vec<Fact> {
     let dels = step.deletes();
     let adds = step.adds();
     let mut out = Vec::new();

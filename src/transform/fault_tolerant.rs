@@ -129,7 +129,7 @@ pub fn builtin_domain() -> &'static Domain {
 /// The domain action that runs `call`'s skill, with its parameters bound to
 /// the call's arguments; `None` when no action runs it or an argument is
 /// missing.
-fn step_of<'d>(d: &'d Domain, call: &SkillCall) -> Option<Step<'d>> {
+pub fn step_of<'d>(d: &'d Domain, call: &SkillCall) -> Option<Step<'d>> {
     d.actions.iter().find_map(|a| {
         if a.skill.as_deref() != Some(call.skill.as_str()) {
             return None;

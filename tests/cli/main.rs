@@ -9,6 +9,7 @@ mod conventions;
 mod formats;
 mod gate;
 mod hostile;
+mod lint;
 mod paper;
 mod plan;
 mod sim;
