@@ -203,13 +203,18 @@ fn outcome_never_reached(p: &Policy, out: &mut Sink) {
         }
     }
     for (owner, r) in regions {
+        // One pass over the region's transitions, then one look-up per outcome.
+        let reached: std::collections::HashSet<&str> = r
+            .states
+            .iter()
+            .flat_map(|&s| &m.states[s].transitions)
+            .filter_map(|t| match &t.target {
+                Target::Outcome(x) => Some(x.as_str()),
+                Target::State(_) => None,
+            })
+            .collect();
         for o in &r.outcomes {
-            let used = r.states.iter().any(|&s| {
-                m.states[s]
-                    .transitions
-                    .iter()
-                    .any(|t| matches!(&t.target, Target::Outcome(x) if x == o))
-            });
+            let used = reached.contains(o.as_str());
             // A region's RUNNING is the tick-driven construction's (Fig. 6).
             if used || o == "RUNNING" {
                 continue;
