@@ -593,7 +593,7 @@ fn the_built_in_domain_describes_the_planar_skills() {
             .unwrap_or_else(|e| panic!("{f}: {}", e.message));
         super::skills::condition(&c, &r.world)
     };
-    let plan: [(&str, &[&str]); 8] = [
+    let plan: [(&str, &[&str]); 9] = [
         ("Move-To", &["cube2"]),
         ("Pick", &["cube2"]),
         ("Move-To", &["delivery"]),
@@ -601,6 +601,7 @@ fn the_built_in_domain_describes_the_planar_skills() {
         ("Tuck-Arm", &[]),
         ("Safe-Move-To", &["charging"]),
         ("Search", &[]),
+        ("Recharge", &[]),
         ("Dock", &[]),
     ];
     for (name, objs) in plan {
