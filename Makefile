@@ -49,7 +49,8 @@ test:
 # mismatches in accept_btcpp_known.txt, which must not go stale); then the
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
 # SubTrees are spread over files given together (projects_btcpp.py); and
-# every SARIF log of `lint` against the official schema (sarif_check.py).
+# every SARIF log of `lint` against the official schema (sarif_check.py);
+# and logs BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py).
 $(VENV)/.installed: tests/differential/requirements.txt
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
@@ -66,6 +67,9 @@ differential: $(VENV)/.installed
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
 	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
+	$(VENV)/bin/python tests/differential/btlog_check.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_check.txt 2>&1 \
+	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_check.txt | tail -40; exit 1; }
+	@tail -1 $(TARGET_DIR)/btlog_check.txt
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).

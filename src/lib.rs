@@ -13,6 +13,7 @@ pub mod format;
 pub mod fuzzing;
 pub mod graph;
 pub mod lint;
+pub mod log;
 pub mod metrics;
 pub mod model;
 pub mod plan;

@@ -154,6 +154,8 @@ pub enum Command {
     /// smells); text, JSON or SARIF; exit 1 when an error-level finding
     /// remains
     Lint(super::lint::LintArgs),
+    /// Reads BehaviorTree.CPP execution logs (.btlog): `log report`
+    Log(super::log::LogArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
     Completions {

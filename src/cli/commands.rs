@@ -301,6 +301,7 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Tick(args) => super::tick::execute(args),
         Command::Plan(args) => super::plan::execute(args),
         Command::Lint(args) => super::lint::execute(args),
+        Command::Log(args) => super::log::execute(args),
         Command::Completions { shell } => {
             use clap::CommandFactory;
             let mut out = Vec::new();

@@ -28,6 +28,7 @@ mod compare;
 mod convert;
 mod edit;
 mod lint;
+mod log;
 pub mod out;
 mod paper;
 mod plan;

@@ -10,6 +10,7 @@ mod formats;
 mod gate;
 mod hostile;
 mod lint;
+mod log;
 mod paper;
 mod plan;
 mod sim;

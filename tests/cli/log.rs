@@ -1,0 +1,112 @@
+//! `btfsm log report` on logs BehaviorTree.CPP wrote (tests/fixtures/logs/):
+//! figures, coverage gate, and corrupt logs refused with the byte offset.
+
+use super::*;
+use common::scratch;
+
+const FIG01: &str = "tests/fixtures/logs/fig01.btlog";
+
+#[test]
+fn log_report_counts_every_record_of_a_behaviortree_cpp_log() {
+    let (code, out, err) = btfsm(&["log", "report", FIG01, "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    assert_eq!(v["layout"], "protocol1");
+    // The file: 23 header bytes, the XML, 8 timestamp bytes, 9 per record.
+    let bytes = std::fs::read(FIG01).expect("fixture");
+    let xml = i32::from_le_bytes(bytes[19..23].try_into().unwrap()) as usize;
+    let records = (bytes.len() - 23 - xml - 8) / 9;
+    assert_eq!(v["records"], records as u64);
+    let sum: u64 = v["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|n| n["statuses"].as_object().unwrap().values())
+        .map(|x| x.as_u64().unwrap())
+        .sum();
+    assert_eq!(
+        sum, records as u64,
+        "every record is one status change of one node"
+    );
+    assert_eq!(v["node_coverage"]["total"], 14);
+}
+
+#[test]
+fn log_report_gates_on_coverage() {
+    let (code, out, _) = btfsm(&["log", "report", FIG01, "--min-coverage", "0.9"]);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("node coverage 14/14 (100.0 %)"), "{out}");
+    let (code, _, err) = btfsm(&[
+        "log",
+        "report",
+        "tests/fixtures/logs/subtree.btlog",
+        "--min-coverage",
+        "1",
+    ]);
+    let (_, out, _) = btfsm(&[
+        "log",
+        "report",
+        "tests/fixtures/logs/subtree.btlog",
+        "--format",
+        "json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let full = v["node_coverage"]["ratio"] == 1.0 && v["branch_coverage"]["ratio"] == 1.0;
+    assert_eq!(code, if full { 0 } else { 1 }, "{err}");
+    let (code, _, err) = btfsm(&["log", "report", FIG01, "--min-coverage", "2"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("ratio from 0 to 1"), "{err}");
+}
+
+#[test]
+fn a_cut_or_foreign_log_is_refused_with_the_byte_offset() {
+    let d = scratch("btlog-cut");
+    let bytes = std::fs::read(FIG01).expect("fixture");
+    let cut = d.join("cut.btlog");
+    std::fs::write(&cut, &bytes[..bytes.len() - 4]).expect("write");
+    let (code, _, err) = btfsm(&["log", "report", cut.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains(&format!(
+            "byte {}: the log ends inside a record",
+            bytes.len() - 9
+        )),
+        "{err}"
+    );
+    let foreign = d.join("policy.btlog");
+    std::fs::write(
+        &foreign,
+        std::fs::read("policies/paper/fig01-bt.toml").unwrap(),
+    )
+    .expect("write");
+    let (code, _, err) = btfsm(&["log", "report", foreign.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_long_log_is_streamed_in_bounded_memory() {
+    // 2,000,000 records (18 MB) after fig01.btlog's header, read under a
+    // 64 MiB address-space cap: memory holds the tree and its counters.
+    let d = scratch("btlog-long");
+    let bytes = std::fs::read(FIG01).expect("fixture");
+    let xml = i32::from_le_bytes(bytes[19..23].try_into().unwrap()) as usize;
+    let mut out = bytes[..23 + xml + 8].to_vec();
+    out.reserve(9 * 2_000_000);
+    for i in 0..2_000_000u64 {
+        out.extend(&i.to_le_bytes()[..6]);
+        out.extend(((i % 14) as u16 + 1).to_le_bytes());
+        out.push((i % 4) as u8);
+    }
+    let long = d.join("long.btlog");
+    std::fs::write(&long, &out).expect("write");
+    drop(out);
+    let (code, stdout, err, _) = common::btfsm_capped(
+        64,
+        &["log", "report", long.to_str().unwrap(), "--format", "json"],
+    );
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(v["records"], 2_000_000);
+    let _ = std::fs::remove_dir_all(&d);
+}
