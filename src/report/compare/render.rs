@@ -1,6 +1,7 @@
 //! `compare`'s output formats: JSON (SPEC §7), the table with the edit
 //! script, and GitHub markdown for a pull-request comment.
 
+use super::changes_text::{Style, change_lines, counts, summary_markdown};
 use super::{ArcRef, CompareReport, ModeReport, VertexRef};
 use crate::metrics::ged::GedMode;
 
@@ -63,6 +64,15 @@ pub fn render_table(r: &CompareReport) -> String {
             "note: the search hit its budget; the distance lies in the certified interval (raise --timeout-ms to narrow it)\n",
         );
     }
+    if let Some(p) = r.primary()
+        && p.relabels + p.reorders > 0
+    {
+        out.push_str(&format!(
+            "note: the {} mapping also has {}; the GED counts neither reorders nor relabels\n",
+            p.mode.as_str(),
+            counts(p)
+        ));
+    }
     if let Some(p) = r.primary() {
         out.push('\n');
         out.push_str(&render_script(p));
@@ -70,16 +80,19 @@ pub fn render_table(r: &CompareReport) -> String {
     out
 }
 
-/// The report as GitHub-flavoured markdown, for a pull-request comment: the
-/// two policies and the modes as tables, the primary edit script as a
-/// `diff` block (added lines green, removed red) in a collapsible section.
+/// The report as GitHub-flavoured markdown, for a pull-request comment:
+/// what changed (reorders and relabels first), the two policies and the
+/// modes as tables, the primary edit script as a `diff` block (added lines
+/// green, removed red) in a collapsible section, and the diff as a Mermaid
+/// diagram when it is small enough to read.
 pub fn render_markdown(r: &CompareReport) -> String {
     let cell = crate::sanitize::markdown_cell;
     let code = crate::sanitize::markdown_code;
     let mut out = format!(
-        "### btfsm compare: {} → {}\n\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
+        "### btfsm compare: {} → {}\n\n{}\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
         code(&r.a.file),
-        code(&r.b.file)
+        code(&r.b.file),
+        summary_markdown(r)
     );
     for (tag, s) in [("a", &r.a), ("b", &r.b)] {
         out.push_str(&format!(
@@ -179,6 +192,9 @@ fn render_script(m: &ModeReport) -> String {
             shown(&k.b)
         ));
     }
+    for l in change_lines(s, &Style::plain(), false) {
+        out.push_str(&format!("  ~ {l}\n"));
+    }
     for a in s.arcs_kept.iter().filter(|a| a.label_in_a.is_some()) {
         out.push_str(&format!(
             "  ~ arc `{}` -> `{}` relabelled [{}] -> [{}]\n",
@@ -188,7 +204,7 @@ fn render_script(m: &ModeReport) -> String {
             shown(&a.label)
         ));
     }
-    if cost == 0 && s.rematched().next().is_none() {
+    if s.is_unchanged() {
         out.push_str("  (none: the graphs are identical under this mapping)\n");
     }
     out
