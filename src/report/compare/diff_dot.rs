@@ -39,7 +39,8 @@ impl Pair<'_> {
         for r in &script.reordered {
             let (before, _) = changed_window(&r.before, &r.after);
             let list: Vec<&str> = before.iter().map(|t| t.as_str()).collect();
-            add(&r.key, format!("{} order was: {}", r.of, list.join(", ")));
+            let what = if r.of == "guards" { "guard order" } else { "order" };
+            add(&r.key, format!("{what} was: {}", list.join(", ")));
         }
         for r in &script.relabelled {
             let line = match &r.to {

@@ -1,7 +1,7 @@
 //! `compare`'s output formats: JSON (SPEC §7), the table with the edit
 //! script, and GitHub markdown for a pull-request comment.
 
-use super::changes_text::{Style, change_lines, counts, summary_markdown};
+use super::changes_text::{Style, change_lines, summary_markdown};
 use super::{ArcRef, CompareReport, ModeReport, VertexRef};
 use crate::metrics::ged::GedMode;
 
@@ -68,9 +68,10 @@ pub fn render_table(r: &CompareReport) -> String {
         && p.relabels + p.reorders > 0
     {
         out.push_str(&format!(
-            "note: the {} mapping also has {}; the GED counts neither reorders nor relabels\n",
+            "note: the GED counts neither reorders nor relabels; the {} mapping has {} and {}\n",
             p.mode.as_str(),
-            counts(p)
+            plural(p.reorders, "reorder", "reorders"),
+            plural(p.relabels, "relabel", "relabels"),
         ));
     }
     if let Some(p) = r.primary() {
@@ -208,4 +209,9 @@ fn render_script(m: &ModeReport) -> String {
         out.push_str("  (none: the graphs are identical under this mapping)\n");
     }
     out
+}
+
+/// `1 reorder`, `2 relabels`.
+fn plural(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }
