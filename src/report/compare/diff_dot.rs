@@ -39,7 +39,11 @@ impl Pair<'_> {
         for r in &script.reordered {
             let (before, _) = changed_window(&r.before, &r.after);
             let list: Vec<&str> = before.iter().map(|t| t.as_str()).collect();
-            let what = if r.of == "guards" { "guard order" } else { "order" };
+            let what = if r.of == "guards" {
+                "guard order"
+            } else {
+                "order"
+            };
             add(&r.key, format!("{what} was: {}", list.join(", ")));
         }
         for r in &script.relabelled {

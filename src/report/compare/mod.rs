@@ -181,6 +181,9 @@ pub struct CompareReport {
     pub a: SideSummary,
     pub b: SideSummary,
     pub modes: Vec<ModeReport>,
+    /// The primary mode's diff as a Mermaid flowchart (`diff_mermaid.rs`),
+    /// `Err` with the numbers of nodes and links when it is too large.
+    pub diagram: Option<Result<String, (usize, usize)>>,
 }
 
 impl CompareReport {
@@ -308,10 +311,16 @@ impl<'a> Pair<'a> {
             vertices: g.vertex_count(),
             arcs: g.arc_count(),
         };
+        let diagram = modes
+            .iter()
+            .find(|m| m.mode == GedMode::Named)
+            .or(modes.first())
+            .map(|p| self.diagram(&p.edit_script));
         CompareReport {
             a: summary(&self.a, &self.ga),
             b: summary(&self.b, &self.gb),
             modes,
+            diagram,
         }
     }
 }

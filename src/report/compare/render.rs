@@ -135,6 +135,7 @@ pub fn render_markdown(r: &CompareReport) -> String {
             cell(title)
         ));
     }
+    out.push_str(&super::diff_mermaid::markdown_section(r));
     out
 }
 
