@@ -1573,6 +1573,20 @@ root = 'go "home" now'
         }
     }
 
+    /// Added and changed elements are drawn in colours that no transition
+    /// label, guard, status fill or ghost uses (issue 15, point 5).
+    #[test]
+    fn diff_colours_are_used_by_no_transition_label() {
+        let statuses = [Status::Running, Status::Success, Status::Failure];
+        let mut taken: Vec<&str> = statuses.iter().map(|s| s.line_color()).collect();
+        taken.extend(statuses.iter().map(|s| s.fill_color()));
+        taken.extend([GUARD, REMOVED, "black"]);
+        for c in [ADDED, CHANGED] {
+            assert!(!taken.contains(&c), "{c}");
+        }
+        assert_ne!(ADDED, CHANGED);
+    }
+
     #[test]
     fn highlights_and_ghosts() {
         let p = policy(FSM);
@@ -1598,13 +1612,13 @@ root = 'go "home" now'
                 .unwrap_or_else(|| panic!("no line for {id} in\n{dot}"))
                 .to_string()
         };
-        assert!(line("\"Pick cube2\"[").contains("color=red"), "{dot}");
+        assert!(line("\"Pick cube2\"[").contains("color=magenta"), "{dot}");
         assert!(line("SELECTOR[").contains("fillcolor=gold"), "{dot}");
         assert!(line("SUCCESS[").contains("style=dashed"), "{dot}");
         assert!(line("\"Tuck arm\"[").contains("style=dashed"), "{dot}");
         assert!(line("gone[").contains("color=grey55"), "{dot}");
         assert!(
-            line("\"Move-To cube2\" -> \"Pick cube2\"").contains("color=red"),
+            line("\"Move-To cube2\" -> \"Pick cube2\"").contains("color=magenta"),
             "{dot}"
         );
         assert!(

@@ -177,9 +177,12 @@ impl Pair<'_> {
                     self.relabel(s, "skill", v, x);
                 }
             }
-            let (aa, ab) = (or_none(bt_args(na)), or_none(bt_args(nb)));
-            if aa != ab {
-                self.relabel(s, "arguments", v, (aa, ab));
+            // Strings only for nodes whose arguments may differ.
+            if na.skill != nb.skill || na.kind != nb.kind || na.ports != nb.ports {
+                let (aa, ab) = (or_none(bt_args(na)), or_none(bt_args(nb)));
+                if aa != ab {
+                    self.relabel(s, "arguments", v, (aa, ab));
+                }
             }
             // A default name (`Fallback`) changes with the type: no rename.
             let default = |n: &BtNode| n.label == n.kind.default_label();
@@ -254,7 +257,9 @@ impl Pair<'_> {
                 continue;
             };
             debug_assert_eq!(state_vertex_type(&sa.body), ta);
-            if let (StateBody::Task(ca), StateBody::Task(cb)) = (&sa.body, &sb.body) {
+            if let (StateBody::Task(ca), StateBody::Task(cb)) = (&sa.body, &sb.body)
+                && ca != cb
+            {
                 let [skill, args] = binding_changes(ca.as_ref(), cb.as_ref());
                 if let Some(x) = skill {
                     self.relabel(s, "skill", v, x);

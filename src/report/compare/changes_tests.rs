@@ -223,3 +223,51 @@ fn unchanged_policies_have_no_relabel_nor_reorder() {
         assert!(render_markdown(&r).contains("**What changed** (named mapping): nothing"));
     }
 }
+
+/// A BT whose root Sequence has `n` condition leaves, in order or reversed.
+fn wide_bt(n: usize, reversed: bool) -> String {
+    let mut ids: Vec<String> = (0..n).map(|i| format!("c{i}")).collect();
+    if reversed {
+        ids.reverse();
+    }
+    let list: Vec<String> = ids.iter().map(|i| format!("\"{i}\"")).collect();
+    let mut s = format!(
+        "kind = \"bt\"\nroot = \"r\"\n[nodes]\nr = {{ sequence = [{}] }}\n",
+        list.join(", ")
+    );
+    for i in 0..n {
+        s.push_str(&format!(
+            "c{i} = {{ condition = \"C{i}\", skill = \"Found\" }}\n"
+        ));
+    }
+    s
+}
+
+#[test]
+fn a_long_reorder_is_cut_in_every_line_and_a_large_diff_is_not_drawn() {
+    let (a, b) = (policy(&wide_bt(200, false)), policy(&wide_bt(200, true)));
+    let side = |policy| Side {
+        file: "test.toml",
+        policy,
+    };
+    let pair = Pair::new(side(&a), side(&b));
+    let r = pair.report(vec![pair.run(GedMode::Named, &GedOptions::default())]);
+    let m = r.mode(GedMode::Named).unwrap();
+    assert_eq!((m.ged, m.reorders), (0, 1));
+    assert_eq!(m.edit_script.reordered[0].before.len(), 200);
+    let table = render_table(&r);
+    let line = table.lines().find(|l| l.contains("order of `r`")).unwrap();
+    assert!(line.contains("(192 more)") && line.len() < 200, "{line}");
+    let md = render_markdown(&r);
+    assert!(
+        md.contains("The diff diagram is left out: 201 nodes"),
+        "{md}"
+    );
+    assert!(!md.contains("```mermaid"));
+    let note = &pair.dot_options(&m.edit_script).changed["r"];
+    assert!(note.len() < 200, "{note}");
+    // Small enough: drawn, with the note.
+    let (a, b) = (policy(&wide_bt(5, false)), policy(&wide_bt(5, true)));
+    let r = all_modes(&a, &b);
+    assert!(render_markdown(&r).contains("```mermaid\n"));
+}

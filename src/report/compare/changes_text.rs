@@ -48,13 +48,22 @@ pub(super) fn changed_window<'t>(a: &'t [Text], b: &'t [Text]) -> (&'t [Text], &
     (&a[..a.len() - suf], &b[..b.len() - suf])
 }
 
+/// Most items of an order a line shows; the rest are counted.
+pub(super) const ORDER_ITEMS: usize = 8;
+
+/// `a, b, c` of at most [`ORDER_ITEMS`] items, then `… (N more)`.
+pub(super) fn list_items(l: &[Text], item: fn(&str) -> String) -> String {
+    let mut names: Vec<String> = l.iter().take(ORDER_ITEMS).map(|t| item(t)).collect();
+    if l.len() > ORDER_ITEMS {
+        names.push(format!("… ({} more)", l.len() - ORDER_ITEMS));
+    }
+    names.join(", ")
+}
+
 /// One reorder, without its sign.
 pub(super) fn reorder_line(r: &Reorder, st: &Style) -> String {
     let (before, after) = changed_window(&r.before, &r.after);
-    let list = |l: &[Text]| {
-        let names: Vec<String> = l.iter().map(|t| (st.item)(t)).collect();
-        names.join(", ")
-    };
+    let list = |l: &[Text]| list_items(l, st.item);
     let (what, whose) = match r.of {
         "guards" => ("order of guards of", "its guards"),
         _ => ("order of", "its children"),

@@ -7,16 +7,19 @@
 //! a legend.
 
 use super::changes::child_positions;
-use super::changes_text::changed_window;
+use super::changes_text::{changed_window, list_items};
 use super::{Pair, Script, VertexRef};
 use crate::model::PolicyBody;
 use crate::render::dot::{DotOptions, Highlight};
+use crate::sanitize::shown_max;
 use std::collections::{BTreeMap, BTreeSet};
+
+/// Longest line of a drawing's change note (the old value is cut after it).
+const NOTE_CHARS: usize = 120;
 
 impl Pair<'_> {
     /// `a → b`, each file escaped and cut as in a message.
     pub fn title(&self) -> String {
-        use crate::sanitize::shown_max;
         format!(
             "{} → {}",
             shown_max(self.a.file, 80),
@@ -38,20 +41,21 @@ impl Pair<'_> {
         };
         for r in &script.reordered {
             let (before, _) = changed_window(&r.before, &r.after);
-            let list: Vec<&str> = before.iter().map(|t| t.as_str()).collect();
+            let list = list_items(before, |t| t.to_string());
             let what = if r.of == "guards" {
                 "guard order"
             } else {
                 "order"
             };
-            add(&r.key, format!("{what} was: {}", list.join(", ")));
+            let line = format!("{what} was: {list}");
+            add(&r.key, shown_max(&line, NOTE_CHARS).into_owned());
         }
         for r in &script.relabelled {
             let line = match &r.to {
                 Some(to) => format!("{} to {to} was: {}", r.what, r.before),
                 None => format!("{} was: {}", r.what, r.before),
             };
-            add(&r.key, line);
+            add(&r.key, shown_max(&line, NOTE_CHARS).into_owned());
         }
         notes
     }

@@ -257,10 +257,8 @@ impl Pair<'_> {
                 }
             }
         }
-        for g in 0..opts.ghost_arcs.len() {
-            if !done[g] {
-                ghost(&mut links, g);
-            }
+        for (g, _) in done.iter().enumerate().filter(|x| !*x.1) {
+            ghost(&mut links, g);
         }
         out.push_str(&links.text);
         if opts.legend {
