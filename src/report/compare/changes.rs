@@ -171,7 +171,7 @@ impl Pair<'_> {
                 self.relabel(s, "type", v, (ta.to_string(), tb.to_string()));
             }
             let leaf = |n: &BtNode| matches!(n.kind, BtNodeKind::Action | BtNodeKind::Condition);
-            if leaf(na) && leaf(nb) {
+            if leaf(na) && leaf(nb) && na.skill != nb.skill {
                 let [skill, _] = binding_changes(na.skill.as_ref(), nb.skill.as_ref());
                 if let Some(x) = skill {
                     self.relabel(s, "skill", v, x);
