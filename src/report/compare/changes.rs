@@ -63,6 +63,59 @@ pub struct Reorder {
 
 const NONE: &str = "(none)";
 
+/// What the relabel and reorder checks read of a BT, laid out once per
+/// pair (outside a mode's clock) so that a mode reads nodes only where
+/// something changed: per node a fingerprint of all a relabel compares
+/// (type, kind parameters, skill and arguments, ports, name, id), its
+/// parent and its number of children. The fingerprints of both sides are
+/// keyed with one random key per pair, so that no input can be made to
+/// collide on purpose and hide a change.
+pub(super) struct BtFacts {
+    fp: Vec<u64>,
+    parent: Vec<Option<usize>>,
+    kids: Vec<u32>,
+}
+
+/// The facts of two BTs, with one key; `None` unless both are BTs.
+pub(super) fn bt_facts(
+    a: &crate::model::Policy,
+    b: &crate::model::Policy,
+) -> Option<(BtFacts, BtFacts)> {
+    use std::fmt::Write;
+    use std::hash::{BuildHasher, Hasher};
+    let (PolicyBody::Bt(a), PolicyBody::Bt(b)) = (&a.body, &b.body) else {
+        return None;
+    };
+    let key = std::collections::hash_map::RandomState::new();
+    let mut buf = String::new();
+    let mut facts = |bt: &Bt| BtFacts {
+        fp: bt
+            .nodes
+            .iter()
+            .map(|n| {
+                buf.clear();
+                let _ = write!(
+                    buf,
+                    "{}\0{:?}\0{:?}\0{:?}\0{}\0{}",
+                    bt_type(n),
+                    n.kind,
+                    n.skill,
+                    n.ports,
+                    n.label,
+                    n.id
+                );
+                let mut h = key.build_hasher();
+                h.write(buf.as_bytes());
+                h.finish()
+            })
+            .collect(),
+        parent: bt.parents(),
+        kids: bt.nodes.iter().map(|n| n.children.len() as u32).collect(),
+    };
+    let fa = facts(a);
+    Some((fa, facts(b)))
+}
+
 /// Each BT node's place among its parent's children (0 for the root).
 pub(super) fn child_positions(bt: &Bt) -> Vec<usize> {
     let mut pos = vec![0usize; bt.nodes.len()];
@@ -133,6 +186,10 @@ impl Pair<'_> {
             (PolicyBody::Machine(a), PolicyBody::Machine(b)) => self.machine_changes(a, b, fwd, s),
             _ => {}
         }
+        // Found in memory order (one sequential pass), listed by key in b;
+        // stable, so a vertex's changes keep their order.
+        s.relabelled.sort_by(|x, y| x.key.cmp(&y.key));
+        s.reordered.sort_by(|x, y| x.key.cmp(&y.key));
     }
 
     fn relabel(
@@ -151,6 +208,30 @@ impl Pair<'_> {
         });
     }
 
+    /// The relabels of kept BT node `na` (a) as `nb` (b's vertex `v`).
+    fn bt_relabels(&self, na: &BtNode, nb: &BtNode, v: usize, s: &mut Script) {
+        let (ta, tb) = (bt_type(na), bt_type(nb));
+        if ta != tb {
+            self.relabel(s, "type", v, (ta.to_string(), tb.to_string()));
+        }
+        let leaf = |n: &BtNode| matches!(n.kind, BtNodeKind::Action | BtNodeKind::Condition);
+        if leaf(na) && leaf(nb) && na.skill != nb.skill {
+            let [skill, _] = binding_changes(na.skill.as_ref(), nb.skill.as_ref());
+            if let Some(x) = skill {
+                self.relabel(s, "skill", v, x);
+            }
+        }
+        let (aa, ab) = (or_none(bt_args(na)), or_none(bt_args(nb)));
+        if aa != ab {
+            self.relabel(s, "arguments", v, (aa, ab));
+        }
+        // A default name (`Fallback`) changes with the type: no rename.
+        let default = |n: &BtNode| n.label == n.kind.default_label();
+        if na.label != nb.label && na.id == nb.id && !(default(na) && default(nb)) {
+            self.relabel(s, "name", v, (na.label.clone(), nb.label.clone()));
+        }
+    }
+
     fn bt_changes(
         &self,
         a: &Bt,
@@ -159,36 +240,27 @@ impl Pair<'_> {
         inv: &[Option<usize>],
         s: &mut Script,
     ) {
-        let (pa, pb) = (a.parents(), b.parents());
-        for &u in self.ia.by_key() {
-            let u = u as usize;
-            let (Some(v), Some(na)) = (fwd.get(u).copied().flatten(), a.nodes.get(u)) else {
+        let Some((fa, fb)) = &self.bt_facts else {
+            return;
+        };
+        let (pa, pb) = (&fa.parent, &fb.parent);
+        for u in 0..a.nodes.len() {
+            let Some(v) = fwd.get(u).copied().flatten() else {
                 continue;
             };
-            let Some(nb) = b.nodes.get(v) else { continue };
-            let (ta, tb) = (bt_type(na), bt_type(nb));
-            if ta != tb {
-                self.relabel(s, "type", v, (ta.to_string(), tb.to_string()));
+            // Nodes are read only where their facts differ.
+            if fa.fp.get(u) != fb.fp.get(v) {
+                let (Some(na), Some(nb)) = (a.nodes.get(u), b.nodes.get(v)) else {
+                    continue;
+                };
+                self.bt_relabels(na, nb, v, s);
             }
-            let leaf = |n: &BtNode| matches!(n.kind, BtNodeKind::Action | BtNodeKind::Condition);
-            if leaf(na) && leaf(nb) && na.skill != nb.skill {
-                let [skill, _] = binding_changes(na.skill.as_ref(), nb.skill.as_ref());
-                if let Some(x) = skill {
-                    self.relabel(s, "skill", v, x);
-                }
+            if fa.kids.get(u).is_none_or(|&k| k < 2) {
+                continue;
             }
-            // Strings only for nodes whose arguments may differ.
-            if na.skill != nb.skill || na.kind != nb.kind || na.ports != nb.ports {
-                let (aa, ab) = (or_none(bt_args(na)), or_none(bt_args(nb)));
-                if aa != ab {
-                    self.relabel(s, "arguments", v, (aa, ab));
-                }
-            }
-            // A default name (`Fallback`) changes with the type: no rename.
-            let default = |n: &BtNode| n.label == n.kind.default_label();
-            if na.label != nb.label && na.id == nb.id && !(default(na) && default(nb)) {
-                self.relabel(s, "name", v, (na.label.clone(), nb.label.clone()));
-            }
+            let (Some(na), Some(nb)) = (a.nodes.get(u), b.nodes.get(v)) else {
+                continue;
+            };
             // Kept children that stay children of v, in a's order and in b's.
             let before: Vec<usize> = na
                 .children
@@ -243,8 +315,7 @@ impl Pair<'_> {
             });
         }
         let (ga, gb) = (self.ga.g.raw_nodes(), self.gb.g.raw_nodes());
-        for &u in self.ia.by_key() {
-            let u = u as usize;
+        for u in 0..self.ga.vertex_count() {
             let Some(v) = fwd.get(u).copied().flatten() else {
                 continue;
             };

@@ -213,6 +213,8 @@ pub struct Pair<'a> {
     ids_b: Vec<u32>,
     /// HFSM containment in a: state key -> its container's key.
     parent_a: BTreeMap<String, String>,
+    /// What relabels and reorders read of two BTs (`changes.rs`).
+    bt_facts: Option<(changes::BtFacts, changes::BtFacts)>,
 }
 
 /// State key -> container key, for every nested state of an HFSM.
@@ -241,6 +243,7 @@ impl<'a> Pair<'a> {
             ga,
             gb,
             parent_a: containers(a.policy),
+            bt_facts: changes::bt_facts(a.policy, b.policy),
             a,
             b,
         }

@@ -133,11 +133,6 @@ impl ScriptIndex {
             .map(|i| self.by_key[i] as usize)
     }
 
-    /// Vertices in key order.
-    pub(super) fn by_key(&self) -> &[u32] {
-        &self.by_key
-    }
-
     pub(super) fn key(&self, u: usize) -> Text {
         Text::at(&self.keys, u)
     }
