@@ -315,11 +315,12 @@ impl Pair<'_> {
             });
         }
         let (ga, gb) = (self.ga.g.raw_nodes(), self.gb.g.raw_nodes());
-        for u in 0..self.ga.vertex_count() {
+        for (u, na) in ga.iter().enumerate() {
             let Some(v) = fwd.get(u).copied().flatten() else {
                 continue;
             };
-            let (ta, tb) = (ga[u].weight.vtype, gb[v].weight.vtype);
+            let Some(nb) = gb.get(v) else { continue };
+            let (ta, tb) = (na.weight.vtype, nb.weight.vtype);
             if ta != tb {
                 self.relabel(s, "type", v, (ta.as_str().into(), tb.as_str().into()));
             }
@@ -339,7 +340,7 @@ impl Pair<'_> {
                     self.relabel(s, "arguments", v, x);
                 }
             }
-            if sa.label != sb.label && ga[u].weight.key == gb[v].weight.key {
+            if sa.label != sb.label && na.weight.key == nb.weight.key {
                 self.relabel(s, "name", v, (sa.label.clone(), sb.label.clone()));
             }
             if let (StateBody::Container(ra), StateBody::Container(rb)) = (&sa.body, &sb.body)
