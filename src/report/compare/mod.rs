@@ -1,9 +1,11 @@
 //! `btfsm compare`: graph edit distance between two policies (paper sec. IV-A 2,
 //! Eq. 2; SPEC §3) in the `structural`, `labeled` and `named` modes, each with
 //! the edit script of its mapping told in the policies' own terms (vertex
-//! names and types, transition labels), and the diff drawing of the paper's
-//! Figs. 7 and 8 (the new policy with added elements red and the old one's
-//! removed elements dashed grey).
+//! names and types, transition labels) with the relabels and reorders the
+//! distance does not count (`changes.rs`), and the diff drawing of the
+//! paper's Figs. 7 and 8 (the new policy with added elements magenta, the
+//! old one's removed elements dashed grey, changed ones orange; DOT in
+//! `diff_dot.rs`, Mermaid in `diff_mermaid.rs`).
 //!
 //! The GED engine (`metrics::ged`) works on unlabeled arcs, so a mapping says
 //! only how many arcs between two vertices are kept. Which of several

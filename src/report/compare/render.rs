@@ -124,9 +124,11 @@ pub fn render_markdown(r: &CompareReport) -> String {
         let script = render_script(p);
         let mut lines = script.lines();
         let title = lines.next().unwrap_or_default().trim_end_matches(':');
+        // `<` as the sanitizer's escape: no tag, even inside the block.
         let body: String = lines
             .map(|l| format!("{}\n", l.strip_prefix("  ").unwrap_or(l)))
-            .collect();
+            .collect::<String>()
+            .replace('<', "\\u{3c}");
         // Names are escaped onto one line each and every line starts with
         // its sign; the fence is longer than any run of backticks anyway.
         let fence = crate::sanitize::code_fence(&body);
