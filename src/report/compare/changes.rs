@@ -81,31 +81,18 @@ pub(super) fn bt_facts(
     a: &crate::model::Policy,
     b: &crate::model::Policy,
 ) -> Option<(BtFacts, BtFacts)> {
-    use std::fmt::Write;
     use std::hash::{BuildHasher, Hasher};
     let (PolicyBody::Bt(a), PolicyBody::Bt(b)) = (&a.body, &b.body) else {
         return None;
     };
     let key = std::collections::hash_map::RandomState::new();
-    let mut buf = String::new();
-    let mut facts = |bt: &Bt| BtFacts {
+    let facts = |bt: &Bt| BtFacts {
         fp: bt
             .nodes
             .iter()
             .map(|n| {
-                buf.clear();
-                let _ = write!(
-                    buf,
-                    "{}\0{:?}\0{:?}\0{:?}\0{}\0{}",
-                    bt_type(n),
-                    n.kind,
-                    n.skill,
-                    n.ports,
-                    n.label,
-                    n.id
-                );
                 let mut h = key.build_hasher();
-                h.write(buf.as_bytes());
+                hash_node(&mut h, n);
                 h.finish()
             })
             .collect(),
@@ -114,6 +101,62 @@ pub(super) fn bt_facts(
     };
     let fa = facts(a);
     Some((fa, facts(b)))
+}
+
+/// Feeds everything a relabel compares of `n` to `h`, each string ended
+/// by `0xff` (a byte no UTF-8 string holds), so that different nodes feed
+/// different byte sequences.
+fn hash_node(h: &mut impl std::hash::Hasher, n: &BtNode) {
+    use crate::model::ArgValue;
+    let mut text = |s: &str| {
+        h.write(s.as_bytes());
+        h.write_u8(0xff);
+    };
+    text(bt_type(n));
+    text(n.kind.keyword());
+    text(&n.label);
+    text(&n.id);
+    for (k, v) in &n.ports {
+        text(k);
+        text(v);
+    }
+    match n.kind {
+        BtNodeKind::Parallel { success } => h.write_u64(success as u64),
+        BtNodeKind::Repeat { times } => h.write_u64(times.map_or(u64::MAX, u64::from)),
+        BtNodeKind::Retry { times } => h.write_u64(u64::from(times)),
+        BtNodeKind::Timeout { ms } => h.write_u64(ms),
+        _ => h.write_u8(0),
+    }
+    let Some(c) = &n.skill else {
+        h.write_u8(0);
+        return;
+    };
+    h.write_u8(1);
+    h.write(c.skill.as_bytes());
+    h.write_u8(0xff);
+    for (k, v) in &c.args {
+        h.write(k.as_bytes());
+        h.write_u8(0xff);
+        match v {
+            ArgValue::Str(s) => {
+                h.write_u8(0);
+                h.write(s.as_bytes());
+                h.write_u8(0xff);
+            }
+            ArgValue::Int(i) => {
+                h.write_u8(1);
+                h.write_i64(*i);
+            }
+            ArgValue::Float(x) => {
+                h.write_u8(2);
+                h.write_u64(x.to_bits());
+            }
+            ArgValue::Bool(b) => {
+                h.write_u8(3);
+                h.write_u8(u8::from(*b));
+            }
+        }
+    }
 }
 
 /// Each BT node's place among its parent's children (0 for the root).

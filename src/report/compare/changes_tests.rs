@@ -271,3 +271,30 @@ fn a_long_reorder_is_cut_in_every_line_and_a_large_diff_is_not_drawn() {
     let r = all_modes(&a, &b);
     assert!(render_markdown(&r).contains("```mermaid\n"));
 }
+
+#[test]
+fn a_bt_leaf_with_other_arguments_is_an_arguments_relabel() {
+    let src = paper("fig01-bt.toml");
+    let b = src.replace(
+        "skill = \"Move-To\", args = { target = \"delivery\" }",
+        "skill = \"Move-To\", args = { target = \"home\" }",
+    );
+    assert_ne!(src, b);
+    let r = all_modes(&policy(&src), &policy(&b));
+    let named = r.mode(GedMode::Named).unwrap();
+    let got: Vec<(&str, &str, &str, &str)> = named
+        .edit_script
+        .relabelled
+        .iter()
+        .map(|l| (l.what, l.key.as_str(), l.before.as_str(), l.after.as_str()))
+        .collect();
+    assert_eq!(
+        got,
+        [(
+            "arguments",
+            "move-to-delivery",
+            "target=delivery",
+            "target=home"
+        )]
+    );
+}
