@@ -298,3 +298,31 @@ fn a_bt_leaf_with_other_arguments_is_an_arguments_relabel() {
         )]
     );
 }
+
+#[test]
+fn a_relabelled_transition_is_drawn_with_its_old_label() {
+    let b = FSM.replace("label = \"battery low\"", "label = \"battery critical\"");
+    let (pa, pb) = (policy(FSM), policy(&b));
+    let side = |policy| Side {
+        file: "test.toml",
+        policy,
+    };
+    let pair = Pair::new(side(&pa), side(&pb));
+    let m = pair.run(GedMode::Named, &GedOptions::default());
+    assert_eq!((m.ged, m.relabels), (0, 1));
+    let opts = pair.dot_options(&m.edit_script);
+    let dot = crate::render::dot::policy_dot(&pb, &opts);
+    let arc = dot
+        .lines()
+        .find(|l| l.contains("battery critical"))
+        .expect("the arc");
+    assert!(
+        arc.contains("battery critical\\n(was battery low)") && arc.contains("darkorange3"),
+        "{arc}"
+    );
+    let mermaid = pair.diff_mermaid(&opts).expect("small");
+    assert!(
+        mermaid.contains("|\"battery critical (was battery low)\"|"),
+        "{mermaid}"
+    );
+}
