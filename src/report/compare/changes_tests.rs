@@ -326,3 +326,30 @@ fn a_relabelled_transition_is_drawn_with_its_old_label() {
         "{mermaid}"
     );
 }
+
+#[test]
+fn the_drawings_title_names_both_files_escaped() {
+    let p = policy(FSM);
+    let pair = Pair::new(
+        Side {
+            file: "evil\u{1b}[31m\n.toml",
+            policy: &p,
+        },
+        Side {
+            file: "b.toml",
+            policy: &p,
+        },
+    );
+    let m = pair.run(GedMode::Named, &GedOptions::default());
+    let opts = pair.dot_options(&m.edit_script);
+    let title = opts.title.clone().unwrap();
+    assert_eq!(title, "evil\\u{1b}[31m\\n.toml → b.toml");
+    let dot = crate::render::dot::policy_dot(&p, &opts);
+    assert!(!crate::sanitize::has_raw_control(&dot), "{dot}");
+    let mermaid = pair.diff_mermaid(&opts).unwrap();
+    assert!(!crate::sanitize::has_raw_control(&mermaid), "{mermaid}");
+    assert!(
+        mermaid.contains("title: 'evil\\u{1b}[31m\\n.toml → b.toml'"),
+        "{mermaid}"
+    );
+}
