@@ -81,6 +81,19 @@ mermaid-oracle: build
 	  $$(grep -L OrthogonalState $$(find tests/fixtures/corpus/yasmin -name '*.xml'))
 	node tests/differential/mermaid/check.mjs $(BIN) --nodes-model $(NAV2)/nav2_tree_nodes.xml -- \
 	  $$(ls $(NAV2)/*.xml | grep -v tree_nodes) tests/fixtures/corpus/bt-xml/btcpp/parent_include_child.xml
+	node tests/differential/mermaid/check_diff.mjs $(BIN) $(DIFF_PAIRS)
+
+# Pairs whose `compare --format markdown` diff diagram Mermaid must parse
+# (check_diff.mjs): reorder, BT insertion, FSM edits with guards, hostile
+# labels both ways, HFSM, and policies of different kinds.
+DP := policies/paper
+DM := tests/differential/mermaid
+DIFF_PAIRS := $(DP)/fig01-bt.toml $(DP)/fig03-bt.toml $(DP)/fig07a-bt.toml $(DP)/fig07b-bt.toml \
+  $(DP)/fig07b-bt.toml $(DP)/fig07e-bt.toml $(DP)/fig08a-fsm.toml $(DP)/fig08b-fsm.toml \
+  $(DP)/fig08b-fsm.toml $(DP)/fig08d-fsm.toml $(DP)/fig04-fsm.toml $(DP)/fig09b-fsm.toml \
+  $(DM)/labels-bt.toml $(DP)/fig01-bt.toml $(DP)/fig01-bt.toml $(DM)/labels-bt.toml \
+  $(DM)/labels-fsm.toml $(DP)/fig04-fsm.toml $(DP)/fig04-fsm.toml $(DM)/labels-fsm.toml \
+  $(DP)/fig06-hfsm.toml $(DP)/fig05-bt.toml $(DP)/fig01-bt.toml $(DP)/fig06-hfsm.toml
 
 # Man pages from the argument definitions: target/man/btfsm.1 and one
 # btfsm-SUBCOMMAND.1 per subcommand (`man -l target/man/btfsm.1`).

@@ -301,11 +301,24 @@ pub fn compare_policies(a: &Policy, b: &Policy, opts: &GedOptions) {
             r.upper_bound,
             "{mode:?}: the labelled script does not cost the upper bound"
         );
+        // Relabels and reorders: counted as listed, each reorder a
+        // permutation of the same kept children (or guards).
+        let s = &r.edit_script;
+        assert_eq!(r.reorders, s.reordered.len() as u64);
+        assert!(r.relabels >= s.relabelled.len() as u64);
+        for o in &s.reordered {
+            let (mut x, mut y) = (o.before.clone(), o.after.clone());
+            assert_ne!(x, y, "{mode:?}: a reorder that keeps the order");
+            x.sort();
+            y.sort();
+            assert_eq!(x, y, "{mode:?}: a reorder that is no permutation");
+        }
         reports.push(r);
     }
     let report = pair.report(reports);
     let _ = compare::render_json(&report);
     let _ = compare::render_table(&report);
+    let _ = compare::render_markdown(&report);
     if let Some(primary) = report.primary() {
         let dot = pair.dot_options(&primary.edit_script);
         let _ = crate::render::dot::policy_dot(b, &dot);

@@ -92,8 +92,10 @@ pub enum Command {
         /// Output format
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
         format: CompareFormat,
-        /// Also draw B with added elements red and A's removed ones dashed grey
-        /// (the edit script of --mode; named when all modes run)
+        /// Also draw B with added elements magenta, A's removed ones dashed
+        /// grey and changed ones (relabels, reorders) orange with their old
+        /// value, a title and a legend (the edit script of --mode; named when
+        /// all modes run)
         #[arg(long, value_name = "OUT")]
         dot: Option<PathBuf>,
         /// With --dot: render through Graphviz instead of writing DOT (under

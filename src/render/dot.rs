@@ -82,7 +82,8 @@ impl Status {
 /// How one element is emphasised (by `compare` and by the simulator).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Highlight {
-    /// An element the edit added: drawn red.
+    /// An element the edit added: drawn magenta (as the paper's Fig. 8), a
+    /// colour no transition label uses.
     Added,
     /// An element the edit removed: drawn dashed grey.
     Removed,
@@ -110,12 +111,30 @@ pub struct DotOptions {
     pub ghost_vertices: Vec<(String, String)>,
     /// Removed arcs, drawn dashed grey: `(from key, to key, label)`.
     pub ghost_arcs: Vec<(String, String, String)>,
+    /// Where ghost arcs of a BT go among their tail's children: index in
+    /// `ghost_arcs` -> how many of the tail's children come before it (the
+    /// removed child's place among its siblings). Others come after all.
+    pub ghost_slot: BTreeMap<usize, usize>,
+    /// Kept vertices that changed (type, binding, arguments, order), by key:
+    /// drawn in [`CHANGED`] with these lines (`was: fallback`) under their
+    /// label.
+    pub changed: BTreeMap<String, String>,
+    /// Kept arcs whose label changed, by `(from key, to key, label)`: the
+    /// old label, drawn as `(was ...)` in [`CHANGED`].
+    pub changed_arcs: BTreeMap<(String, String, String), String>,
+    /// The diagram's title instead of the policy's name.
+    pub title: Option<String>,
+    /// Adds a legend of the diff colours (added, removed, changed).
+    pub legend: bool,
 }
 
 const FONT: &str = "Helvetica";
 const ACTION_FILL: &str = "#dce8f7";
 const DECISION_FILL: &str = "#eeeeee";
-const ADDED: &str = "red";
+const ADDED: &str = "magenta";
+/// Kept elements an edit changed (relabels, reorders): no status, guard or
+/// diff colour uses it.
+pub const CHANGED: &str = "darkorange3";
 const REMOVED: &str = "grey55";
 const GUARD: &str = "blue";
 /// Clusters nested deeper than this are drawn beside their parent's cluster
@@ -126,7 +145,7 @@ const MAX_CLUSTER_NESTING: usize = 48;
 pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     let mut b = Builder::new(opts);
     let mut graph_attrs = Attrs::default();
-    graph_attrs.set("label", &policy.name);
+    graph_attrs.set("label", opts.title.as_deref().unwrap_or(&policy.name));
     graph_attrs.set("labelloc", "t");
     graph_attrs.set("fontname", FONT);
     graph_attrs.set("fontsize", "14");
@@ -151,6 +170,10 @@ pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     }
     b.ghosts();
     b.assemble();
+    if opts.legend {
+        let legend = b.legend();
+        b.root.push(legend);
+    }
 
     let mut node_defaults = Attrs::default();
     node_defaults.set("fontname", FONT);
@@ -483,6 +506,22 @@ impl Attrs {
         self
     }
 
+    /// Marks a kept element that changed: [`CHANGED`] outline and text,
+    /// `note` (the old values) under its label.
+    fn changed(&mut self, note: Option<&String>) {
+        let Some(note) = note else { return };
+        let label = self
+            .list
+            .iter()
+            .find(|(k, _)| *k == "label")
+            .map(|(_, v)| v.clone())
+            .unwrap_or_default();
+        self.set("label", &format!("{label}\n{note}"))
+            .set("color", CHANGED)
+            .set("fontcolor", CHANGED)
+            .set("penwidth", "2.5");
+    }
+
     fn unstyle(&mut self, s: &'static str) -> &mut Self {
         self.styles.retain(|x| *x != s);
         self
@@ -599,6 +638,9 @@ struct Builder<'o> {
     /// Top-level states in order, and what follows them (outcomes).
     top_states: Vec<usize>,
     top_tail: Vec<Stmt>,
+    /// `(position in edges, ghost arc)`: ghost arcs of a BT drawn among
+    /// their tail's children, in edge order.
+    bt_ghost_slots: Vec<(usize, usize)>,
 }
 
 /// How one container's cluster is put together.
@@ -629,6 +671,7 @@ impl<'o> Builder<'o> {
             clusters: Vec::new(),
             top_states: Vec::new(),
             top_tail: Vec::new(),
+            bt_ghost_slots: Vec::new(),
         }
     }
 
@@ -704,13 +747,30 @@ impl<'o> Builder<'o> {
         for (n, id) in bt.nodes.iter().zip(&ids) {
             let mut a = bt_node_attrs(n);
             a.node_highlight(self.vhl(&n.id));
+            a.changed(self.opts.changed.get(&n.id));
             self.root.push(node_stmt(id, a));
         }
+        // Ghost arcs with a slot among a drawn node's children, by tail.
+        let mut slotted: HashMap<&str, Vec<(usize, usize)>> = HashMap::new();
+        for (&g, &slot) in &self.opts.ghost_slot {
+            if let Some((from, _, _)) = self.opts.ghost_arcs.get(g) {
+                slotted.entry(from.as_str()).or_default().push((slot, g));
+            }
+        }
         for (n, id) in bt.nodes.iter().zip(&ids) {
-            for &c in &n.children {
+            let mut ghosts = slotted.remove(n.id.as_str()).unwrap_or_default();
+            ghosts.sort_unstable();
+            let mut ghosts = ghosts.into_iter().peekable();
+            for (k, &c) in n.children.iter().enumerate() {
+                while let Some((_, g)) = ghosts.next_if(|&(slot, _)| slot <= k) {
+                    self.bt_ghost_slots.push((self.edges.len(), g));
+                }
                 let mut a = Attrs::default();
                 a.edge_highlight(self.ahl(&n.id, &bt.nodes[c].id, ""));
                 self.edges.push(edge_stmt(id, &ids[c], a));
+            }
+            for (_, g) in ghosts {
+                self.bt_ghost_slots.push((self.edges.len(), g));
             }
         }
     }
@@ -809,6 +869,7 @@ impl<'o> Builder<'o> {
                 a.set("penwidth", "2.2");
             }
             a.node_highlight(self.vhl(&key[i]));
+            a.changed(self.opts.changed.get(&key[i]));
             self.state_stmt[i] = Some(node_stmt(&state_id[i], a));
         }
         for (o, id) in m.top.outcomes.iter().zip(&top_outcome_id) {
@@ -911,6 +972,12 @@ impl<'o> Builder<'o> {
                     .set("color", color)
                     .set("fontcolor", color);
                 a.edge_highlight(self.ahl(&key[i], &to_key, &label));
+                let was = (key[i].clone(), to_key, label);
+                if let Some(old) = self.opts.changed_arcs.get(&was) {
+                    a.set("label", &format!("{}\n(was {old})", was.2))
+                        .set("color", CHANGED)
+                        .set("fontcolor", CHANGED);
+                }
                 self.edges.push(edge_stmt(&tail, &head, a));
             }
         }
@@ -949,6 +1016,7 @@ impl<'o> Builder<'o> {
             }
             None => {}
         }
+        ca.changed(self.opts.changed.get(key));
         let mut header: Vec<Stmt> = ca.into_vec().into_iter().map(Stmt::Attribute).collect();
         let mut ea = Attrs::default();
         ea.set("shape", "point")
@@ -989,6 +1057,9 @@ impl<'o> Builder<'o> {
 
     fn ghosts(&mut self) {
         let mut ghost_ids: HashMap<&str, String> = HashMap::new();
+        let slotted: HashMap<usize, usize> =
+            self.bt_ghost_slots.iter().map(|&(at, g)| (g, at)).collect();
+        let mut placed: Vec<(usize, Stmt)> = Vec::with_capacity(slotted.len());
         for (key, label) in &self.opts.ghost_vertices {
             let id = self.fresh(key);
             let mut a = Attrs::default();
@@ -999,7 +1070,7 @@ impl<'o> Builder<'o> {
             self.extra.entry(cluster).or_default().push(stmt);
             ghost_ids.entry(key.as_str()).or_insert(id);
         }
-        for (from, to, label) in &self.opts.ghost_arcs {
+        for (g, (from, to, label)) in self.opts.ghost_arcs.iter().enumerate() {
             let mut ends = Vec::with_capacity(2);
             for key in [from, to] {
                 let id = match self.by_key.get(key).or(ghost_ids.get(key.as_str())) {
@@ -1021,8 +1092,65 @@ impl<'o> Builder<'o> {
                 a.set("label", label);
             }
             a.edge_highlight(Some(&Highlight::Removed));
-            self.edges.push(edge_stmt(&ends[0], &ends[1], a));
+            match slotted.get(&g) {
+                Some(&at) => placed.push((at, edge_stmt(&ends[0], &ends[1], a))),
+                None => self.edges.push(edge_stmt(&ends[0], &ends[1], a)),
+            }
         }
+        // Slotted ghost arcs go before the edge they were placed at (one
+        // merge: `placed` is in edge order).
+        if !placed.is_empty() {
+            placed.sort_by_key(|x| x.0);
+            let edges = std::mem::take(&mut self.edges);
+            let mut placed = placed.into_iter().peekable();
+            for (i, e) in edges.into_iter().enumerate() {
+                while let Some((_, p)) = placed.next_if(|x| x.0 <= i) {
+                    self.edges.push(p);
+                }
+                self.edges.push(e);
+            }
+            self.edges.extend(placed.map(|x| x.1));
+        }
+    }
+
+    /// The legend of a diff drawing: one sample node per highlight, side by
+    /// side in a cluster of their own (ids not used by the policy).
+    fn legend(&mut self) -> Stmt {
+        let mut ca = Attrs::default();
+        ca.set("label", "legend")
+            .set("fontname", FONT)
+            .set("fontsize", "9")
+            .set("color", "grey70")
+            .style("rounded");
+        let mut stmts: Vec<Stmt> = ca.into_vec().into_iter().map(Stmt::Attribute).collect();
+        let samples = [
+            ("legend: added", "added", Some(Highlight::Added)),
+            ("legend: removed", "removed", Some(Highlight::Removed)),
+            ("legend: changed", "changed\n(was: old value)", None),
+        ];
+        let mut ids = Vec::new();
+        for (id, label, h) in samples {
+            let id = self.fresh(id);
+            let mut a = Attrs::default();
+            a.set("label", label)
+                .set("shape", "box")
+                .set("fontsize", "9")
+                .set("height", "0.3")
+                .style("rounded");
+            a.node_highlight(h.as_ref());
+            if h.is_none() {
+                a.set("color", CHANGED)
+                    .set("fontcolor", CHANGED)
+                    .set("penwidth", "2.5");
+            }
+            stmts.push(node_stmt(&id, a));
+            ids.push(id);
+        }
+        stmts.push(rank_group("same", &ids));
+        Stmt::Subgraph(Subgraph {
+            id: dot_id("cluster legend"),
+            stmts,
+        })
     }
 
     /// The cluster a ghost vertex belongs in: the longest container key that
@@ -1445,6 +1573,20 @@ root = 'go "home" now'
         }
     }
 
+    /// Added and changed elements are drawn in colours that no transition
+    /// label, guard, status fill or ghost uses (issue 15, point 5).
+    #[test]
+    fn diff_colours_are_used_by_no_transition_label() {
+        let statuses = [Status::Running, Status::Success, Status::Failure];
+        let mut taken: Vec<&str> = statuses.iter().map(|s| s.line_color()).collect();
+        taken.extend(statuses.iter().map(|s| s.fill_color()));
+        taken.extend([GUARD, REMOVED, "black"]);
+        for c in [ADDED, CHANGED] {
+            assert!(!taken.contains(&c), "{c}");
+        }
+        assert_ne!(ADDED, CHANGED);
+    }
+
     #[test]
     fn highlights_and_ghosts() {
         let p = policy(FSM);
@@ -1470,13 +1612,13 @@ root = 'go "home" now'
                 .unwrap_or_else(|| panic!("no line for {id} in\n{dot}"))
                 .to_string()
         };
-        assert!(line("\"Pick cube2\"[").contains("color=red"), "{dot}");
+        assert!(line("\"Pick cube2\"[").contains("color=magenta"), "{dot}");
         assert!(line("SELECTOR[").contains("fillcolor=gold"), "{dot}");
         assert!(line("SUCCESS[").contains("style=dashed"), "{dot}");
         assert!(line("\"Tuck arm\"[").contains("style=dashed"), "{dot}");
         assert!(line("gone[").contains("color=grey55"), "{dot}");
         assert!(
-            line("\"Move-To cube2\" -> \"Pick cube2\"").contains("color=red"),
+            line("\"Move-To cube2\" -> \"Pick cube2\"").contains("color=magenta"),
             "{dot}"
         );
         assert!(

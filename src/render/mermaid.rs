@@ -22,7 +22,7 @@ use crate::model::{BtNodeKind, PolicyBody, StateBody, StateMachine, Target};
 use std::fmt::Write;
 
 /// A label as Mermaid reads it between quotes (or after a transition's `:`).
-fn label(s: &str) -> String {
+pub(crate) fn label(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -43,7 +43,7 @@ fn label(s: &str) -> String {
 /// The front matter with the policy's name as the diagram's title: a YAML
 /// single-quoted string (where only `'` is special, written `''`), on one
 /// line, without control characters.
-fn front_matter(name: &str) -> String {
+pub(crate) fn front_matter(name: &str) -> String {
     let title: String = name
         .chars()
         .filter_map(|c| match c {

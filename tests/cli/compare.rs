@@ -219,8 +219,8 @@ fn compare_table_lists_the_edits_and_dot_draws_them() {
     );
     assert!(
         dot.lines()
-            .any(|l| l.contains(" -> ") && l.contains("color=red")),
-        "one added arc in red:\n{dot}"
+            .any(|l| l.contains(" -> ") && l.contains("color=magenta")),
+        "one added arc in magenta:\n{dot}"
     );
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }

@@ -330,13 +330,20 @@ fn control_characters_never_reach_an_output() {
     let r = run_in(&d.0, &["compare", &a, &b, "--format", "markdown"], None);
     check(&r, &d.0, &[0], "markdown");
     assert!(!r.stdout.contains("<img"), "{}", r.stdout);
-    // The diff block is closed only by its own fence, on the last lines.
+    // The diff block and the Mermaid diagram are each closed only by their
+    // own fence: four fence lines, each block's closing one its opening
+    // one's backticks alone.
     let fence_lines: Vec<&str> = r
         .stdout
         .lines()
         .filter(|l| l.trim_start().starts_with("```"))
         .collect();
-    assert_eq!(fence_lines.len(), 2, "{}", r.stdout);
+    assert_eq!(fence_lines.len(), 4, "{}", r.stdout);
+    for pair in fence_lines.chunks(2) {
+        let fence = pair[0].trim_end_matches(|c: char| c.is_ascii_alphabetic());
+        assert!(pair[0].ends_with("diff") || pair[0].ends_with("mermaid"));
+        assert_eq!(pair[1], fence, "{}", r.stdout);
+    }
 }
 
 /// Parameters doubled level by level, a file of a million TOML errors, the

@@ -1,9 +1,11 @@
 //! `btfsm compare`: graph edit distance between two policies (paper sec. IV-A 2,
 //! Eq. 2; SPEC §3) in the `structural`, `labeled` and `named` modes, each with
 //! the edit script of its mapping told in the policies' own terms (vertex
-//! names and types, transition labels), and the diff drawing of the paper's
-//! Figs. 7 and 8 (the new policy with added elements red and the old one's
-//! removed elements dashed grey).
+//! names and types, transition labels) with the relabels and reorders the
+//! distance does not count (`changes.rs`), and the diff drawing of the
+//! paper's Figs. 7 and 8 (the new policy with added elements magenta, the
+//! old one's removed elements dashed grey, changed ones orange; DOT in
+//! `diff_dot.rs`, Mermaid in `diff_mermaid.rs`).
 //!
 //! The GED engine (`metrics::ged`) works on unlabeled arcs, so a mapping says
 //! only how many arcs between two vertices are kept. Which of several
@@ -11,13 +13,19 @@
 //! labels agree are kept first, so a re-routed `FAILURE` arc shows up as one
 //! `FAILURE` arc removed and one added, not as an arbitrary pair.
 
+mod changes;
+#[cfg(test)]
+mod changes_tests;
+mod changes_text;
 mod diff_dot;
+mod diff_mermaid;
 mod render;
 mod script;
 #[cfg(test)]
 mod tests;
 mod text;
 
+pub use changes::{Relabel, Reorder};
 pub use render::{render_json, render_markdown, render_table};
 use script::{ScriptIndex, key_ids};
 pub use text::Text;
@@ -92,6 +100,12 @@ pub struct Script {
     pub arcs_added: Vec<ArcRef>,
     pub arcs_removed: Vec<ArcRef>,
     pub arcs_kept: Vec<ArcRef>,
+    /// Kept elements whose type, skill, arguments, name, initial state or
+    /// guard terms changed (not charged by the GED; `changes.rs`).
+    pub relabelled: Vec<Relabel>,
+    /// Kept composites whose kept children (states whose kept guards) come
+    /// in another order (not charged by the GED; `changes.rs`).
+    pub reordered: Vec<Reorder>,
 }
 
 impl Script {
@@ -108,15 +122,44 @@ impl Script {
     pub fn rematched(&self) -> impl Iterator<Item = &KeptVertex> {
         self.vertices_kept.iter().filter(|k| k.a != k.b)
     }
+
+    /// Relabels: the entries of `relabelled` and the kept arcs whose label
+    /// changed (each parallel arc once).
+    pub fn relabels(&self) -> u64 {
+        let arcs: u64 = self
+            .arcs_kept
+            .iter()
+            .filter(|a| a.label_in_a.is_some())
+            .map(|a| u64::from(a.count))
+            .sum();
+        self.relabelled.len() as u64 + arcs
+    }
+
+    /// Reorders: the entries of `reordered`.
+    pub fn reorders(&self) -> u64 {
+        self.reordered.len() as u64
+    }
+
+    /// Whether the mapping keeps everything as it was: no edit, no
+    /// rematch, no relabel, no reorder.
+    pub fn is_unchanged(&self) -> bool {
+        self.cost() == 0
+            && self.rematched().next().is_none()
+            && self.relabels() == 0
+            && self.reorders() == 0
+    }
 }
 
 /// One mode's result (SPEC §7: `ged`, `exact`, `lower_bound`, `upper_bound`,
-/// `millis`, `edit_script`).
+/// `millis`, `edit_script`), with the counts of the script's relabels and
+/// reorders beside the distance, which does not count them.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ModeReport {
     #[serde(skip)]
     pub mode: GedMode,
     pub ged: u64,
+    pub relabels: u64,
+    pub reorders: u64,
     pub exact: bool,
     pub lower_bound: u64,
     pub upper_bound: u64,
@@ -140,6 +183,9 @@ pub struct CompareReport {
     pub a: SideSummary,
     pub b: SideSummary,
     pub modes: Vec<ModeReport>,
+    /// The primary mode's diff as a Mermaid flowchart (`diff_mermaid.rs`),
+    /// `Err` with the numbers of nodes and links when it is too large.
+    pub diagram: Option<Result<String, (usize, usize)>>,
 }
 
 impl CompareReport {
@@ -169,6 +215,8 @@ pub struct Pair<'a> {
     ids_b: Vec<u32>,
     /// HFSM containment in a: state key -> its container's key.
     parent_a: BTreeMap<String, String>,
+    /// What relabels and reorders read of two BTs (`changes.rs`).
+    bt_facts: Option<(changes::BtFacts, changes::BtFacts)>,
 }
 
 /// State key -> container key, for every nested state of an HFSM.
@@ -197,6 +245,7 @@ impl<'a> Pair<'a> {
             ga,
             gb,
             parent_a: containers(a.policy),
+            bt_facts: changes::bt_facts(a.policy, b.policy),
             a,
             b,
         }
@@ -249,6 +298,8 @@ impl<'a> Pair<'a> {
         ModeReport {
             mode,
             ged: upper,
+            relabels: edit_script.relabels(),
+            reorders: edit_script.reorders(),
             exact: lower >= upper,
             lower_bound: lower.min(upper),
             upper_bound: upper,
@@ -265,10 +316,16 @@ impl<'a> Pair<'a> {
             vertices: g.vertex_count(),
             arcs: g.arc_count(),
         };
+        let diagram = modes
+            .iter()
+            .find(|m| m.mode == GedMode::Named)
+            .or(modes.first())
+            .map(|p| self.diagram(&p.edit_script));
         CompareReport {
             a: summary(&self.a, &self.ga),
             b: summary(&self.b, &self.gb),
             modes,
+            diagram,
         }
     }
 }

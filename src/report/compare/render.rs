@@ -1,6 +1,7 @@
 //! `compare`'s output formats: JSON (SPEC §7), the table with the edit
 //! script, and GitHub markdown for a pull-request comment.
 
+use super::changes_text::{Style, change_lines, summary_markdown};
 use super::{ArcRef, CompareReport, ModeReport, VertexRef};
 use crate::metrics::ged::GedMode;
 
@@ -63,6 +64,16 @@ pub fn render_table(r: &CompareReport) -> String {
             "note: the search hit its budget; the distance lies in the certified interval (raise --timeout-ms to narrow it)\n",
         );
     }
+    if let Some(p) = r.primary()
+        && p.relabels + p.reorders > 0
+    {
+        out.push_str(&format!(
+            "note: the GED counts neither reorders nor relabels; the {} mapping has {} and {}\n",
+            p.mode.as_str(),
+            plural(p.reorders, "reorder", "reorders"),
+            plural(p.relabels, "relabel", "relabels"),
+        ));
+    }
     if let Some(p) = r.primary() {
         out.push('\n');
         out.push_str(&render_script(p));
@@ -70,16 +81,19 @@ pub fn render_table(r: &CompareReport) -> String {
     out
 }
 
-/// The report as GitHub-flavoured markdown, for a pull-request comment: the
-/// two policies and the modes as tables, the primary edit script as a
-/// `diff` block (added lines green, removed red) in a collapsible section.
+/// The report as GitHub-flavoured markdown, for a pull-request comment:
+/// what changed (reorders and relabels first), the two policies and the
+/// modes as tables, the primary edit script as a `diff` block (added lines
+/// green, removed red) in a collapsible section, and the diff as a Mermaid
+/// diagram when it is small enough to read.
 pub fn render_markdown(r: &CompareReport) -> String {
     let cell = crate::sanitize::markdown_cell;
     let code = crate::sanitize::markdown_code;
     let mut out = format!(
-        "### btfsm compare: {} → {}\n\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
+        "### btfsm compare: {} → {}\n\n{}\n| | file | kind | name | vertices | arcs |\n|---|---|---|---|---:|---:|\n",
         code(&r.a.file),
-        code(&r.b.file)
+        code(&r.b.file),
+        summary_markdown(r)
     );
     for (tag, s) in [("a", &r.a), ("b", &r.b)] {
         out.push_str(&format!(
@@ -110,9 +124,11 @@ pub fn render_markdown(r: &CompareReport) -> String {
         let script = render_script(p);
         let mut lines = script.lines();
         let title = lines.next().unwrap_or_default().trim_end_matches(':');
+        // `<` as the sanitizer's escape: no tag, even inside the block.
         let body: String = lines
             .map(|l| format!("{}\n", l.strip_prefix("  ").unwrap_or(l)))
-            .collect();
+            .collect::<String>()
+            .replace('<', "\\u{3c}");
         // Names are escaped onto one line each and every line starts with
         // its sign; the fence is longer than any run of backticks anyway.
         let fence = crate::sanitize::code_fence(&body);
@@ -121,6 +137,7 @@ pub fn render_markdown(r: &CompareReport) -> String {
             cell(title)
         ));
     }
+    out.push_str(&super::diff_mermaid::markdown_section(r));
     out
 }
 
@@ -179,6 +196,9 @@ fn render_script(m: &ModeReport) -> String {
             shown(&k.b)
         ));
     }
+    for l in change_lines(s, &Style::plain(), false) {
+        out.push_str(&format!("  ~ {l}\n"));
+    }
     for a in s.arcs_kept.iter().filter(|a| a.label_in_a.is_some()) {
         out.push_str(&format!(
             "  ~ arc `{}` -> `{}` relabelled [{}] -> [{}]\n",
@@ -188,8 +208,13 @@ fn render_script(m: &ModeReport) -> String {
             shown(&a.label)
         ));
     }
-    if cost == 0 && s.rematched().next().is_none() {
+    if s.is_unchanged() {
         out.push_str("  (none: the graphs are identical under this mapping)\n");
     }
     out
+}
+
+/// `1 reorder`, `2 relabels`.
+fn plural(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }

@@ -125,7 +125,15 @@ impl ScriptIndex {
             .map(|i| s as usize + i)
     }
 
-    fn key(&self, u: usize) -> Text {
+    /// The vertex with key `k`, if any.
+    pub(super) fn find(&self, k: &str) -> Option<usize> {
+        self.by_key
+            .binary_search_by(|&u| self.keys[u as usize].as_str().cmp(k))
+            .ok()
+            .map(|i| self.by_key[i] as usize)
+    }
+
+    pub(super) fn key(&self, u: usize) -> Text {
         Text::at(&self.keys, u)
     }
 
@@ -283,6 +291,8 @@ impl Pair<'_> {
             arcs_kept: Vec::with_capacity(ia.groups.len().min(ib.groups.len())),
             arcs_added: Vec::with_capacity(ib.groups.len()),
             arcs_removed: Vec::with_capacity(ia.groups.len()),
+            relabelled: Vec::new(),
+            reordered: Vec::new(),
         };
         // In key order: the lists come out sorted.
         for &u in &ia.by_key {
@@ -322,6 +332,7 @@ impl Pair<'_> {
             split.of(ia.group_labels(k), lb);
             push_grouped(&mut s.arcs_removed, ia.key(t), ia.key(h), &mut split.only_a);
         }
+        self.changes(&fwd, &inv, &mut s);
         s
     }
 
