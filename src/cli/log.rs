@@ -19,6 +19,34 @@ pub enum LogCommand {
     /// Per node: activations, status changes, time RUNNING; node and branch
     /// coverage (exit 1 below --min-coverage)
     Report(ReportArgs),
+    /// Draws the log's tree with each node coloured by its status at a
+    /// moment (RUNNING yellow, SUCCESS green, FAILURE red), as `dot --trace`
+    Dot(DotArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct DotArgs {
+    /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog)
+    pub log: PathBuf,
+    /// The moment: this many seconds after the log's first timestamp
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        conflicts_with = "step",
+        required_unless_present = "step"
+    )]
+    pub at: Option<f64>,
+    /// The moment: after this many records (status changes)
+    #[arg(long, value_name = "K")]
+    pub step: Option<u64>,
+    /// Output file (default: stdout); the render format follows its extension
+    #[arg(short, long, value_name = "OUT")]
+    pub output: Option<PathBuf>,
+    /// Render through Graphviz (svg, png, pdf) instead of writing DOT
+    #[arg(long, value_enum)]
+    pub render: Option<crate::render::dot::RenderFormat>,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -42,7 +70,10 @@ pub struct ReportArgs {
 }
 
 pub fn execute(a: LogArgs) -> u8 {
-    let LogCommand::Report(a) = a.command;
+    let a = match a.command {
+        LogCommand::Report(a) => a,
+        LogCommand::Dot(d) => return dot(d),
+    };
     if let Some(x) = a.min_coverage
         && !(0.0..=1.0).contains(&x)
     {
@@ -99,4 +130,64 @@ pub fn execute(a: LogArgs) -> u8 {
         }
         _ => EXIT_OK,
     }
+}
+
+fn dot(a: DotArgs) -> u8 {
+    use crate::log::replay::{At, replay};
+    use crate::render::dot::{DotOptions, Highlight, Status as Drawn};
+    let at = match (a.at, a.step) {
+        (Some(t), _) if t.is_finite() && t >= 0.0 => At::Time((t * 1e6) as u64),
+        (Some(t), _) => {
+            eprintln!("error: --at must be a time in seconds from 0, found {t}");
+            return EXIT_BAD_INPUT;
+        }
+        (None, Some(k)) => At::Step(k),
+        (None, None) => unreachable!("clap requires one"),
+    };
+    let shown = a.log.display().to_string();
+    let file = match std::fs::File::open(&a.log) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!(
+                "error: {}: cannot read this file: {e}",
+                crate::sanitize::shown(&shown)
+            );
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let limits = a.limits.limits();
+    let r = match replay(file, at, &limits) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!(
+                "error: {}: {}",
+                crate::sanitize::shown(&shown),
+                crate::sanitize::shown(&e.to_string())
+            );
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let mut opts = DotOptions::default();
+    for (id, s) in &r.statuses {
+        let st = match s {
+            crate::log::btlog::Status::Running => Drawn::Running,
+            crate::log::btlog::Status::Success => Drawn::Success,
+            crate::log::btlog::Status::Failure => Drawn::Failure,
+            _ => continue,
+        };
+        opts.highlight.insert(id.clone(), Highlight::Status(st));
+    }
+    opts.title = Some(format!(
+        "{} at {:.3} s ({} status changes)",
+        shown,
+        r.t_usec as f64 / 1e6,
+        r.applied
+    ));
+    super::commands::draw(
+        &r.policy,
+        &opts,
+        a.output.as_deref(),
+        a.render,
+        std::time::Duration::from_secs(60),
+    )
 }

@@ -4,5 +4,6 @@
 //! coverage (`btfsm log report`).
 
 pub mod btlog;
+pub mod replay;
 pub mod report;
 pub mod tree;

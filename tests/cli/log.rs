@@ -110,3 +110,40 @@ fn a_long_log_is_streamed_in_bounded_memory() {
     assert_eq!(v["records"], 2_000_000);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn log_dot_colours_each_node_by_its_status_at_the_step() {
+    // The statuses after K records, replayed here from the raw bytes, are
+    // the fills of the drawing: as many RUNNING (gold), SUCCESS and FAILURE
+    // nodes as the replay says.
+    let bytes = std::fs::read(FIG01).expect("fixture");
+    let xml = i32::from_le_bytes(bytes[19..23].try_into().unwrap()) as usize;
+    let mut status = std::collections::BTreeMap::new();
+    let k = 20;
+    for r in bytes[23 + xml + 8..].chunks(9).take(k) {
+        status.insert(u16::from_le_bytes([r[6], r[7]]), r[8]);
+    }
+    let count = |s: u8| status.values().filter(|&&x| x == s).count();
+    let (code, dot, err) = btfsm(&["log", "dot", FIG01, "--step", &k.to_string()]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        dot.matches("fillcolor=gold").count(),
+        count(1),
+        "RUNNING\n{dot}"
+    );
+    assert_eq!(
+        dot.matches("fillcolor=palegreen").count(),
+        count(2),
+        "SUCCESS\n{dot}"
+    );
+    assert_eq!(
+        dot.matches("fillcolor=tomato").count(),
+        count(3),
+        "FAILURE\n{dot}"
+    );
+    assert!(dot.contains(&format!("({k} status changes)")), "{dot}");
+    assert!(
+        !dot.contains("_uid"),
+        "the log's bookkeeping is not drawn as ports"
+    );
+}

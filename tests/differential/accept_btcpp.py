@@ -604,7 +604,7 @@ XML_PROBES = [
 def toml_files():
     """Bundled TOML policies: btfsm's own BTs, checked on export only."""
     out = sorted((REPO / "policies").rglob("*.toml")) + sorted((FIXTURES / "valid").rglob("*.toml"))
-    return [p for p in out if not {"scenarios", "lib", "tables"} & set(p.parts)]
+    return [p for p in out if not {"scenarios", "lib", "tables", "domains"} & set(p.parts)]
 
 
 # --------------------------------------------------------------------------
