@@ -397,11 +397,7 @@ impl Reader<'_> {
             return;
         };
         let states: Vec<usize> = made.iter().map(|&(_, s)| s).collect();
-        let region = Region {
-            initial: start,
-            outcomes,
-            states,
-        };
+        let region = Region::at(start, outcomes, states);
         match p.state {
             None => m.top = region,
             Some(c) => m.states[c].body = StateBody::Container(region),
@@ -583,9 +579,9 @@ mod tests {
 </StateMachine>"#,
         );
         assert!(!m.hierarchical);
-        assert_eq!(m.states[m.top.initial].name, "Foo");
+        assert_eq!(m.states[m.top.initial_state().unwrap()].name, "Foo");
         assert_eq!(m.top.outcomes, vec!["outcome4"]);
-        let foo = &m.states[m.top.initial];
+        let foo = &m.states[m.top.initial_state().unwrap()];
         assert_eq!(foo.transitions.len(), 2);
         assert_eq!(foo.transitions[0].target, Target::State(0));
         assert_eq!(
@@ -607,7 +603,11 @@ mod tests {
             m.states[0].transitions[0].target,
             Target::Outcome("done".into())
         );
-        assert_eq!(m.states[m.top.initial].name, "a", "the first state starts");
+        assert_eq!(
+            m.states[m.top.initial_state().unwrap()].name,
+            "a",
+            "the first state starts"
+        );
     }
 
     #[test]
@@ -625,16 +625,19 @@ mod tests {
 </StateMachine>"#,
         );
         assert!(m.hierarchical);
-        let nested = &m.states[m.top.initial];
+        let nested = &m.states[m.top.initial_state().unwrap()];
         assert_eq!(nested.name, "NestedSM");
         let StateBody::Container(r) = &nested.body else {
             panic!("not a container")
         };
         assert_eq!(r.outcomes, vec!["outcome1", "outcome2"]);
-        assert_eq!(m.states[r.initial].name, "InnerState");
-        assert_eq!(m.states[r.initial].parent, Some(m.top.initial));
+        assert_eq!(m.states[r.initial_state().unwrap()].name, "InnerState");
+        assert_eq!(
+            m.states[r.initial_state().unwrap()].parent,
+            m.top.initial_state()
+        );
         assert_eq!(nested.transitions.len(), 2);
-        assert_eq!(nested.transitions[0].target, Target::State(m.top.initial));
+        assert_eq!(nested.transitions[0].target, m.top.initial.clone());
     }
 
     #[test]

@@ -115,13 +115,75 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
     enum Item {
         Region(Option<usize>, usize),
         Close(usize),
+        /// `--` between two regions of a parallel state (Mermaid's
+        /// concurrency separator).
+        Separator(usize),
+        /// A region of a parallel state at a depth: its start, and the
+        /// state itself (a block when it holds states).
+        Orthogonal(usize, usize),
     }
+    // The transitions of state `s`, whose region's outcomes are `outcomes`
+    // (an outcome of an enclosing region: that region's outcome state).
+    let transitions = |out: &mut String, pad: &str, s: usize, outcomes: &[String]| {
+        for t in &m.states[s].transitions {
+            let to = match &t.target {
+                Target::State(j) => format!("s{j}"),
+                Target::Outcome(o) => match outcomes.iter().position(|x| x == o) {
+                    Some(k) => outcome_id(m.states[s].parent, k),
+                    None => continue,
+                },
+                Target::OuterOutcome { owner, outcome } => {
+                    let outer = match owner {
+                        None => &m.top.outcomes,
+                        Some(c) => match &m.states[*c].body {
+                            StateBody::Container(r) => &r.outcomes,
+                            _ => continue,
+                        },
+                    };
+                    match outer.iter().position(|x| x == outcome) {
+                        Some(k) => outcome_id(*owner, k),
+                        None => continue,
+                    }
+                }
+            };
+            match label(&t.trigger.label()) {
+                l if l.trim().is_empty() => {
+                    let _ = writeln!(out, "{pad}s{s} --> {to}");
+                }
+                l => {
+                    let _ = writeln!(out, "{pad}s{s} --> {to} : {l}");
+                }
+            }
+        }
+    };
     let mut decisions = Vec::new();
     let mut stack = vec![Item::Region(None, 1)];
     while let Some(item) = stack.pop() {
         let (owner, depth) = match item {
             Item::Close(depth) => {
                 let _ = writeln!(out, "{}}}", "    ".repeat(depth - 1));
+                continue;
+            }
+            Item::Separator(depth) => {
+                let _ = writeln!(out, "{}--", "    ".repeat(depth));
+                continue;
+            }
+            Item::Orthogonal(s, depth) => {
+                let pad = "    ".repeat(depth);
+                let st = &m.states[s];
+                if st.pseudo.is_none() {
+                    let _ = writeln!(out, "{pad}[*] --> s{s}");
+                }
+                if !matches!(st.body, StateBody::Container(_)) {
+                    if matches!(st.body, StateBody::Decision) {
+                        decisions.push(s);
+                    }
+                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&st.label));
+                }
+                transitions(&mut out, &pad, s, &[]);
+                if matches!(st.body, StateBody::Container(_)) {
+                    stack.push(Item::Region(Some(s), depth + 1));
+                }
                 continue;
             }
             Item::Region(owner, depth) => (owner, depth),
@@ -143,8 +205,25 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
                 }
             }
         };
-        if region.initial < m.states.len() {
-            let _ = writeln!(out, "{pad}[*] --> s{}", region.initial);
+        if region.parallel {
+            // Each state is a region of its own, separated by `--`.
+            if owner.is_some() {
+                stack.push(Item::Close(depth));
+            }
+            for (k, &c) in region.states.iter().enumerate().rev() {
+                stack.push(Item::Orthogonal(c, depth));
+                if k > 0 {
+                    stack.push(Item::Separator(depth));
+                }
+            }
+            continue;
+        }
+        if let Some(i) = region.initial_state() {
+            let _ = writeln!(out, "{pad}[*] --> s{i}");
+        } else if let Target::Outcome(o) = &region.initial
+            && let Some(k) = region.outcomes.iter().position(|x| x == o)
+        {
+            let _ = writeln!(out, "{pad}[*] --> {}", outcome_id(owner, k));
         }
         for (k, o) in region.outcomes.iter().enumerate() {
             let id = outcome_id(owner, k);
@@ -166,23 +245,7 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
             }
         }
         for &s in &region.states {
-            for t in &m.states[s].transitions {
-                let to = match &t.target {
-                    Target::State(j) => format!("s{j}"),
-                    Target::Outcome(o) => match region.outcomes.iter().position(|x| x == o) {
-                        Some(k) => outcome_id(owner, k),
-                        None => continue,
-                    },
-                };
-                match label(&t.trigger.label()) {
-                    l if l.trim().is_empty() => {
-                        let _ = writeln!(out, "{pad}s{s} --> {to}");
-                    }
-                    l => {
-                        let _ = writeln!(out, "{pad}s{s} --> {to} : {l}");
-                    }
-                }
-            }
+            transitions(&mut out, &pad, s, &region.outcomes);
         }
         if owner.is_some() {
             stack.push(Item::Close(depth));

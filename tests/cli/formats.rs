@@ -163,39 +163,41 @@ fn count_tree_nodes(path: &Path) -> usize {
 }
 
 /// Vertices and arcs of an SCXML file's HFSM graph by the test's own scanner:
-/// every `<state>` and `<history>`, plus the `<final>` states of the top level
-/// (the machine's outcomes; nested finals are their container's outcomes, not
-/// vertices); one arc per `<transition>` with a target (not the one of an
-/// `<initial>`, which is the container's arc), plus one per state holding
-/// states (to its initial child). A machine embedded in `<invoke>` is
-/// another machine: not counted.
+/// every `<state>`, `<parallel>` and `<history>`, plus the `<final>` states of
+/// the top level (the machine's outcomes; nested finals are their
+/// container's outcomes, not vertices); one arc per `<transition>` with a
+/// target (not the one of an `<initial>`, which is the container's arc),
+/// plus one per state holding states (to its initial child; a state holding
+/// only finals starts in one: no arc), and one per region of a `<parallel>`
+/// (each `<state>` or `<parallel>` directly inside it: all are entered). A
+/// machine embedded in `<invoke>` is another machine: not counted.
 fn count_scxml_graph(path: &Path) -> (usize, usize) {
     let text = std::fs::read_to_string(path).expect("read");
-    // (element name, holds a state)
-    let mut stack: Vec<(String, bool)> = Vec::new();
+    // (element name, arcs it adds when closed)
+    let mut stack: Vec<(String, usize)> = Vec::new();
     let (mut n, mut arcs) = (0, 0);
     for (name, attrs, self_closing) in scan_tags(&text) {
         if let Some(closed) = name.strip_prefix('/') {
-            let (open, compound) = stack.pop().expect("balanced");
+            let (open, initial_arcs) = stack.pop().expect("balanced");
             assert_eq!(open, closed);
-            if compound {
-                arcs += 1;
-            }
+            arcs += initial_arcs;
             continue;
         }
         let inside = |tag: &str| stack.iter().any(|(p, _)| p == tag);
         if inside("invoke") {
             if !self_closing {
-                stack.push((name, false));
+                stack.push((name, 0));
             }
             continue;
         }
         match name.as_str() {
             "transition" if stack.last().map(|(p, _)| p.as_str()) == Some("initial") => {}
-            "state" | "history" => {
+            "state" | "history" | "parallel" => {
                 n += 1;
-                if let Some(parent) = stack.last_mut().filter(|(p, _)| p == "state") {
-                    parent.1 = true;
+                match stack.last_mut() {
+                    Some((p, k)) if p == "state" => *k = 1,
+                    Some((p, k)) if p == "parallel" && name != "history" => *k += 1,
+                    _ => {}
                 }
             }
             "final" if stack.last().map(|(p, _)| p.as_str()) == Some("scxml") => n += 1,
@@ -203,7 +205,7 @@ fn count_scxml_graph(path: &Path) -> (usize, usize) {
             _ => {}
         }
         if !self_closing {
-            stack.push((name, false));
+            stack.push((name, 0));
         }
     }
     (n, arcs)
@@ -399,12 +401,21 @@ fn same_model(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> Result<(), 
             Ok(())
         }
         (PolicyBody::Machine(x), PolicyBody::Machine(y)) => {
+            // Where a region starts: a state's path or an outcome.
+            let start = |m: &btfsm::model::StateMachine, t: &Target| match t {
+                Target::State(j) => m.path(*j),
+                Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
+                    format!("outcome {o}")
+                }
+            };
             let desc = |m: &btfsm::model::StateMachine, i: usize| {
                 let s = &m.states[i];
                 let body = match &s.body {
                     StateBody::Container(r) => format!(
-                        "container initial={} outcomes={:?}",
-                        m.states[r.initial].name, r.outcomes
+                        "container initial={} parallel={} outcomes={:?}",
+                        start(m, &r.initial),
+                        r.parallel,
+                        r.outcomes
                     ),
                     other => format!("{other:?}"),
                 };
@@ -415,14 +426,18 @@ fn same_model(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> Result<(), 
                         let to = match &t.target {
                             Target::State(j) => m.path(*j),
                             Target::Outcome(o) => format!("outcome {o}"),
+                            Target::OuterOutcome { owner, outcome } => format!(
+                                "outcome {outcome} of {}",
+                                owner.map_or("the machine".into(), |c| m.path(c))
+                            ),
                         };
                         format!("{:?} -> {to}", t.trigger)
                     })
                     .collect();
                 format!("{} {body} {:?} {trs:?}", s.label, s.pseudo)
             };
-            if (x.top.outcomes.clone(), x.states[x.top.initial].name.clone())
-                != (y.top.outcomes.clone(), y.states[y.top.initial].name.clone())
+            if (x.top.outcomes.clone(), start(x, &x.top.initial))
+                != (y.top.outcomes.clone(), start(y, &y.top.initial))
             {
                 return Err("different top level".into());
             }

@@ -12,16 +12,11 @@ use crate::format::xml::{self, BTFSM_NS, XDoc, XElem, shown};
 use crate::model::skill::SkillCall;
 use crate::model::{Pseudo, Region, State, StateBody, StateMachine};
 use std::borrow::Cow;
-use std::collections::{BTreeMap, HashSet};
+use std::collections::BTreeMap;
 
-/// The state-like elements in document order with their parent entry, and
-/// the ids inside unsupported elements (transitions to them are not
-/// reported again). `None` after an error that stops the reading.
-pub(super) fn collect(
-    doc: &XDoc,
-    limits: &Limits,
-    diags: &mut xml::Sink,
-) -> Option<(Vec<Entry>, HashSet<String>)> {
+/// The state-like elements in document order with their parent entry.
+/// `None` after an error that stops the reading.
+pub(super) fn collect(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Vec<Entry>> {
     let f = &doc.file;
     let err = |diags: &mut xml::Sink, e: &XElem, msg: String, hint: &str| {
         diags.push(Diagnostic::error(msg).at(f, e.span.clone()).hint(hint));
@@ -37,9 +32,6 @@ pub(super) fn collect(
     // Containers around each entry of `found` (checked against --max-depth
     // as the document is read).
     let mut depth_of: Vec<usize> = Vec::new();
-    // Ids inside unsupported `<parallel>` elements: transitions to them are
-    // not reported again.
-    let mut skipped: std::collections::HashSet<String> = std::collections::HashSet::new();
     let mut stack: Vec<(usize, Option<usize>)> = doc.elems[doc.root]
         .children
         .iter()
@@ -58,22 +50,7 @@ pub(super) fn collect(
                 Some("deep") => Pseudo::DeepHistory,
                 _ => Pseudo::ShallowHistory,
             }),
-            "parallel" => {
-                err(
-                    diags,
-                    el,
-                    "`<parallel>` states are not supported".into(),
-                    "the paper's FSMs and HFSMs run one state per region; model each parallel region as its own machine",
-                );
-                let mut inner = vec![e];
-                while let Some(x) = inner.pop() {
-                    if let Some(id) = doc.elems[x].attr("id") {
-                        skipped.insert(id.to_string());
-                    }
-                    inner.extend(doc.elems[x].children.iter().copied());
-                }
-                continue;
-            }
+            "parallel" => Kind::Parallel,
             _ => continue, // transitions, initial, executable content: read later
         };
         if let Some(d) = long_attr(el, f, limits) {
@@ -106,13 +83,13 @@ pub(super) fn collect(
         let idx = found.len();
         found.push((e, kind, parent));
         depth_of.push(depth);
-        if matches!(found[idx].1, Kind::State) {
+        if matches!(found[idx].1, Kind::State | Kind::Parallel) {
             for &c in el.children.iter().rev() {
                 stack.push((c, Some(idx)));
             }
         }
     }
-    Some((found, skipped))
+    Some(found)
 }
 
 /// Each entry's id: its `id`, else a generated `_state1`, `_final2`, ...
@@ -155,6 +132,18 @@ pub(super) fn states(
                 None => m.top.outcomes.push(name),
                 Some(p) => {
                     if let StateBody::Container(r) = &mut m.states[p].body {
+                        if r.parallel {
+                            // SCXML 3.4: a `<parallel>` holds no `<final>`.
+                            diags.push(
+                                Diagnostic::error(format!(
+                                    "final state `{}` directly inside `<parallel>`",
+                                    shown(&ids[k])
+                                ))
+                                .at(f, el.span.clone())
+                                .hint("a parallel state completes when each of its regions reaches a final state: put the `<final>` inside a region's `<state>`"),
+                            );
+                            continue;
+                        }
                         r.outcomes.push(name);
                     } else {
                         m.states[p].body = StateBody::Container(Region::unset(vec![name]));
@@ -167,6 +156,11 @@ pub(super) fn states(
         state_of[k] = Some(si);
         let body = match kind {
             Kind::History(_) => StateBody::Decision,
+            // Its regions are added as they are read.
+            Kind::Parallel => StateBody::Container(Region {
+                parallel: true,
+                ..Region::unset(vec![])
+            }),
             _ if el.btfsm_attr("decision") == Some("true") => StateBody::Decision,
             _ => StateBody::Task(el.btfsm_attr("skill").map(|s| {
                 SkillCall {
@@ -209,12 +203,18 @@ pub(super) fn states(
                 StateBody::Container(r) => r.states.push(si),
                 _ => {
                     m.states[p].body = StateBody::Container(Region {
-                        initial: usize::MAX,
-                        outcomes: vec![],
                         states: vec![si],
+                        ..Region::unset(vec![])
                     })
                 }
             },
+        }
+    }
+    // A `<parallel>` with no states inside is entered and stays, as a
+    // plain state.
+    for s in &mut m.states {
+        if matches!(&s.body, StateBody::Container(r) if r.parallel && r.states.is_empty()) {
+            s.body = StateBody::Task(None);
         }
     }
     m.hierarchical = m

@@ -37,7 +37,7 @@ use super::{Limits, Loaded};
 use crate::diagnostic::{Diagnostic, SourceFile};
 use crate::model::{Policy, PolicyBody, Pseudo};
 use std::borrow::Cow;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -67,6 +67,8 @@ pub fn parse_str(name: &str, text: &str, limits: &Limits) -> Result<Loaded, Vec<
 /// A state-like element found in the document.
 enum Kind {
     State,
+    /// `<parallel>`: a container whose states are its orthogonal regions.
+    Parallel,
     History(Pseudo),
     Final,
 }
@@ -120,9 +122,18 @@ struct Ctx<'a> {
     found: &'a [Entry],
     ids: &'a [Cow<'a, str>],
     by_id: &'a HashMap<&'a str, usize>,
-    skipped: &'a HashSet<String>,
     state_of: &'a [Option<usize>],
     entry_of: &'a [usize],
+}
+
+impl Ctx<'_> {
+    /// The outcome name of the final state of entry `k`.
+    fn final_name(&self, k: usize) -> String {
+        self.doc.elems[self.found[k].0]
+            .btfsm_attr("name")
+            .unwrap_or(&self.ids[k])
+            .to_string()
+    }
 }
 
 fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
@@ -143,7 +154,7 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
         );
         return None;
     }
-    let (found, skipped) = elements::collect(doc, limits, diags)?;
+    let found = elements::collect(doc, limits, diags)?;
     let ids = elements::ids(doc, &found);
     let mut by_id: HashMap<&str, usize> = HashMap::with_capacity(ids.len());
     for (k, id) in ids.iter().enumerate() {
@@ -163,7 +174,6 @@ fn read(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Option<Policy> {
         found: &found,
         ids: &ids,
         by_id: &by_id,
-        skipped: &skipped,
         state_of: &state_of,
         entry_of: &entry_of,
     };

@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::model::{StateBody, StateMachine, Target, Trigger};
+use std::path::Path;
 
 fn machine(l: &Loaded) -> &StateMachine {
     match &l.policy.body {
@@ -65,7 +66,7 @@ fn nested_states_history_and_foreign_namespaces() {
     let StateBody::Container(r) = &m.states[0].body else {
         panic!()
     };
-    assert_eq!(m.states[r.initial].name, "c1");
+    assert_eq!(m.states[r.initial_state().unwrap()].name, "c1");
     assert_eq!(m.states[4].transitions[0].target, Target::State(3));
 }
 
@@ -180,13 +181,14 @@ fn an_initial_state_deeper_in_the_region_enters_the_containers_on_the_way() {
     .unwrap();
     let m = machine(&l);
     let name = |i: usize| m.states[i].name.as_str();
-    assert_eq!(name(m.top.initial), "outer");
+    let top = m.top.initial_state().unwrap();
+    assert_eq!(name(top), "outer");
     let init = |i: usize| match &m.states[i].body {
-        StateBody::Container(r) => r.initial,
+        StateBody::Container(r) => r.initial_state().unwrap(),
         _ => panic!(),
     };
-    assert_eq!(name(init(m.top.initial)), "inner");
-    assert_eq!(name(init(init(m.top.initial))), "deep");
+    assert_eq!(name(init(top)), "inner");
+    assert_eq!(name(init(init(top))), "deep");
     // A container whose own initial says otherwise: the model cannot say both.
     let e = parse_str(
         "t.scxml",
@@ -327,17 +329,289 @@ fn skill_bindings_are_checked_as_in_toml() {
     assert!(parse_str("t.scxml", &ok, &Limits::default()).is_ok());
 }
 
+/// The graph's (vertices, arcs) of a machine read from text.
+fn counts(l: &Loaded) -> (usize, usize) {
+    let g = crate::graph::policy_graph(&l.policy);
+    (g.g.node_count(), g.g.edge_count())
+}
+
+/// A machine as a set of lines by state path (the TOML reader numbers
+/// states breadth first, the SCXML reader in document order).
+fn describe(m: &StateMachine) -> std::collections::BTreeSet<String> {
+    let start = |t: &Target| match t {
+        Target::State(j) => m.path(*j),
+        Target::Outcome(o) => format!("outcome {o}"),
+        Target::OuterOutcome { owner, outcome } => {
+            format!("outcome {outcome} of {:?}", owner.map(|c| m.path(c)))
+        }
+    };
+    let region = |r: &crate::model::Region| {
+        format!(
+            "initial {} parallel {} outcomes {:?}",
+            start(&r.initial),
+            r.parallel,
+            r.outcomes
+        )
+    };
+    let mut out: std::collections::BTreeSet<String> = (0..m.states.len())
+        .map(|i| {
+            let s = &m.states[i];
+            let body = match &s.body {
+                StateBody::Container(r) => region(r),
+                other => format!("{other:?}"),
+            };
+            let trs: Vec<String> = s
+                .transitions
+                .iter()
+                .map(|t| format!("{:?} -> {}", t.trigger, start(&t.target)))
+                .collect();
+            format!("{} {} {body} {:?} {trs:?}", m.path(i), s.label, s.pseudo)
+        })
+        .collect();
+    out.insert(format!("top {} {}", region(&m.top), m.hierarchical));
+    out
+}
+
+/// Reads, writes as SCXML and as TOML, and reads both back: the same
+/// machine each time.
+fn round_trips(l: &Loaded) {
+    let out = crate::format::scxml_write::write_policy(&l.policy).unwrap();
+    let back =
+        parse_str("b.scxml", &out, &Limits::default()).unwrap_or_else(|e| panic!("{out}\n{e:?}"));
+    assert_eq!(describe(machine(&back)), describe(machine(l)), "{out}");
+    let toml = crate::format::toml_write::write_policy(&l.policy);
+    let back = crate::format::toml::parse_str("b.toml", &toml, Path::new("."), &Limits::default())
+        .unwrap_or_else(|e| panic!("{toml}\n{e:?}"));
+    assert_eq!(describe(machine(&back)), describe(machine(l)), "{toml}");
+}
+
+const PARALLEL: &str = r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="p">
+  <parallel id="p">
+    <state id="r1"><state id="a1"><transition event="go" target="a2"/></state><state id="a2"/><final id="r1done"/></state>
+    <state id="r2" initial="b2"><state id="b1"/><state id="b2"><transition event="x" target="pass"/></state></state>
+    <state id="r3"/>
+    <transition event="done.state.p" target="pass"/>
+  </parallel>
+  <state id="q"><transition event="back" target="b1"/></state>
+  <final id="pass"/>
+</scxml>"#;
+
+/// `<parallel>`: a container whose states are its regions, all entered: one
+/// initial arc per region; no unreachable warning for the regions' initial
+/// states; a nested state's transition to a top-level final is an outcome
+/// of the machine.
 #[test]
-fn parallel_is_reported_with_its_position() {
+fn parallel_states_are_containers_of_orthogonal_regions() {
+    let l = parse_str("t.scxml", PARALLEL, &Limits::default()).unwrap();
+    let m = machine(&l);
+    assert!(m.hierarchical && m.has_parallel());
+    let StateBody::Container(p) = &m.states[0].body else {
+        panic!("p is a container")
+    };
+    assert!(p.parallel);
+    let names = |v: Vec<usize>| {
+        v.into_iter()
+            .map(|i| m.states[i].name.clone())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(names(p.entered(&m.states)), ["r1", "r2", "r3"]);
+    assert!(p.outcomes.is_empty());
+    // `done.state.p` is an event (a parallel state has no outcomes).
+    assert!(matches!(
+        m.states[0].transitions[0].trigger,
+        Trigger::Guard(_)
+    ));
+    // b2 -> pass leaves r2 and p: the machine's outcome.
+    let b2 = m.states.iter().position(|s| s.name == "b2").unwrap();
+    assert_eq!(
+        m.states[b2].transitions[0].target,
+        Target::OuterOutcome {
+            owner: None,
+            outcome: "pass".into()
+        }
+    );
+    // Only `q` is unreachable: a1, b2 and r3 are entered with p; b1 by
+    // nothing (q is never entered).
+    let w: Vec<&str> = l.warnings.iter().map(|d| d.message.as_str()).collect();
+    assert_eq!(
+        w,
+        [
+            "state `b1` is unreachable from the initial state",
+            "state `q` is unreachable from the initial state"
+        ]
+    );
+    // Vertices: p r1 a1 a2 r2 b1 b2 r3 q + pass = 10; arcs: the
+    // transitions of a1, b2, p and q, 3 regions of p, r1 -> a1, r2 -> b2 = 9.
+    assert_eq!(counts(&l), (10, 9));
+    round_trips(&l);
+}
+
+/// Entering one region of a parallel state enters the others at their
+/// initial states (W3C SCXML 3.13): no false unreachable warning.
+#[test]
+fn entering_one_region_enters_its_siblings() {
+    let l = parse_str(
+        "t.scxml",
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="a">
+  <state id="a"><transition event="go" target="x2"/></state>
+  <parallel id="p">
+    <state id="rx"><state id="x1"/><state id="x2"/></state>
+    <state id="ry"><state id="y1"/><state id="y2"/></state>
+  </parallel>
+</scxml>"#,
+        &Limits::default(),
+    )
+    .unwrap();
+    let w: Vec<&str> = l.warnings.iter().map(|d| d.message.as_str()).collect();
+    // x1 is skipped by the jump to x2, y2 has no way in; ry and y1 are entered.
+    assert_eq!(
+        w,
+        [
+            "state `x1` is unreachable from the initial state",
+            "state `y2` is unreachable from the initial state"
+        ]
+    );
+}
+
+/// An `initial` naming one state per region of a parallel state below the
+/// region's child: the containers on the way start there; an `initial`
+/// naming a `<parallel>` is an ordinary initial state.
+#[test]
+fn an_initial_naming_states_of_several_parallel_regions() {
+    let l = parse_str(
+        "t.scxml",
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="x2 y2">
+  <state id="s">
+    <parallel id="p">
+      <state id="rx"><state id="x1"/><state id="x2"/></state>
+      <state id="ry"><state id="y1"/><state id="y2"/></state>
+    </parallel>
+  </state>
+</scxml>"#,
+        &Limits::default(),
+    )
+    .unwrap();
+    let m = machine(&l);
+    let init = |n: &str| {
+        let i = m.states.iter().position(|s| s.name == n).unwrap();
+        match &m.states[i].body {
+            StateBody::Container(r) => m.states[r.initial_state().unwrap()].name.clone(),
+            _ => panic!(),
+        }
+    };
+    assert_eq!(m.states[m.top.initial_state().unwrap()].name, "s");
+    assert_eq!(
+        (init("s"), init("rx"), init("ry")),
+        ("p".into(), "x2".into(), "y2".into())
+    );
+    round_trips(&l);
+    // Two states of one (non-parallel) region cannot both start.
     let e = parse_str(
+        "t.scxml",
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="a b"><state id="a"/><state id="b"/></scxml>"#,
+        &Limits::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e[0].message.contains("names several states of this region"),
+        "{}",
+        e[0]
+    );
+    assert_eq!(e[0].location().unwrap().1, 1);
+}
+
+/// A machine that is only a `<final>`, and a state holding only a
+/// `<final>`: their regions start in that outcome (no initial arc).
+#[test]
+fn regions_whose_initial_is_a_final_state() {
+    let only = parse_str(
+        "t.scxml",
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="done"><final id="done"/></scxml>"#,
+        &Limits::default(),
+    )
+    .unwrap();
+    let m = machine(&only);
+    assert_eq!(m.top.initial, Target::Outcome("done".into()));
+    assert!(m.states.is_empty());
+    assert_eq!(counts(&only), (1, 0));
+    round_trips(&only);
+    let l = parse_str(
+        "t.scxml",
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml">
+  <state id="s0"><final id="s0final"/><transition event="done.state.s0" target="pass"/></state>
+  <final id="pass"/>
+</scxml>"#,
+        &Limits::default(),
+    )
+    .unwrap();
+    let m = machine(&l);
+    let StateBody::Container(r) = &m.states[0].body else {
+        panic!()
+    };
+    assert_eq!(r.initial, Target::Outcome("s0final".into()));
+    // s0 and pass; the one transition (no initial arc).
+    assert_eq!(counts(&l), (2, 1));
+    round_trips(&l);
+}
+
+/// A transition to a final state of a region that does not enclose the
+/// source is refused with its position; one to an enclosing container's
+/// final is that container's outcome.
+#[test]
+fn finals_of_enclosing_regions_only() {
+    let l = parse_str(
+        "t.scxml",
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml">
+  <state id="c"><state id="d"><state id="x"><transition event="e" target="cdone"/></state></state><final id="cdone"/></state>
+</scxml>"#,
+        &Limits::default(),
+    )
+    .unwrap();
+    let m = machine(&l);
+    assert_eq!(
+        m.states[2].transitions[0].target,
+        Target::OuterOutcome {
+            owner: Some(0),
+            outcome: "cdone".into()
+        }
+    );
+    round_trips(&l);
+    let e = parse_str(
+        "t.scxml",
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\">\n<state id=\"a\"><transition event=\"e\" target=\"bdone\"/></state>\n<state id=\"b\"><state id=\"b1\"/><final id=\"bdone\"/></state></scxml>",
+        &Limits::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e[0].message
+            .contains("of a region that does not enclose it"),
+        "{}",
+        e[0]
+    );
+    assert_eq!(e[0].location().unwrap().1, 2);
+}
+
+/// A `<final>` directly in a `<parallel>` (not SCXML) is an error at it; an
+/// empty `<parallel>` is a plain state.
+#[test]
+fn parallel_edge_cases() {
+    let e = parse_str(
+        "t.scxml",
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\">\n  <parallel id=\"p\"><state id=\"r\"/>\n<final id=\"f\"/></parallel>\n</scxml>",
+        &Limits::default(),
+    )
+    .unwrap_err();
+    assert!(
+        e[0].message.contains("directly inside `<parallel>`"),
+        "{}",
+        e[0]
+    );
+    assert_eq!(e[0].location().unwrap().1, 3);
+    let l = parse_str(
         "t.scxml",
         "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\">\n  <parallel id=\"p\"/>\n</scxml>",
         &Limits::default(),
     )
-    .unwrap_err();
-    let p = e
-        .iter()
-        .find(|d| d.message.contains("`<parallel>`"))
-        .expect("parallel reported");
-    assert_eq!(p.location().unwrap().1, 2);
+    .unwrap();
+    assert!(matches!(machine(&l).states[0].body, StateBody::Task(None)));
 }

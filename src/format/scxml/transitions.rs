@@ -21,7 +21,6 @@ pub(super) fn transitions(cx: &Ctx<'_>, m: &mut StateMachine, diags: &mut xml::S
         found,
         ids,
         by_id,
-        skipped,
         state_of,
         ..
     } = *cx;
@@ -77,9 +76,6 @@ pub(super) fn transitions(cx: &Ctx<'_>, m: &mut StateMachine, diags: &mut xml::S
             }
             let tid = targets[0];
             let Some(&tk) = by_id.get(tid) else {
-                if skipped.contains(tid) {
-                    continue;
-                }
                 let h = if diags.room_for_errors() {
                     suggest(tid, ids.iter().map(|i| &**i))
                 } else {
@@ -98,18 +94,25 @@ pub(super) fn transitions(cx: &Ctx<'_>, m: &mut StateMachine, diags: &mut xml::S
             let target = match state_of[tk] {
                 Some(ts) => Target::State(ts),
                 None => {
-                    // A final state: an outcome of the source's own region.
+                    // A final state: an outcome of the source's own region,
+                    // or of a region enclosing it.
                     let fparent = region_owner(found[tk].2);
-                    if fparent == m.states[si].parent {
+                    let own = m.states[si].parent;
+                    if fparent == own {
                         Target::Outcome(m_final_name(doc, found, ids, tk))
+                    } else if encloses(m, fparent, own) {
+                        Target::OuterOutcome {
+                            owner: fparent,
+                            outcome: m_final_name(doc, found, ids, tk),
+                        }
                     } else {
                         diags.push(
                             Diagnostic::error(format!(
-                                "transition from `{src}` to final state `{}` of another region",
+                                "transition from `{src}` to final state `{}` of a region that does not enclose it",
                                 shown(tid)
                             ))
                             .at(f, ta.span.clone())
-                            .hint("only a final state of the source's own region (its parent's outcome) is supported"),
+                            .hint("target a final state of the source's own region or of one around it"),
                         );
                         continue;
                     }
@@ -273,6 +276,19 @@ pub fn parse_terms(text: &str) -> Option<Vec<GuardTerm>> {
         });
     }
     Some(out)
+}
+
+/// Is the region of container `owner` (`None`: the top region) around the
+/// region of container `inner`, further out? (At most --max-depth steps.)
+fn encloses(m: &StateMachine, owner: Option<usize>, inner: Option<usize>) -> bool {
+    let mut cur = inner;
+    while let Some(p) = cur {
+        cur = m.states[p].parent;
+        if cur == owner {
+            return true;
+        }
+    }
+    false
 }
 
 /// The outcome name of a final state.
