@@ -67,6 +67,7 @@ pub fn bt_graph(bt: &Bt) -> PolicyGraph {
 /// The vertex type of a state.
 pub fn state_vertex_type(body: &StateBody) -> VertexType {
     match body {
+        StateBody::Container(r) if r.parallel => VertexType::ParallelState,
         StateBody::Container(_) => VertexType::Container,
         StateBody::Decision => VertexType::Decision,
         StateBody::Task(Some(call)) if skill_kind(&call.skill) == Some(SkillKind::Condition) => {

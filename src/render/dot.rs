@@ -1287,6 +1287,48 @@ on = { SUCCESS = "SUCCESS", FAILURE = "FAILURE", RUNNING = "RUNNING" }
         insta::assert_snapshot!("fsm", dot);
     }
 
+    /// A parallel state (TOML `parallel = true`): its regions are dashed
+    /// clusters inside its box, one initial arc to each; `/done` is the
+    /// machine's outcome, taken from inside a region.
+    const PARALLEL: &str = r#"kind = "hfsm"
+name = "arm-and-base"
+initial = "both"
+outcomes = ["done"]
+
+[states.both]
+parallel = true
+guards = [{ to = "done", label = "done.state.both" }]
+
+[states.both.states.arm]
+initial = "tuck"
+outcomes = ["arm-ok"]
+
+[states.both.states.arm.states.tuck]
+on = { SUCCESS = "arm-ok" }
+
+[states.both.states.base]
+initial = "move"
+outcomes = ["base-ok"]
+
+[states.both.states.base.states.move]
+on = { SUCCESS = "dock", FAILURE = "/done" }
+
+[states.both.states.base.states.dock]
+on = { SUCCESS = "base-ok" }
+"#;
+
+    #[test]
+    fn parallel_golden() {
+        let p = policy(PARALLEL);
+        let dot = policy_dot(&p, &DotOptions::default());
+        // Two regions with one outcome box each.
+        assert_matches_graph(&p, &dot, 2);
+        assert!(dot.contains("label=\"both ‖\""), "{dot}");
+        assert_eq!(dot.matches("style=dashed").count(), 2, "{dot}");
+        assert!(dot.contains("move -> done [label=FAILURE"), "{dot}");
+        insta::assert_snapshot!("parallel", dot);
+    }
+
     #[test]
     fn hfsm_golden() {
         let p = policy(HFSM);

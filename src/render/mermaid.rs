@@ -171,9 +171,7 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
             Item::Orthogonal(s, depth) => {
                 let pad = "    ".repeat(depth);
                 let st = &m.states[s];
-                if st.pseudo.is_none() {
-                    let _ = writeln!(out, "{pad}[*] --> s{s}");
-                }
+                let _ = writeln!(out, "{pad}[*] --> s{s}");
                 if !matches!(st.body, StateBody::Container(_)) {
                     if matches!(st.body, StateBody::Decision) {
                         decisions.push(s);
@@ -206,11 +204,20 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
             }
         };
         if region.parallel {
-            // Each state is a region of its own, separated by `--`.
+            // Each state is a region of its own, separated by `--`; history
+            // pseudo-states (no region) go in the first.
+            for &s in &region.states {
+                if m.states[s].pseudo.is_some() {
+                    decisions.push(s);
+                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&m.states[s].label));
+                    transitions(&mut out, &pad, s, &[]);
+                }
+            }
             if owner.is_some() {
                 stack.push(Item::Close(depth));
             }
-            for (k, &c) in region.states.iter().enumerate().rev() {
+            let regions = region.entered(&m.states);
+            for (k, &c) in regions.iter().enumerate().rev() {
                 stack.push(Item::Orthogonal(c, depth));
                 if k > 0 {
                     stack.push(Item::Separator(depth));
@@ -305,6 +312,48 @@ mod tests {
         let edges = text.matches(" --> ").count();
         assert_eq!(nodes, bt.nodes.len());
         assert_eq!(edges, bt.nodes.len() - 1);
+    }
+
+    /// A parallel state's regions are separated by `--`, each starting with
+    /// its own `[*] -->`; a transition out to the machine's outcome.
+    #[test]
+    fn parallel_regions_are_separated_by_dashes() {
+        let l = crate::format::toml::parse_str(
+            "p.toml",
+            r#"kind = "hfsm"
+name = "arm-and-base"
+initial = "both"
+outcomes = ["done"]
+
+[states.both]
+parallel = true
+guards = [{ to = "done", label = "done.state.both" }]
+
+[states.both.states.arm]
+initial = "tuck"
+outcomes = ["arm-ok"]
+
+[states.both.states.arm.states.tuck]
+on = { SUCCESS = "arm-ok" }
+
+[states.both.states.base]
+initial = "move"
+outcomes = ["base-ok"]
+
+[states.both.states.base.states.move]
+on = { SUCCESS = "dock", FAILURE = "/done" }
+
+[states.both.states.base.states.dock]
+on = { SUCCESS = "base-ok" }
+"#,
+            Path::new("."),
+            &Default::default(),
+        )
+        .unwrap();
+        let text = policy_mermaid(&l.policy);
+        insta::assert_snapshot!("parallel", text);
+        assert_eq!(text.matches("\n        --\n").count(), 1, "{text}");
+        assert!(text.contains("s4 --> o0 : FAILURE"), "{text}");
     }
 
     #[test]

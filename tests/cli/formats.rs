@@ -756,3 +756,72 @@ fn a_directory_is_every_policy_below_it_and_a_bad_file_hides_no_report() {
     std::fs::remove_dir_all(&dir).expect("cleanup");
     std::fs::remove_dir_all(&empty).expect("cleanup");
 }
+
+/// SCXML `<parallel>` (Apache Commons SCXML's parallel-01): counted with one
+/// initial arc per region, drawn as dashed regions inside the parallel
+/// state's box, written as `parallel = true` in TOML and `<parallel>` in
+/// SCXML (both read back), `--` between regions in Mermaid; the simulator
+/// refuses it with its reason, exit 2.
+#[test]
+fn parallel_regions_are_counted_drawn_converted_and_refused_by_the_simulator() {
+    let f = format!("{CORPUS}/scxml/commons-scxml/parallel-01.scxml");
+    let (code, stdout, stderr) = btfsm(&["analyze", "--format", "json", &f]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    // para, para1, para11, para12, para2, para21, para22, end: 8 vertices;
+    // 3 transitions + para -> para1, para2 + para1 -> para11, para2 -> para21.
+    assert_eq!(
+        (&v["policies"][0]["vertices"], &v["policies"][0]["edges"]),
+        (&serde_json::json!(8), &serde_json::json!(7))
+    );
+    let (code, dot, _) = btfsm(&["dot", &f]);
+    assert_eq!(code, 0);
+    assert!(dot.contains("label=\"para ‖\""), "{dot}");
+    assert_eq!(dot.matches("style=dashed").count(), 2, "{dot}");
+    assert!(dot.contains("para -> para1 [lhead=cluster_para1]"), "{dot}");
+    let (code, toml, stderr) = btfsm(&["convert", &f, "--to", "toml"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(toml.contains("[states.para]\nparallel = true\n"), "{toml}");
+    let (code, mermaid, _) = btfsm(&["convert", &f, "--to", "mermaid"]);
+    assert_eq!(code, 0);
+    assert_eq!(mermaid.matches("\n        --\n").count(), 1, "{mermaid}");
+    let (code, scxml, _) = btfsm(&["convert", &f, "--to", "scxml"]);
+    assert_eq!(code, 0);
+    assert!(scxml.contains("<parallel id=\"para\">"), "{scxml}");
+    let dir = scratch("parallel-sim");
+    std::fs::copy(&f, dir.join("p.scxml")).expect("copy");
+    let scenario = dir.join("s.toml");
+    std::fs::write(
+        &scenario,
+        "[world]\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"p.scxml\"\n",
+    )
+    .expect("write");
+    let (code, _, stderr) = btfsm(&["sim", &scenario.display().to_string()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains(
+            "has parallel regions (SCXML `<parallel>`): the simulator runs one state at a time"
+        ),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+/// The W3C tests' `pass`/`fail` (a nested state's transition to a top-level
+/// `<final>`) and a state holding only a `<final>` (test372) read, count and
+/// round-trip; `validate` gives no warning.
+#[test]
+fn w3c_finals_of_enclosing_regions_and_final_only_states_read() {
+    for t in ["test372", "test403a", "test412", "test579"] {
+        let f = format!("{CORPUS}/scxml/w3c/{t}.scxml");
+        let (code, _, stderr) = btfsm(&["validate", &f]);
+        assert_eq!(code, 0, "{stderr}");
+        assert!(stderr.contains(", 0 warnings)"), "{t}: {stderr}");
+    }
+    let f = format!("{CORPUS}/scxml/commons-scxml/scxml-initial-attr.scxml");
+    let (code, stdout, stderr) = btfsm(&["analyze", "--format", "json", &f]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    assert_eq!(v["policies"][0]["vertices"], 1, "the machine is one final");
+    assert_eq!(v["policies"][0]["edges"], 0);
+}
