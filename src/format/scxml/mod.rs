@@ -3,10 +3,25 @@
 //! - `<scxml initial>` and nested `<state>`: a state holding states is a container,
 //!   so a machine with any is an HFSM, else an FSM. A region's initial state is
 //!   its `initial` attribute, its `<initial><transition target>`, or its first
-//!   child state in document order (SCXML 3.3); an `initial` naming a state
-//!   deeper inside enters each container on the way at the next one.
+//!   child (state, parallel state or final) in document order (SCXML 3.3); an
+//!   `initial` naming a state deeper inside enters each container on the way
+//!   at the next one (one `initial` may name one state in each region of a
+//!   `<parallel>` inside it). An `initial` naming a final state of the region
+//!   (or a region holding only finals, or a machine that is only a `<final>`)
+//!   starts the region in that outcome: entering it completes it at once.
+//!   A container whose own `initial` differs from the one an outer `initial`
+//!   enters it at is refused (the model has one initial state per region).
+//! - `<parallel>` is a parallel region (`Region::parallel`): a container whose
+//!   states are its orthogonal regions, all entered together; it has no
+//!   outcomes of its own (it completes when all its regions have, SCXML's
+//!   `done.state.ID`, an event), and holds no `<final>`. An empty
+//!   `<parallel>` is a plain state.
 //! - `<final>` states are the outcomes of their region (top level: the machine's
-//!   outcomes, vertices of the graph; inside a container: the container's).
+//!   outcomes, vertices of the graph; inside a container: the container's). A
+//!   transition to a final state of a region around the source's (every W3C
+//!   test's `pass` and `fail`, targeted from deep inside) is a
+//!   `Target::OuterOutcome` of that region; to a final of a region that does
+//!   not enclose the source, an error.
 //! - `<transition event cond target>`: an event that is an outcome the source
 //!   state can return (`SUCCESS`, `FAILURE`, `RUNNING` of a task state, a
 //!   container's final states) with no `cond` becomes an outcome transition;
@@ -14,9 +29,9 @@
 //!   `[cond]`. Targets may be in other regions (SCXML allows it). Transitions
 //!   without a target change no state and are not counted (a warning says so).
 //! - `<history>` is modelled as a decision pseudo-state of its region (its
-//!   default transition, if any, is its guard); `<parallel>`, transitions with
-//!   several targets, and transitions into a final state of another region are
-//!   reported as unsupported with their position.
+//!   default transition, if any, is its guard). Transitions with several
+//!   targets (into several regions of a `<parallel>` at once) are reported as
+//!   unsupported with their position.
 //! - Executable content (`<onentry>`, `<send>`, `<script>`, ...) and elements
 //!   and attributes of other namespaces (Qt Creator's `qt:editorinfo`) are
 //!   ignored; btfsm's own namespace carries what SCXML has no place for
