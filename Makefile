@@ -44,7 +44,9 @@ test:
 # random trees (docs/bt-semantics.md); then every BT XML fixture accepted or
 # rejected by both engines alike, and every export loading in BT.CPP with
 # the same shape (tests/differential/accept_btcpp.py; known, explained
-# mismatches in accept_btcpp_known.txt, which must not go stale).
+# mismatches in accept_btcpp_known.txt, which must not go stale); and every
+# corpus SCXML file read by btfsm and by an independent SCXML engine (PyPI
+# `scjson`) alike (tests/differential/scxml_engine.py).
 $(VENV)/.installed: tests/differential/requirements.txt
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
@@ -57,6 +59,7 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/accept_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/accept_btcpp.txt 2>&1 \
 	  || { tail -40 $(TARGET_DIR)/accept_btcpp.txt; exit 1; }
 	@grep -m1 "fixture files" $(TARGET_DIR)/accept_btcpp.txt
+	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).
