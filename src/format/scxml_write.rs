@@ -214,7 +214,9 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             "state"
         };
         if close {
-            if let StateBody::Container(r) = &s.body {
+            if let StateBody::Container(r) = &s.body
+                && !r.parallel
+            {
                 for (k, fid) in final_id[i].iter().enumerate() {
                     let _ = write!(out, "{pad}  <final id=\"{}\"", escape_attr(fid));
                     if *fid != r.outcomes[k] {
@@ -242,6 +244,18 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
                 }
             };
             let _ = write!(attrs, " initial=\"{}\"", escape_attr(&init));
+        }
+        // A parallel state's outcomes (yasmin's OrthogonalState; SCXML's
+        // `<parallel>` holds no `<final>`).
+        if let StateBody::Container(r) = &s.body
+            && r.parallel
+            && !r.outcomes.is_empty()
+        {
+            let _ = write!(
+                attrs,
+                " btfsm:outcomes=\"{}\"",
+                escape_attr(&r.outcomes.join(" "))
+            );
         }
         if state_id[i] != s.name {
             let _ = write!(attrs, " btfsm:name=\"{}\"", escape_attr(&s.name));

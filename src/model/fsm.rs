@@ -33,7 +33,9 @@ pub struct Region {
     /// state is entered, see [`Region::entered`]).
     pub initial: Target,
     /// Terminal outcomes of this region ("SUCCESS", "FAILURE", ...). A
-    /// parallel region has none (its completion is its states').
+    /// parallel region's are those its states' completion maps to: none for
+    /// SCXML's `<parallel>` (its `done.state.ID` is an event), yasmin's
+    /// `OutcomeMap` and `default_outcome` for an OrthogonalState.
     pub outcomes: Vec<String>,
     /// The states directly inside this region, in file order.
     pub states: Vec<StateIdx>,

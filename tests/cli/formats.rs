@@ -577,6 +577,14 @@ fn count_yasmin_graph(path: &Path) -> (usize, usize) {
                 }
             }
             "State" => v += 1,
+            // A parallel state: one vertex, its arcs are its regions'.
+            "OrthogonalState" => v += 1,
+            // A region: one vertex, the arc to it from its orthogonal
+            // state and the arc to its start state.
+            "Region" => {
+                v += 1;
+                e += 2;
+            }
             "Transition" => e += 1,
             _ => {}
         }
@@ -585,7 +593,7 @@ fn count_yasmin_graph(path: &Path) -> (usize, usize) {
 }
 
 #[test]
-fn corpus_yasmin_imports_analyzes_and_draws_orthogonal_states_are_refused() {
+fn corpus_yasmin_imports_analyzes_and_draws_orthogonal_states_as_parallel_regions() {
     let files: Vec<PathBuf> = corpus_files("xml")
         .into_iter()
         .filter(|p| p.components().any(|c| c.as_os_str() == "yasmin"))
@@ -596,39 +604,39 @@ fn corpus_yasmin_imports_analyzes_and_draws_orthogonal_states_are_refused() {
         let file = f.display().to_string();
         let text = std::fs::read_to_string(&f).expect("read");
         let (code, stdout, stderr) = btfsm(&["analyze", "--format", "json", &file]);
-        if text.contains("<OrthogonalState") {
-            assert_eq!(code, 2, "{file}");
-            assert!(
-                stderr.contains("`<OrthogonalState>` (concurrent regions) is not supported"),
-                "{stderr}"
-            );
-            continue;
-        }
         assert_eq!(code, 0, "{file}: {stderr}");
         let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
         let p = &v["policies"][0];
         let (vertices, arcs) = count_yasmin_graph(&f);
         assert_eq!(p["vertices"], vertices as u64, "{file}");
         assert_eq!(p["edges"], arcs as u64, "{file}");
-        let nested = text.matches("<StateMachine").count() > 1;
+        let nested = text.matches("<StateMachine").count() > 1 || text.contains("<OrthogonalState");
+        assert_eq!(
+            p["counts"]["parallel_state"].as_u64().unwrap_or(0) as usize,
+            text.matches("<OrthogonalState").count(),
+            "{file}"
+        );
         assert_eq!(p["kind"], if nested { "hfsm" } else { "fsm" }, "{file}");
         let (code, dot, stderr) = btfsm(&["dot", &file]);
         assert_eq!(code, 0, "{file}: {stderr}");
         assert!(dot.starts_with("digraph"));
         loaded += 1;
     }
-    assert!(loaded >= 8, "{loaded}");
+    assert!(loaded >= 10, "{loaded}");
 }
 
 #[test]
 fn yasmin_machines_round_trip_through_toml_and_scxml_at_named_ged_0() {
     let dir = scratch("yasmin-rt");
+    let mut orthogonal = 0;
     for f in corpus_files("xml") {
-        let text = std::fs::read_to_string(&f).expect("read");
-        if f.components().any(|c| c.as_os_str() == "yasmin") && !text.contains("<OrthogonalState") {
+        if f.components().any(|c| c.as_os_str() == "yasmin") {
+            let text = std::fs::read_to_string(&f).expect("read");
+            orthogonal += usize::from(text.contains("<OrthogonalState"));
             round_trip(&f, "toml", "scxml", "toml", "scxml", &dir);
         }
     }
+    assert!(orthogonal >= 2, "{orthogonal} orthogonal machines");
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
 

@@ -157,9 +157,16 @@ pub(super) fn states(
         let body = match kind {
             Kind::History(_) => StateBody::Decision,
             // Its regions are added as they are read.
+            // Outcomes only in `btfsm:outcomes` (a yasmin OrthogonalState's).
             Kind::Parallel => StateBody::Container(Region {
                 parallel: true,
-                ..Region::unset(vec![])
+                ..Region::unset(
+                    el.btfsm_attr("outcomes")
+                        .unwrap_or_default()
+                        .split_whitespace()
+                        .map(str::to_string)
+                        .collect(),
+                )
             }),
             _ if el.btfsm_attr("decision") == Some("true") => StateBody::Decision,
             _ => StateBody::Task(el.btfsm_attr("skill").map(|s| {

@@ -36,7 +36,8 @@
 //!   and attributes of other namespaces (Qt Creator's `qt:editorinfo`) are
 //!   ignored; btfsm's own namespace carries what SCXML has no place for
 //!   (`btfsm:name`, `btfsm:label`, `btfsm:skill`, `btfsm:arg.NAME`,
-//!   `btfsm:decision` on states; `btfsm:label`, `btfsm:terms`, `btfsm:guard`
+//!   `btfsm:decision` on states, `btfsm:outcomes` on a `<parallel>` (a yasmin
+//!   OrthogonalState's outcomes); `btfsm:label`, `btfsm:terms`, `btfsm:guard`
 //!   on transitions), written by `btfsm convert --to scxml`.
 //!
 //! The document is walked with explicit stacks (no recursion on nesting depth).

@@ -51,27 +51,15 @@ impl Loader {
             qi += 1;
             let owner =
                 container.map_or_else(|| "the machine".to_string(), |c| format!("`{}`", m.path(c)));
-            // A parallel state has no outcomes of its own (it completes when
-            // its regions have): `outcomes` may be left out, or empty.
+            // A parallel state completes when its regions have: SCXML's
+            // has no outcomes (`outcomes` may be left out), yasmin's
+            // OrthogonalState those its outcome map gives.
             let is_parallel = container.is_some()
                 && table.get("parallel").and_then(|v| v.get_ref().as_bool()) == Some(true);
             let outcomes = match table.get("outcomes") {
                 None if is_parallel => vec![],
                 _ => self.outcomes(cx, table, &span, &owner),
             };
-            if is_parallel && !outcomes.is_empty() {
-                let at = table.get("outcomes").map_or(span.clone(), |v| v.span());
-                self.err(
-                    cx,
-                    at,
-                    format!("{owner} is parallel: it has no outcomes of its own"),
-                )
-                .hint = Some(
-                    "a parallel state completes when each region reaches one of its outcomes: give them to the regions"
-                        .into(),
-                );
-                ok = false;
-            }
             let Some(states_v) = table.get("states") else {
                 self.err(
                     cx,
