@@ -321,6 +321,13 @@ impl StateMachine {
         // Each state's default entry and its way up are walked once.
         let mut defaulted = vec![false; n];
         let mut climbed = vec![false; n];
+        // Per parallel state, the first region entered other than at its
+        // default, and whether a second one has been (then every region
+        // has been entered at its default): each parallel state's regions
+        // are pushed at most twice, so the walk stays linear however many
+        // regions are entered directly.
+        let mut first_way_in: Vec<Option<StateIdx>> = vec![None; n];
+        let mut all_defaulted = vec![false; n];
         let mut stack: Vec<(StateIdx, Entry)> = self
             .top
             .entered(&self.states)
@@ -363,13 +370,24 @@ impl StateMachine {
                     // others at their defaults (W3C SCXML 3.13).
                     if let StateBody::Container(r) = &self.states[p].body
                         && r.parallel
+                        && !all_defaulted[p]
                     {
-                        stack.extend(
-                            r.entered(&self.states)
-                                .into_iter()
-                                .filter(|&c| c != s)
-                                .map(|c| (c, Entry::Default)),
-                        );
+                        match first_way_in[p] {
+                            None => {
+                                first_way_in[p] = Some(s);
+                                stack.extend(
+                                    r.entered(&self.states)
+                                        .into_iter()
+                                        .filter(|&c| c != s)
+                                        .map(|c| (c, Entry::Default)),
+                                );
+                            }
+                            Some(first) if first != s => {
+                                all_defaulted[p] = true;
+                                stack.push((first, Entry::Default));
+                            }
+                            Some(_) => {}
+                        }
                     }
                 }
             }
@@ -491,5 +509,45 @@ mod tests {
         let k = m.keys();
         let unique: std::collections::BTreeSet<_> = k.iter().collect();
         assert_eq!(unique.len(), k.len(), "{k:?}");
+    }
+
+    /// A parallel state with 50,000 regions, each entered directly by a
+    /// transition: every region is reached, and the walk stays linear (each
+    /// parallel state's regions are pushed at most twice; pushing them once
+    /// per region entered made 2.5 billion entries).
+    #[test]
+    fn many_regions_entered_directly_stay_linear() {
+        let n = 50_000;
+        let mut states = vec![
+            state("go", None, StateBody::Task(None)),
+            state(
+                "p",
+                None,
+                StateBody::Container(Region {
+                    parallel: true,
+                    ..Region::at(2, vec![], (2..n + 2).collect())
+                }),
+            ),
+        ];
+        states.extend((0..n).map(|i| state(&format!("r{i}"), Some(1), StateBody::Task(None))));
+        states[0].transitions = (2..n + 2)
+            .map(|j| Transition {
+                trigger: Trigger::Outcome("SUCCESS".into()),
+                target: Target::State(j),
+                span: None,
+            })
+            .collect();
+        let m = StateMachine {
+            hierarchical: true,
+            top: Region::at(0, vec![], vec![0, 1]),
+            states,
+        };
+        let t = std::time::Instant::now();
+        assert!(m.reachable().iter().all(|&r| r));
+        assert!(
+            t.elapsed() < std::time::Duration::from_secs(20),
+            "{:?}",
+            t.elapsed()
+        );
     }
 }

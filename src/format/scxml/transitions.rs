@@ -26,6 +26,22 @@ pub(super) fn transitions(cx: &Ctx<'_>, m: &mut StateMachine, diags: &mut xml::S
     } = *cx;
     let f = &doc.file;
     let region_owner = |k: Option<usize>| k.and_then(|p| state_of[p]);
+    // States are in document order (pre-order): the states inside state
+    // `c` are those from `c + 1` up to `inside_end[c]` (excluded), so
+    // whether a region encloses another is one comparison.
+    let mut inside_end: Vec<usize> = (1..=m.states.len()).collect();
+    for i in (0..m.states.len()).rev() {
+        if let Some(p) = m.states[i].parent {
+            inside_end[p] = inside_end[p].max(inside_end[i]);
+        }
+    }
+    // Is the region of container `owner` (`None`: the top region) around
+    // the region of container `inner`, further out?
+    let encloses = |owner: Option<usize>, inner: Option<usize>| match (owner, inner) {
+        (_, None) => false,
+        (None, Some(_)) => true,
+        (Some(c), Some(p)) => c < p && p < inside_end[c],
+    };
     for (k, (e, kind, _)) in found.iter().enumerate() {
         let Some(si) = state_of[k] else { continue };
         if matches!(kind, Kind::Final) {
@@ -100,7 +116,7 @@ pub(super) fn transitions(cx: &Ctx<'_>, m: &mut StateMachine, diags: &mut xml::S
                     let own = m.states[si].parent;
                     if fparent == own {
                         Target::Outcome(m_final_name(doc, found, ids, tk))
-                    } else if encloses(m, fparent, own) {
+                    } else if encloses(fparent, own) {
                         Target::OuterOutcome {
                             owner: fparent,
                             outcome: m_final_name(doc, found, ids, tk),
@@ -276,19 +292,6 @@ pub fn parse_terms(text: &str) -> Option<Vec<GuardTerm>> {
         });
     }
     Some(out)
-}
-
-/// Is the region of container `owner` (`None`: the top region) around the
-/// region of container `inner`, further out? (At most --max-depth steps.)
-fn encloses(m: &StateMachine, owner: Option<usize>, inner: Option<usize>) -> bool {
-    let mut cur = inner;
-    while let Some(p) = cur {
-        cur = m.states[p].parent;
-        if cur == owner {
-            return true;
-        }
-    }
-    false
 }
 
 /// The outcome name of a final state.
