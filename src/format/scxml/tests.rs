@@ -396,6 +396,29 @@ const PARALLEL: &str = r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial
   <final id="pass"/>
 </scxml>"#;
 
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
+
+    /// Mutated parallel machines (regions, finals of enclosing regions,
+    /// several initial states) never panic anywhere downstream: the fuzz
+    /// target's body (graph, metrics, DOT, TOML write-back as a fixpoint,
+    /// effort), then the SCXML and Mermaid writers.
+    #[test]
+    fn mutated_parallel_machines_never_panic(
+        cuts in proptest::collection::vec((0usize..900, 0usize..8, "[<>/=\" a-z0-9]{0,3}"), 1..4)
+    ) {
+        let text = crate::format::xml::mutate(PARALLEL, &cuts);
+        crate::fuzzing::scxml(text.as_bytes());
+        if let Ok(l) = parse_str("t.scxml", &text, &Limits::default()) {
+            let out = crate::format::scxml_write::write_policy(&l.policy).expect("a machine");
+            let back = parse_str("back.scxml", &out, &Limits::default())
+                .unwrap_or_else(|e| panic!("{out}\n{e:?}"));
+            proptest::prop_assert_eq!(describe(machine(&back)), describe(machine(&l)));
+            let _ = crate::render::mermaid::policy_mermaid(&l.policy);
+        }
+    }
+}
+
 /// `<parallel>`: a container whose states are its regions, all entered: one
 /// initial arc per region; no unreachable warning for the regions' initial
 /// states; a nested state's transition to a top-level final is an outcome
