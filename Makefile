@@ -27,8 +27,10 @@ run: build
 	  $(BIN) sim $$s --format json --plot out/sim-$$b.svg > out/sim-$$b.json || exit 2; \
 	done
 	$(BIN) sim policies/scenarios/exp1-pick-fails.toml
-	@if command -v dot >/dev/null 2>&1; then echo "wrote out/analysis.json, out/*.dot, out/*.svg and out/sim-*.json"; \
-	 else echo "wrote out/analysis.json, out/*.dot, out/sim-*.json and out/sim-*.svg (install Graphviz for the policy SVGs)"; fi
+	$(BIN) plan policies/domains/moma.toml -o out/planned
+	$(BIN) sim policies/domains/moma-sim.toml --runs 300
+	@if command -v dot >/dev/null 2>&1; then echo "wrote out/analysis.json, out/*.dot, out/*.svg, out/sim-*.json and out/planned/"; \
+	 else echo "wrote out/analysis.json, out/*.dot, out/sim-*.json, out/sim-*.svg and out/planned/ (install Graphviz for the policy SVGs)"; fi
 
 test:
 	$(CARGO) fmt --check
@@ -44,7 +46,10 @@ test:
 # random trees (docs/bt-semantics.md); then every BT XML fixture accepted or
 # rejected by both engines alike, and every export loading in BT.CPP with
 # the same shape (tests/differential/accept_btcpp.py; known, explained
-# mismatches in accept_btcpp_known.txt, which must not go stale); and every
+# mismatches in accept_btcpp_known.txt, which must not go stale); then the
+# trees of every project folder of tests/fixtures/btcpp-projects/, whose
+# SubTrees are spread over files given together (projects_btcpp.py); every
+# SARIF log of `lint` against the official schema (sarif_check.py); and every
 # corpus SCXML file read by btfsm and by an independent SCXML engine (PyPI
 # `scjson`) alike (tests/differential/scxml_engine.py).
 $(VENV)/.installed: tests/differential/requirements.txt
@@ -59,6 +64,10 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/accept_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/accept_btcpp.txt 2>&1 \
 	  || { tail -40 $(TARGET_DIR)/accept_btcpp.txt; exit 1; }
 	@grep -m1 "fixture files" $(TARGET_DIR)/accept_btcpp.txt
+	$(VENV)/bin/python tests/differential/projects_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/projects_btcpp.txt 2>&1 \
+	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
+	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
+	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in

@@ -5,7 +5,7 @@
 # in fuzz/artifacts/TARGET/ (keep each as a regression test:
 # tests/fixtures/fuzz-regressions/, see docs/robustness.md).
 # Usage: fuzz/run.sh [TARGET...]   (default: every target in fuzz/Cargo.toml:
-# toml_policy, compare, btcpp_xml, scxml, yasmin, scenario, project)
+# toml_policy, compare, btcpp_xml, scxml, yasmin, scenario, project, domain)
 set -eu
 cd "$(dirname "$0")"
 SECONDS_EACH=${FUZZ_SECONDS:-600}
@@ -54,6 +54,10 @@ for t in $TARGETS; do
       for f in ../tests/fixtures/fuzz-regressions/project-*; do
         [ -f "$f" ] && cp "$f" "corpus/$t/"
       done ;;
+    domain)
+      for f in ../policies/domains/*.toml ../tests/fixtures/fuzz-regressions/domain-*; do
+        [ -f "$f" ] && cp "$f" "corpus/$t/seed-$(basename "$f")"
+      done ;;
     *)
       for f in ../tests/fixtures/fuzz-regressions/*; do
         [ -f "$f" ] && cp "$f" "corpus/$t/"
@@ -61,7 +65,7 @@ for t in $TARGETS; do
   esac
   dict=""
   [ -f "$t.dict" ] && dict="-dict=$t.dict"
-  case $t in toml_policy|compare|scenario|project) dict="-dict=toml.dict" ;; esac
+  case $t in toml_policy|compare|scenario|project|domain) dict="-dict=toml.dict" ;; esac
   echo "== fuzzing $t for ${SECONDS_EACH}s"
   nice cargo +nightly fuzz run "$t" "corpus/$t" -- \
     -max_total_time="$SECONDS_EACH" -timeout="$TIMEOUT" -rss_limit_mb="$RSS" \

@@ -127,6 +127,53 @@ pub fn scenario(data: &[u8]) {
     }
 }
 
+/// Fuzz target `domain`: any bytes as an action domain; an accepted one is
+/// planned (at most 2000 nodes) into a BT, its FSM and HFSM, each through
+/// [`exercise`], and with `--no-reorder` too. A planning error is a
+/// clear refusal (the tree would be too large), never a panic.
+pub fn domain(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    let file = crate::diagnostic::SourceFile::new("fuzz-domain.toml", text);
+    let d = match crate::plan::load(&file) {
+        Ok(d) => d,
+        Err(diags) => return check_diagnostics(&diags),
+    };
+    for reorder in [true, false] {
+        let opts = crate::plan::Options {
+            reorder,
+            max_nodes: 2000,
+            ..Default::default()
+        };
+        let Ok(p) = crate::plan::plan_bt(&d, &opts) else {
+            continue;
+        };
+        let mut policies = vec![crate::model::Policy {
+            name: "planned".into(),
+            description: None,
+            body: crate::model::PolicyBody::Bt(p.bt.clone()),
+        }];
+        if let Ok(m) = crate::plan::fsm::plan_fsm(&d, &p) {
+            policies.push(crate::model::Policy {
+                name: "planned fsm".into(),
+                description: None,
+                body: crate::model::PolicyBody::Machine(m),
+            });
+        }
+        for policy in policies {
+            if crate::format::check_shape(&policy, &limits()).is_some() {
+                continue;
+            }
+            exercise(&Loaded {
+                path: "planned".into(),
+                policy,
+                warnings: Vec::new(),
+            });
+        }
+    }
+}
+
 /// Fuzz target `project`: several files that name each other (TOML
 /// subtrees with `with` parameters, BehaviorTree.CPP includes, a scenario
 /// and its policies). The bytes split at `\n%%\n` into at most six files,
@@ -363,6 +410,7 @@ mod tests {
                 Some("yasmin") => yasmin(&data),
                 Some("scenario") => scenario(&data),
                 Some("project") => project(&data),
+                Some("domain") => domain(&data),
                 other => panic!("{}: no fuzz target `{other:?}`", f.display()),
             }
         }

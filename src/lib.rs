@@ -12,8 +12,10 @@ pub mod format;
 #[doc(hidden)]
 pub mod fuzzing;
 pub mod graph;
+pub mod lint;
 pub mod metrics;
 pub mod model;
+pub mod plan;
 pub mod render;
 pub mod report;
 pub mod sanitize;

@@ -114,6 +114,11 @@ pub enum Command {
         /// Output file (default: stdout)
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// With --to fault-tolerant: the action domain giving the skills'
+        /// preconditions and effects (default: the built-in
+        /// policies/domains/moma.toml)
+        #[arg(long, value_name = "DOMAIN.toml")]
+        domain: Option<PathBuf>,
         #[command(flatten)]
         limits: LimitArgs,
     },
@@ -141,6 +146,14 @@ pub enum Command {
     Sim(super::sim::SimArgs),
     /// Ticks a BT against scripted leaf outcomes (BehaviorTree.CPP 4 semantics)
     Tick(super::tick::TickArgs),
+    /// Backchains an action domain's goal into a BT, and derives the
+    /// fault-tolerant FSM and the HFSM of the same plan (exit 1 when a
+    /// precondition conflict no order resolves is left)
+    Plan(super::plan::PlanArgs),
+    /// Checks policies against coded rules (structure, the paper's
+    /// smells); text, JSON or SARIF; exit 1 when an error-level finding
+    /// remains
+    Lint(super::lint::LintArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
     Completions {
@@ -230,7 +243,8 @@ pub struct LimitArgs {
     pub nodes_model: Vec<PathBuf>,
     /// The BehaviorTree.CPP tree to read, by its `<BehaviorTree ID>` (over
     /// `main_tree_to_execute`; needed when a file holds several trees and
-    /// names none, as a program names it to BT.CPP's factory)
+    /// names none, as a program names it to BT.CPP's factory); among
+    /// several BehaviorTree.CPP files given together, the files that define it
     #[arg(long, value_name = "ID")]
     pub tree: Option<String>,
     /// Read BehaviorTree.CPP leaves of unknown type as actions or conditions

@@ -71,6 +71,27 @@ pub fn execute(cli: Cli) -> u8 {
                 };
                 let fmt = match input {
                     format::Input::Policy(fmt) => fmt,
+                    format::Input::Scenario if crate::sim::symbolic::looks_symbolic(&file.text) => {
+                        let base = f.parent().unwrap_or(Path::new(""));
+                        match crate::sim::symbolic::scenario::parse(&file, base, &limits) {
+                            Ok(s) => {
+                                let _ = writeln!(
+                                    err,
+                                    "{}: ok (symbolic scenario `{}`, domain `{}`, {} polic{})",
+                                    shown(&f.display().to_string()),
+                                    shown(&s.name),
+                                    shown(&s.domain.name),
+                                    s.policies.len(),
+                                    if s.policies.len() == 1 { "y" } else { "ies" }
+                                );
+                            }
+                            Err(diags) => {
+                                failed = true;
+                                print_diagnostics(&mut err, &diags);
+                            }
+                        }
+                        continue;
+                    }
                     format::Input::Scenario => {
                         let base = f.parent().unwrap_or(Path::new(""));
                         match crate::sim::scenario::parse(&file, base, &limits) {
@@ -163,8 +184,20 @@ pub fn execute(cli: Cli) -> u8 {
             file,
             to,
             output,
+            domain,
             limits,
         } => {
+            if domain.is_some() && to != ConvertTarget::FaultTolerant {
+                eprintln!("error: --domain applies to --to fault-tolerant only");
+                return EXIT_BAD_INPUT;
+            }
+            let domain = match &domain {
+                None => None,
+                Some(path) => match super::plan::read_domain(path, &limits.limits()) {
+                    Some(d) => Some(d),
+                    None => return EXIT_BAD_INPUT,
+                },
+            };
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
@@ -180,12 +213,14 @@ pub fn execute(cli: Cli) -> u8 {
                     );
                 }
                 ConvertTarget::FaultTolerant => {
-                    match crate::transform::fault_tolerant::fault_tolerant_policy(&l.policy) {
+                    use crate::transform::fault_tolerant as ft;
+                    let d = domain.as_ref().unwrap_or_else(|| ft::builtin_domain());
+                    match ft::fault_tolerant_policy_with(&l.policy, d) {
                         Ok(p) => p,
                         Err(errs) => {
                             for e in errs {
                                 eprintln!(
-                                    "error: {}: {}\n  = hint: the construction needs a flat FSM whose action states use skills with a known postcondition (Move-To, Safe-Move-To, Pick, Place, Dock, Tuck-Arm, Search, Recharge)",
+                                    "error: {}: {}\n  = hint: the construction needs a flat FSM whose action states run skills the domain has actions for (--domain; built in: policies/domains/moma.toml)",
                                     shown(&l.path),
                                     crate::sanitize::shown_max(&e.to_string(), 1000)
                                 );
@@ -243,6 +278,8 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Edit(args) => super::edit::edit(&args),
         Command::Sim(args) => super::sim::execute(args),
         Command::Tick(args) => super::tick::execute(args),
+        Command::Plan(args) => super::plan::execute(args),
+        Command::Lint(args) => super::lint::execute(args),
         Command::Completions { shell } => {
             use clap::CommandFactory;
             let mut out = Vec::new();
@@ -345,8 +382,22 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
             return None;
         }
     };
+    let (limits, only) = match with_companions(&inputs, limits) {
+        Ok(x) => x,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return None;
+        }
+    };
+    let limits = &limits;
     let (mut out, mut failed, mut skipped) = (Vec::new(), false, 0usize);
     for input in &inputs {
+        if let Some(only) = &only
+            && is_btcpp_candidate(&input.path)
+            && !only.contains(&input.path)
+        {
+            continue; // a companion of the files that define `--tree`
+        }
         let r = match discover::read(input, limits) {
             Ok((file, Some(format::Input::Policy(fmt)))) => {
                 format::load_read(file, &input.path, fmt, limits)
@@ -373,6 +424,58 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
         return None;
     }
     Some((out, failed))
+}
+
+/// May `path` be a BehaviorTree.CPP file given together with others (a
+/// regular `.xml` or Groot2 `.btproj` file; a pipe is read once, as the
+/// input it is)?
+fn is_btcpp_candidate(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("btproj"))
+        && std::fs::metadata(path).is_ok_and(|m| m.is_file())
+}
+
+/// The limits with the BehaviorTree.CPP files given together as each
+/// other's companions (SubTrees one defines and another uses are found, as
+/// BehaviorTree.CPP's factory registers every file it loads), and, with
+/// `--tree ID` and several such files, the files that define `ID` (the
+/// others are read only as companions). No file defining `ID`: an error
+/// listing the trees there are.
+fn with_companions(
+    inputs: &[format::discover::Input],
+    limits: &Limits,
+) -> Result<(Limits, Option<Vec<PathBuf>>), Diagnostic> {
+    let files: Vec<PathBuf> = inputs
+        .iter()
+        .filter(|i| is_btcpp_candidate(&i.path))
+        .map(|i| i.path.clone())
+        .collect();
+    if files.len() < 2 {
+        return Ok((limits.clone(), None));
+    }
+    let comp = std::sync::Arc::new(format::btcpp_xml::Companions::new(files));
+    let mut limits = limits.clone();
+    limits.companions = Some(comp.clone());
+    let Some(id) = limits.tree.clone() else {
+        return Ok((limits, None));
+    };
+    let only: Vec<PathBuf> = comp
+        .defining(&id, &limits)
+        .into_iter()
+        .map(Path::to_path_buf)
+        .collect();
+    if only.is_empty() {
+        let trees = comp.tree_ids(&limits);
+        let hint = crate::diagnostic::suggest(&id, trees.iter().copied());
+        return Err(Diagnostic::error(format!(
+            "--tree `{}`: none of the {} BehaviorTree.CPP files given defines it",
+            crate::sanitize::shown(&id),
+            comp.len()
+        ))
+        .hint(hint));
+    }
+    Ok((limits, Some(only)))
 }
 
 /// Says how many files found below directories held no policy.

@@ -27,8 +27,10 @@ mod commands;
 mod compare;
 mod convert;
 mod edit;
+mod lint;
 pub mod out;
 mod paper;
+mod plan;
 pub mod sim;
 mod tick;
 

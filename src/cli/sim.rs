@@ -74,7 +74,24 @@ pub fn execute(a: SimArgs) -> u8 {
     if !super::commands::outputs_distinct(&outputs, true) {
         return EXIT_BAD_INPUT;
     }
-    let mut s = match scenario::load(&a.scenario, &a.limits.limits()) {
+    let limits = a.limits.limits();
+    let shown = a.scenario.display().to_string();
+    let file = match crate::format::toml::read_source(&a.scenario, &shown, &limits) {
+        Ok(f) => f,
+        Err(d) => {
+            print_diagnostics(&mut std::io::stderr().lock(), &d);
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let base = a
+        .scenario
+        .parent()
+        .unwrap_or(std::path::Path::new(""))
+        .to_path_buf();
+    if crate::sim::symbolic::looks_symbolic(&file.text) {
+        return symbolic(&a, &file, &base, &limits);
+    }
+    let mut s = match scenario::parse(&file, &base, &limits) {
         Ok(s) => s,
         Err(d) => {
             print_diagnostics(&mut std::io::stderr().lock(), &d);
@@ -407,4 +424,38 @@ fn read_trace(
 ) -> Result<std::sync::Arc<crate::diagnostic::SourceFile>, Vec<crate::diagnostic::Diagnostic>> {
     let shown = path.display().to_string();
     crate::format::source::read(path, &shown, limits, false)
+}
+
+/// A symbolic scenario (a top-level `domain`): one run per policy, or
+/// `--runs` Monte Carlo episodes, in the domain's world of facts.
+fn symbolic(
+    a: &SimArgs,
+    file: &std::sync::Arc<crate::diagnostic::SourceFile>,
+    base: &std::path::Path,
+    limits: &crate::format::Limits,
+) -> u8 {
+    use crate::sim::symbolic::{report, run};
+    if a.trace.is_some() || a.plot.is_some() || a.format == OutputFormat::Markdown {
+        eprintln!(
+            "error: a symbolic scenario has no trace, plot or markdown report\n  = hint: print `table` or `json`"
+        );
+        return EXIT_BAD_INPUT;
+    }
+    let s = match crate::sim::symbolic::scenario::parse(file, base, limits) {
+        Ok(s) => s,
+        Err(d) => {
+            print_diagnostics(&mut std::io::stderr().lock(), &d);
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let json = a.format == OutputFormat::Json;
+    let text = match a.runs {
+        Some(n) => {
+            let seed = a.seed.unwrap_or(s.seed);
+            let (p, q) = run::monte_carlo(&s, n, seed);
+            report::render_mc(&s, n, seed, &p, &q, json)
+        }
+        None => report::render_runs(&s, &run::run_all(&s, a.seed.unwrap_or(s.seed)), json),
+    };
+    emit_text(None, text)
 }

@@ -63,6 +63,10 @@ pub struct Limits {
     /// it to the factory; over `main_tree_to_execute`. Other formats
     /// ignore it.
     pub tree: Option<String>,
+    /// The BehaviorTree.CPP files given together with the one being read:
+    /// a `<SubTree>` that no file it reads defines is looked up in them
+    /// ([`btcpp_xml::Companions`]).
+    pub companions: Option<Arc<btcpp_xml::Companions>>,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -95,6 +99,7 @@ impl Default for Limits {
             read_budget: source::Budget::new(source::DEFAULT_MAX_TOTAL_BYTES),
             expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
             tree: None,
+            companions: None,
         }
     }
 }

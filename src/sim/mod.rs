@@ -17,5 +17,6 @@ pub mod robot;
 pub mod run;
 pub mod scenario;
 pub mod skills;
+pub mod symbolic;
 pub mod trace;
 pub mod world;

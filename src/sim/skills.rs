@@ -50,9 +50,17 @@ pub enum Target {
 /// A skill binding resolved against a world.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Call {
-    MoveTo { target: Target, safe: bool },
-    Pick { object: usize },
-    Place { object: usize, at: usize },
+    MoveTo {
+        target: Target,
+        safe: bool,
+    },
+    Pick {
+        object: usize,
+    },
+    Place {
+        object: usize,
+        at: usize,
+    },
     Recharge,
     Dock,
     TuckArm,
@@ -60,11 +68,21 @@ pub enum Call {
     ShutDown,
     RobotAt(Target),
     InHand(usize),
-    ObjectAt { object: usize, at: usize },
+    ObjectAt {
+        object: usize,
+        at: usize,
+    },
     BatteryLevel(f64),
     ArmTucked,
     Found,
     NoEmergency,
+    /// A leaf or guard term of the symbolic world (`sim::symbolic`): an
+    /// index into its table of bindings, and whether it is an action. The
+    /// planar world never makes one and evaluates it as a failing leaf.
+    Symbolic {
+        id: u32,
+        action: bool,
+    },
 }
 
 impl Call {
@@ -87,6 +105,7 @@ impl Call {
             Call::ArmTucked => "Arm-Tucked",
             Call::Found => "Found",
             Call::NoEmergency => "No-Emergency",
+            Call::Symbolic { .. } => "symbolic",
         }
     }
 
@@ -101,6 +120,7 @@ impl Call {
                 | Call::TuckArm
                 | Call::Search
                 | Call::ShutDown
+                | Call::Symbolic { action: true, .. }
         )
     }
 }
@@ -212,6 +232,14 @@ pub fn resolve(c: &SkillCall, w: &World) -> Result<Call, Unresolved> {
         "Arm-Tucked" => Call::ArmTucked,
         "Found" => Call::Found,
         "No-Emergency" => Call::NoEmergency,
+        other if other.contains(':') => {
+            return Err(Unresolved {
+                message: format!(
+                    "unknown skill `{other}` (a skill of an action domain: it runs in symbolic scenarios, not in the planar room)"
+                ),
+                hint: "give the scenario `domain = \"DOMAIN.toml\"` to run it in the domain's world of facts (README \"Symbolic simulation\")".into(),
+            });
+        }
         other => {
             return Err(Unresolved {
                 message: format!("unknown skill `{other}`"),

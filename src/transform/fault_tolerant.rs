@@ -15,17 +15,26 @@
 //!   and `SUCCESS` -> `SELECTOR`.
 //!
 //! Arcs already present are kept, so the transform of a fault-tolerant FSM is
-//! the FSM itself. The `SELECTOR`'s resume guards are generated from the
-//! skills' postconditions ([`postcondition`]): resume at step k when step
-//! k - 1's postcondition holds, finish when the last step's holds, restart
-//! when the first step's does not. A connected state is entered on the guard
-//! the other states use to reach it. Review the guards of a generated
-//! machine: they are a starting point, the structure is the paper's.
+//! the FSM itself. The `SELECTOR`'s resume guards come from an action
+//! domain (`policies/domains/moma.toml` built in, or `convert --domain`):
+//! each step's state is the domain action that runs its skill, and the
+//! SELECTOR resumes at step k when k's *kernel* holds — the last step's
+//! effect regressed through steps k..n, the facts the rest of the task
+//! needs (the STRIPS triangle table, [`crate::plan::fsm::kernels`]) — tested
+//! latest step first; it finishes when the last step's effect holds. So it
+//! resumes correctly whatever a disturbance undid (a cube dropped at the
+//! delivery station: not "Place", whose kernel also needs the cube in hand).
+//! A connected state is entered on the guard the other states use to reach
+//! it, else when its action's effect does not hold. Review the guards of a
+//! generated machine: the structure is the paper's.
 
 use crate::model::{
     ArgValue, Guard, GuardTerm, Policy, PolicyBody, SkillCall, State, StateBody, StateMachine,
     Target, Transition, Trigger,
 };
+use crate::plan::Domain;
+use crate::plan::backchain::Step;
+use crate::plan::fact::Fact;
 use std::collections::BTreeMap;
 
 const SUCCESS: &str = "SUCCESS";
@@ -91,51 +100,67 @@ pub enum FaultTolerantError {
     #[error("the fault-tolerant construction applies to flat FSMs, not to {0}s")]
     NotAnFsm(&'static str),
     #[error(
-        "state `{state}` runs {skill}, whose postcondition is unknown, so the SELECTOR has no condition to resume the task there"
+        "state `{state}` runs {skill}, which no action of domain `{domain}` runs, so the SELECTOR has no condition to resume the task there"
     )]
-    NoPostcondition { state: String, skill: String },
+    NoPostcondition {
+        state: String,
+        skill: String,
+        domain: String,
+    },
+    #[error(
+        "predicate `{predicate}` of domain `{domain}` has no `skill`, so the SELECTOR cannot check it"
+    )]
+    Unchecked { predicate: String, domain: String },
 }
 
-/// The condition that holds once a skill has done its work, for the skills
-/// of the shared library (SPEC §6) that have one: Move-To / Safe-Move-To ->
-/// Robot-At, Pick -> In-Hand, Place -> Object-At, Dock -> Robot-At
-/// inspection, Tuck-Arm -> Arm-Tucked, Search -> Found, Recharge ->
-/// Battery-Level 20 (the paper's "Battery > 20%?").
-pub fn postcondition(call: &SkillCall) -> Option<GuardTerm> {
-    let arg = |k: &str| call.args.get(k).cloned();
-    let mut args = BTreeMap::new();
-    let skill = match call.skill.as_str() {
-        "Move-To" | "Safe-Move-To" => {
-            args.insert("target".to_string(), arg("target")?);
-            "Robot-At"
+/// The built-in domain (`policies/domains/moma.toml`): the shared skill
+/// library's preconditions and effects.
+pub fn builtin_domain() -> &'static Domain {
+    static D: std::sync::OnceLock<Domain> = std::sync::OnceLock::new();
+    D.get_or_init(|| {
+        let file = crate::diagnostic::SourceFile::new(
+            "policies/domains/moma.toml",
+            include_str!("../../policies/domains/moma.toml"),
+        );
+        crate::plan::load(&file).expect("the built-in domain is valid (plan tests)")
+    })
+}
+
+/// The domain action that runs `call`'s skill, with its parameters bound to
+/// the call's arguments; `None` when no action runs it or an argument is
+/// missing.
+pub fn step_of<'d>(d: &'d Domain, call: &SkillCall) -> Option<Step<'d>> {
+    d.actions.iter().find_map(|a| {
+        if a.skill.as_deref() != Some(call.skill.as_str()) {
+            return None;
         }
-        "Pick" => {
-            args.insert("object".to_string(), arg("object")?);
-            "In-Hand"
+        let mut bind = BTreeMap::new();
+        for p in &a.params {
+            let v = match call.args.get(&p.name)? {
+                ArgValue::Str(s) => s.clone(),
+                ArgValue::Int(i) => i.to_string(),
+                ArgValue::Float(x) => x.to_string(),
+                ArgValue::Bool(b) => b.to_string(),
+            };
+            bind.insert(p.name.clone(), v);
         }
-        "Place" => {
-            args.insert("object".to_string(), arg("object")?);
-            args.insert("at".to_string(), arg("at")?);
-            "Object-At"
-        }
-        "Dock" => {
-            args.insert("target".to_string(), ArgValue::Str("inspection".into()));
-            "Robot-At"
-        }
-        "Tuck-Arm" => "Arm-Tucked",
-        "Search" => "Found",
-        "Recharge" => {
-            args.insert("min".to_string(), ArgValue::Int(20));
-            "Battery-Level"
-        }
-        _ => return None,
-    };
-    Some(GuardTerm {
-        condition: SkillCall {
-            skill: skill.to_string(),
-            args,
-        },
-        negate: false,
+        Some(Step { action: a, bind })
+    })
+}
+
+/// A fact as a guard term (its predicate's condition skill).
+fn fact_term(d: &Domain, f: &Fact, negate: bool) -> Result<GuardTerm, FaultTolerantError> {
+    let pred = d.predicate(&f.pred).expect("validated domain");
+    let skill = pred
+        .skill
+        .as_deref()
+        .ok_or_else(|| FaultTolerantError::Unchecked {
+            predicate: pred.name.clone(),
+            domain: d.name.clone(),
+        })?;
+    Ok(GuardTerm {
+        condition: Domain::skill_call(skill, &pred.params, &f.args),
+        negate,
     })
 }
 
@@ -165,6 +190,15 @@ fn guards_first(s: &mut State) {
 
 /// The fault-tolerant version of a policy (see the module documentation).
 pub fn fault_tolerant_policy(p: &Policy) -> Result<Policy, Vec<FaultTolerantError>> {
+    fault_tolerant_policy_with(p, builtin_domain())
+}
+
+/// [`fault_tolerant_policy`] with the skills' preconditions and effects
+/// from `domain`.
+pub fn fault_tolerant_policy_with(
+    p: &Policy,
+    domain: &Domain,
+) -> Result<Policy, Vec<FaultTolerantError>> {
     let m = match &p.body {
         PolicyBody::Machine(m) if !m.hierarchical => m,
         _ => return Err(vec![FaultTolerantError::NotAnFsm(p.kind().as_str())]),
@@ -175,27 +209,34 @@ pub fn fault_tolerant_policy(p: &Policy) -> Result<Policy, Vec<FaultTolerantErro
             "generated by `btfsm convert --to fault-tolerant` from `{}` (the paper's sec. IV-B construction; review the SELECTOR's guards)",
             p.name
         )),
-        body: PolicyBody::Machine(fault_tolerant(m)?),
+        body: PolicyBody::Machine(fault_tolerant(m, domain)?),
     })
 }
 
 /// The fault-tolerant version of a flat FSM (see the module documentation).
-pub fn fault_tolerant(m: &StateMachine) -> Result<StateMachine, Vec<FaultTolerantError>> {
+pub fn fault_tolerant(
+    m: &StateMachine,
+    domain: &Domain,
+) -> Result<StateMachine, Vec<FaultTolerantError>> {
     if m.hierarchical {
         return Err(vec![FaultTolerantError::NotAnFsm("hfsm")]);
     }
     let det = detect(m);
     let mut out = m.clone();
     let mut errors = Vec::new();
-    let post = |i: usize| -> Option<GuardTerm> {
+    let step = |i: usize| -> Option<Step<'_>> {
         match &m.states[i].body {
-            StateBody::Task(Some(call)) => postcondition(call),
+            StateBody::Task(Some(call)) => step_of(domain, call),
             _ => None,
         }
     };
-    let skill_name = |i: usize| match &m.states[i].body {
-        StateBody::Task(Some(call)) => call.skill.clone(),
-        _ => "no skill".to_string(),
+    let no_action = |i: usize| FaultTolerantError::NoPostcondition {
+        state: m.states[i].name.clone(),
+        skill: match &m.states[i].body {
+            StateBody::Task(Some(call)) => call.skill.clone(),
+            _ => "no skill".to_string(),
+        },
+        domain: domain.name.clone(),
     };
 
     // The task's steps in execution order: the SUCCESS chain from the initial
@@ -294,19 +335,19 @@ pub fn fault_tolerant(m: &StateMachine) -> Result<StateMachine, Vec<FaultToleran
         });
         let guard = match used {
             Some(g) => g,
-            None => match post(c) {
-                Some(mut term) => {
-                    term.negate = true;
-                    Guard {
+            None => match step(c).and_then(|st| st.adds().into_iter().next()) {
+                Some(f) => match fact_term(domain, &f, true) {
+                    Ok(term) => Guard {
                         label: format!("{term}"),
                         all: vec![term],
+                    },
+                    Err(e) => {
+                        errors.push(e);
+                        continue;
                     }
-                }
+                },
                 None => {
-                    errors.push(FaultTolerantError::NoPostcondition {
-                        state: m.states[c].name.clone(),
-                        skill: skill_name(c),
-                    });
+                    errors.push(no_action(c));
                     continue;
                 }
             },
@@ -317,51 +358,68 @@ pub fn fault_tolerant(m: &StateMachine) -> Result<StateMachine, Vec<FaultToleran
             span: None,
         });
     }
-    let resume = |label: String, term: GuardTerm, target: Target| Transition {
-        trigger: Trigger::Guard(Guard {
-            label,
-            all: vec![term],
-        }),
+    let resume = |label: String, all: Vec<GuardTerm>, target: Target| Transition {
+        trigger: Trigger::Guard(Guard { label, all }),
         target,
         span: None,
     };
-    if let (Some(o), Some(&last)) = (&end, chain.last()) {
-        let target = Target::Outcome(o.clone());
-        if !selector_has(&target) {
-            match post(last) {
-                Some(term) => back.push(resume(format!("done: {term}"), term, target)),
-                None => errors.push(FaultTolerantError::NoPostcondition {
-                    state: m.states[last].name.clone(),
-                    skill: skill_name(last),
-                }),
-            }
+    // The chain's steps in the domain, and their kernels.
+    let steps: Vec<Option<Step<'_>>> = chain.iter().map(|&s| step(s)).collect();
+    for (k, st) in steps.iter().enumerate() {
+        if st.is_none() {
+            errors.push(no_action(chain[k]));
         }
     }
-    for k in (0..chain.len()).rev() {
-        let s = chain[k];
-        let target = Target::State(s);
-        if selector_has(&target) {
-            continue;
-        }
-        let (from, negate) = if k == 0 {
-            (s, true)
-        } else {
-            (chain[k - 1], false)
+    let steps: Vec<Step<'_>> = steps.into_iter().flatten().collect();
+    if !chain.is_empty() && steps.len() == chain.len() {
+        let goal = steps.last().map(Step::adds).unwrap_or_default();
+        let kernels = crate::plan::fsm::kernels(&steps, &goal);
+        let terms = |fs: &[Fact], negate: bool| -> Result<Vec<GuardTerm>, FaultTolerantError> {
+            fs.iter().map(|f| fact_term(domain, f, negate)).collect()
         };
-        match post(from) {
-            Some(mut term) => {
-                term.negate = negate;
-                let label = if negate {
-                    format!("restart: {term}")
-                } else {
-                    format!("resume at {}: {term}", m.states[s].label)
-                };
-                back.push(resume(label, term, target));
+        let text = |ts: &[GuardTerm]| {
+            ts.iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(" and ")
+        };
+        if let Some(o) = &end {
+            let target = Target::Outcome(o.clone());
+            if !selector_has(&target) {
+                match terms(&goal, false) {
+                    Ok(ts) => back.push(resume(format!("done: {}", text(&ts)), ts, target)),
+                    Err(e) => errors.push(e),
+                }
             }
-            None => errors.push(FaultTolerantError::NoPostcondition {
-                state: m.states[from].name.clone(),
-                skill: skill_name(from),
-            }),
+        }
+        for k in (0..chain.len()).rev() {
+            let s = chain[k];
+            let target = Target::State(s);
+            if selector_has(&target) {
+                continue;
+            }
+            // An empty kernel (the first step's, usually): "not the next
+            // kernel's first fact", which the SELECTOR knows here.
+            let made = if kernels[k].is_empty() {
+                kernels
+                    .get(k + 1)
+                    .and_then(|next| next.first())
+                    .map(|f| terms(std::slice::from_ref(f), true).map(|ts| (true, ts)))
+            } else {
+                Some(terms(&kernels[k], false).map(|ts| (false, ts)))
+            };
+            match made {
+                Some(Ok((restart, ts))) => {
+                    let label = if restart {
+                        format!("restart: {}", text(&ts))
+                    } else {
+                        format!("resume at {}: {}", m.states[s].label, text(&ts))
+                    };
+                    back.push(resume(label, ts, target));
+                }
+                Some(Err(e)) => errors.push(e),
+                None => {}
+            }
         }
     }
     if !errors.is_empty() {

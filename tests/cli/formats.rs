@@ -833,3 +833,121 @@ fn w3c_finals_of_enclosing_regions_and_final_only_states_read() {
     assert_eq!(v["policies"][0]["vertices"], 1, "the machine is one final");
     assert_eq!(v["policies"][0]["edges"], 0);
 }
+
+const PROJECTS: &str = "tests/fixtures/btcpp-projects";
+
+/// Vertices per reported file of `analyze --format json`.
+fn vertices_by_file(stdout: &str) -> Vec<(String, u64)> {
+    let v: serde_json::Value = serde_json::from_str(stdout).expect("json");
+    v["policies"]
+        .as_array()
+        .expect("policies")
+        .iter()
+        .map(|p| {
+            let f = p["file"].as_str().expect("file");
+            (
+                f.rsplit('/').next().unwrap_or(f).to_string(),
+                p["vertices"].as_u64().expect("vertices"),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn subtrees_resolve_across_files_given_together() {
+    // pick.xml uses Approach (subtrees/approach.xml), which uses Localize
+    // (subtrees/localize.xml); no file includes another.
+    let dir = format!("{PROJECTS}/pick");
+    let (code, out, err) = btfsm(&["analyze", &dir, "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        vertices_by_file(&out),
+        [
+            ("pick.xml".to_string(), 10),
+            ("approach.xml".to_string(), 6),
+            ("localize.xml".to_string(), 4)
+        ]
+    );
+    // The same files named one by one.
+    let files = [
+        format!("{dir}/pick.xml"),
+        format!("{dir}/subtrees/approach.xml"),
+        format!("{dir}/subtrees/localize.xml"),
+    ];
+    let (code, named, err) = btfsm(&[
+        "analyze", &files[0], &files[1], &files[2], "--format", "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(vertices_by_file(&named), vertices_by_file(&out));
+    // Alone, pick.xml cannot resolve Approach, and the hint says how.
+    let (code, _, err) = btfsm(&["analyze", &files[0]]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("unknown tree `Approach` in `<SubTree>`"),
+        "{err}"
+    );
+    assert!(err.contains("given with this one"), "{err}");
+}
+
+#[test]
+fn tree_flag_reads_the_file_that_defines_it_among_several() {
+    let dir = format!("{PROJECTS}/pick");
+    let (code, out, err) = btfsm(&["analyze", &dir, "--tree", "Approach", "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(vertices_by_file(&out), [("approach.xml".to_string(), 6)]);
+    let (code, _, err) = btfsm(&["analyze", &dir, "--tree", "Aproach"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("none of the 3 BehaviorTree.CPP files given defines it")
+            && err.contains("did you mean `Approach`?"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_subtree_defined_by_several_files_given_together_is_an_error() {
+    let d = scratch("ambiguous-subtree");
+    let tree = |id: &str, body: &str| {
+        format!("<root BTCPP_format=\"4\"><BehaviorTree ID=\"{id}\">{body}</BehaviorTree></root>")
+    };
+    std::fs::write(d.join("main.xml"), tree("Main", "<SubTree ID=\"Dock\"/>")).expect("write");
+    std::fs::write(d.join("a.xml"), tree("Dock", "<AlwaysSuccess/>")).expect("write");
+    std::fs::write(d.join("b.xml"), tree("Dock", "<AlwaysFailure/>")).expect("write");
+    let main = d.join("main.xml").display().to_string();
+    let (code, _, err) = btfsm(&["analyze", d.to_str().expect("utf-8"), "--tree", "Main"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("tree `Dock` in `<SubTree>` is defined by several files given together")
+            && err.contains(&format!("{main}:1:")),
+        "{err}"
+    );
+    // One companion: no ambiguity.
+    let a = d.join("a.xml").display().to_string();
+    let (code, out, err) = btfsm(&["analyze", &main, &a, "--tree", "Main", "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(vertices_by_file(&out), [("main.xml".to_string(), 1)]);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_groot2_project_file_reads_the_trees_it_includes() {
+    // Husarion's LightsBT.btproj: a Groot2 project (includes and a nodes
+    // model, no tree of its own), read as BehaviorTree.CPP registers it.
+    let husarion = format!("{CORPUS}/bt-xml/husarion");
+    let (code, proj, err) = btfsm(&[
+        "analyze",
+        &format!("{husarion}/LightsBT.btproj"),
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (code, tree, err) = btfsm(&[
+        "analyze",
+        &format!("{husarion}/lights.xml"),
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(vertices_by_file(&proj)[0].1, 16);
+    assert_eq!(vertices_by_file(&tree)[0].1, 16);
+}

@@ -29,6 +29,24 @@ impl Loader {
             None => BTreeMap::new(),
             Some(a) => self.args(cx, a, owner)?,
         };
+        // A skill of an action domain (`domain:Name`, README "Action
+        // domains"): its arguments are the domain's to check (symbolic
+        // simulation checks them against the domain when it binds them).
+        if let Some((dom, own)) = name.split_once(':') {
+            let named = |x: &str| {
+                !x.is_empty()
+                    && x.len() <= 128
+                    && x.chars()
+                        .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+            };
+            if named(dom) && named(own) {
+                return Some(SkillCall { skill: name, args });
+            }
+            self.err(cx, sv.span(), format!("`{name}` is not a skill name"))
+                .hint =
+                Some("a domain's own skill is `domain:Name`: letters, digits, `-` and `_`".into());
+            return None;
+        }
         match skill::skill_kind(&name) {
             None => {
                 let cands: Vec<&str> = match want {

@@ -1,0 +1,155 @@
+//! `btfsm lint FILE|DIR...`: runs the lint rules (src/lint/) on every policy
+//! given or found below a directory; prints findings as positioned text,
+//! JSON or SARIF 2.1.0; exit 1 when an error-level finding remains, 2 when
+//! an input does not load (its errors printed, the others still linted).
+
+use super::commands::{emit_text, print_diagnostics};
+use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
+use crate::format;
+use crate::lint::{self, Level, config};
+use clap::{Args, ValueEnum};
+use std::io::Write;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LintFormat {
+    /// Positioned messages with snippet and help, as `validate` prints
+    Text,
+    Json,
+    /// SARIF 2.1.0, for GitHub code scanning
+    Sarif,
+}
+
+#[derive(Debug, Args)]
+pub struct LintArgs {
+    /// Policy files (any format), `-` for stdin, or directories
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = LintFormat::Text)]
+    pub format: LintFormat,
+    /// Report rule CODE as an error (repeatable)
+    #[arg(long, value_name = "CODE")]
+    pub deny: Vec<String>,
+    /// Report rule CODE as a warning (repeatable)
+    #[arg(long, value_name = "CODE")]
+    pub warn: Vec<String>,
+    /// Do not report rule CODE (repeatable)
+    #[arg(long, value_name = "CODE")]
+    pub allow: Vec<String>,
+    /// Do not read btfsm.toml (by default: the one in the current folder or
+    /// above it, up to the repository root)
+    #[arg(long)]
+    pub no_config: bool,
+    /// List the rules with their default level and summary, and exit
+    #[arg(long, exclusive = true)]
+    pub list: bool,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+pub fn execute(a: LintArgs) -> u8 {
+    if a.list {
+        let mut t = crate::report::table::Table::new(&["code", "level", "what it finds"]);
+        for r in lint::RULES {
+            t.row(vec![
+                r.code.to_string(),
+                r.level.as_str().to_string(),
+                r.summary.to_string(),
+            ]);
+        }
+        return emit_text(None, t.render());
+    }
+    let stderr = std::io::stderr();
+    let mut err = stderr.lock();
+    let mut cfg = config::Config::default();
+    if !a.no_config
+        && let Ok(cwd) = std::env::current_dir()
+        && let Some(path) = config::find(&cwd)
+    {
+        let limits = a.limits.limits();
+        let shown = path.display().to_string();
+        match format::source::read(&path, &shown, &limits, true).map(|f| config::read(&f)) {
+            Ok(Ok(c)) => cfg = c,
+            Ok(Err(d)) | Err(d) => {
+                print_diagnostics(&mut err, &d);
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    for (codes, level) in [
+        (&a.allow, Level::Allow),
+        (&a.warn, Level::Warning),
+        (&a.deny, Level::Error),
+    ] {
+        for c in codes {
+            if let Err(e) = cfg.set(c, level) {
+                let _ = writeln!(err, "error: {e}");
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    let limits = a.limits.limits();
+    let inputs = match format::discover::expand(&a.files) {
+        Ok(i) => i,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let mut findings = Vec::new();
+    let mut failed = false;
+    for input in &inputs {
+        let (file, fmt) = match format::discover::read(input, &limits) {
+            Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
+            Ok(_) => continue,
+            Err(d) => {
+                failed = true;
+                print_diagnostics(&mut err, &d);
+                continue;
+            }
+        };
+        match format::load_read(file.clone(), &input.path, fmt, &limits) {
+            Ok(l) => findings.extend(lint::lint(&l.policy, Some(&file), &l.path, &cfg)),
+            Err(d) => {
+                failed = true;
+                print_diagnostics(&mut err, &d);
+            }
+        }
+    }
+    let text = match a.format {
+        LintFormat::Sarif => lint::sarif::render(&findings),
+        LintFormat::Json => {
+            let mut s = crate::sanitize::json(
+                serde_json::to_string_pretty(&findings).expect("serializable"),
+            );
+            s.push('\n');
+            s
+        }
+        LintFormat::Text => {
+            let mut s: String = findings.iter().map(lint::render_text).collect();
+            let count = |l: Level| findings.iter().filter(|f| f.level == l).count();
+            s.push_str(&format!(
+                "{} error{}, {} warning{}, {} note{} in {} file{}\n",
+                count(Level::Error),
+                if count(Level::Error) == 1 { "" } else { "s" },
+                count(Level::Warning),
+                if count(Level::Warning) == 1 { "" } else { "s" },
+                count(Level::Note),
+                if count(Level::Note) == 1 { "" } else { "s" },
+                inputs.len(),
+                if inputs.len() == 1 { "" } else { "s" },
+            ));
+            s
+        }
+    };
+    let code = emit_text(None, text);
+    if code != EXIT_OK || failed {
+        return EXIT_BAD_INPUT;
+    }
+    if findings.iter().any(|f| f.level == Level::Error) {
+        EXIT_CHECK_FAILED
+    } else {
+        EXIT_OK
+    }
+}

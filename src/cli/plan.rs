@@ -1,0 +1,289 @@
+//! `btfsm plan DOMAIN`: backchains the domain's goal into a BT, derives the
+//! fault-tolerant FSM of the same plan and the HFSM of the BT (the paper's
+//! BT -> HFSM construction), prints the conflicts the planner resolved or
+//! left and the metrics of the three side by side, and writes the policies
+//! with `-o DIR` (or one of them to stdout with `-o -`).
+
+use super::commands::{emit_text, print_diagnostics};
+use super::{EXIT_BAD_INPUT, EXIT_OK};
+use crate::format::{Limits, Loaded};
+use crate::model::{Policy, PolicyBody};
+use crate::plan::{self, Options};
+use crate::report::{self, OutputFormat};
+use clap::{Args, ValueEnum};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PlanTarget {
+    /// The backchained Behavior Tree
+    Bt,
+    /// The fault-tolerant FSM of the same plan (SELECTOR with triangle-table kernels)
+    Fsm,
+    /// The HFSM of the BT (the paper's BT -> HFSM construction)
+    Hfsm,
+    /// All three
+    All,
+}
+
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// Action domain (TOML; README "Action domains"), e.g. policies/domains/moma.toml
+    pub domain: PathBuf,
+    /// A task of the domain (`[tasks.NAME]`) instead of its `[goal]`
+    #[arg(long, value_name = "NAME")]
+    pub task: Option<String>,
+    /// Goal fact replacing the domain's goal, e.g. "Object-At(cube2, delivery)"
+    /// (repeat for several, in order)
+    #[arg(long = "goal", value_name = "FACT")]
+    pub goals: Vec<String>,
+    /// Which policies to make
+    #[arg(long, value_enum, default_value_t = PlanTarget::All)]
+    pub to: PlanTarget,
+    /// Write the policies (TOML) into this directory as NAME-bt.toml,
+    /// NAME-fsm.toml, NAME-hfsm.toml; `-`: the one policy of --to on stdout
+    #[arg(short, long, value_name = "DIR")]
+    pub output: Option<PathBuf>,
+    /// Keep the domain's precondition order and only report the conflicts
+    /// (a later sibling undoing an earlier one's condition: the robot chatters)
+    #[arg(long)]
+    pub no_reorder: bool,
+    /// Deepest nesting of achievers below a goal condition (1 to 256)
+    #[arg(long, default_value_t = 16, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+    pub max_plan_depth: u16,
+    /// Output format of the report (table or json)
+    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+    pub format: OutputFormat,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+/// Reads and validates a domain file, printing its errors.
+pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> {
+    let stderr = std::io::stderr();
+    let shown = path.display().to_string();
+    let file = match crate::format::source::read(path, &shown, limits, true) {
+        Ok(f) => f,
+        Err(d) => {
+            print_diagnostics(&mut stderr.lock(), &d);
+            return None;
+        }
+    };
+    match plan::load(&file) {
+        Ok(d) => Some(d),
+        Err(d) => {
+            print_diagnostics(&mut stderr.lock(), &d);
+            None
+        }
+    }
+}
+
+pub fn execute(a: PlanArgs) -> u8 {
+    if a.format == OutputFormat::Csv {
+        eprintln!("error: `plan` prints `table` or `json`, not `csv`");
+        return EXIT_BAD_INPUT;
+    }
+    let limits = a.limits.limits();
+    let shown = a.domain.display().to_string();
+    let Some(mut domain) = read_domain(&a.domain, &limits) else {
+        return EXIT_BAD_INPUT;
+    };
+    if let Some(t) = &a.task
+        && let Err(e) = domain.select_task(t)
+    {
+        eprintln!("error: {e}");
+        return EXIT_BAD_INPUT;
+    }
+    if !a.goals.is_empty()
+        && let Err(es) = domain.set_goal(&a.goals)
+    {
+        for e in es {
+            eprintln!("error: {e}");
+        }
+        return EXIT_BAD_INPUT;
+    }
+    let opts = Options {
+        reorder: !a.no_reorder,
+        max_depth: usize::from(a.max_plan_depth),
+        max_nodes: limits.max_nodes,
+        ..Options::default()
+    };
+    let planned = match plan::plan_bt(&domain, &opts) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!(
+                "error: {shown}: {e}\n  = hint: raise --max-nodes, or lower --max-plan-depth"
+            );
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let policies = match policies(&domain, &planned, a.to, &limits) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {shown}: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if a.output.as_deref() == Some(Path::new("-")) {
+        let [(_, p)] = policies.as_slice() else {
+            eprintln!("error: `-o -` writes one policy: choose it with --to bt, fsm or hfsm");
+            return EXIT_BAD_INPUT;
+        };
+        return emit_text(None, crate::format::toml_write::write_policy(p));
+    }
+    let mut written: Vec<(String, &Policy)> = Vec::new();
+    for (tag, p) in &policies {
+        written.push((format!("{}-{tag}.toml", domain.name), p));
+    }
+    if let Some(dir) = &a.output {
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            eprintln!(
+                "error: cannot create {}: {e}",
+                crate::sanitize::shown(&dir.display().to_string())
+            );
+            return EXIT_BAD_INPUT;
+        }
+        for (name, p) in &written {
+            let code = emit_text(
+                Some(&dir.join(name)),
+                crate::format::toml_write::write_policy(p),
+            );
+            if code != EXIT_OK {
+                return code;
+            }
+        }
+    }
+    let rows: Vec<report::PolicyReport> = written
+        .iter()
+        .map(|(name, p)| {
+            let path = match &a.output {
+                Some(dir) => dir.join(name).display().to_string(),
+                None => name.clone(),
+            };
+            report::analyze(&Loaded {
+                path,
+                policy: (*p).clone(),
+                warnings: Vec::new(),
+            })
+        })
+        .collect();
+    let text = match a.format {
+        OutputFormat::Json => {
+            #[derive(serde::Serialize)]
+            struct Out<'a> {
+                domain: &'a str,
+                goal: Vec<String>,
+                conflicts: &'a [plan::conflicts::Conflict],
+                policies: &'a [report::PolicyReport],
+            }
+            let out = Out {
+                domain: &domain.name,
+                goal: domain.goal.facts.iter().map(ToString::to_string).collect(),
+                conflicts: &planned.conflicts,
+                policies: &rows,
+            };
+            let mut s =
+                crate::sanitize::json(serde_json::to_string_pretty(&out).expect("serializable"));
+            s.push('\n');
+            s
+        }
+        _ => {
+            let mut s = format!(
+                "domain `{}`, goal: {}\n",
+                crate::sanitize::shown(&domain.name),
+                crate::sanitize::shown(
+                    &domain
+                        .goal
+                        .facts
+                        .iter()
+                        .map(ToString::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            );
+            let shown_conflicts: Vec<&plan::conflicts::Conflict> = planned
+                .conflicts
+                .iter()
+                .filter(|c| c.outcome != plan::conflicts::Outcome::InOrder)
+                .collect();
+            if shown_conflicts.is_empty() {
+                s.push_str("conflicts: none\n");
+            } else {
+                s.push_str("conflicts:\n");
+                for c in shown_conflicts {
+                    s.push_str(&format!("  {c}\n"));
+                }
+            }
+            s.push('\n');
+            s.push_str(&report::render_analysis(&rows, OutputFormat::Table));
+            s
+        }
+    };
+    let code = emit_text(None, text);
+    let left = planned.conflicts.iter().any(|c| {
+        matches!(
+            c.outcome,
+            plan::conflicts::Outcome::Left | plan::conflicts::Outcome::Cycle
+        )
+    });
+    if code == EXIT_OK && left && !a.no_reorder {
+        // A cycle no order resolves: the tree chatters; say so in the status.
+        return super::EXIT_CHECK_FAILED;
+    }
+    code
+}
+
+/// The policies `to` asks for, named after the domain.
+fn policies(
+    d: &plan::Domain,
+    planned: &plan::Planned,
+    to: PlanTarget,
+    limits: &Limits,
+) -> Result<Vec<(&'static str, Policy)>, String> {
+    let desc = |what: &str| {
+        Some(format!(
+            "{what} generated by `btfsm plan` from domain `{}` (goal: {})",
+            d.name,
+            d.goal
+                .facts
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    };
+    let bt = Policy {
+        name: format!("{} (planned BT)", d.name),
+        description: desc("Behavior Tree"),
+        body: PolicyBody::Bt(planned.bt.clone()),
+    };
+    let mut out = Vec::new();
+    if matches!(to, PlanTarget::Bt | PlanTarget::All) {
+        out.push(("bt", bt.clone()));
+    }
+    if matches!(to, PlanTarget::Fsm | PlanTarget::All) {
+        let m = plan::fsm::plan_fsm(d, planned).map_err(|e| e.to_string())?;
+        out.push((
+            "fsm",
+            Policy {
+                name: format!("{} (planned fault-tolerant FSM)", d.name),
+                description: desc("Fault-tolerant FSM"),
+                body: PolicyBody::Machine(m),
+            },
+        ));
+    }
+    if matches!(to, PlanTarget::Hfsm | PlanTarget::All) {
+        let h = crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&bt).map_err(|es| {
+            es.iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join("; ")
+        })?;
+        out.push(("hfsm", h));
+    }
+    for (_, p) in &out {
+        if let Some(d) = crate::format::check_shape(p, limits) {
+            return Err(d.message);
+        }
+    }
+    Ok(out)
+}

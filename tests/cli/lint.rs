@@ -1,0 +1,131 @@
+//! `btfsm lint`: every rule fires on its bad fixture (tests/fixtures/lint/
+//! CODE/bad.*) and stays silent on its good one; the bad fixtures' text
+//! output is a snapshot; levels, exit codes, JSON and SARIF.
+
+use super::*;
+
+const LINT: &str = "tests/fixtures/lint";
+
+fn fixture(code: &str, which: &str) -> String {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(LINT).join(code);
+    let f = std::fs::read_dir(&dir)
+        .unwrap_or_else(|_| panic!("{code}: no fixture folder {}", dir.display()))
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| p.file_stem().is_some_and(|s| s == which))
+        .unwrap_or_else(|| panic!("{code}: no {which}.* fixture"));
+    format!("{LINT}/{code}/{}", f.file_name().unwrap().to_string_lossy())
+}
+
+/// The codes `btfsm lint --list` prints.
+fn codes() -> Vec<String> {
+    let (code, out, err) = btfsm(&["lint", "--list"]);
+    assert_eq!(code, 0, "{err}");
+    out.lines()
+        .skip(1)
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .collect()
+}
+
+#[test]
+fn every_rule_fires_on_its_bad_fixture_and_not_on_its_good_one() {
+    let all = codes();
+    assert!(all.len() >= 8, "{all:?}");
+    for code in &all {
+        let (_, out, err) = btfsm(&["lint", &fixture(code, "bad"), "--format", "json"]);
+        let v: serde_json::Value =
+            serde_json::from_str(&out).unwrap_or_else(|_| panic!("{code}: {out}{err}"));
+        let found: Vec<&str> = v
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|f| f["code"].as_str())
+            .collect();
+        assert!(
+            found.contains(&code.as_str()),
+            "{code} silent on its bad fixture: {found:?}"
+        );
+        let (_, out, _) = btfsm(&["lint", &fixture(code, "good"), "--format", "json"]);
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let found: Vec<&str> = v
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|f| f["code"].as_str())
+            .collect();
+        assert!(
+            !found.contains(&code.as_str()),
+            "{code} fires on its good fixture"
+        );
+        // The text a user reads, per rule.
+        let (_, text, _) = btfsm(&["lint", &fixture(code, "bad")]);
+        insta::assert_snapshot!(format!("lint_{}", code.replace('-', "_")), text);
+        // Every rule is documented with a bad and a good example.
+        let docs =
+            std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/lint.md"))
+                .unwrap();
+        let section = docs
+            .split("\n## ")
+            .find(|s| s.starts_with(&format!("`{code}`")))
+            .unwrap_or_else(|| panic!("docs/lint.md has no section `{code}`"));
+        assert!(
+            section.contains("Bad:") && section.contains("Good:"),
+            "{code}: docs need a bad and a good example"
+        );
+    }
+}
+
+#[test]
+fn lint_exit_codes_levels_and_sarif() {
+    let bad = fixture("chattering-precondition-order", "bad");
+    let (code, out, _) = btfsm(&["lint", &bad]);
+    assert_eq!(code, 1, "an error-level finding: exit 1\n{out}");
+    assert!(
+        out.contains("error[chattering-precondition-order]"),
+        "{out}"
+    );
+    let (code, _, _) = btfsm(&["lint", &bad, "--warn", "chattering-precondition-order"]);
+    assert_eq!(code, 0);
+    let (code, out, _) = btfsm(&["lint", &bad, "--allow", "chattering-precondition-order"]);
+    assert_eq!(code, 0);
+    assert!(out.starts_with("0 errors, 0 warnings"), "{out}");
+    let (code, _, err) = btfsm(&["lint", &bad, "--deny", "chatering"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unknown lint `chatering`"), "{err}");
+    let (code, out, _) = btfsm(&["lint", &bad, "--format", "sarif"]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["version"], "2.1.0");
+    let r = &v["runs"][0]["results"][0];
+    assert_eq!(r["ruleId"], "chattering-precondition-order");
+    assert_eq!(
+        r["locations"][0]["physicalLocation"]["region"]["startLine"],
+        10
+    );
+    // A file that does not load: exit 2, the others still linted.
+    let (code, out, err) = btfsm(&[
+        "lint",
+        "tests/fixtures/invalid/control-no-children.toml",
+        &bad,
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(out.contains("chattering-precondition-order"), "{out}");
+}
+
+#[test]
+fn the_paper_policies_have_one_lint_error_fig_3() {
+    let (code, out, _) = btfsm(&["lint", "policies/paper", "--format", "json"]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let errors: Vec<String> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|f| f["level"] == "error")
+        .map(|f| format!("{} {}", f["file"], f["code"]))
+        .collect();
+    assert_eq!(
+        errors,
+        ["\"policies/paper/fig03-bt.toml\" \"chattering-precondition-order\""]
+    );
+}
