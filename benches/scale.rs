@@ -1,7 +1,9 @@
 //! Scale benchmark (issue: large inputs): a BT with 100,000 nodes, a BT nested
-//! 100,000 levels deep and a fault-tolerant FSM with 10,000 states are parsed,
-//! validated and analyzed; prints the time of each phase. Target: under 1 s per
-//! input, end to end. Run with `cargo bench --bench scale`.
+//! 100,000 levels deep, a chain of 100,000 Sequences each guarding a Move-To
+//! (every level a chattering-order finding for `lint`) and a fault-tolerant
+//! FSM with 10,000 states are parsed, validated, analyzed and linted; prints
+//! the time of each phase. Target: under 1 s per input, end to end, and
+//! under 1 s for `lint` (issue 17). Run with `cargo bench --bench scale`.
 
 use btfsm::format::{Limits, Loaded, toml::parse_str};
 use btfsm::graph::policy_graph;
@@ -45,6 +47,33 @@ pub fn deep_bt(depth: usize) -> String {
         "n{} = {{ action = \"Dock!\", skill = \"Dock\" }}",
         depth - 1
     );
+    s
+}
+
+/// Sequences nested `depth` levels: level i is `Sequence(Fallback(at p_i,
+/// Move-To p_i), level i+1)`, so every Move-To below undoes the Robot-At an
+/// earlier sibling ensured: `depth` lint findings, each found in O(1).
+pub fn chain_bt(depth: usize) -> String {
+    let mut s = String::from("kind = \"bt\"\nname = \"chain\"\nroot = \"s0\"\n[nodes]\n");
+    let k = depth / 4;
+    for i in 0..k {
+        let next = if i + 1 < k {
+            format!("s{}", i + 1)
+        } else {
+            "done".into()
+        };
+        let _ = writeln!(s, "s{i} = {{ sequence = [\"f{i}\", \"{next}\"] }}");
+        let _ = writeln!(s, "f{i} = {{ fallback = [\"c{i}\", \"a{i}\"] }}");
+        let _ = writeln!(
+            s,
+            "c{i} = {{ condition = \"At p{i}?\", skill = \"Robot-At\", args = {{ target = \"p{i}\" }} }}"
+        );
+        let _ = writeln!(
+            s,
+            "a{i} = {{ action = \"Move-To p{i}!\", skill = \"Move-To\", args = {{ target = \"p{i}\" }} }}"
+        );
+    }
+    s.push_str("done = { action = \"Dock!\", skill = \"Dock\" }\n");
     s
 }
 
@@ -101,6 +130,9 @@ fn run(name: &str, text: &str) {
     let t3 = Instant::now();
     let report = analyze(&loaded);
     let t_all = t3.elapsed();
+    let t4 = Instant::now();
+    let findings = btfsm::lint::lint(&loaded.policy, None, name, &Default::default());
+    let t_lint = t4.elapsed();
     let total = t_parse + t_all;
     println!(
         "{name:<22} {:>7} vertices {:>7} arcs  parse {:>7.1} ms  graph {:>6.1} ms  cc+essential {:>6.1} ms  analyze {:>7.1} ms  total {:>7.1} ms  {}",
@@ -118,6 +150,16 @@ fn run(name: &str, text: &str) {
         }
     );
     assert!(cc >= 1 && ess >= 1);
+    println!(
+        "{name:<22} lint {:>7.1} ms ({} findings)  {}",
+        t_lint.as_secs_f64() * 1e3,
+        findings.len(),
+        if t_lint.as_secs_f64() < 1.0 {
+            "ok (< 1 s)"
+        } else {
+            "SLOW (target < 1 s)"
+        }
+    );
 }
 
 fn main() {
@@ -130,5 +172,6 @@ fn main() {
     };
     run("bt 100k nodes", &wide_bt(n));
     run("bt 100k levels deep", &deep_bt(d));
+    run("bt 100k chain of seqs", &chain_bt(d));
     run("fsm 10k states", &big_fsm(m));
 }

@@ -240,6 +240,7 @@ pub fn project(data: &[u8]) {
         Ok((file, crate::format::Input::Policy(f))) => {
             accepted(crate::format::load_read(file, &top, f, &limits));
         }
+        Ok((file, crate::format::Input::Domain)) => domain(file.text.as_bytes()),
         Err(diags) => check_diagnostics(&diags),
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -71,6 +71,27 @@ pub fn execute(cli: Cli) -> u8 {
                 };
                 let fmt = match input {
                     format::Input::Policy(fmt) => fmt,
+                    format::Input::Domain => {
+                        match crate::plan::load(&file) {
+                            Ok(d) => {
+                                let _ = writeln!(
+                                    err,
+                                    "{}: ok (action domain `{}`, {} predicates, {} actions, {} task{})",
+                                    shown(&f.display().to_string()),
+                                    shown(&d.name),
+                                    d.predicates.len(),
+                                    d.actions.len(),
+                                    d.tasks.len() + 1,
+                                    if d.tasks.is_empty() { "" } else { "s" }
+                                );
+                            }
+                            Err(diags) => {
+                                failed = true;
+                                print_diagnostics(&mut err, &diags);
+                            }
+                        }
+                        continue;
+                    }
                     format::Input::Scenario if crate::sim::symbolic::looks_symbolic(&file.text) => {
                         let base = f.parent().unwrap_or(Path::new(""));
                         match crate::sim::symbolic::scenario::parse(&file, base, &limits) {
@@ -407,6 +428,11 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
             Ok((file, Some(format::Input::Scenario))) if !input.found => {
                 format::load_read(file, &input.path, format::FileFormat::Toml, limits)
             }
+            Ok((file, Some(format::Input::Domain))) if !input.found => Err(vec![
+                crate::diagnostic::Diagnostic::error("an action domain, not a policy")
+                    .in_file(&file)
+                    .hint("`btfsm plan DOMAIN` makes its policies; `btfsm validate` checks it"),
+            ]),
             Ok(_) => {
                 skipped += 1;
                 continue;

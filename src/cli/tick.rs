@@ -75,6 +75,13 @@ fn one(
     let (file, input) = format::read_input(tree, limits)?;
     let f = match input {
         format::Input::Policy(f) => f,
+        format::Input::Domain => {
+            return Err(vec![
+                Diagnostic::error("an action domain, not a BT")
+                    .in_file(&file)
+                    .hint("`btfsm plan DOMAIN --to bt -o -` makes its BT"),
+            ]);
+        }
         format::Input::Scenario => {
             return Err(vec![
                 Diagnostic::error("a scenario, not a BT")

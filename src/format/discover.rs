@@ -118,6 +118,9 @@ pub fn read(
         FileFormat::Toml if crate::sim::scenario::looks_like_scenario(super::head(text)) => {
             Some(super::Input::Scenario)
         }
+        FileFormat::Toml if crate::plan::domain::looks_like_domain(text) => {
+            Some(super::Input::Domain)
+        }
         FileFormat::Toml if !has_top_level_kind(text) => None,
         FileFormat::BtcppXml if !text.contains("<BehaviorTree") => None,
         f => Some(super::Input::Policy(f)),

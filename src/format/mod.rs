@@ -233,6 +233,8 @@ pub enum Input {
     Policy(FileFormat),
     /// A simulator scenario (`sim`, `validate`).
     Scenario,
+    /// An action domain (`plan`, `validate`; README "Action domains").
+    Domain,
 }
 
 /// Reads a command-line file once ([`source::read`]: bounded, charged,
@@ -247,13 +249,14 @@ pub fn read_input(
         FileFormat::Toml if crate::sim::scenario::looks_like_scenario(head(&file.text)) => {
             Input::Scenario
         }
+        FileFormat::Toml if crate::plan::domain::looks_like_domain(&file.text) => Input::Domain,
         f => Input::Policy(f),
     };
     Ok((file, input))
 }
 
 /// The first 4 KiB of a text (at a character boundary), for sniffing.
-fn head(text: &str) -> &str {
+pub(crate) fn head(text: &str) -> &str {
     let mut end = text.len().min(4096);
     while !text.is_char_boundary(end) {
         end -= 1;

@@ -10,7 +10,7 @@ use crate::plan::Domain;
 use crate::plan::fact::Fact;
 use crate::sim::symbolic::world::{Binding, binding};
 use crate::transform::fault_tolerant::{builtin_domain, step_of};
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, HashMap};
 
 pub const CHATTERING_PRECONDITION_ORDER: Rule = Rule {
     code: "chattering-precondition-order",
@@ -37,61 +37,185 @@ fn ensured(d: &Domain, bt: &Bt, n: usize) -> Option<Fact> {
     }
 }
 
-/// The facts the actions below `n` delete (explicitly or by excluding
-/// them), among `wanted`; with the action that does.
-fn undone(d: &Domain, bt: &Bt, n: usize, wanted: &[Option<Fact>]) -> Vec<(Fact, String)> {
-    let mut out = Vec::new();
-    let mut stack = vec![n];
-    while let Some(x) = stack.pop() {
-        let node = &bt.nodes[x];
-        stack.extend(node.children.iter().copied());
-        if node.kind != BtNodeKind::Action {
-            continue;
+/// What the actions of a subtree undo: facts they delete, and per
+/// exclusive predicate and its other arguments, the values of the
+/// exclusive argument they add (adding `Robot-At(cube2)` undoes every other
+/// `Robot-At`). With the action that does it, for the message.
+/// An exclusive predicate and its arguments but the exclusive one.
+type ExclKey = (String, Vec<String>);
+
+#[derive(Default)]
+struct Undoes {
+    dels: HashMap<Fact, String>,
+    excl: HashMap<ExclKey, BTreeMap<String, String>>,
+    /// The values in `excl`, all keys together.
+    values: usize,
+}
+
+impl Undoes {
+    fn size(&self) -> usize {
+        self.dels.len() + self.values
+    }
+
+    /// Merges `other` into `self` (small into large: linear-logarithmic
+    /// over a tree).
+    fn absorb(&mut self, mut other: Undoes) {
+        if other.size() > self.size() {
+            std::mem::swap(self, &mut other);
         }
-        let Some(step) = node.skill.as_ref().and_then(|c| step_of(d, c)) else {
-            continue;
-        };
-        for f in crate::plan::conflicts::undone_by(d, &step, wanted) {
-            out.push((f, node.id.clone()));
+        for (f, by) in other.dels {
+            self.dels.entry(f).or_insert(by);
+        }
+        for (k, vs) in other.excl {
+            let e = self.excl.entry(k).or_default();
+            for (v, by) in vs {
+                if let std::collections::btree_map::Entry::Vacant(slot) = e.entry(v) {
+                    slot.insert(by);
+                    self.values += 1;
+                }
+            }
         }
     }
-    out
+
+    /// The action undoing `f`, if one does.
+    fn undoing(&self, d: &Domain, f: &Fact) -> Option<&str> {
+        if let Some(by) = self.dels.get(f) {
+            return Some(by);
+        }
+        let k = d.predicate(&f.pred)?.exclusive?;
+        let mut rest = f.args.clone();
+        rest.remove(k);
+        let vs = self.excl.get(&(f.pred.clone(), rest))?;
+        vs.iter()
+            .find(|(v, _)| **v != f.args[k])
+            .map(|(_, by)| by.as_str())
+    }
+}
+
+/// The undoes of one action node.
+fn of_action(d: &Domain, node: &crate::model::BtNode) -> Undoes {
+    let mut u = Undoes::default();
+    let Some(step) = node.skill.as_ref().and_then(|c| step_of(d, c)) else {
+        return u;
+    };
+    let adds = step.adds();
+    for f in step.deletes() {
+        if !adds.contains(&f) {
+            u.dels.insert(f, node.id.clone());
+        }
+    }
+    for f in adds {
+        if let Some(k) = d.predicate(&f.pred).and_then(|p| p.exclusive) {
+            let mut rest = f.args.clone();
+            let v = rest.remove(k);
+            if u.excl
+                .entry((f.pred.clone(), rest))
+                .or_default()
+                .insert(v, node.id.clone())
+                .is_none()
+            {
+                u.values += 1;
+            }
+        }
+    }
+    u
 }
 
 fn chattering(p: &Policy, out: &mut Sink) {
     let PolicyBody::Bt(bt) = &p.body else { return };
     let d = builtin_domain();
-    for node in &bt.nodes {
-        if !matches!(node.kind, BtNodeKind::Sequence | BtNodeKind::SequenceMemory) {
+    // Post-order: each subtree's undoes, built from its children's (small
+    // into large), checked at each Sequence before they merge.
+    let mut undoes: Vec<Option<Undoes>> = (0..bt.nodes.len()).map(|_| None).collect();
+    let mut stack = vec![(bt.root, false)];
+    while let Some((n, done)) = stack.pop() {
+        let node = &bt.nodes[n];
+        if !done {
+            stack.push((n, true));
+            stack.extend(node.children.iter().map(|&c| (c, false)));
             continue;
         }
-        let kids = &node.children;
-        let facts: Vec<Option<Fact>> = kids.iter().map(|&c| ensured(d, bt, c)).collect();
-        let mut reported = BTreeSet::new();
-        for (j, &c) in kids.iter().enumerate() {
-            // The achieving action of a Sequence consumes its preconditions
-            // by design (Place lets go of the cube): only subtrees count.
-            if bt.nodes[c].kind == BtNodeKind::Action {
-                continue;
+        if matches!(node.kind, BtNodeKind::Sequence | BtNodeKind::SequenceMemory) {
+            check_sequence(d, bt, n, &undoes, out);
+        }
+        let mut u = if node.kind == BtNodeKind::Action {
+            of_action(d, node)
+        } else {
+            Undoes::default()
+        };
+        for &c in &node.children {
+            if let Some(x) = undoes[c].take() {
+                u.absorb(x);
             }
-            for (f, by) in undone(d, bt, c, &facts[..j]) {
-                let Some(i) = facts[..j].iter().position(|x| x.as_ref() == Some(&f)) else {
-                    continue;
-                };
-                if !reported.insert((i, j)) {
-                    continue;
-                }
-                let (earlier, later) = (&bt.nodes[kids[i]].id, &bt.nodes[c].id);
+        }
+        undoes[n] = Some(u);
+    }
+}
+
+/// Sequence `n`: a later child undoing the fact an earlier child ensures.
+/// Each later child is checked against the earlier facts or its undoes,
+/// whichever is fewer.
+fn check_sequence(d: &Domain, bt: &Bt, n: usize, undoes: &[Option<Undoes>], out: &mut Sink) {
+    let node = &bt.nodes[n];
+    let kids = &node.children;
+    let mut earlier: Vec<(Fact, usize)> = Vec::new();
+    let mut by_fact: HashMap<Fact, usize> = HashMap::new();
+    // Per exclusive predicate and other arguments: up to two earlier facts
+    // with distinct values of the exclusive argument.
+    let mut by_key: HashMap<ExclKey, Vec<(String, usize, Fact)>> = HashMap::new();
+    for (j, &c) in kids.iter().enumerate() {
+        // The achieving action of a Sequence consumes its preconditions by
+        // design (Place lets go of the cube): only subtrees count.
+        if bt.nodes[c].kind != BtNodeKind::Action
+            && let Some(u) = undoes[c].as_ref()
+            && !earlier.is_empty()
+        {
+            let hit: Option<(usize, Fact, String)> = if earlier.len() <= u.size() {
+                earlier
+                    .iter()
+                    .find_map(|(f, i)| u.undoing(d, f).map(|by| (*i, f.clone(), by.to_string())))
+            } else {
+                u.dels
+                    .iter()
+                    .find_map(|(f, by)| by_fact.get(f).map(|&i| (i, f.clone(), by.clone())))
+                    .or_else(|| {
+                        u.excl.iter().find_map(|(key, vs)| {
+                            let list = by_key.get(key)?;
+                            // An earlier fact with another value of the
+                            // exclusive argument: among the first two of
+                            // the list, one differs from any one added value.
+                            list.iter().take(2).find_map(|(v, i, f)| {
+                                vs.iter()
+                                    .find(|(w, _)| *w != v)
+                                    .map(|(_, by)| (*i, f.clone(), by.clone()))
+                            })
+                        })
+                    })
+            };
+            if let Some((i, f, by)) = hit {
+                let (earlier_id, later) = (&bt.nodes[kids[i]].id, &bt.nodes[c].id);
                 out.push(
                     &node.id,
                     node.span.clone(),
                     format!(
-                        "in Sequence `{}`, `{later}` runs `{by}`, which undoes {f}, the condition `{earlier}` before it ensures: the Sequence goes back to `{earlier}` and the robot chatters between them",
+                        "in Sequence `{}`, `{later}` runs `{by}`, which undoes {f}, the condition `{earlier_id}` before it ensures: the Sequence goes back to `{earlier_id}` and the robot chatters between them",
                         node.id
                     ),
-                    format!("put `{later}` before `{earlier}` (as `btfsm plan` orders preconditions)"),
+                    format!("put `{later}` before `{earlier_id}` (as `btfsm plan` orders preconditions)"),
                 );
             }
+        }
+        if let Some(f) = ensured(d, bt, c) {
+            by_fact.entry(f.clone()).or_insert(j);
+            if let Some(k) = d.predicate(&f.pred).and_then(|p| p.exclusive) {
+                let mut rest = f.args.clone();
+                let v = rest.remove(k);
+                let list = by_key.entry((f.pred.clone(), rest)).or_default();
+                if list.len() < 2 && list.iter().all(|(w, _, _)| *w != v) {
+                    list.push((v, j, f.clone()));
+                }
+            }
+            earlier.push((f, j));
         }
     }
 }

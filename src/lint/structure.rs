@@ -214,6 +214,16 @@ fn outcome_never_reached(p: &Policy, out: &mut Sink) {
         })
         .collect();
     for (owner, r) in regions {
+        // One pass over the region's transitions, then one look-up per outcome.
+        let reached: std::collections::HashSet<&str> = r
+            .states
+            .iter()
+            .flat_map(|&s| &m.states[s].transitions)
+            .filter_map(|t| match &t.target {
+                Target::Outcome(x) => Some(x.as_str()),
+                Target::State(_) | Target::OuterOutcome { .. } => None,
+            })
+            .collect();
         for o in &r.outcomes {
             // A region that starts in an outcome reaches it; a parallel
             // state's outcomes are its regions' completion's (yasmin's
@@ -221,12 +231,7 @@ fn outcome_never_reached(p: &Policy, out: &mut Sink) {
             let used = r.parallel
                 || r.initial == Target::Outcome(o.clone())
                 || outer.contains(&(owner, o.as_str()))
-                || r.states.iter().any(|&s| {
-                    m.states[s]
-                        .transitions
-                        .iter()
-                        .any(|t| matches!(&t.target, Target::Outcome(x) if x == o))
-                });
+                || reached.contains(o.as_str());
             // A region's RUNNING is the tick-driven construction's (Fig. 6).
             if used || o == "RUNNING" {
                 continue;

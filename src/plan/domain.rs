@@ -268,6 +268,27 @@ impl Domain {
     }
 }
 
+/// Does a TOML text look like an action domain: no top-level `kind`, and
+/// a `[actions...]` or `[predicates...]` table?
+pub fn looks_like_domain(text: &str) -> bool {
+    let mut tables = false;
+    for line in text.lines() {
+        let l = line.trim();
+        if let Some(h) = l.strip_prefix('[') {
+            let h = h.trim_start();
+            if h.starts_with("actions") || h.starts_with("predicates") {
+                tables = true;
+            }
+            continue;
+        }
+        let key = l.split('=').next().unwrap_or("").trim().trim_matches('"');
+        if key == "kind" && l.contains('=') && !tables {
+            return false;
+        }
+    }
+    tables
+}
+
 /// Reads and validates a domain from its text.
 pub fn load(file: &Arc<SourceFile>) -> Result<Domain, Vec<Diagnostic>> {
     let raw: RawDomain = toml::from_str(&file.text).map_err(|e| {

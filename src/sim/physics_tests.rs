@@ -570,3 +570,86 @@ fn random_worlds_and_disturbances_never_panic() {
     }
     assert!(ran >= 40, "{ran}");
 }
+
+/// The built-in action domain (`policies/domains/moma.toml`) describes the
+/// planar simulator: along a run of the domain's actions in the paper's
+/// room, each action's preconditions hold (as the room's conditions say)
+/// before it starts, it succeeds, and afterwards the facts it adds hold,
+/// the facts it deletes and the ones its additions exclude do not.
+#[test]
+fn the_built_in_domain_describes_the_planar_skills() {
+    use crate::plan::Domain;
+    use crate::plan::fact::Fact;
+    let d = crate::transform::fault_tolerant::builtin_domain();
+    let mut r = robot(world(), 1);
+    let holds = |r: &Robot, f: &Fact| -> bool {
+        let pred = d.predicate(&f.pred).expect("domain predicate");
+        let call = Domain::skill_call(
+            pred.skill.as_deref().expect("library skill"),
+            &pred.params,
+            &f.args,
+        );
+        let c = super::skills::resolve(&call, &r.world)
+            .unwrap_or_else(|e| panic!("{f}: {}", e.message));
+        super::skills::condition(&c, &r.world)
+    };
+    let plan: [(&str, &[&str]); 9] = [
+        ("Move-To", &["cube2"]),
+        ("Pick", &["cube2"]),
+        ("Move-To", &["delivery"]),
+        ("Place", &["cube2", "delivery"]),
+        ("Tuck-Arm", &[]),
+        ("Safe-Move-To", &["charging"]),
+        ("Search", &[]),
+        ("Recharge", &[]),
+        ("Dock", &[]),
+    ];
+    for (name, objs) in plan {
+        let a = d.actions.iter().find(|a| a.name == name).expect("action");
+        let bind = a
+            .params
+            .iter()
+            .map(|p| p.name.clone())
+            .zip(objs.iter().map(|o| o.to_string()))
+            .collect();
+        let step = crate::plan::backchain::Step { action: a, bind };
+        for f in step.pre() {
+            assert!(
+                holds(&r, &f),
+                "{name}: precondition {f} does not hold in the room"
+            );
+        }
+        let call = Domain::skill_call(
+            a.skill.as_deref().expect("library skill"),
+            &a.params,
+            &objs.iter().map(|o| o.to_string()).collect::<Vec<_>>(),
+        );
+        let c = super::skills::resolve(&call, &r.world)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.message));
+        let mut s = Status::Running;
+        let mut steps = 0;
+        while s == Status::Running && steps < 5000 {
+            s = r.action(0, &c);
+            end(&mut r);
+            steps += 1;
+        }
+        assert_eq!(s, Status::Success, "{name} {objs:?} in the room");
+        for f in step.adds() {
+            assert!(holds(&r, &f), "{name}: {f} does not hold after it");
+        }
+        for f in step.deletes() {
+            assert!(!holds(&r, &f), "{name}: {f} still holds after it");
+        }
+        for f in step.adds() {
+            if let Some(k) = d.predicate(&f.pred).and_then(|p| p.exclusive) {
+                for other in d.objects_of(&d.predicate(&f.pred).unwrap().params[k].ty) {
+                    let mut g = f.clone();
+                    g.args[k] = other.to_string();
+                    if g != f && r.world.layout.station_index(other).is_some() {
+                        assert!(!holds(&r, &g), "{name}: {g} holds beside {f}");
+                    }
+                }
+            }
+        }
+    }
+}

@@ -825,6 +825,12 @@ fn w3c_finals_of_enclosing_regions_and_final_only_states_read() {
         let (code, _, stderr) = btfsm(&["validate", &f]);
         assert_eq!(code, 0, "{stderr}");
         assert!(stderr.contains(", 0 warnings)"), "{t}: {stderr}");
+        // `pass` / `fail` are reached from nested states: lint agrees.
+        let (_, stdout, stderr) = btfsm(&["lint", &f]);
+        assert!(
+            !format!("{stdout}{stderr}").contains("outcome-never-reached"),
+            "{t}: {stdout}{stderr}"
+        );
     }
     let f = format!("{CORPUS}/scxml/commons-scxml/scxml-initial-attr.scxml");
     let (code, stdout, stderr) = btfsm(&["analyze", "--format", "json", &f]);

@@ -322,3 +322,17 @@ unset = { probability = 0.6, facts = ["Door-Open(door)", "Holding(cup)"], window
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn validate_checks_action_domains_and_symbolic_scenarios() {
+    let (code, _, err) = btfsm(&["validate", "policies/domains"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("moma.toml: ok (action domain `moma`"), "{err}");
+    assert!(
+        err.contains("moma-sim.toml: ok (symbolic scenario `symbolic-moma`"),
+        "{err}"
+    );
+    let (code, _, err) = btfsm(&["analyze", MOMA]);
+    assert_eq!(code, 2);
+    assert!(err.contains("an action domain, not a policy"), "{err}");
+}
