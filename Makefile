@@ -48,9 +48,11 @@ test:
 # the same shape (tests/differential/accept_btcpp.py; known, explained
 # mismatches in accept_btcpp_known.txt, which must not go stale); then the
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
-# SubTrees are spread over files given together (projects_btcpp.py); and
-# every SARIF log of `lint` against the official schema (sarif_check.py);
-# and logs BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py).
+# SubTrees are spread over files given together (projects_btcpp.py); every
+# SARIF log of `lint` against the official schema (sarif_check.py); logs
+# BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py); and
+# every corpus SCXML file read by btfsm and by an independent SCXML engine
+# (PyPI `scjson`) alike (tests/differential/scxml_engine.py).
 $(VENV)/.installed: tests/differential/requirements.txt
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
@@ -70,6 +72,7 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/btlog_check.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_check.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_check.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_check.txt
+	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).
@@ -78,7 +81,7 @@ mermaid-oracle: build
 	cd tests/differential/mermaid && npm ci --silent --no-audit --no-fund
 	node tests/differential/mermaid/check.mjs $(BIN) -- tests/differential/mermaid/labels-*.toml \
 	  policies/paper/*.toml $$(find tests/fixtures/corpus -name '*.scxml') \
-	  $$(grep -L OrthogonalState $$(find tests/fixtures/corpus/yasmin -name '*.xml'))
+	  $$(find tests/fixtures/corpus/yasmin -name '*.xml')
 	node tests/differential/mermaid/check.mjs $(BIN) --nodes-model $(NAV2)/nav2_tree_nodes.xml -- \
 	  $$(ls $(NAV2)/*.xml | grep -v tree_nodes) tests/fixtures/corpus/bt-xml/btcpp/parent_include_child.xml
 	node tests/differential/mermaid/check_diff.mjs $(BIN) $(DIFF_PAIRS)

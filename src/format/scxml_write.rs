@@ -3,7 +3,9 @@
 //! nested), outcomes `<final>` states of their region, outcome transitions
 //! `<transition event="SUCCESS">`, guards `<transition event cond>` split back
 //! from their label (`event`, `event [cond]`, `[cond]`; a label with spaces is a
-//! `cond`), history pseudo-states `<history>`.
+//! `cond`), history pseudo-states `<history>`, parallel regions `<parallel>`
+//! (no `initial`), an initial or a target that is an outcome (of the region's
+//! own or of an enclosing one) the id of that region's `<final>`.
 //!
 //! SCXML ids are unique XML names in a document while model names are unique per
 //! region and may hold spaces: a state's id is its name (or, when another state
@@ -185,9 +187,10 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
         })
         .collect();
     let mut out = String::new();
-    // The final id of outcome `o` in the region a state is in.
-    let outcome_id = |src: usize, o: &str| -> String {
-        match m.states[src].parent {
+    // The final id of outcome `o` in the region of container `owner`
+    // (`None`: the top region).
+    let outcome_id = |owner: Option<usize>, o: &str| -> String {
+        match owner {
             None => top_at
                 .get(o)
                 .map_or(o.to_string(), |&k| top_final[k].clone()),
@@ -205,11 +208,15 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
         let pad = indent(depth);
         let tag = if s.pseudo.is_some() {
             "history"
+        } else if matches!(&s.body, StateBody::Container(r) if r.parallel) {
+            "parallel"
         } else {
             "state"
         };
         if close {
-            if let StateBody::Container(r) = &s.body {
+            if let StateBody::Container(r) = &s.body
+                && !r.parallel
+            {
                 for (k, fid) in final_id[i].iter().enumerate() {
                     let _ = write!(out, "{pad}  <final id=\"{}\"", escape_attr(fid));
                     if *fid != r.outcomes[k] {
@@ -227,8 +234,28 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             Some(Pseudo::DeepHistory) => attrs.push_str(" type=\"deep\""),
             None => {}
         }
-        if let StateBody::Container(r) = &s.body {
-            let _ = write!(attrs, " initial=\"{}\"", escape_attr(&state_id[r.initial]));
+        if let StateBody::Container(r) = &s.body
+            && !r.parallel
+        {
+            let init = match &r.initial {
+                Target::State(j) => state_id[*j].clone(),
+                Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
+                    outcome_id(Some(i), o)
+                }
+            };
+            let _ = write!(attrs, " initial=\"{}\"", escape_attr(&init));
+        }
+        // A parallel state's outcomes (yasmin's OrthogonalState; SCXML's
+        // `<parallel>` holds no `<final>`).
+        if let StateBody::Container(r) = &s.body
+            && r.parallel
+            && !r.outcomes.is_empty()
+        {
+            let _ = write!(
+                attrs,
+                " btfsm:outcomes=\"{}\"",
+                escape_attr(&r.outcomes.join(" "))
+            );
         }
         if state_id[i] != s.name {
             let _ = write!(attrs, " btfsm:name=\"{}\"", escape_attr(&s.name));
@@ -282,7 +309,8 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             }
             let target = match &t.target {
                 Target::State(j) => state_id[*j].clone(),
-                Target::Outcome(o) => outcome_id(i, o),
+                Target::Outcome(o) => outcome_id(s.parent, o),
+                Target::OuterOutcome { owner, outcome } => outcome_id(*owner, outcome),
             };
             let mut ta = String::new();
             if let Some(e) = event {
@@ -321,7 +349,10 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
         head,
         "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" name=\"{}\" initial=\"{}\"",
         escape_attr(name),
-        escape_attr(&state_id[m.top.initial])
+        escape_attr(&match &m.top.initial {
+            Target::State(j) => state_id[*j].clone(),
+            Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => outcome_id(None, o),
+        })
     );
     if out.contains(" btfsm:") {
         let _ = write!(head, " xmlns:btfsm=\"{BTFSM_NS}\"");

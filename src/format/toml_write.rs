@@ -221,10 +221,22 @@ fn guard_inline(g: &Guard, to: &str) -> String {
     )
 }
 
+/// A region's initial state or outcome, by name.
+fn initial_name(m: &StateMachine, t: &Target) -> String {
+    match t {
+        Target::State(j) => m.states[*j].name.clone(),
+        Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => o.clone(),
+    }
+}
+
 fn write_machine(out: &mut String, m: &StateMachine, max: usize) -> Option<()> {
     let outcomes = |o: &[String]| o.iter().map(|s| quote(s)).collect::<Vec<_>>().join(", ");
-    let _ = writeln!(out, "initial = {}", quote(&m.states[m.top.initial].name));
+    let _ = writeln!(out, "initial = {}", quote(&initial_name(m, &m.top.initial)));
     let _ = writeln!(out, "outcomes = [{}]", outcomes(&m.top.outcomes));
+    if m.top.states.is_empty() {
+        // Only outcomes (an SCXML machine that is one `<final>`).
+        let _ = writeln!(out, "\n[states]");
+    }
     // Pre-order over the state hierarchy, without recursion.
     let mut stack: Vec<usize> = m.top.states.iter().rev().copied().collect();
     while let Some(i) = stack.pop() {
@@ -261,7 +273,15 @@ fn write_machine(out: &mut String, m: &StateMachine, max: usize) -> Option<()> {
                 }
             }
             StateBody::Container(r) => {
-                let _ = writeln!(out, "initial = {}", quote(&m.states[r.initial].name));
+                if r.parallel {
+                    let _ = writeln!(out, "parallel = true");
+                } else {
+                    let _ = writeln!(out, "initial = {}", quote(&initial_name(m, &r.initial)));
+                }
+                if r.states.is_empty() {
+                    // Only outcomes (an SCXML state holding only finals).
+                    let _ = writeln!(out, "states = {{}}");
+                }
                 let _ = writeln!(out, "outcomes = [{}]", outcomes(&r.outcomes));
                 stack.extend(r.states.iter().rev().copied());
             }
@@ -271,6 +291,12 @@ fn write_machine(out: &mut String, m: &StateMachine, max: usize) -> Option<()> {
             Target::State(j) if m.states[*j].parent != s.parent => m.path(*j),
             Target::State(j) => m.states[*j].name.clone(),
             Target::Outcome(o) => o.clone(),
+            // An outcome of an enclosing region: `/OUTCOME` (the machine's),
+            // `PATH/OUTCOME` (the container's at PATH).
+            Target::OuterOutcome { owner, outcome } => match owner {
+                None => format!("/{outcome}"),
+                Some(c) => format!("{}/{outcome}", m.path(*c)),
+            },
         };
         // The text of one state is bounded too (a state may have many
         // transitions to a deep state named by its path).

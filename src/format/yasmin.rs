@@ -18,10 +18,16 @@
 //!   else is an error at the attribute, as yasmin's `validate` refuses it.
 //! - A container's own `<Transition>` children map its outcomes in the
 //!   enclosing machine.
-//! - `<OrthogonalState>` (concurrent regions) is refused with its position:
-//!   the model runs one state per region. `<Param>`, `<Key>`, `<ParamRemap>`,
-//!   `<Remap>` and other elements (data flow, parameters, editor positions)
-//!   are ignored.
+//! - `<OrthogonalState name default_outcome>` is a parallel state
+//!   (`Region::parallel`, as SCXML's `<parallel>`): its `<Region name
+//!   outcomes start_state>` children are its regions, read as nested
+//!   machines and all run at once; its outcomes are its `outcomes` attribute,
+//!   the `outcome` of each `<OutcomeMap>`, its `default_outcome` and its
+//!   `<FinalOutcome>`s (yasmin_factory's `_create_orthogonal_state`), and its
+//!   own `<Transition>`s map them. Which region outcomes give which outcome
+//!   (the `<Item>`s of an `<OutcomeMap>`) is not kept: the graph does not
+//!   count it. `<Param>`, `<Key>`, `<ParamRemap>`, `<Remap>` and other
+//!   elements (data flow, parameters, editor positions) are ignored.
 //!
 //! The document is walked region by region with a queue (no recursion on
 //! nesting depth), and every element and included byte is charged to the
@@ -206,38 +212,44 @@ impl Reader<'_> {
             }
         }
         let kids: Vec<usize> = self.docs[doc].0.elems[elem].children.clone();
+        // An `<OrthogonalState>`: its states are its `<Region>`s, all run at
+        // once; its outcomes also those its `<OutcomeMap>`s and
+        // `default_outcome` give (yasmin's OrthogonalState).
+        let orth = self.docs[doc].0.elems[elem].name == "OrthogonalState";
+        let mut mapped_outcomes: Vec<&str> = Vec::new();
+        if orth {
+            let e = &self.docs[doc].0.elems[elem];
+            mapped_outcomes.extend(e.attr("default_outcome").filter(|o| !o.is_empty()));
+            for &c in &kids {
+                let k = &self.docs[doc].0.elems[c];
+                if k.name == "OutcomeMap"
+                    && let Some(o) = k.attr("outcome")
+                {
+                    mapped_outcomes.push(o);
+                }
+            }
+        }
         for &c in &kids {
             let e = &self.docs[doc].0.elems[c];
             if e.name == "FinalOutcome"
                 && let Some(n) = e.attr("name")
-                && outcome_set.insert(n.to_string())
             {
+                mapped_outcomes.push(n);
+            }
+        }
+        for n in mapped_outcomes {
+            if outcome_set.insert(n.to_string()) {
                 outcomes.push(n.to_string());
             }
         }
         // States, in document order.
         let mut names: HashMap<String, usize> = HashMap::new();
         let mut made: Vec<(usize, usize)> = Vec::new(); // (element, state)
-        // Unsupported states, reported once: transitions to them are not.
-        let mut skipped: std::collections::HashSet<String> = Default::default();
         for &c in &kids {
             let e = &self.docs[doc].0.elems[c];
-            let container = match e.name.as_str() {
-                "State" => false,
-                "StateMachine" => true,
-                "OrthogonalState" => {
-                    if let Some(n) = e.attr("name") {
-                        skipped.insert(n.to_string());
-                    }
-                    let span = e.span.clone();
-                    self.err(
-                        doc,
-                        span,
-                        "`<OrthogonalState>` (concurrent regions) is not supported".into(),
-                        "the FSM/HFSM model runs one state per region; model each region as its own machine",
-                    );
-                    continue;
-                }
+            let container = match (orth, e.name.as_str()) {
+                (false, "State") => false,
+                (false, "StateMachine" | "OrthogonalState") | (true, "Region") => true,
                 _ => continue,
             };
             let Some(name) = e.attr("name").map(str::to_string) else {
@@ -288,7 +300,10 @@ impl Reader<'_> {
             }
             let span = (doc == 0).then(|| e.span.clone());
             let body = if container {
-                StateBody::Container(Region::unset(vec![]))
+                StateBody::Container(Region {
+                    parallel: e.name == "OrthogonalState",
+                    ..Region::unset(vec![])
+                })
             } else {
                 StateBody::Task(None)
             };
@@ -322,19 +337,32 @@ impl Reader<'_> {
             },
             None => made.first().map(|&(_, s)| s),
         };
+        let start = if orth {
+            made.first().map(|&(_, s)| s)
+        } else {
+            start
+        };
         if made.is_empty() {
             if !self.diags.has_errors() {
-                self.err(
-                    doc,
-                    outer_span,
-                    "this state machine has no states".into(),
-                    "add a `<State name=\"...\">` with its `<Transition from=\"...\" to=\"...\"/>`s",
-                );
+                let (msg, hint) = if orth {
+                    (
+                        "this orthogonal state has no regions",
+                        "add `<Region name=\"...\" outcomes=\"...\">` children with their states",
+                    )
+                } else {
+                    (
+                        "this state machine has no states",
+                        "add a `<State name=\"...\">` with its `<Transition from=\"...\" to=\"...\"/>`s",
+                    )
+                };
+                self.err(doc, outer_span, msg.into(), hint);
             }
             return;
         }
-        // Transitions of each state (a container's are its outcome map).
-        for &(c, s) in &made {
+        // Transitions of each state (a container's are its outcome map; a
+        // region of an orthogonal state has none: yasmin reads only its
+        // states).
+        for &(c, s) in made.iter().filter(|_| !orth) {
             let tkids: Vec<usize> = self.docs[doc].0.elems[c].children.clone();
             // An outcome maps to one target (yasmin keeps transitions in a
             // dict): a second one is an error, not a silent overwrite.
@@ -368,8 +396,6 @@ impl Reader<'_> {
                     Target::Outcome(to_v)
                 } else if let Some(&n) = names.get(to_v.as_str()) {
                     Target::State(n)
-                } else if skipped.contains(&to_v) {
-                    continue;
                 } else {
                     self.err(
                         doc,
@@ -398,9 +424,8 @@ impl Reader<'_> {
         };
         let states: Vec<usize> = made.iter().map(|&(_, s)| s).collect();
         let region = Region {
-            initial: start,
-            outcomes,
-            states,
+            parallel: orth,
+            ..Region::at(start, outcomes, states)
         };
         match p.state {
             None => m.top = region,
@@ -408,7 +433,10 @@ impl Reader<'_> {
         }
         // Nested machines: their content, inline or from their file.
         for &(c, s) in &made {
-            if self.docs[doc].0.elems[c].name != "StateMachine" {
+            if !matches!(
+                self.docs[doc].0.elems[c].name.as_str(),
+                "StateMachine" | "OrthogonalState" | "Region"
+            ) {
                 continue;
             }
             if p.depth + 1 > self.limits.max_depth {
@@ -534,7 +562,7 @@ impl Reader<'_> {
 
 /// Is the element a nested machine (a container)?
 fn container_state(e: &XElem) -> bool {
-    e.name == "StateMachine"
+    e.name == "StateMachine" || e.name == "OrthogonalState"
 }
 
 /// The machine's `description` attribute, if any.
@@ -583,9 +611,9 @@ mod tests {
 </StateMachine>"#,
         );
         assert!(!m.hierarchical);
-        assert_eq!(m.states[m.top.initial].name, "Foo");
+        assert_eq!(m.states[m.top.initial_state().unwrap()].name, "Foo");
         assert_eq!(m.top.outcomes, vec!["outcome4"]);
-        let foo = &m.states[m.top.initial];
+        let foo = &m.states[m.top.initial_state().unwrap()];
         assert_eq!(foo.transitions.len(), 2);
         assert_eq!(foo.transitions[0].target, Target::State(0));
         assert_eq!(
@@ -607,7 +635,11 @@ mod tests {
             m.states[0].transitions[0].target,
             Target::Outcome("done".into())
         );
-        assert_eq!(m.states[m.top.initial].name, "a", "the first state starts");
+        assert_eq!(
+            m.states[m.top.initial_state().unwrap()].name,
+            "a",
+            "the first state starts"
+        );
     }
 
     #[test]
@@ -625,35 +657,88 @@ mod tests {
 </StateMachine>"#,
         );
         assert!(m.hierarchical);
-        let nested = &m.states[m.top.initial];
+        let nested = &m.states[m.top.initial_state().unwrap()];
         assert_eq!(nested.name, "NestedSM");
         let StateBody::Container(r) = &nested.body else {
             panic!("not a container")
         };
         assert_eq!(r.outcomes, vec!["outcome1", "outcome2"]);
-        assert_eq!(m.states[r.initial].name, "InnerState");
-        assert_eq!(m.states[r.initial].parent, Some(m.top.initial));
+        assert_eq!(m.states[r.initial_state().unwrap()].name, "InnerState");
+        assert_eq!(
+            m.states[r.initial_state().unwrap()].parent,
+            m.top.initial_state()
+        );
         assert_eq!(nested.transitions.len(), 2);
-        assert_eq!(nested.transitions[0].target, Target::State(m.top.initial));
+        assert_eq!(nested.transitions[0].target, m.top.initial.clone());
     }
 
     #[test]
-    fn bad_targets_start_states_and_orthogonal_states_are_errors_at_once() {
+    fn bad_targets_and_start_states_are_errors_at_once() {
         let e = errors(
             r#"<StateMachine outcomes="end" start_state="nope">
   <State name="a"><Transition from="x" to="nowhere"/></State>
   <State name="a"/>
-  <OrthogonalState name="o"/>
 </StateMachine>"#,
         );
-        assert_eq!(e.len(), 4, "{e:#?}");
+        assert_eq!(e.len(), 3, "{e:#?}");
         assert!(e[0].contains("start state `nope`"), "{e:#?}");
         assert!(
             e.iter()
                 .any(|m| m.contains("`nowhere` is neither a state nor an outcome"))
         );
         assert!(e.iter().any(|m| m.contains("duplicate state `a`")));
-        assert!(e.iter().any(|m| m.contains("`<OrthogonalState>`")));
+        // An orthogonal state needs regions.
+        let e = errors(
+            r#"<StateMachine outcomes="end">
+  <OrthogonalState name="o"/>
+</StateMachine>"#,
+        );
+        assert!(
+            e[0].contains("this orthogonal state has no regions"),
+            "{e:#?}"
+        );
+    }
+
+    /// `<OrthogonalState>`: a parallel state whose `<Region>`s are its
+    /// regions (nested machines, all run at once), whose outcomes are its
+    /// outcome map's, `default_outcome` and its `<FinalOutcome>`s, mapped by
+    /// its own `<Transition>`s.
+    #[test]
+    fn orthogonal_states_are_parallel_regions() {
+        let m = machine(
+            r#"<StateMachine outcomes="done fail" start_state="start">
+  <State name="start"><Transition from="ok" to="par"/></State>
+  <OrthogonalState name="par" default_outcome="timeout">
+    <Transition from="success" to="done"/>
+    <Transition from="timeout" to="fail"/>
+    <OutcomeMap outcome="success"><Item state="A" outcome="a_done"/><Item state="B" outcome="b_done"/></OutcomeMap>
+    <Region name="A" outcomes="a_done" start_state="w"><State name="w"><Transition from="ok" to="a_done"/></State></Region>
+    <Region name="B" outcomes="b_done"><State name="v"><Transition from="ok" to="b_done"/></State></Region>
+  </OrthogonalState>
+</StateMachine>"#,
+        );
+        assert!(m.hierarchical && m.has_parallel());
+        let par = m.states.iter().position(|s| s.name == "par").unwrap();
+        let StateBody::Container(r) = &m.states[par].body else {
+            panic!("a container")
+        };
+        assert!(r.parallel);
+        assert_eq!(r.outcomes, ["timeout", "success"]);
+        let regions: Vec<&str> = r
+            .entered(&m.states)
+            .into_iter()
+            .map(|i| m.states[i].name.as_str())
+            .collect();
+        assert_eq!(regions, ["A", "B"]);
+        assert_eq!(m.states[par].transitions.len(), 2);
+        let g = crate::graph::policy_graph(&Policy {
+            name: "t".into(),
+            description: None,
+            body: PolicyBody::Machine(m.clone()),
+        });
+        // start par A w B v + done fail; start->par, par's 2 outcomes, 2
+        // regions, A->w, B->v, w's and v's transitions.
+        assert_eq!((g.g.node_count(), g.g.edge_count()), (8, 9));
     }
 
     proptest::proptest! {

@@ -7,6 +7,13 @@
 //!   top-level outcome; a transition to a container's own outcome becomes an arc
 //!   to the container's vertex, and each container has one more arc to its
 //!   initial child (Fig. 1 as an HFSM: 17 vertices, 44 arcs).
+//! - Beyond the paper (SCXML): a parallel state has one arc to each of its
+//!   orthogonal regions (the states directly inside it, all entered
+//!   together); a region whose initial is one of its outcomes (a state
+//!   holding only a `<final>`) has no initial arc, and a machine that is only
+//!   outcomes enters at its initial outcome's vertex; a transition to an
+//!   outcome of an enclosing region is an arc to that region's container (or
+//!   to the top-level outcome's vertex), as one to the source's own region's.
 
 use super::{ArcKind, PolicyGraph, Vertex, VertexType};
 use crate::model::skill::{SkillKind, skill_kind};
@@ -60,6 +67,7 @@ pub fn bt_graph(bt: &Bt) -> PolicyGraph {
 /// The vertex type of a state.
 pub fn state_vertex_type(body: &StateBody) -> VertexType {
     match body {
+        StateBody::Container(r) if r.parallel => VertexType::ParallelState,
         StateBody::Container(_) => VertexType::Container,
         StateBody::Decision => VertexType::Decision,
         StateBody::Task(Some(call)) if skill_kind(&call.skill) == Some(SkillKind::Condition) => {
@@ -90,28 +98,31 @@ pub fn machine_graph(m: &StateMachine) -> PolicyGraph {
             vtype: VertexType::Outcome,
         });
     }
+    let top_outcome = |o: &str| {
+        let k = m
+            .top
+            .outcomes
+            .iter()
+            .position(|x| x == o)
+            .expect("validated: outcome of the top region");
+        outcome_base + k
+    };
     for (i, s) in m.states.iter().enumerate() {
         if let StateBody::Container(r) = &s.body {
-            g.add_edge(
-                NodeIndex::new(i),
-                NodeIndex::new(r.initial),
-                ArcKind::Initial,
-            );
+            for c in r.entered(&m.states) {
+                g.add_edge(NodeIndex::new(i), NodeIndex::new(c), ArcKind::Initial);
+            }
         }
         for t in &s.transitions {
             let to = match &t.target {
                 Target::State(j) => *j,
                 Target::Outcome(o) => match s.parent {
                     Some(p) => p,
-                    None => {
-                        let k = m
-                            .top
-                            .outcomes
-                            .iter()
-                            .position(|x| x == o)
-                            .expect("validated: outcome of the top region");
-                        outcome_base + k
-                    }
+                    None => top_outcome(o),
+                },
+                Target::OuterOutcome { owner, outcome } => match owner {
+                    Some(c) => *c,
+                    None => top_outcome(outcome),
                 },
             };
             let kind = match &t.trigger {
@@ -123,6 +134,9 @@ pub fn machine_graph(m: &StateMachine) -> PolicyGraph {
     }
     PolicyGraph {
         g,
-        entry: Some(NodeIndex::new(m.top.initial)),
+        entry: Some(NodeIndex::new(match &m.top.initial {
+            Target::State(s) => *s,
+            Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => top_outcome(o),
+        })),
     }
 }

@@ -30,6 +30,9 @@ pub enum VertexType {
     Decision,
     /// An HFSM container state.
     Container,
+    /// An HFSM parallel state (SCXML `<parallel>`): a container whose states
+    /// are its orthogonal regions.
+    ParallelState,
     /// A terminal outcome (SUCCESS, FAILURE, RUNNING).
     Outcome,
 }
@@ -50,6 +53,7 @@ impl VertexType {
             VertexType::ConditionState => "condition_state",
             VertexType::Decision => "decision",
             VertexType::Container => "container",
+            VertexType::ParallelState => "parallel_state",
             VertexType::Outcome => "outcome",
         }
     }

@@ -202,6 +202,17 @@ fn outcome_never_reached(p: &Policy, out: &mut Sink) {
             regions.push((Some(i), r));
         }
     }
+    // Outcomes reached from deeper inside (SCXML: a nested state's
+    // transition to a final of an enclosing region).
+    let outer: std::collections::HashSet<(Option<usize>, &str)> = m
+        .states
+        .iter()
+        .flat_map(|s| &s.transitions)
+        .filter_map(|t| match &t.target {
+            Target::OuterOutcome { owner, outcome } => Some((*owner, outcome.as_str())),
+            _ => None,
+        })
+        .collect();
     for (owner, r) in regions {
         // One pass over the region's transitions, then one look-up per outcome.
         let reached: std::collections::HashSet<&str> = r
@@ -210,11 +221,17 @@ fn outcome_never_reached(p: &Policy, out: &mut Sink) {
             .flat_map(|&s| &m.states[s].transitions)
             .filter_map(|t| match &t.target {
                 Target::Outcome(x) => Some(x.as_str()),
-                Target::State(_) => None,
+                Target::State(_) | Target::OuterOutcome { .. } => None,
             })
             .collect();
         for o in &r.outcomes {
-            let used = reached.contains(o.as_str());
+            // A region that starts in an outcome reaches it; a parallel
+            // state's outcomes are its regions' completion's (yasmin's
+            // outcome map), not transitions'.
+            let used = r.parallel
+                || r.initial == Target::Outcome(o.clone())
+                || outer.contains(&(owner, o.as_str()))
+                || reached.contains(o.as_str());
             // A region's RUNNING is the tick-driven construction's (Fig. 6).
             if used || o == "RUNNING" {
                 continue;

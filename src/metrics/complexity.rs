@@ -125,7 +125,8 @@ fn bt_control_flow(bt: &Bt) -> ControlFlow {
 
 /// FSM/HFSM control flow: a task or decision state is one vertex, a container
 /// has IN (-> its initial state) and OUT; outcomes of the top level merge into
-/// EXIT.
+/// EXIT. A parallel state's IN reaches each of its regions, and each
+/// compound region's OUT reaches the parallel state's OUT (the join).
 ///
 /// A container's transition on one of its region's outcomes leaves from OUT:
 /// the region has finished with that outcome (every BT converted to an HFSM
@@ -171,7 +172,16 @@ fn machine_control_flow(m: &StateMachine) -> ControlFlow {
     }
     for (i, s) in m.states.iter().enumerate() {
         if let StateBody::Container(r) = &s.body {
-            cf.arc(entry[i], entry[r.initial]);
+            for c in r.entered(&m.states) {
+                cf.arc(entry[i], entry[c]);
+            }
+        }
+        // A compound region of a parallel state joins it when it completes
+        // (the parallel state completes when all of its regions have).
+        if let (Some(p), StateBody::Container(_)) = (s.parent, &s.body)
+            && matches!(&m.states[p].body, StateBody::Container(r) if r.parallel)
+        {
+            cf.arc(exit[i], exit[p]);
         }
         if !matches!(s.body, StateBody::Container(_))
             && let Some(up) = s.parent.and_then(|p| any[p])
@@ -185,6 +195,10 @@ fn machine_control_flow(m: &StateMachine) -> ControlFlow {
                     Some(p) => exit[p],
                     None => 0,
                 },
+                Target::OuterOutcome { owner, .. } => match owner {
+                    Some(p) => exit[*p],
+                    None => 0,
+                },
             };
             let from = match any[i] {
                 Some(v) if preempts(i, t) => v,
@@ -193,7 +207,7 @@ fn machine_control_flow(m: &StateMachine) -> ControlFlow {
             cf.arc(from, to);
         }
     }
-    cf.entry = entry[m.top.initial];
+    cf.entry = m.top.initial_state().map_or(0, |s| entry[s]);
     cf
 }
 

@@ -7,7 +7,7 @@ pub mod fsm;
 pub mod skill;
 
 pub use bt::{Bt, BtNode, BtNodeKind};
-pub use fsm::{Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger};
+pub use fsm::{Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger, UNSET};
 pub use skill::{ArgValue, Guard, GuardTerm, SkillCall, SkillKind};
 
 use std::ops::Range;

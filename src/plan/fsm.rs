@@ -268,11 +268,7 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
     let count = states.len();
     Ok(StateMachine {
         hierarchical: false,
-        top: Region {
-            initial: 0,
-            outcomes: vec!["SUCCESS".into()],
-            states: (0..count).collect(),
-        },
+        top: Region::at(0, vec!["SUCCESS".into()], (0..count).collect()),
         states,
     })
 }

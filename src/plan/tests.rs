@@ -141,7 +141,7 @@ fn machine_shape(m: &crate::model::StateMachine) -> Vec<String> {
                     };
                     let to = match &t.target {
                         Target::State(j) => m.states[*j].name.clone(),
-                        Target::Outcome(o) => o.clone(),
+                        Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => o.clone(),
                     };
                     format!("{trig} -> {to}")
                 })
@@ -150,7 +150,10 @@ fn machine_shape(m: &crate::model::StateMachine) -> Vec<String> {
         })
         .collect();
     out.sort();
-    out.push(format!("initial {}", m.states[m.top.initial].name));
+    out.push(format!(
+        "initial {}",
+        m.states[m.top.initial_state().expect("a state")].name
+    ));
     out
 }
 

@@ -824,7 +824,12 @@ impl<'o> Builder<'o> {
             let mut a = Attrs::default();
             match &s.body {
                 StateBody::Container(r) => {
-                    self.container_nodes(i, &s.label, &key[i], r, &outcome_box);
+                    // A region of a parallel state: a dashed box, as UML
+                    // separates orthogonal regions with dashed lines.
+                    let orthogonal = s.parent.is_some_and(
+                        |p| matches!(&m.states[p].body, StateBody::Container(pr) if pr.parallel),
+                    );
+                    self.container_nodes(i, &s.label, &key[i], r, orthogonal, &outcome_box);
                     continue;
                 }
                 // SCXML history pseudo-states as in UML: a small circle with H / H*.
@@ -865,7 +870,7 @@ impl<'o> Builder<'o> {
                     a.set("tooltip", &tip).style("filled");
                 }
             }
-            if s.parent.is_none() && m.top.initial == i {
+            if s.parent.is_none() && m.top.initial == Target::State(i) {
                 a.set("penwidth", "2.2");
             }
             a.node_highlight(self.vhl(&key[i]));
@@ -912,13 +917,14 @@ impl<'o> Builder<'o> {
             let s = &m.states[i];
             let reg = region(i);
             if let Some(r) = reg {
-                let j = r.initial;
-                let mut a = Attrs::default();
-                if region(j).is_some() {
-                    a.set("lhead", &cluster_name(j));
+                for j in r.entered(&m.states) {
+                    let mut a = Attrs::default();
+                    if region(j).is_some() {
+                        a.set("lhead", &cluster_name(j));
+                    }
+                    a.edge_highlight(self.ahl(&key[i], &key[j], "initial"));
+                    self.edges.push(edge_stmt(&state_id[i], &state_id[j], a));
                 }
-                a.edge_highlight(self.ahl(&key[i], &key[j], "initial"));
-                self.edges.push(edge_stmt(&state_id[i], &state_id[j], a));
             }
             for t in &s.transitions {
                 let mut a = Attrs::default();
@@ -937,7 +943,12 @@ impl<'o> Builder<'o> {
                         }
                         (state_id[j].clone(), key[j].clone())
                     }
-                    Target::Outcome(o) => match s.parent {
+                    Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => match match &t
+                        .target
+                    {
+                        Target::OuterOutcome { owner, .. } => *owner,
+                        _ => s.parent,
+                    } {
                         Some(p) => {
                             let head = outcome_box.get(&(p, o.as_str())).unwrap_or(&state_id[p]);
                             (head.clone(), key[p].clone())
@@ -991,15 +1002,22 @@ impl<'o> Builder<'o> {
         label: &str,
         key: &str,
         r: &crate::model::Region,
+        orthogonal: bool,
         outcome_box: &HashMap<(usize, &str), String>,
     ) {
         let mut ca = Attrs::default();
-        ca.set("label", label)
+        // A parallel state says so in its label (UML's regions).
+        let shown_label = if r.parallel {
+            format!("{label} ‖")
+        } else {
+            label.to_string()
+        };
+        ca.set("label", &shown_label)
             .set("fontname", FONT)
             .set("fontsize", "11")
             .set("labeljust", "l")
             .set("color", "grey40")
-            .style("rounded");
+            .style(if orthogonal { "dashed" } else { "rounded" });
         match self.vhl(key) {
             Some(Highlight::Added) => {
                 ca.set("color", ADDED)
@@ -1397,6 +1415,48 @@ on = { SUCCESS = "SUCCESS", FAILURE = "FAILURE", RUNNING = "RUNNING" }
         insta::assert_snapshot!("fsm", dot);
     }
 
+    /// A parallel state (TOML `parallel = true`): its regions are dashed
+    /// clusters inside its box, one initial arc to each; `/done` is the
+    /// machine's outcome, taken from inside a region.
+    const PARALLEL: &str = r#"kind = "hfsm"
+name = "arm-and-base"
+initial = "both"
+outcomes = ["done"]
+
+[states.both]
+parallel = true
+guards = [{ to = "done", label = "done.state.both" }]
+
+[states.both.states.arm]
+initial = "tuck"
+outcomes = ["arm-ok"]
+
+[states.both.states.arm.states.tuck]
+on = { SUCCESS = "arm-ok" }
+
+[states.both.states.base]
+initial = "move"
+outcomes = ["base-ok"]
+
+[states.both.states.base.states.move]
+on = { SUCCESS = "dock", FAILURE = "/done" }
+
+[states.both.states.base.states.dock]
+on = { SUCCESS = "base-ok" }
+"#;
+
+    #[test]
+    fn parallel_golden() {
+        let p = policy(PARALLEL);
+        let dot = policy_dot(&p, &DotOptions::default());
+        // Two regions with one outcome box each.
+        assert_matches_graph(&p, &dot, 2);
+        assert!(dot.contains("label=\"both ‖\""), "{dot}");
+        assert_eq!(dot.matches("style=dashed").count(), 2, "{dot}");
+        assert!(dot.contains("move -> done [label=FAILURE"), "{dot}");
+        insta::assert_snapshot!("parallel", dot);
+    }
+
     #[test]
     fn hfsm_golden() {
         let p = policy(HFSM);
@@ -1680,11 +1740,7 @@ root = 'go "home" now'
                 name: format!("c{k}"),
                 label: format!("C{k}"),
                 parent: k.checked_sub(1),
-                body: StateBody::Container(Region {
-                    initial: k + 1,
-                    outcomes: ok(),
-                    states: vec![k + 1],
-                }),
+                body: StateBody::Container(Region::at(k + 1, ok(), vec![k + 1])),
                 transitions: vec![to_success()],
                 pseudo: None,
                 span: None,
@@ -1704,11 +1760,7 @@ root = 'go "home" now'
             description: None,
             body: PolicyBody::Machine(StateMachine {
                 hierarchical: true,
-                top: Region {
-                    initial: 0,
-                    outcomes: ok(),
-                    states: vec![0],
-                },
+                top: Region::at(0, ok(), vec![0]),
                 states,
             }),
         };

@@ -115,13 +115,73 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
     enum Item {
         Region(Option<usize>, usize),
         Close(usize),
+        /// `--` between two regions of a parallel state (Mermaid's
+        /// concurrency separator).
+        Separator(usize),
+        /// A region of a parallel state at a depth: its start, and the
+        /// state itself (a block when it holds states).
+        Orthogonal(usize, usize),
     }
+    // The transitions of state `s`, whose region's outcomes are `outcomes`
+    // (an outcome of an enclosing region: that region's outcome state).
+    let transitions = |out: &mut String, pad: &str, s: usize, outcomes: &[String]| {
+        for t in &m.states[s].transitions {
+            let to = match &t.target {
+                Target::State(j) => format!("s{j}"),
+                Target::Outcome(o) => match outcomes.iter().position(|x| x == o) {
+                    Some(k) => outcome_id(m.states[s].parent, k),
+                    None => continue,
+                },
+                Target::OuterOutcome { owner, outcome } => {
+                    let outer = match owner {
+                        None => &m.top.outcomes,
+                        Some(c) => match &m.states[*c].body {
+                            StateBody::Container(r) => &r.outcomes,
+                            _ => continue,
+                        },
+                    };
+                    match outer.iter().position(|x| x == outcome) {
+                        Some(k) => outcome_id(*owner, k),
+                        None => continue,
+                    }
+                }
+            };
+            match label(&t.trigger.label()) {
+                l if l.trim().is_empty() => {
+                    let _ = writeln!(out, "{pad}s{s} --> {to}");
+                }
+                l => {
+                    let _ = writeln!(out, "{pad}s{s} --> {to} : {l}");
+                }
+            }
+        }
+    };
     let mut decisions = Vec::new();
     let mut stack = vec![Item::Region(None, 1)];
     while let Some(item) = stack.pop() {
         let (owner, depth) = match item {
             Item::Close(depth) => {
                 let _ = writeln!(out, "{}}}", "    ".repeat(depth - 1));
+                continue;
+            }
+            Item::Separator(depth) => {
+                let _ = writeln!(out, "{}--", "    ".repeat(depth));
+                continue;
+            }
+            Item::Orthogonal(s, depth) => {
+                let pad = "    ".repeat(depth);
+                let st = &m.states[s];
+                let _ = writeln!(out, "{pad}[*] --> s{s}");
+                if !matches!(st.body, StateBody::Container(_)) {
+                    if matches!(st.body, StateBody::Decision) {
+                        decisions.push(s);
+                    }
+                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&st.label));
+                }
+                transitions(&mut out, &pad, s, &[]);
+                if matches!(st.body, StateBody::Container(_)) {
+                    stack.push(Item::Region(Some(s), depth + 1));
+                }
                 continue;
             }
             Item::Region(owner, depth) => (owner, depth),
@@ -143,8 +203,34 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
                 }
             }
         };
-        if region.initial < m.states.len() {
-            let _ = writeln!(out, "{pad}[*] --> s{}", region.initial);
+        if region.parallel {
+            // Each state is a region of its own, separated by `--`; history
+            // pseudo-states (no region) go in the first.
+            for &s in &region.states {
+                if m.states[s].pseudo.is_some() {
+                    decisions.push(s);
+                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&m.states[s].label));
+                    transitions(&mut out, &pad, s, &[]);
+                }
+            }
+            if owner.is_some() {
+                stack.push(Item::Close(depth));
+            }
+            let regions = region.entered(&m.states);
+            for (k, &c) in regions.iter().enumerate().rev() {
+                stack.push(Item::Orthogonal(c, depth));
+                if k > 0 {
+                    stack.push(Item::Separator(depth));
+                }
+            }
+            continue;
+        }
+        if let Some(i) = region.initial_state() {
+            let _ = writeln!(out, "{pad}[*] --> s{i}");
+        } else if let Target::Outcome(o) = &region.initial
+            && let Some(k) = region.outcomes.iter().position(|x| x == o)
+        {
+            let _ = writeln!(out, "{pad}[*] --> {}", outcome_id(owner, k));
         }
         for (k, o) in region.outcomes.iter().enumerate() {
             let id = outcome_id(owner, k);
@@ -166,23 +252,7 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
             }
         }
         for &s in &region.states {
-            for t in &m.states[s].transitions {
-                let to = match &t.target {
-                    Target::State(j) => format!("s{j}"),
-                    Target::Outcome(o) => match region.outcomes.iter().position(|x| x == o) {
-                        Some(k) => outcome_id(owner, k),
-                        None => continue,
-                    },
-                };
-                match label(&t.trigger.label()) {
-                    l if l.trim().is_empty() => {
-                        let _ = writeln!(out, "{pad}s{s} --> {to}");
-                    }
-                    l => {
-                        let _ = writeln!(out, "{pad}s{s} --> {to} : {l}");
-                    }
-                }
-            }
+            transitions(&mut out, &pad, s, &region.outcomes);
         }
         if owner.is_some() {
             stack.push(Item::Close(depth));
@@ -242,6 +312,48 @@ mod tests {
         let edges = text.matches(" --> ").count();
         assert_eq!(nodes, bt.nodes.len());
         assert_eq!(edges, bt.nodes.len() - 1);
+    }
+
+    /// A parallel state's regions are separated by `--`, each starting with
+    /// its own `[*] -->`; a transition out to the machine's outcome.
+    #[test]
+    fn parallel_regions_are_separated_by_dashes() {
+        let l = crate::format::toml::parse_str(
+            "p.toml",
+            r#"kind = "hfsm"
+name = "arm-and-base"
+initial = "both"
+outcomes = ["done"]
+
+[states.both]
+parallel = true
+guards = [{ to = "done", label = "done.state.both" }]
+
+[states.both.states.arm]
+initial = "tuck"
+outcomes = ["arm-ok"]
+
+[states.both.states.arm.states.tuck]
+on = { SUCCESS = "arm-ok" }
+
+[states.both.states.base]
+initial = "move"
+outcomes = ["base-ok"]
+
+[states.both.states.base.states.move]
+on = { SUCCESS = "dock", FAILURE = "/done" }
+
+[states.both.states.base.states.dock]
+on = { SUCCESS = "base-ok" }
+"#,
+            Path::new("."),
+            &Default::default(),
+        )
+        .unwrap();
+        let text = policy_mermaid(&l.policy);
+        insta::assert_snapshot!("parallel", text);
+        assert_eq!(text.matches("\n        --\n").count(), 1, "{text}");
+        assert!(text.contains("s4 --> o0 : FAILURE"), "{text}");
     }
 
     #[test]

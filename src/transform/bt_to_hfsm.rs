@@ -99,11 +99,7 @@ pub fn bt_to_hfsm(bt: &Bt) -> Result<StateMachine, Vec<Unsupported>> {
             body: if n.children.is_empty() {
                 StateBody::Task(n.skill.clone())
             } else {
-                StateBody::Container(Region {
-                    initial: n.children[0],
-                    outcomes: outcomes(),
-                    states: n.children.clone(),
-                })
+                StateBody::Container(Region::at(n.children[0], outcomes(), n.children.clone()))
             },
             transitions: Vec::new(),
             pseudo: None,
@@ -150,11 +146,7 @@ pub fn bt_to_hfsm(bt: &Bt) -> Result<StateMachine, Vec<Unsupported>> {
     }
     Ok(StateMachine {
         hierarchical: true,
-        top: Region {
-            initial: bt.root,
-            outcomes: outcomes(),
-            states: vec![bt.root],
-        },
+        top: Region::at(bt.root, outcomes(), vec![bt.root]),
         states,
     })
 }

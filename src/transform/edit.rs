@@ -423,6 +423,17 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
                 _ => unreachable!("checked above"),
             },
         };
+        if r.parallel {
+            // A state here would be a new region, run beside the others:
+            // none of the paper's edit operations.
+            return Err(err(
+                format!(
+                    "`{}` is a parallel state: a state added to it would be a region of its own",
+                    container.map_or_else(String::new, |c| m.path(c))
+                ),
+                Some("add the state inside one of its regions (--in REGION)".into()),
+            ));
+        }
         (r.states.clone(), r.outcomes.clone())
     };
     // HFSM vertex identity is the name where it is unique in the machine, so
@@ -909,6 +920,30 @@ mod tests {
         s.within = Some("pick".into());
         let e = add_state(fsm(&mut q), &s).unwrap_err();
         assert!(e.message.contains("not a container"), "{}", e.message);
+    }
+
+    /// A parallel state's states are its regions: adding one is refused;
+    /// adding inside a region works.
+    #[test]
+    fn states_are_not_added_beside_parallel_regions() {
+        let l = crate::format::scxml::parse_str(
+            "p.scxml",
+            r#"<scxml xmlns="http://www.w3.org/2005/07/scxml">
+  <parallel id="p"><state id="r1"><state id="a"><transition event="SUCCESS" target="r1done"/></state><final id="r1done"/></state><state id="r2"><state id="b"/></state></parallel>
+</scxml>"#,
+            &crate::format::Limits::default(),
+        )
+        .unwrap();
+        let mut p = l.policy;
+        let mut s = spec(AddKind::Sequential, "x", None, "Dock");
+        s.within = Some("p".into());
+        let e = add_state(fsm(&mut p), &s).unwrap_err();
+        assert!(e.message.contains("is a parallel state"), "{}", e.message);
+        let s = spec(AddKind::Sequential, "x", Some("a"), "Dock");
+        add_state(fsm(&mut p), &s).unwrap();
+        let m = fsm(&mut p);
+        let x = m.states.iter().position(|s| s.name == "x").unwrap();
+        assert_eq!(m.path(x), "p/r1/x");
     }
 
     #[test]

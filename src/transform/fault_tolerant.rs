@@ -243,7 +243,7 @@ pub fn fault_tolerant(
     // state, then sequential states off the chain in file order.
     let mut chain: Vec<usize> = Vec::new();
     let mut end: Option<String> = None;
-    let mut cur = Some(m.top.initial);
+    let mut cur = m.top.initial_state();
     while let Some(s) = cur.take() {
         if !det.sequential.contains(&s) || chain.contains(&s) {
             break;
@@ -253,7 +253,9 @@ pub fn fault_tolerant(
             if matches!(&t.trigger, Trigger::Outcome(o) if o == SUCCESS) {
                 match &t.target {
                     Target::State(j) => cur = Some(*j),
-                    Target::Outcome(o) => end = Some(o.clone()),
+                    Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
+                        end = Some(o.clone())
+                    }
                 }
                 break;
             }

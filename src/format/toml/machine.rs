@@ -13,11 +13,7 @@ impl Loader {
     ) -> Option<StateMachine> {
         let mut m = StateMachine {
             hierarchical,
-            top: Region {
-                initial: 0,
-                outcomes: vec![],
-                states: vec![],
-            },
+            top: Region::at(0, vec![], vec![]),
             states: Vec::new(),
         };
         // Regions are read breadth-first with an explicit queue (no recursion).
@@ -55,7 +51,15 @@ impl Loader {
             qi += 1;
             let owner =
                 container.map_or_else(|| "the machine".to_string(), |c| format!("`{}`", m.path(c)));
-            let outcomes = self.outcomes(cx, table, &span, &owner);
+            // A parallel state completes when its regions have: SCXML's
+            // has no outcomes (`outcomes` may be left out), yasmin's
+            // OrthogonalState those its outcome map gives.
+            let is_parallel = container.is_some()
+                && table.get("parallel").and_then(|v| v.get_ref().as_bool()) == Some(true);
+            let outcomes = match table.get("outcomes") {
+                None if is_parallel => vec![],
+                _ => self.outcomes(cx, table, &span, &owner),
+            };
             let Some(states_v) = table.get("states") else {
                 self.err(
                     cx,
@@ -118,7 +122,9 @@ impl Loader {
                 };
                 let is_container = st.contains_key("states");
                 let allowed: &[&str] = if is_container {
-                    &["label", "initial", "outcomes", "states", "on", "guards"]
+                    &[
+                        "label", "initial", "outcomes", "states", "on", "guards", "parallel",
+                    ]
                 } else {
                     &[
                         "label", "skill", "args", "decision", "history", "on", "guards",
@@ -290,12 +296,42 @@ impl Loader {
                 region.states.push(idx);
                 local.push((name, idx, k.span()));
             }
-            if local.is_empty() {
+            // A parallel region (SCXML `<parallel>`): every state runs at
+            // once; no `initial`.
+            match container.and(table.get("parallel")) {
+                None => {}
+                Some(pv) => match pv.get_ref().as_bool() {
+                    Some(b) => region.parallel = b,
+                    None => {
+                        self.err(cx, pv.span(), "`parallel` must be `true` or `false`");
+                        ok = false;
+                    }
+                },
+            }
+            let starts_in_outcome = table
+                .get("initial")
+                .and_then(|iv| iv.get_ref().as_str())
+                .is_some_and(|s| outcomes.iter().any(|o| o == s));
+            if local.is_empty() && !starts_in_outcome {
                 self.err(cx, states_v.span(), format!("{owner} has no states"));
                 ok = false;
             }
             // Initial state.
             match table.get("initial") {
+                None if region.parallel => {
+                    if let Some((_, idx, _)) = local.first() {
+                        region.initial = Target::State(*idx);
+                    }
+                }
+                Some(iv) if region.parallel => {
+                    self.err(
+                        cx,
+                        iv.span(),
+                        format!("{owner} is parallel: all its states start, it has no `initial`"),
+                    )
+                    .hint = Some("remove `initial`, or `parallel = true`".into());
+                    ok = false;
+                }
                 None => {
                     let h = local
                         .first()
@@ -311,7 +347,8 @@ impl Loader {
                 }
                 Some(iv) => match iv.get_ref().as_str() {
                     Some(s) => match local.iter().find(|(n, _, _)| n == s) {
-                        Some((_, idx, _)) => region.initial = *idx,
+                        Some((_, idx, _)) => region.initial = Target::State(*idx),
+                        None if starts_in_outcome => region.initial = Target::Outcome(s.into()),
                         None => {
                             let h = self.suggest(s, local.iter().map(|(n, _, _)| n.as_str()));
                             self.err(
@@ -400,6 +437,8 @@ impl Loader {
                     Target::Outcome(target)
                 } else if let Some(&t) = by_path.get(&target) {
                     Target::State(t)
+                } else if let Some(o) = outer_outcome(&m, &by_path, si, &target) {
+                    o
                 } else {
                     let cands: Vec<&str> = region
                         .states
@@ -432,7 +471,7 @@ impl Loader {
         if !ok {
             return None;
         }
-        if m.top.initial != usize::MAX {
+        if !m.top.is_unset() {
             self.unreachable_states(cx, &m);
         }
         Some(m)
@@ -652,4 +691,40 @@ impl Loader {
             }
         }
     }
+}
+
+/// An outcome of a region enclosing state `si` (SCXML imports: a nested
+/// state's transition to a final state further out), written `/OUTCOME` for
+/// the machine's own outcomes and `PATH/OUTCOME` for those of the container
+/// at `PATH`, an ancestor of `si`.
+fn outer_outcome(
+    m: &StateMachine,
+    by_path: &HashMap<String, usize>,
+    si: usize,
+    target: &str,
+) -> Option<Target> {
+    m.states[si].parent?;
+    let (path, o) = target.rsplit_once('/')?;
+    let owner = if path.is_empty() {
+        m.top.outcomes.iter().any(|x| x == o).then_some(None)?
+    } else {
+        let c = *by_path.get(path)?;
+        let StateBody::Container(r) = &m.states[c].body else {
+            return None;
+        };
+        r.outcomes.iter().any(|x| x == o).then_some(Some(c))?
+    };
+    // The owner must enclose the source (further out than its own region).
+    let mut cur = m.states[si].parent;
+    let own = cur;
+    while let Some(p) = cur {
+        if Some(p) == owner && Some(p) != own {
+            break;
+        }
+        cur = m.states[p].parent;
+    }
+    (owner.is_none() || cur.is_some()).then(|| Target::OuterOutcome {
+        owner,
+        outcome: o.to_string(),
+    })
 }

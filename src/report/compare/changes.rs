@@ -346,8 +346,11 @@ impl Pair<'_> {
         let key_a = |u: usize| self.ia.key(u).to_string();
         let key_b = |v: usize| self.ib.key(v).to_string();
         // The machine's own initial state (not a vertex: the graph's entry).
-        let (ia, ib) = (a.top.initial, b.top.initial);
-        if ia < a.states.len() && ib < b.states.len() && fwd.get(ia).copied().flatten() != Some(ib)
+        if let (Target::State(ia), Target::State(ib)) = (&a.top.initial, &b.top.initial)
+            && let (ia, ib) = (*ia, *ib)
+            && ia < a.states.len()
+            && ib < b.states.len()
+            && fwd.get(ia).copied().flatten() != Some(ib)
         {
             s.relabelled.push(Relabel {
                 what: "initial",
@@ -387,11 +390,13 @@ impl Pair<'_> {
                 self.relabel(s, "name", v, (sa.label.clone(), sb.label.clone()));
             }
             if let (StateBody::Container(ra), StateBody::Container(rb)) = (&sa.body, &sb.body)
-                && ra.initial < a.states.len()
-                && rb.initial < b.states.len()
-                && fwd.get(ra.initial).copied().flatten() != Some(rb.initial)
+                && let (Target::State(ia), Target::State(ib)) = (&ra.initial, &rb.initial)
+                && let (ia, ib) = (*ia, *ib)
+                && ia < a.states.len()
+                && ib < b.states.len()
+                && fwd.get(ia).copied().flatten() != Some(ib)
             {
-                self.relabel(s, "initial", v, (key_a(ra.initial), key_b(rb.initial)));
+                self.relabel(s, "initial", v, (key_a(ia), key_b(ib)));
             }
             self.guard_changes(a, b, u, v, fwd, s);
         }
@@ -415,6 +420,10 @@ impl Pair<'_> {
                 Target::Outcome(o) => match m.states.get(st)?.parent {
                     Some(p) => Some(format!("s{p}")),
                     None => Some(format!("o{o}")),
+                },
+                Target::OuterOutcome { owner, outcome } => match owner {
+                    Some(p) => Some(format!("s{p}")),
+                    None => Some(format!("o{outcome}")),
                 },
             }
         };
@@ -440,6 +449,10 @@ impl Pair<'_> {
                 Target::Outcome(o) => match a.states[u].parent {
                     Some(p) => fwd.get(p).copied().flatten().map(|x| format!("s{x}")),
                     None => Some(format!("o{o}")),
+                },
+                Target::OuterOutcome { owner, outcome } => match owner {
+                    Some(p) => fwd.get(*p).copied().flatten().map(|x| format!("s{x}")),
+                    None => Some(format!("o{outcome}")),
                 },
             };
             let Some(head) = head else { continue };
@@ -489,6 +502,10 @@ impl Pair<'_> {
             Target::Outcome(o) => match b.states.get(v)?.parent {
                 Some(p) => Some(self.ib.key(p)),
                 None => Some(Text::from(o.as_str())),
+            },
+            Target::OuterOutcome { owner, outcome } => match owner {
+                Some(p) => Some(self.ib.key(*p)),
+                None => Some(Text::from(outcome.as_str())),
             },
         }
     }

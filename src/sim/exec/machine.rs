@@ -119,7 +119,7 @@ enum Flow<'a> {
 
 impl MachineExec {
     pub fn new(c: Arc<CompiledMachine>, record: bool) -> Self {
-        let current = c.m.top.initial;
+        let current = Self::start(&c);
         MachineExec {
             current,
             finished: None,
@@ -130,6 +130,13 @@ impl MachineExec {
         }
     }
 
+    /// The state a run starts in (the scenario reader refuses machines that
+    /// start in an outcome or hold parallel regions: see
+    /// `sim::scenario::policies`).
+    fn start(c: &CompiledMachine) -> usize {
+        c.m.top.initial_state().unwrap_or(0)
+    }
+
     fn holds(s: usize, terms: &GuardTerms, leaves: &mut impl Leaves) -> bool {
         terms.iter().all(|(c, neg)| leaves.condition(s, c) != *neg)
     }
@@ -138,6 +145,7 @@ impl MachineExec {
         match t {
             Target::State(s) => Flow::Enter(*s),
             Target::Outcome(o) => Flow::Up(c.m.states[from].parent, o),
+            Target::OuterOutcome { owner, outcome } => Flow::Up(*owner, outcome),
         }
     }
 
@@ -190,11 +198,11 @@ impl MachineExec {
             let (from, outcome) = match flow {
                 Flow::Up(None, o) => {
                     if o == "RUNNING" {
-                        self.current = c.m.top.initial;
+                        self.current = Self::start(&c);
                         return Status::Running;
                     }
                     if o == "SUCCESS" && self.keep_ticking {
-                        self.current = c.m.top.initial;
+                        self.current = Self::start(&c);
                         return Status::Success;
                     }
                     // `after_failure = "keep-ticking"` (the default of a
@@ -202,7 +210,7 @@ impl MachineExec {
                     // BT -> HFSM construction makes): re-entered after a
                     // failure, as a BT's root is ticked again.
                     if o != "SUCCESS" && self.reenter_on_failure {
-                        self.current = c.m.top.initial;
+                        self.current = Self::start(&c);
                         return Status::Failure;
                     }
                     let st = if o == "SUCCESS" {
@@ -227,7 +235,12 @@ impl MachineExec {
                     }
                     let st = match &c.m.states[s].body {
                         StateBody::Container(r) => {
-                            flow = Flow::Enter(r.initial);
+                            flow = match &r.initial {
+                                Target::State(i) => Flow::Enter(*i),
+                                Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
+                                    Flow::Up(Some(s), o)
+                                }
+                            };
                             continue;
                         }
                         StateBody::Decision => Status::Running,
@@ -266,7 +279,7 @@ impl MachineExec {
                     return Status::Running;
                 }
                 None if self.reenter_on_failure && outcome != "SUCCESS" => {
-                    self.current = c.m.top.initial;
+                    self.current = Self::start(&c);
                     return Status::Failure;
                 }
                 None => {

@@ -268,6 +268,25 @@ impl Reader {
             }
         }
         check_bindings(&policy, &loaded.path, limits, world, &mut self.diags);
+        // The executor runs one state per region, from a state.
+        if let PolicyBody::Machine(m) = &policy.body {
+            if m.has_parallel() {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` has parallel regions (SCXML `<parallel>`): the simulator runs one state at a time"),
+                    "simulate each region as its own machine; `analyze`, `dot` and `compare` take the whole machine",
+                );
+                return None;
+            }
+            if m.top.initial_state().is_none() {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` starts in an outcome: it has no state to run"),
+                    "give the machine a state to start in",
+                );
+                return None;
+            }
+        }
         if convert.is_none()
             && let PolicyBody::Machine(m) = &policy.body
             && m.top.outcomes.iter().any(|o| o == "RUNNING")

@@ -3,10 +3,12 @@
 // parsed diagram must hold the policy's graph as `btfsm analyze` counts it.
 //   BT (flowchart):  vertices = V, edges = E, one vertex per node id n<i>.
 //   FSM/HFSM (stateDiagram-v2): states s<i> = V - top-level outcomes,
-//   composite states = containers, transitions (arrows between states) =
-//   E - containers,
+//   composite states = containers (parallel states included),
 //   arrows from a start pseudo-state = containers + 1 (the initial state of
-//   every region).
+//   every region), where each of the D regions of the P parallel states
+//   (Mermaid's `--` dividers) has its own start instead of the parallel
+//   state's: containers + 1 - P + D, transitions (arrows between states) =
+//   E - (containers - P + D) (btfsm's graph has one initial arc per region).
 // Usage: node check.mjs BTFSM [FLAG...] -- FILE...   (FLAGs go to both
 // commands, e.g. --nodes-model; exit 1 when any policy disagrees)
 import { JSDOM } from 'jsdom';
@@ -46,15 +48,23 @@ for (const file of files) {
     expect(file, 'generated ids', v.filter((x) => /^n\d+$/.test(x.id)).length, a.vertices);
   } else {
     const g = db.getData();
-    const containers = a.counts.container ?? 0;
+    const parallels = a.counts.parallel_state ?? 0;
+    const containers = (a.counts.container ?? 0) + parallels;
+    const dividers = g.nodes.filter((n) => n.shape === 'divider').length;
     const outcomes = a.counts.outcome ?? 0;
     const states = g.nodes.filter((n) => /^s\d+$/.test(n.id));
     expect(file, 'states', states.length, a.vertices - outcomes);
-    expect(file, 'composite states', g.nodes.filter((n) => n.isGroup).length, containers);
+    expect(file, 'composite states', g.nodes.filter((n) => n.isGroup && n.shape !== 'divider').length, containers);
+    if (parallels === 0) expect(file, 'regions of parallel states', dividers, 0);
     const starts = new Set(g.nodes.filter((n) => n.shape === 'stateStart').map((n) => n.id));
     const ends = new Set(g.nodes.filter((n) => n.shape === 'stateEnd').map((n) => n.id));
-    expect(file, 'transitions', g.edges.filter((e) => !starts.has(e.start) && !ends.has(e.end)).length, a.edges - containers);
-    expect(file, 'initial arrows', g.edges.filter((e) => starts.has(e.start)).length, containers + 1);
+    // A region that starts in one of its outcomes (an SCXML state holding
+    // only a `<final>`) has a start arrow to it but no arc in btfsm's graph
+    // (the machine's own start, `root_start`, is no arc either way).
+    const toOutcome = g.edges.filter((e) => starts.has(e.start) && e.start !== 'root_start' && /^o\d+(_\d+)?$/.test(e.end)).length;
+    const regions = containers - parallels + dividers;
+    expect(file, 'transitions', g.edges.filter((e) => !starts.has(e.start) && !ends.has(e.end)).length, a.edges - (regions - toOutcome));
+    expect(file, 'initial arrows', g.edges.filter((e) => starts.has(e.start)).length, regions + 1);
   }
 }
 console.log(`mermaid oracle: ${files.length - failed} of ${files.length} policies parse with their graph`);
