@@ -90,7 +90,7 @@ pub enum Command {
         #[arg(long, default_value_t = 2000, value_name = "MS")]
         timeout_ms: u64,
         /// Work budget of the exact search per mode, in work units (one per
-        /// assignment-matrix entry the search builds; 15-60 ns each).
+        /// assignment-matrix entry the search builds; 20-50 ns each).
         /// The same pair gives the same result (GED, exact, interval) on any
         /// machine under any load; when the budget runs out the result is a
         /// certified interval with `exact: false` and `stopped_by: work`

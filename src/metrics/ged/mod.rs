@@ -105,15 +105,16 @@ pub struct GedOptions {
     pub timeout: Duration,
     /// Work budget of the branch and bound, in work units: one unit per
     /// entry of an assignment matrix built to bound a search node (a node
-    /// with k unmapped vertices costs about k² units, plus one), and per
-    /// (vertex, image) pair scored by the forest bound (`treebound.rs`):
-    /// 15 to 60 ns each on the machine of docs/performance.md. Structural GED on labeled graphs
+    /// with k unmapped vertices costs about k² units, plus n + 1 for its
+    /// set-up), and per (vertex, image) pair scored by the forest bound
+    /// (`treebound.rs`): 20 to 50 ns each on the machine of
+    /// docs/performance.md. Structural GED on labeled graphs
     /// may run up to three searches (see `structural`), each with a third.
     pub work: u64,
 }
 
-/// The default work budget ([`GedOptions::work`]): 0.3 to 1.2 s on the
-/// machine of docs/performance.md, inside the default 2 s cap.
+/// The default work budget ([`GedOptions::work`]): 0.4 to 1 s on the
+/// machine of docs/performance.md under load, inside the default 2 s cap.
 pub const DEFAULT_WORK: u64 = 20_000_000;
 
 impl Default for GedOptions {

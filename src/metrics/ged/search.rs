@@ -759,7 +759,7 @@ impl<'a> Bnb<'a> {
             let (est, v) = top.children[top.cur];
             let u = top.u;
             self.expansions += 1;
-            self.work += 1;
+            self.work += 1 + self.n as u64;
             if self.work > self.lim.work || Instant::now() > self.lim.deadline {
                 timed_out = true;
                 break;
