@@ -10,11 +10,12 @@
 //! - `Structural`: the minimum over all vertex mappings — what NetworkX's
 //!   `graph_edit_distance` computes by default, which the paper used, but with
 //!   self-loops scored correctly (NetworkX issues #5400, #8188). NP-hard:
-//!   exact by an embedding fast path (`embed.rs`) and a branch and bound
-//!   with assignment lower bounds (`search.rs`); when the work budget (or
-//!   the wall-clock safety cap) runs out, a certified interval
-//!   `[lower_bound, upper_bound]` with `exact = false`, never a guess, and
-//!   the reason ([`StopReason`]).
+//!   exact by an embedding fast path (`embed.rs`), a Lagrangian forest
+//!   bound and search when one side is a forest (`treebound.rs`), and a
+//!   branch and bound with assignment lower bounds (`search.rs`); when the
+//!   work budget (or the wall-clock safety cap) runs out, a certified
+//!   interval `[lower_bound, upper_bound]` with `exact = false`, never a
+//!   guess, and the reason ([`StopReason`]).
 //! - `Labeled`: the same, but a vertex maps only to a vertex of the same
 //!   type.
 //! - `Named`: vertices map by key; linear time (plus sorting the script),
@@ -33,7 +34,9 @@
 //! Files: `graph.rs` the compact graph; `problem.rs` the padded instance and
 //! its cost; `embed.rs` the count-bound fast path; `lsap.rs` linear
 //! assignment; `local.rs` 2-swap local search; `wl.rs` Weisfeiler–Lehman
-//! tie-breaking; `search.rs` the branch and bound; `script.rs` edit scripts
+//! tie-breaking; `treebound.rs` the Lagrangian forest bound and its search
+//! (when one side is a forest: BTs); `search.rs` the branch and bound;
+//! `script.rs` edit scripts
 //! and the named mapping; `brute.rs` and `tests.rs` the test oracle and
 //! tests.
 
@@ -95,7 +98,8 @@ impl GedMode {
 ///
 /// Memory does not grow with either budget: with n the larger vertex count,
 /// the search holds two n × n tables (4 + 1 bytes per entry) and a stack of
-/// at most n frames of O(n) words. Above 2048 vertices no search is made
+/// at most n frames of O(n) words; when one side is a forest, the forest
+/// bound adds one n × n table of 8 bytes per entry. Above 2048 vertices no search is made
 /// (the count bound and a local-search mapping are returned).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GedOptions {
@@ -113,9 +117,11 @@ pub struct GedOptions {
     pub work: u64,
 }
 
-/// The default work budget ([`GedOptions::work`]): 0.4 to 1 s on the
-/// machine of docs/performance.md under load, inside the default 2 s cap.
-pub const DEFAULT_WORK: u64 = 20_000_000;
+/// The default work budget ([`GedOptions::work`]): 0.2 to 0.5 s on the
+/// machine of docs/performance.md at load average 9 (two cores shared by
+/// nine busy processes), up to about 1 s on the slowest pairs there, inside
+/// the default 2 s cap.
+pub const DEFAULT_WORK: u64 = 10_000_000;
 
 impl Default for GedOptions {
     fn default() -> Self {

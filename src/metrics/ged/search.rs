@@ -46,6 +46,10 @@
 //! sibling leaves of one type) are branched in index order onto increasing
 //! images.
 //!
+//! **Forests.** When one side is a forest (BTs), the forest search of
+//! `treebound.rs` runs first with three quarters of the work budget; its
+//! bound and best mapping seed this search.
+//!
 //! **Budgets.** Work, not time, decides where the search stops: each node
 //! evaluated charges the entries of its assignment matrices (Σ k² over
 //! classes, plus one) to the work budget, so a pair gets the same result on

@@ -69,6 +69,8 @@ struct Dp<'a> {
     fixed: Vec<u32>,
     /// Vertices of `b` that are the fixed image of some vertex.
     used: Vec<bool>,
+    /// Work budget: an evaluation that goes past it is abandoned.
+    limit: u64,
 }
 
 /// Children `(child, multiplicity)` of each vertex, a children-first
@@ -126,6 +128,7 @@ impl<'a> Dp<'a> {
             aborted: false,
             fixed: vec![NONE; n],
             used: vec![false; n],
+            limit: u64::MAX,
         })
     }
 
@@ -199,6 +202,12 @@ impl<'a> Dp<'a> {
     fn evaluate(&mut self, lambda: &[i64], deadline: Instant) -> Option<i64> {
         let n = self.a.n;
         for oi in 0..self.order.len() {
+            // Large instances: the budget and the clock are read at every
+            // vertex, an evaluation cut short is flagged, not used.
+            if oi % 16 == 15 && (self.work > self.limit || Instant::now() > deadline) {
+                self.aborted = true;
+                return Some(i64::MAX);
+            }
             let x = self.order[oi];
             let cls = self.class_of[x as usize] as usize;
             let base: i64 = self.children[x as usize]
@@ -465,7 +474,8 @@ const MAX_DEPTH: usize = MAX_TREE_N;
 pub(crate) fn solve(p: &Problem, best: &[u32], work: u64, deadline: Instant) -> Option<TreeBound> {
     let flip = forest(&p.s1).is_none();
     let (a, b) = if flip { (&p.s2, &p.s1) } else { (&p.s1, &p.s2) };
-    let dp = Dp::new(a, b, p)?;
+    let mut dp = Dp::new(a, b, p)?;
+    dp.limit = work;
     let n = p.n();
     let total = p.vertex_cost + p.s1.arcs + p.s2.arcs;
     let mut s = Search {
