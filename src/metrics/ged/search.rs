@@ -46,9 +46,10 @@
 //! sibling leaves of one type) are branched in index order onto increasing
 //! images.
 //!
-//! **Forests.** When one side is a forest (BTs), the forest search of
-//! `treebound.rs` runs first with three quarters of the work budget; its
-//! bound and best mapping seed this search.
+//! **Forest bound.** The Lagrangian search of `treebound.rs` (over a forest
+//! side, such as a BT's, or a spanning branching) runs first with three
+//! quarters of the work budget; its best mapping seeds this search and its
+//! bound is kept beside this search's own.
 //!
 //! **Budgets.** Work, not time, decides where the search stops: each node
 //! evaluated charges the entries of its assignment matrices (Σ k² over
@@ -858,9 +859,12 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     if lb >= ub {
         return done(ub, ub, best, stats);
     }
-    // The forest search, when one side is a forest (BTs): three quarters
-    // of the work budget; the general search below gets the rest.
+    // The forest search (`treebound.rs`): three quarters of the work
+    // budget; the general search below gets the rest.
     let mut lim = *lim;
+    // Kept apart from the search's own root bound: as a floor under every
+    // node's bound it would flatten the order of children (by bound).
+    let mut tree_lb = 0;
     if p.n() <= MAX_SEARCH_N
         && let Some(tb) = treebound::solve(p, &best, lim.work / 4 * 3, lim.deadline)
     {
@@ -873,20 +877,20 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
                 ub = c;
             }
         }
-        lb = lb.max(tb.lower);
-        if lb >= ub {
+        tree_lb = tb.lower;
+        if lb.max(tree_lb) >= ub {
             return done(ub, ub, best, stats);
         }
     }
     // Setting the search up costs O(n²) (its tables): not when the budget
     // is already spent.
     if p.n() > MAX_SEARCH_N || Instant::now() >= lim.deadline {
-        let mut out = done(lb, ub, best, stats);
+        let mut out = done(lb.max(tree_lb).min(ub), ub, best, stats);
         out.too_large = p.n() > MAX_SEARCH_N;
         return out;
     }
     let mut bnb = Bnb::new(p, ub, best, lim);
-    let lower = bnb.run(lb);
+    let lower = bnb.run(lb).max(tree_lb).min(bnb.ub);
     stats.root_lower = bnb.root_lower;
     stats.expansions = bnb.expansions;
     stats.work = bnb.work;
