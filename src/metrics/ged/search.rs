@@ -859,15 +859,21 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     if lb >= ub {
         return done(ub, ub, best, stats);
     }
-    // The forest search (`treebound.rs`): three quarters of the work
-    // budget; the general search below gets the rest.
+    // The forest search (`treebound.rs`). On a forest (BTs) it runs first,
+    // with three quarters of the work budget, and this search gets the rest.
+    // On other graphs only its root bound runs first; this search gets a
+    // quarter, and if that does not settle the value the forest search
+    // (over a spanning branching) gets what remains, from the best mapping.
     let mut lim = *lim;
-    // Kept apart from the search's own root bound: as a floor under every
+    let total_work = lim.work;
+    // Kept apart from this search's own root bound: as a floor under every
     // node's bound it would flatten the order of children (by bound).
     let mut tree_lb = 0;
+    let mut forest = false;
     if p.n() <= MAX_SEARCH_N
-        && let Some(tb) = treebound::solve(p, &best, lim.work / 4 * 3, lim.deadline)
+        && let Some(tb) = treebound::solve(p, &best, total_work / 4 * 3, lim.deadline, false)
     {
+        forest = tb.forest;
         lim.work = lim.work.saturating_sub(tb.work);
         stats.tree_lower = Some(tb.lower);
         if let Some(s) = tb.mapping {
@@ -889,12 +895,33 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
         out.too_large = p.n() > MAX_SEARCH_N;
         return out;
     }
+    let general_first = p.n() <= MAX_SEARCH_N && !forest;
+    if general_first {
+        lim.work = lim.work.min(total_work / 4);
+    }
     let mut bnb = Bnb::new(p, ub, best, lim);
-    let lower = bnb.run(lb).max(tree_lb).min(bnb.ub);
+    let mut lower = bnb.run(lb).max(tree_lb).min(bnb.ub);
     stats.root_lower = bnb.root_lower;
     stats.expansions = bnb.expansions;
     stats.work = bnb.work;
-    done(lower, bnb.ub, bnb.best, stats)
+    let (mut ub, mut best) = (bnb.ub, bnb.best);
+    let left = total_work.saturating_sub(bnb.work);
+    if general_first
+        && lower < ub
+        && left > 0
+        && Instant::now() < lim.deadline
+        && let Some(tb) = treebound::solve(p, &best, left, lim.deadline, true)
+    {
+        if let Some(s) = tb.mapping {
+            let c = p.cost(&s);
+            if c < ub {
+                best = s;
+                ub = c;
+            }
+        }
+        lower = lower.max(tb.lower).min(ub);
+    }
+    done(lower, ub, best, stats)
 }
 
 #[cfg(test)]

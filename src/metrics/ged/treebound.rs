@@ -53,6 +53,8 @@ pub(crate) struct TreeBound {
     /// A bijection (of the instance's orientation) from a relaxed optimum.
     pub mapping: Option<Vec<u32>>,
     pub work: u64,
+    /// One side is a forest (the search went over it).
+    pub forest: bool,
 }
 
 /// One orientation: `a` is the forest side, `b` the other; `flip` says
@@ -543,20 +545,27 @@ const MAX_DEPTH: usize = MAX_TREE_N;
 /// The forest bound of `p` and its search (over a forest side if there is
 /// one, else over a spanning branching of `s1`): the Lagrangian bound at
 /// the root, then (up to `work` units, on padded sizes up to 256) a
-/// depth-first branch and bound with the same bound at every node. `best`
+/// depth-first branch and bound with the same bound at every node (on a
+/// branching that is not a forest only if `search_any`). `best`
 /// is the best bijection known. The bound returned is certified; when the
 /// search finished it equals the cost of `mapping`. `None` only if the
 /// root is infeasible or out of budget before one evaluation.
-pub(crate) fn solve(p: &Problem, best: &[u32], work: u64, deadline: Instant) -> Option<TreeBound> {
+pub(crate) fn solve(
+    p: &Problem,
+    best: &[u32],
+    work: u64,
+    deadline: Instant,
+    search_any: bool,
+) -> Option<TreeBound> {
     let b1 = Branching::of(&p.s1);
-    let (flip, br) = if b1.is_forest() {
-        (false, b1)
+    let (flip, br, forest) = if b1.is_forest() {
+        (false, b1, true)
     } else {
         let b2 = Branching::of(&p.s2);
         if b2.is_forest() {
-            (true, b2)
+            (true, b2, true)
         } else {
-            (false, b1)
+            (false, b1, false)
         }
     };
     let (a, b) = if flip { (&p.s2, &p.s1) } else { (&p.s1, &p.s2) };
@@ -579,7 +588,7 @@ pub(crate) fn solve(p: &Problem, best: &[u32], work: u64, deadline: Instant) -> 
     };
     let start_cost = s.best_cost;
     let root = s.lagrange(ROOT_STEPS)?;
-    let open = if n <= MAX_TREE_N && !s.stopped {
+    let open = if (forest || search_any) && n <= MAX_TREE_N && !s.stopped {
         s.branch(root, 0)
     } else {
         root
@@ -596,6 +605,7 @@ pub(crate) fn solve(p: &Problem, best: &[u32], work: u64, deadline: Instant) -> 
         lower,
         mapping: (s.best_cost < start_cost).then_some(s.best),
         work: s.dp.work,
+        forest,
     })
 }
 
@@ -664,14 +674,14 @@ mod tests {
                 let p = Problem::new(g1, g2);
                 let start = p.greedy();
                 let far = Instant::now() + Duration::from_secs(60);
-                let tb = solve(&p, &start, u64::MAX, far).expect("one side is a forest");
+                let tb = solve(&p, &start, u64::MAX, far, true).expect("one side is a forest");
                 let best = tb.mapping.unwrap_or_else(|| start.clone());
                 assert!(p.is_valid(&best));
                 assert_eq!(tb.lower, truth, "pair {i}");
                 assert_eq!(p.cost(&best), truth, "pair {i}");
                 closed += 1;
                 // Cut short by a tiny work budget: still a certified bound.
-                let cut = solve(&p, &start, 1 + i as u64 % 40, far).expect("forest");
+                let cut = solve(&p, &start, 1 + i as u64 % 40, far, true).expect("forest");
                 assert!(cut.lower <= truth, "pair {i}");
                 if let Some(m) = cut.mapping {
                     assert!(p.is_valid(&m) && p.cost(&m) >= truth);
@@ -712,12 +722,12 @@ mod tests {
             let p = Problem::new(&a, &b);
             let start = p.greedy();
             let far = Instant::now() + Duration::from_secs(60);
-            let tb = solve(&p, &start, u64::MAX, far).expect("a branching always exists");
+            let tb = solve(&p, &start, u64::MAX, far, true).expect("a branching always exists");
             assert_eq!(tb.lower, truth, "pair {i}");
             let best = tb.mapping.unwrap_or_else(|| start.clone());
             assert!(p.is_valid(&best));
             assert_eq!(p.cost(&best), truth, "pair {i}");
-            let cut = solve(&p, &start, 1 + i as u64 % 40, far).expect("branching");
+            let cut = solve(&p, &start, 1 + i as u64 % 40, far, true).expect("branching");
             assert!(cut.lower <= truth, "pair {i}");
             tight += usize::from(cut.lower == truth);
         }
