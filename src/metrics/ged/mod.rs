@@ -346,8 +346,8 @@ pub fn search_mapping(
 /// Structural GED. When the graphs carry more than one label, a labeled
 /// mapping is also a structural one, and on policy graphs usually a very
 /// good one, while the labeled search is far easier (its classes are
-/// small); so if a first structural search (a third of the work budget)
-/// does not settle the value, a labeled search (another third) seeds a
+/// small); so, unless a side is a forest, if a first structural search (a
+/// third of the work budget) does not settle the value, a labeled search (another third) seeds a
 /// second structural search with its mapping. Both structural lower bounds
 /// are certified; the larger is kept. The split is by work, never by time.
 /// Returns the bound, the mapping, and whether the graphs were too large
@@ -368,7 +368,10 @@ fn structural(
         .iter()
         .chain(b.labels())
         .any(|l| Some(l) != first_label);
-    if !multi_class {
+    // One search with the whole budget when there is one class, or when a
+    // side is a forest (BTs): the forest search settles those far better
+    // than a labeled seed would help it.
+    if !multi_class || treebound::has_forest(&st.p) {
         let lim = search::Limits { deadline, work };
         let out = search::solve(&st.p, &lim, None);
         return (out.lower, st.to_ab(&out.sigma), out.too_large);

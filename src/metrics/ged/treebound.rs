@@ -360,6 +360,12 @@ impl<'a> Dp<'a> {
     }
 }
 
+/// Whether either side of `p` is a forest (then the forest search alone is
+/// strong: `structural` gives it the whole budget).
+pub(crate) fn has_forest(p: &Problem) -> bool {
+    Branching::of(&p.s1).is_forest() || Branching::of(&p.s2).is_forest()
+}
+
 /// Repairs a class-preserving map with repeats into a bijection: the first
 /// claim of each image wins (vertices in index order), the rest are filled
 /// with free images of their class in index order.
