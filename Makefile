@@ -73,6 +73,7 @@ differential: $(VENV)/.installed
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_check.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_check.txt
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
+	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).
@@ -115,9 +116,13 @@ paper-docs:
 bench: build
 	$(CARGO) bench --locked
 
-# btfsm vs NetworkX on the same GED pairs, in one run (docs/performance.md).
-bench-ged:
+# btfsm vs NetworkX, then vs HiGHS (highspy, the exact MIP oracle of
+# `make differential`), each on the same GED pairs in one run
+# (docs/performance.md).
+bench-ged: $(VENV)/.installed
 	python3 bench/ged_vs_networkx.py
+	$(CARGO) build --quiet --locked --release
+	$(VENV)/bin/python bench/ged_vs_highs.py $(BIN)
 
 # Each fuzz target for FUZZ_SECONDS (default 600) with cargo-fuzz on nightly
 # (docs/robustness.md); FUZZ_TARGETS="toml_policy" runs only some.

@@ -37,7 +37,7 @@ pub fn limits() -> Limits {
 pub fn ged_options() -> GedOptions {
     GedOptions {
         timeout: Duration::from_millis(20),
-        max_expansions: 2_000,
+        work: 200_000,
     }
 }
 

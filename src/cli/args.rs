@@ -83,12 +83,19 @@ pub enum Command {
         /// vertex type only), named (by node id / state name), or all three
         #[arg(long, value_enum, default_value_t = CompareMode::All)]
         mode: CompareMode,
-        /// Time budget per mode, its whole computation (graphs, search, edit
-        /// script; docs/robustness.md gives the floor on large graphs); when
-        /// the search runs out the result is a certified interval with
-        /// `exact: false`
+        /// Wall-clock safety cap per mode, its whole computation (graphs,
+        /// search, edit script; docs/robustness.md gives the floor on large
+        /// graphs). The work budget (--work) decides the result; when this
+        /// cap ends a search first the report says `stopped_by: timeout`
         #[arg(long, default_value_t = 2000, value_name = "MS")]
         timeout_ms: u64,
+        /// Work budget of the exact search per mode, in work units (one per
+        /// assignment-matrix entry the search builds; 20-50 ns each).
+        /// The same pair gives the same result (GED, exact, interval) on any
+        /// machine under any load; when the budget runs out the result is a
+        /// certified interval with `exact: false` and `stopped_by: work`
+        #[arg(long, default_value_t = crate::metrics::ged::DEFAULT_WORK, value_name = "UNITS")]
+        work: u64,
         /// Output format
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
         format: CompareFormat,

@@ -22,6 +22,8 @@ pub struct CompareArgs {
     pub b: PathBuf,
     pub mode: CompareMode,
     pub timeout_ms: u64,
+    /// Work budget (`GedOptions::work`).
+    pub work: u64,
     pub format: CompareFormat,
     pub dot: Option<PathBuf>,
     pub render: Option<RenderFormat>,
@@ -40,7 +42,7 @@ pub fn execute(args: CompareArgs) -> u8 {
     };
     let opts = GedOptions {
         timeout: Duration::from_millis(args.timeout_ms),
-        ..GedOptions::default()
+        work: args.work,
     };
     let pair = Pair::new(
         Side {

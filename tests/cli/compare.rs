@@ -281,3 +281,56 @@ fn compare_markdown_for_a_pull_request_comment() {
     assert_eq!(diff.lines().filter(|l| !l.starts_with('~')).count(), 6);
     assert!(out.trim_end().ends_with("</details>"));
 }
+
+/// The work budget, not the clock, decides the result: the same dense pair
+/// under a tiny `--work` gives one certified interval, `stopped_by: work`,
+/// whatever the wall-clock cap; and at the default budget Fig. 1 → Fig. 4
+/// is exact with a cap far above what it needs or at the default one.
+#[test]
+fn compare_work_budget_is_deterministic_and_reported() {
+    let (a, b) = (
+        "policies/paper/fig08d-fsm.toml",
+        "policies/paper/scal-fsm.toml",
+    );
+    let keys = |v: &serde_json::Value| {
+        let m = &v["structural"];
+        (
+            m["ged"].clone(),
+            m["exact"].clone(),
+            m["lower_bound"].clone(),
+            m["upper_bound"].clone(),
+            m["stopped_by"].clone(),
+        )
+    };
+    let runs: Vec<_> = ["2000", "600000", "2000"]
+        .iter()
+        .map(|t| {
+            keys(&compare_json(
+                a,
+                b,
+                &["--mode", "structural", "--work", "20000", "--timeout-ms", t],
+            ))
+        })
+        .collect();
+    assert_eq!(runs[0], runs[1]);
+    assert_eq!(runs[0], runs[2]);
+    assert_eq!(runs[0].1, false);
+    assert_eq!(runs[0].4, "work");
+    let (code, stdout, _) = btfsm(&["compare", a, b, "--mode", "structural", "--work", "20000"]);
+    assert_eq!(code, 0);
+    assert!(
+        stdout.contains("the work budget (--work) ended the search"),
+        "{stdout}"
+    );
+    // Exact results carry no `stopped_by`, whatever the cap.
+    let (f1, f4) = (
+        "policies/paper/fig01-bt.toml",
+        "policies/paper/fig04-fsm.toml",
+    );
+    for t in ["2000", "600000"] {
+        let v = compare_json(f1, f4, &["--mode", "structural", "--timeout-ms", t]);
+        assert_eq!(v["structural"]["exact"], true, "{v}");
+        assert_eq!(v["structural"]["ged"], 29);
+        assert!(v["structural"].get("stopped_by").is_none());
+    }
+}

@@ -10,10 +10,12 @@
 //! - `Structural`: the minimum over all vertex mappings — what NetworkX's
 //!   `graph_edit_distance` computes by default, which the paper used, but with
 //!   self-loops scored correctly (NetworkX issues #5400, #8188). NP-hard:
-//!   exact by an embedding fast path (`embed.rs`) and a branch and bound
-//!   with assignment lower bounds (`search.rs`); when the time or expansion
-//!   budget runs out, a certified interval `[lower_bound, upper_bound]` with
-//!   `exact = false`, never a guess.
+//!   exact by an embedding fast path (`embed.rs`), a Lagrangian forest
+//!   bound and search when one side is a forest (`treebound.rs`), and a
+//!   branch and bound with assignment lower bounds (`search.rs`); when the
+//!   work budget (or the wall-clock safety cap) runs out, a certified
+//!   interval `[lower_bound, upper_bound]` with `exact = false`, never a
+//!   guess, and the reason ([`StopReason`]).
 //! - `Labeled`: the same, but a vertex maps only to a vertex of the same
 //!   type.
 //! - `Named`: vertices map by key; linear time (plus sorting the script),
@@ -32,7 +34,9 @@
 //! Files: `graph.rs` the compact graph; `problem.rs` the padded instance and
 //! its cost; `embed.rs` the count-bound fast path; `lsap.rs` linear
 //! assignment; `local.rs` 2-swap local search; `wl.rs` Weisfeiler–Lehman
-//! tie-breaking; `search.rs` the branch and bound; `script.rs` edit scripts
+//! tie-breaking; `treebound.rs` the Lagrangian forest bound and its search
+//! (when one side is a forest: BTs); `search.rs` the branch and bound;
+//! `script.rs` edit scripts
 //! and the named mapping; `brute.rs` and `tests.rs` the test oracle and
 //! tests.
 
@@ -43,6 +47,7 @@ mod lsap;
 mod problem;
 mod script;
 mod search;
+mod treebound;
 mod wl;
 
 #[cfg(test)]
@@ -53,6 +58,7 @@ mod tests;
 use std::time::{Duration, Instant};
 
 pub use graph::{GedGraph, GedGraphError, Shape};
+
 pub use script::{EditScript, injective, named_mapping_of_ids, named_mapping_of_keys};
 
 use crate::graph::PolicyGraph;
@@ -83,27 +89,69 @@ impl GedMode {
 /// Budgets for the exact search (`Structural` and `Labeled`; `Named` needs
 /// none).
 ///
+/// The search is decided by `work` alone: every step that may end it early
+/// counts work units, never the clock, so one pair gives one result (value,
+/// exactness, interval) on any machine under any load, as long as `timeout`
+/// is not reached. `timeout` is a wall-clock safety cap: when it ends a
+/// search first, the result says so ([`StopReason::Timeout`]) and may then
+/// depend on the machine.
+///
 /// Memory does not grow with either budget: with n the larger vertex count,
 /// the search holds two n × n tables (4 + 1 bytes per entry) and a stack of
-/// at most n frames of O(n) words. Above 2048 vertices no search is made
+/// at most n frames of O(n) words; when one side is a forest, the forest
+/// bound adds one n × n table of 8 bytes per entry. Above 2048 vertices no search is made
 /// (the count bound and a local-search mapping are returned).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GedOptions {
-    /// Wall-clock budget of the whole computation of a mode (graphs,
+    /// Wall-clock safety cap of the whole computation of a mode (graphs,
     /// problems, search, script), checked at every search node and inside
     /// long loops (docs/robustness.md "Budgets" measures the overshoot).
     pub timeout: Duration,
-    /// Bound on branch-and-bound nodes expanded. Structural GED on labeled
-    /// graphs may run up to three searches (see `structural`), each with a
-    /// third of both budgets.
-    pub max_expansions: u64,
+    /// Work budget of the branch and bound, in work units: one unit per
+    /// entry of an assignment matrix built to bound a search node (a node
+    /// with k unmapped vertices costs about k² units, plus n + 1 for its
+    /// set-up), and per (vertex, image) pair scored by the forest bound
+    /// (`treebound.rs`): 20 to 50 ns each on the machine of
+    /// docs/performance.md. Structural GED on labeled graphs
+    /// may run up to three searches (see `structural`), each with a third.
+    pub work: u64,
 }
+
+/// The default work budget ([`GedOptions::work`]): 0.2 to 0.5 s on the
+/// machine of docs/performance.md at load average 9 (two cores shared by
+/// nine busy processes), up to about 1 s on the slowest pairs there, inside
+/// the default 2 s cap.
+pub const DEFAULT_WORK: u64 = 10_000_000;
 
 impl Default for GedOptions {
     fn default() -> Self {
         GedOptions {
             timeout: Duration::from_secs(2),
-            max_expansions: 20_000_000,
+            work: DEFAULT_WORK,
+        }
+    }
+}
+
+/// Why an inexact search stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StopReason {
+    /// The work budget ran out: reproducible on any machine.
+    Work,
+    /// The wall-clock cap (`--timeout-ms`) ran out first: the interval may
+    /// differ on another machine or under another load.
+    Timeout,
+    /// The padded graphs are too large for the exact search (above 2048
+    /// vertices): the count bound and a local-search mapping.
+    Size,
+}
+
+impl StopReason {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            StopReason::Work => "work",
+            StopReason::Timeout => "timeout",
+            StopReason::Size => "size",
         }
     }
 }
@@ -121,6 +169,8 @@ pub struct GedResult {
     pub upper_bound: u64,
     /// Wall-clock time spent.
     pub millis: u64,
+    /// Why the search stopped when `exact` is false.
+    pub stopped_by: Option<StopReason>,
     /// The edits of the best mapping found, a → b.
     pub edit_script: EditScript,
 }
@@ -135,6 +185,8 @@ pub struct GedMapping {
     pub upper_bound: u64,
     /// Vertex of a -> vertex of b (a partial injection).
     pub map: Vec<Option<usize>>,
+    /// Why the search stopped, when `lower_bound < upper_bound`.
+    pub stopped_by: Option<StopReason>,
 }
 
 /// GED between two policy graphs (see the module documentation); the
@@ -158,19 +210,20 @@ fn ged_since(
     mode: GedMode,
     opts: &GedOptions,
 ) -> GedResult {
-    let finish = |lower: u64, upper: u64, edit_script: EditScript| GedResult {
+    let finish = |lower: u64, upper: u64, edit_script: EditScript, why| GedResult {
         ged: upper,
         exact: lower >= upper,
         lower_bound: lower.min(upper),
         upper_bound: upper,
         millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
+        stopped_by: if lower >= upper { None } else { why },
         edit_script,
     };
     let mut by_name = script::named_mapping(a, b);
     if mode == GedMode::Named {
         let s = script::build(a, b, &by_name);
         let c = s.cost();
-        return finish(c, c, s);
+        return finish(c, c, s, None);
     }
     // The mapping by name, and its script, first: it competes with the
     // search's mapping below, and building it measures what the script of
@@ -181,13 +234,7 @@ fn ged_since(
     }
     let named = script::build(a, b, &by_name);
     let deadline = start + opts.timeout.saturating_sub(start.elapsed());
-    let found = search_mapping(
-        a,
-        b,
-        mode == GedMode::Labeled,
-        deadline,
-        opts.max_expansions,
-    );
+    let found = search_mapping(a, b, mode == GedMode::Labeled, deadline, opts.work);
     // Among mappings of equal cost, prefer the one by name: its script reads
     // as the engineer's own edits rather than as an arbitrary rematching.
     // It also tightens the upper bound when the search ran out of budget.
@@ -198,7 +245,7 @@ fn ged_since(
     };
     // The script scores the mapping kept, in the original graphs.
     let upper = s.cost();
-    finish(found.lower_bound.min(upper), upper, s)
+    finish(found.lower_bound.min(upper), upper, s, found.stopped_by)
 }
 
 /// Unmaps the pairs of `map` whose labels differ (a mapping by name made
@@ -249,99 +296,107 @@ fn count_bound(a: &Shape, b: &Shape, labeled: bool) -> u64 {
 /// best mapping found. Work after the search is O(n + m log m) (mapping the
 /// padded bijection back and scoring it). If the deadline has passed on
 /// entry, no problem is built: the count bound and the empty mapping.
+///
+/// Nothing but `work` decides how far the search goes; `deadline` only
+/// aborts it, and when it did (the clock is past it at the end) an inexact
+/// result says [`StopReason::Timeout`].
 pub fn search_mapping(
     a: &Shape,
     b: &Shape,
     labeled: bool,
     deadline: Instant,
-    max_expansions: u64,
+    work: u64,
 ) -> GedMapping {
+    let mut too_large = false;
     let (lower, map) = if Instant::now() >= deadline {
         (count_bound(a, b, labeled), vec![None; a.n()])
     } else if labeled {
         match Oriented::within(a, b, deadline) {
             Some(o) => {
-                let lim = search::Limits {
-                    deadline,
-                    max_expansions,
-                };
+                let lim = search::Limits { deadline, work };
                 let out = search::solve(&o.p, &lim, None);
+                too_large = out.too_large;
                 (out.lower, o.to_ab(&out.sigma))
             }
             None => (count_bound(a, b, true), vec![None; a.n()]),
         }
     } else {
-        structural(a, b, deadline, max_expansions)
+        let (lower, map, large) = structural(a, b, deadline, work);
+        too_large = large;
+        (lower, map)
     };
     let upper = mapping_cost(a, b, &map);
+    let stopped_by = if lower >= upper {
+        None
+    } else if Instant::now() >= deadline {
+        Some(StopReason::Timeout)
+    } else if too_large {
+        Some(StopReason::Size)
+    } else {
+        Some(StopReason::Work)
+    };
     GedMapping {
         lower_bound: lower.min(upper),
         upper_bound: upper,
         map,
+        stopped_by,
     }
 }
 
 /// Structural GED. When the graphs carry more than one label, a labeled
 /// mapping is also a structural one, and on policy graphs usually a very
 /// good one, while the labeled search is far easier (its classes are
-/// small); so if a first structural search (a third of the budget) does not
-/// settle the value, a labeled search (another third) seeds a second
-/// structural search with its mapping. Both structural lower bounds are
-/// certified; the larger is kept.
+/// small); so, unless a side is a forest, if a first structural search (a
+/// third of the work budget) does not settle the value, a labeled search (another third) seeds a
+/// second structural search with its mapping. Both structural lower bounds
+/// are certified; the larger is kept. The split is by work, never by time.
+/// Returns the bound, the mapping, and whether the graphs were too large
+/// for the exact search.
 fn structural(
     a: &Shape,
     b: &Shape,
     deadline: Instant,
-    max_expansions: u64,
-) -> (u64, Vec<Option<usize>>) {
-    let start = Instant::now();
-    let total = deadline.saturating_duration_since(start);
+    work: u64,
+) -> (u64, Vec<Option<usize>>, bool) {
     let (ua, ub) = (a.unlabeled(), b.unlabeled());
     let Some(st) = Oriented::within(&ua, &ub, deadline) else {
-        return (count_bound(a, b, false), vec![None; a.n()]);
+        return (count_bound(a, b, false), vec![None; a.n()], false);
     };
-    let built = start.elapsed();
     let first_label = a.labels().first().or(b.labels().first());
     let multi_class = a
         .labels()
         .iter()
         .chain(b.labels())
         .any(|l| Some(l) != first_label);
-    if !multi_class {
-        let lim = search::Limits {
-            deadline,
-            max_expansions,
-        };
+    // One search with the whole budget when there is one class, or when a
+    // side is a forest (BTs): the forest search settles those far better
+    // than a labeled seed would help it.
+    if !multi_class || treebound::has_forest(&st.p) {
+        let lim = search::Limits { deadline, work };
         let out = search::solve(&st.p, &lim, None);
-        return (out.lower, st.to_ab(&out.sigma));
+        return (out.lower, st.to_ab(&out.sigma), out.too_large);
     }
-    let third = total / 3;
-    let part = (max_expansions / 3).max(1);
-    let lim = |deadline: Instant| search::Limits {
+    let lim = search::Limits {
         deadline,
-        max_expansions: part,
+        work: (work / 3).max(1),
     };
-    let first = search::solve(&st.p, &lim(start + third), None);
-    // The labeled stage builds another padded problem and scores two more
-    // mappings before its searches read the clock: each about the cost of
-    // building `st`. Not when less time than that remains.
-    let stage = built.saturating_mul(4);
-    if first.lower >= first.upper || deadline.saturating_duration_since(Instant::now()) < stage {
-        return (first.lower, st.to_ab(&first.sigma));
+    let first = search::solve(&st.p, &lim, None);
+    if first.lower >= first.upper || first.too_large || Instant::now() >= deadline {
+        return (first.lower, st.to_ab(&first.sigma), first.too_large);
     }
     let Some(labeled) = Oriented::within(a, b, deadline) else {
-        return (first.lower, st.to_ab(&first.sigma));
+        return (first.lower, st.to_ab(&first.sigma), false);
     };
-    let lab = search::solve(&labeled.p, &lim(start + 2 * third), None);
+    let lab = search::solve(&labeled.p, &lim, None);
     let hint = st.padded_from_ab(&labeled.to_ab(&lab.sigma));
-    let second = search::solve(&st.p, &lim(deadline), Some(hint));
+    let second = search::solve(&st.p, &lim, Some(hint));
     let lower = first.lower.max(second.lower);
     let best = if second.upper <= first.upper {
         second.sigma
     } else {
         first.sigma
     };
-    (lower, st.to_ab(&best))
+    (lower, st.to_ab(&best), false)
 }
 
 /// A padded instance in canonical orientation, with conversions between its

@@ -46,9 +46,19 @@
 //! sibling leaves of one type) are branched in index order onto increasing
 //! images.
 //!
-//! **Budgets.** When the time or expansion budget runs out, the certified
-//! lower bound is the smallest bound among the subtrees still open on the
-//! stack; the upper bound is the best mapping found.
+//! **Forest bound.** The Lagrangian search of `treebound.rs` (over a forest
+//! side, such as a BT's, or a spanning branching) runs first with three
+//! quarters of the work budget; its best mapping seeds this search and its
+//! bound is kept beside this search's own.
+//!
+//! **Budgets.** Work, not time, decides where the search stops: each node
+//! evaluated charges the entries of its assignment matrices (Σ k² over
+//! classes, plus one) to the work budget, so a pair gets the same result on
+//! any machine. The deadline is a safety cap only. Every other phase
+//! (embedding, dives, 2-swaps) has a fixed, deterministic limit of its own.
+//! When a budget runs out, the certified lower bound is the smallest bound
+//! among the subtrees still open on the stack; the upper bound is the best
+//! mapping found.
 
 use std::cmp::Reverse;
 use std::time::Instant;
@@ -57,6 +67,7 @@ use super::embed::{self, Embedding};
 use super::local;
 use super::lsap::{Assignment, Lsap};
 use super::problem::{NONE, Problem};
+use super::treebound;
 use super::wl::Colours;
 
 /// Above this padded size the exact search is not attempted (the pair table
@@ -69,8 +80,10 @@ const EMBED_BUDGET: u64 = 200_000;
 /// Budgets for one GED computation.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Limits {
+    /// Wall-clock safety cap.
     pub deadline: Instant,
-    pub max_expansions: u64,
+    /// Work budget (see `GedOptions::work`).
+    pub work: u64,
 }
 
 /// A certified interval and the best mapping found.
@@ -80,6 +93,8 @@ pub(crate) struct Outcome {
     pub upper: u64,
     /// Padded G1 → padded G2 bijection of cost `upper`.
     pub sigma: Vec<u32>,
+    /// The instance was too large for the exact search (`MAX_SEARCH_N`).
+    pub too_large: bool,
     /// Search statistics (printed by the timing report in the tests).
     #[allow(dead_code)]
     pub stats: Stats,
@@ -92,7 +107,9 @@ pub(crate) struct Stats {
     pub embedding: Option<bool>,
     pub first_upper: u64,
     pub root_lower: u64,
+    pub tree_lower: Option<u64>,
     pub expansions: u64,
+    pub work: u64,
 }
 
 type Layers = [u32; 4];
@@ -191,6 +208,8 @@ struct Bnb<'a> {
     lsap: Lsap,
     lim: Limits,
     expansions: u64,
+    /// Work units spent (see `Limits::work`).
+    work: u64,
     root_lower: u64,
     /// Nearest lower-index twin of each G1 vertex (see `Side::twin_prev`).
     twin_prev: Vec<u32>,
@@ -250,6 +269,7 @@ impl<'a> Bnb<'a> {
             lsap: Lsap::default(),
             lim,
             expansions: 0,
+            work: 0,
             root_lower: 0,
             twin_prev: p.s1.twin_prev(&p.classes),
             w_out: 1,
@@ -535,6 +555,7 @@ impl<'a> Bnb<'a> {
             if cols.len() != k {
                 return None; // cannot happen: classes are balanced
             }
+            self.work += (k * k) as u64;
             let cost = self.cost_matrix(&rows, &cols);
             let sol = match warm {
                 Some(w) => {
@@ -743,7 +764,8 @@ impl<'a> Bnb<'a> {
             let (est, v) = top.children[top.cur];
             let u = top.u;
             self.expansions += 1;
-            if self.expansions > self.lim.max_expansions || Instant::now() > self.lim.deadline {
+            self.work += 1 + self.n as u64;
+            if self.work > self.lim.work || Instant::now() > self.lim.deadline {
                 timed_out = true;
                 break;
             }
@@ -803,6 +825,7 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
         lower,
         upper,
         sigma,
+        too_large: false,
         stats,
     };
     if ub == count {
@@ -812,14 +835,13 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     if now >= lim.deadline {
         return done(count, ub, best, stats);
     }
-    let embed_deadline = now + lim.deadline.saturating_duration_since(now) / 4;
     let mut lb = count;
     // A hinted call is a second attempt: the embedding search, being
     // deterministic, would only repeat itself.
     let embedding = if hinted {
         Embedding::Unknown
     } else {
-        embed::find(p, embed_deadline, EMBED_BUDGET)
+        embed::find(p, lim.deadline, EMBED_BUDGET)
     };
     match embedding {
         Embedding::Found(sigma) => {
@@ -837,16 +859,69 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     if lb >= ub {
         return done(ub, ub, best, stats);
     }
+    // The forest search (`treebound.rs`). On a forest (BTs) it runs first,
+    // with three quarters of the work budget, and this search gets the rest.
+    // On other graphs only its root bound runs first; this search gets a
+    // quarter, and if that does not settle the value the forest search
+    // (over a spanning branching) gets what remains, from the best mapping.
+    let mut lim = *lim;
+    let total_work = lim.work;
+    // Kept apart from this search's own root bound: as a floor under every
+    // node's bound it would flatten the order of children (by bound).
+    let mut tree_lb = 0;
+    let mut forest = false;
+    if p.n() <= MAX_SEARCH_N
+        && let Some(tb) = treebound::solve(p, &best, total_work / 4 * 3, lim.deadline, false)
+    {
+        forest = tb.forest;
+        lim.work = lim.work.saturating_sub(tb.work);
+        stats.tree_lower = Some(tb.lower);
+        if let Some(s) = tb.mapping {
+            let c = p.cost(&s);
+            if c < ub {
+                best = s;
+                ub = c;
+            }
+        }
+        tree_lb = tb.lower;
+        if lb.max(tree_lb) >= ub {
+            return done(ub, ub, best, stats);
+        }
+    }
     // Setting the search up costs O(n²) (its tables): not when the budget
     // is already spent.
     if p.n() > MAX_SEARCH_N || Instant::now() >= lim.deadline {
-        return done(lb, ub, best, stats);
+        let mut out = done(lb.max(tree_lb).min(ub), ub, best, stats);
+        out.too_large = p.n() > MAX_SEARCH_N;
+        return out;
     }
-    let mut bnb = Bnb::new(p, ub, best, *lim);
-    let lower = bnb.run(lb);
+    let general_first = p.n() <= MAX_SEARCH_N && !forest;
+    if general_first {
+        lim.work = lim.work.min(total_work / 4);
+    }
+    let mut bnb = Bnb::new(p, ub, best, lim);
+    let mut lower = bnb.run(lb).max(tree_lb).min(bnb.ub);
     stats.root_lower = bnb.root_lower;
     stats.expansions = bnb.expansions;
-    done(lower, bnb.ub, bnb.best, stats)
+    stats.work = bnb.work;
+    let (mut ub, mut best) = (bnb.ub, bnb.best);
+    let left = total_work.saturating_sub(bnb.work);
+    if general_first
+        && lower < ub
+        && left > 0
+        && Instant::now() < lim.deadline
+        && let Some(tb) = treebound::solve(p, &best, left, lim.deadline, true)
+    {
+        if let Some(s) = tb.mapping {
+            let c = p.cost(&s);
+            if c < ub {
+                best = s;
+                ub = c;
+            }
+        }
+        lower = lower.max(tb.lower).min(ub);
+    }
+    done(lower, ub, best, stats)
 }
 
 #[cfg(test)]
@@ -885,7 +960,7 @@ mod tests {
             let p = Problem::new(&ga, &gb);
             let lim = Limits {
                 deadline: Instant::now() + Duration::from_secs(60),
-                max_expansions: 0,
+                work: 0,
             };
             let greedy = p.greedy();
             let mut bnb = Bnb::new(&p, p.cost(&greedy), greedy, lim);
@@ -925,7 +1000,7 @@ mod tests {
             let p = Problem::new(&a, &b);
             let lim = Limits {
                 deadline: Instant::now() + Duration::from_secs(60),
-                max_expansions: u64::MAX,
+                work: u64::MAX,
             };
             let greedy = p.greedy();
             let mut bnb = Bnb::new(&p, p.cost(&greedy) + 1, greedy, lim);
@@ -958,7 +1033,7 @@ mod tests {
         let p = Problem::new(&a, &b);
         let lim = Limits {
             deadline: Instant::now() + Duration::from_secs(60),
-            max_expansions: 0,
+            work: 0,
         };
         let mut bnb = Bnb::new(&p, u64::MAX, p.greedy(), lim);
         let snapshot = |b: &Bnb| {

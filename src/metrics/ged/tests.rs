@@ -49,7 +49,7 @@ fn random_graph(rng: &mut Rng, n: usize, max_arcs: usize, n_labels: u64, prefix:
 fn opts() -> GedOptions {
     GedOptions {
         timeout: Duration::from_secs(30),
-        max_expansions: u64::MAX,
+        work: u64::MAX,
     }
 }
 
@@ -750,7 +750,7 @@ fn hfsm_pairs_are_exact() {
 
 #[test]
 fn two_phase_structural_search_stays_certified() {
-    // Tiny expansion budgets force the structural search through its
+    // Tiny work budgets force the structural search through its
     // labeled-seeded second attempt.
     let mut rng = Rng(0xC0FFEE);
     for i in 0..40 {
@@ -758,7 +758,7 @@ fn two_phase_structural_search_stays_certified() {
         let b = random_graph(&mut rng, 6, 12, 3, "b");
         let o = GedOptions {
             timeout: Duration::from_secs(30),
-            max_expansions: 3 + (i % 5) * 4,
+            work: (3 + (i % 5) * 4) * 40,
         };
         let r = ged_graphs(&a, &b, GedMode::Structural, &o);
         let truth = brute_ged(&a, &b, false);
@@ -770,6 +770,40 @@ fn two_phase_structural_search_stays_certified() {
         // The labeled optimum is a structural upper bound.
         assert!(r.upper_bound <= brute_ged(&a, &b, true).max(truth));
     }
+}
+
+/// Point 4 of issue 15: the work budget decides. The same hard pair under
+/// a small work budget gives the same inexact interval (stopped by work)
+/// with a 2 s cap and with a 10-minute one, and twice in a row.
+#[test]
+fn work_budget_decides_not_the_clock() {
+    let mut rng = Rng(0xD37E_0015);
+    let mut inexact = 0;
+    for i in 0..6 {
+        let a = random_graph(&mut rng, 11, 40, 1, "a");
+        let b = random_graph(&mut rng, 12, 44, 1, "b");
+        let run = |secs: u64| {
+            let o = GedOptions {
+                timeout: Duration::from_secs(secs),
+                work: 20_000,
+            };
+            let r = ged_graphs(&a, &b, GedMode::Structural, &o);
+            (r.ged, r.exact, r.lower_bound, r.upper_bound, r.stopped_by)
+        };
+        let first = run(2);
+        assert_eq!(first, run(600), "pair {i}");
+        assert_eq!(first, run(2), "pair {i}");
+        if !first.1 {
+            assert_eq!(first.4, Some(StopReason::Work));
+            inexact += 1;
+        } else {
+            assert_eq!(first.4, None);
+        }
+    }
+    assert!(
+        inexact > 0,
+        "the budget is small enough to stop some searches"
+    );
 }
 
 #[test]
@@ -797,7 +831,7 @@ fn large_random_graphs_return_a_certified_interval_in_budget() {
     let b = random_graph(&mut rng, 200, 800, 4, "b");
     let o = GedOptions {
         timeout: Duration::from_millis(200),
-        max_expansions: 1_000_000,
+        work: 50_000_000,
     };
     for mode in [GedMode::Structural, GedMode::Labeled] {
         let r = ged_graphs(&a, &b, mode, &o);
@@ -809,14 +843,14 @@ fn large_random_graphs_return_a_certified_interval_in_budget() {
 }
 
 #[test]
-fn expansion_budget_gives_a_certified_interval() {
+fn work_budget_gives_a_certified_interval() {
     let mut rng = Rng(42);
     for _ in 0..20 {
         let a = random_graph(&mut rng, 6, 16, 1, "a");
         let b = random_graph(&mut rng, 6, 16, 1, "b");
         let o = GedOptions {
             timeout: Duration::from_secs(30),
-            max_expansions: 3,
+            work: 100,
         };
         let r = ged_graphs(&a, &b, GedMode::Structural, &o);
         let truth = brute_ged(&a, &b, false);
@@ -1032,7 +1066,7 @@ fn report() {
                 let o2 = Oriented::new(&ua, &ub);
                 let lim = search::Limits {
                     deadline: std::time::Instant::now() + o.timeout,
-                    max_expansions: o.max_expansions,
+                    work: o.work,
                 };
                 let out = search::solve(&o2.p, &lim, None);
                 println!("    count bound {}, {:?}", o2.p.count_bound(), out.stats);
@@ -1051,7 +1085,7 @@ fn budget_overshoot_report() {
         for ms in [0u64, 200] {
             let o = GedOptions {
                 timeout: Duration::from_millis(ms),
-                max_expansions: u64::MAX,
+                work: u64::MAX,
             };
             for mode in [GedMode::Structural, GedMode::Labeled] {
                 let t = std::time::Instant::now();

@@ -32,7 +32,7 @@ pub use text::Text;
 
 use crate::graph::{PolicyGraph, VertexType, policy_graph};
 use crate::metrics::ged::{
-    GedMode, GedOptions, Shape, keep_same_labels, mapping_cost, named_mapping_of_ids,
+    GedMode, GedOptions, Shape, StopReason, keep_same_labels, mapping_cost, named_mapping_of_ids,
     search_mapping,
 };
 use crate::model::{Policy, PolicyBody, PolicyKind};
@@ -164,6 +164,12 @@ pub struct ModeReport {
     pub lower_bound: u64,
     pub upper_bound: u64,
     pub millis: u64,
+    /// When `exact` is false: what ended the search, `work` (the work
+    /// budget, reproducible on any machine), `timeout` (the wall-clock cap
+    /// `--timeout-ms`) or `size` (too large for the exact search). Absent
+    /// when exact.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped_by: Option<StopReason>,
     pub edit_script: Script,
 }
 
@@ -268,8 +274,8 @@ impl<'a> Pair<'a> {
         let named_cost = mapping_cost(&sa, &sb, &by_name);
         let before_script = Instant::now();
         let named = self.script(&by_name);
-        let (lower, upper, edit_script) = if mode == GedMode::Named {
-            (named_cost, named_cost, named)
+        let (lower, upper, edit_script, stopped_by) = if mode == GedMode::Named {
+            (named_cost, named_cost, named, None)
         } else {
             let reserve = before_script.elapsed() * 2;
             // Checked: a budget past the clock's range means no deadline.
@@ -278,20 +284,14 @@ impl<'a> Pair<'a> {
                 .unwrap_or_else(|| start + Duration::from_secs(1 << 32))
                 .checked_sub(reserve)
                 .map_or(start, |d| d.max(start));
-            let found = search_mapping(
-                &sa,
-                &sb,
-                mode == GedMode::Labeled,
-                deadline,
-                opts.max_expansions,
-            );
+            let found = search_mapping(&sa, &sb, mode == GedMode::Labeled, deadline, opts.work);
             // Among mappings of equal cost, prefer the one by name: its
             // script reads as the engineer's own edits.
             if named_cost <= found.upper_bound {
-                (found.lower_bound, named_cost, named)
+                (found.lower_bound, named_cost, named, found.stopped_by)
             } else {
                 let s = self.script(&found.map);
-                (found.lower_bound, found.upper_bound, s)
+                (found.lower_bound, found.upper_bound, s, found.stopped_by)
             }
         };
         debug_assert_eq!(edit_script.cost(), upper);
@@ -304,6 +304,7 @@ impl<'a> Pair<'a> {
             lower_bound: lower.min(upper),
             upper_bound: upper,
             millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
+            stopped_by: if lower >= upper { None } else { stopped_by },
             edit_script,
         }
     }

@@ -59,10 +59,8 @@ pub fn render_table(r: &CompareReport) -> String {
         ]);
     }
     out.push_str(&t.render());
-    if r.modes.iter().any(|m| !m.exact) {
-        out.push_str(
-            "note: the search hit its budget; the distance lies in the certified interval (raise --timeout-ms to narrow it)\n",
-        );
+    for line in stop_notes(r) {
+        out.push_str(&format!("note: {line}\n"));
     }
     if let Some(p) = r.primary()
         && p.relabels + p.reorders > 0
@@ -79,6 +77,32 @@ pub fn render_table(r: &CompareReport) -> String {
         out.push_str(&render_script(p));
     }
     out
+}
+
+/// One line per inexact mode: which budget ended its search.
+fn stop_notes(r: &CompareReport) -> Vec<String> {
+    use crate::metrics::ged::StopReason;
+    r.modes
+        .iter()
+        .filter(|m| !m.exact)
+        .map(|m| {
+            let why = match m.stopped_by {
+                Some(StopReason::Timeout) => {
+                    "the wall-clock cap (--timeout-ms) ended the search before the work budget; the interval may differ on another machine (raise --timeout-ms)"
+                }
+                Some(StopReason::Size) => {
+                    "the graphs are too large for the exact search (above 2048 vertices): count bound and local search"
+                }
+                _ => "the work budget (--work) ended the search; the same interval on any machine (raise --work to narrow it)",
+            };
+            format!(
+                "{}: the distance lies in the certified interval [{}, {}]: {why}",
+                m.mode.as_str(),
+                m.lower_bound,
+                m.upper_bound
+            )
+        })
+        .collect()
 }
 
 /// The report as GitHub-flavoured markdown, for a pull-request comment:
@@ -117,8 +141,12 @@ pub fn render_markdown(r: &CompareReport) -> String {
             m.millis
         ));
     }
-    if r.modes.iter().any(|m| !m.exact) {
-        out.push_str("\nThe search hit its budget: the distance lies in the certified interval.\n");
+    let notes = stop_notes(r);
+    if !notes.is_empty() {
+        out.push('\n');
+        for line in notes {
+            out.push_str(&format!("- {line}\n"));
+        }
     }
     if let Some(p) = r.primary() {
         let script = render_script(p);

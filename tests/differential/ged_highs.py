@@ -1,0 +1,242 @@
+#!/usr/bin/env python3
+"""Exact GED by HiGHS (PyPI `highspy`), an independent oracle for btfsm's GED.
+
+The cost model is btfsm's (SPEC §3, src/metrics/ged/mod.rs): directed
+multigraphs with self-loops and parallel arcs, unit costs; for a partial
+injection f of G1's vertices into G2's, the cost is the vertices deleted and
+inserted plus, over ordered pairs (u, w) of G1 vertices (u = w for a
+self-loop), |A(u, w) - B(f u, f w)|, plus every arc at a deleted or inserted
+vertex. With m1, m2 the arc counts this is
+
+    n1 + n2 - 2 |f| + m1 + m2 - 2 * sum_{(u,w)} min(A(u, w), B(f u, f w)),
+
+so minimising it maximises mapped vertices plus twice the preserved arcs.
+
+Binary formulation: the "F2" formulation of Lerouge, Abu-Aisheh, Raveaux,
+Héroux and Adam ("New binary linear programming formulation to compute the
+graph edit distance", Pattern Recognition 72, 2017), specialised to unit
+costs, with substitutions free, and with arc pairs weighted by the smaller
+multiplicity (so parallel arcs and self-loops count as btfsm counts them):
+
+    x[u,v] in {0,1}   u in V1, v in V2 (same label in labeled mode)
+    y[k,l] in [0,1]   k = (u,w) a support pair of A, l = (v,z) one of B,
+                      loops only onto loops (and labels compatible)
+    sum_v x[u,v] <= 1 (each u),   sum_u x[u,v] <= 1 (each v)
+    sum_z y[(u,w),(v,z)] <= x[u,v]   for each k = (u,w) and v
+    sum_v y[(u,w),(v,z)] <= x[w,z]   for each k = (u,w) and z
+    minimise n1 + n2 + m1 + m2 - 2 sum x - 2 sum min(A_k, B_l) y[k,l]
+
+y may stay continuous: with x integral the two F2 rows leave y[k,l] = 1 only
+at l = (f u, f w).
+
+Run as a program it is the differential test of `make differential`: seeded
+random pairs of trees (15-27 nodes, written as BehaviorTree TOML) and of
+FSM-like graphs (written as FSM TOML), structural and labeled, each compared
+with `btfsm compare --format json`: where btfsm says exact its value must be
+HiGHS's optimum, and HiGHS's optimum must lie in btfsm's certified interval
+whatever btfsm says.
+
+Usage: ged_highs.py BTFSM [--pairs N] [--seed S] [--budget ARGS]
+"""
+
+import argparse
+import json
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+import highspy
+
+
+def solve(g1, g2, labeled, time_limit=10.0):
+    """Exact GED of two graphs {n, arcs: [(t, h)], labels: [str]} by HiGHS.
+
+    Returns (value or None if not proven, seconds of `run`)."""
+    from collections import Counter
+
+    n1, n2 = g1["n"], g2["n"]
+    lab1 = g1["labels"] if labeled else ["v"] * n1
+    lab2 = g2["labels"] if labeled else ["v"] * n2
+    pa = sorted(Counter(map(tuple, g1["arcs"])).items())
+    pb = sorted(Counter(map(tuple, g2["arcs"])).items())
+    m1, m2 = len(g1["arcs"]), len(g2["arcs"])
+    xid = {}
+    costs, lower, upper, integ = [], [], [], []
+    for u in range(n1):
+        for v in range(n2):
+            if lab1[u] == lab2[v]:
+                xid[(u, v)] = len(costs)
+                costs.append(-2.0)
+                integ.append(True)
+    yid = []
+    for k, ((u, w), ma) in enumerate(pa):
+        for l, ((v, z), mb) in enumerate(pb):
+            if (u == w) != (v == z) or (u, v) not in xid or (w, z) not in xid:
+                continue
+            yid.append((k, l, len(costs)))
+            costs.append(-2.0 * min(ma, mb))
+            integ.append(False)
+    ncols = len(costs)
+    rows = []  # (indices, values, upper)
+    for u in range(n1):
+        idx = [xid[(u, v)] for v in range(n2) if (u, v) in xid]
+        if idx:
+            rows.append((idx, [1.0] * len(idx)))
+    for v in range(n2):
+        idx = [xid[(u, v)] for u in range(n1) if (u, v) in xid]
+        if idx:
+            rows.append((idx, [1.0] * len(idx)))
+    by_tail, by_head = {}, {}
+    for k, l, c in yid:
+        (v, z), _ = pb[l]
+        by_tail.setdefault((k, v), []).append(c)
+        by_head.setdefault((k, z), []).append(c)
+    for (k, v), cols in by_tail.items():
+        u = pa[k][0][0]
+        rows.append((cols + [xid[(u, v)]], [1.0] * len(cols) + [-1.0]))
+    for (k, z), cols in by_head.items():
+        w = pa[k][0][1]
+        rows.append((cols + [xid[(w, z)]], [1.0] * len(cols) + [-1.0]))
+    rows = [(i, v, 1.0 if all(x > 0 for x in v) else 0.0) for i, v in rows]
+
+    h = highspy.Highs()
+    h.setOptionValue("output_flag", False)
+    h.setOptionValue("time_limit", float(time_limit))
+    h.setOptionValue("threads", 1)
+    h.setOptionValue("mip_rel_gap", 0.0)
+    h.setOptionValue("mip_abs_gap", 0.0)
+    inf = highspy.kHighsInf
+    if ncols:
+        h.addVars(ncols, np.zeros(ncols), np.ones(ncols))
+        h.changeColsCost(ncols, np.arange(ncols, dtype=np.int32), np.array(costs))
+        ints = np.array([i for i in range(ncols) if integ[i]], dtype=np.int32)
+        if len(ints):
+            h.changeColsIntegrality(len(ints), ints,
+                                    np.array([highspy.HighsVarType.kInteger] * len(ints)))
+    for idx, vals, ub in rows:
+        h.addRow(-inf, ub, len(idx), np.array(idx, dtype=np.int32), np.array(vals))
+    t0 = time.perf_counter()
+    h.run()
+    secs = time.perf_counter() - t0
+    const = n1 + n2 + m1 + m2
+    if ncols == 0:
+        return const, secs
+    if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
+        return None, secs
+    return int(round(const + h.getInfo().objective_function_value)), secs
+
+
+# ---- seeded random instances, each both as a btfsm policy and as a graph ----
+
+def random_tree(rng, n):
+    """A random recursive tree as a BT TOML text and its graph (parent -> child)."""
+    parent = [None] + [rng.randrange(i) for i in range(1, n)]
+    kids = [[] for _ in range(n)]
+    for i in range(1, n):
+        kids[parent[i]].append(i)
+    lines = ['kind = "bt"', 'name = "random tree"', 'root = "n0"', "", "[nodes]"]
+    labels = []
+    for i in range(n):
+        if kids[i]:
+            t = rng.choice(["sequence", "fallback"])
+            lines.append(f'n{i} = {{ {t} = [{", ".join(f"{chr(34)}n{c}{chr(34)}" for c in kids[i])}] }}')
+            labels.append(t)
+        elif rng.random() < 0.5:
+            lines.append(f'n{i} = {{ action = "a{i}", skill = "Pick", args = {{ object = "c" }} }}')
+            labels.append("action")
+        else:
+            lines.append(f'n{i} = {{ condition = "c{i}", skill = "In-Hand", args = {{ object = "c" }} }}')
+            labels.append("condition")
+    arcs = [(parent[i], i) for i in range(1, n)]
+    return "\n".join(lines) + "\n", {"n": n, "arcs": arcs, "labels": labels}
+
+
+def random_fsm(rng, n):
+    """A random FSM of n states (plus outcomes SUCCESS and FAILURE): each
+    action state has up to three transitions (SUCCESS, FAILURE, RUNNING),
+    each condition state up to two, to random states or outcomes, self-loops
+    and parallel arcs allowed. The graph is SPEC §2's: states, then outcomes."""
+    outs = ["SUCCESS", "FAILURE"]
+    lines = ['kind = "fsm"', 'name = "random fsm"', 'initial = "s0"',
+             'outcomes = ["SUCCESS", "FAILURE"]', ""]
+    labels, arcs = [], []
+    for i in range(n):
+        cond = rng.random() < 0.3
+        labels.append("condition_state" if cond else "state")
+        lines.append(f"[states.s{i}]")
+        if cond:
+            lines.append('skill = "In-Hand"')
+            triggers = ["SUCCESS", "FAILURE"]
+        else:
+            lines.append('skill = "Pick"')
+            triggers = ["SUCCESS", "FAILURE", "RUNNING"]
+        lines.append('args = { object = "c" }')
+        on = []
+        for t in triggers:
+            if rng.random() < 0.8:
+                j = rng.randrange(n + 2)
+                target = f"s{j}" if j < n else outs[j - n]
+                on.append(f'{t} = "{target}"')
+                arcs.append((i, j))
+        if on:
+            lines.append("on = { " + ", ".join(on) + " }")
+        lines.append("")
+    labels += ["outcome", "outcome"]
+    return "\n".join(lines), {"n": n + 2, "arcs": arcs, "labels": labels}
+
+
+def run_btfsm(btfsm, fa, fb, mode, extra=()):
+    out = subprocess.run([btfsm, "compare", fa, fb, "--mode", mode, "--format", "json", *extra],
+                         capture_output=True, text=True, check=True).stdout
+    return json.loads(out)[mode]
+
+
+def pairs(seed, count):
+    """`count` seeded pairs: trees of 15-27 nodes, then FSM-like graphs."""
+    rng = random.Random(seed)
+    for i in range(count):
+        if i % 2 == 0:
+            yield f"tree-{i}", random_tree(rng, rng.randint(15, 27)), random_tree(rng, rng.randint(15, 27))
+        else:
+            yield f"fsm-{i}", random_fsm(rng, rng.randint(4, 9)), random_fsm(rng, rng.randint(4, 9))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("btfsm")
+    ap.add_argument("--pairs", type=int, default=16)
+    ap.add_argument("--seed", type=int, default=15)
+    args = ap.parse_args()
+    bad = 0
+    exact = 0
+    checked = 0
+    with tempfile.TemporaryDirectory() as d:
+        for name, (ta, ga), (tb, gb) in pairs(args.seed, args.pairs):
+            fa, fb = os.path.join(d, "a.toml"), os.path.join(d, "b.toml")
+            with open(fa, "w") as f:
+                f.write(ta)
+            with open(fb, "w") as f:
+                f.write(tb)
+            for mode in ("structural", "labeled"):
+                r = run_btfsm(args.btfsm, fa, fb, mode)
+                truth, _ = solve(ga, gb, mode == "labeled", time_limit=60)
+                if truth is None:
+                    print(f"{name} {mode}: HiGHS did not finish, skipped")
+                    continue
+                checked += 1
+                exact += r["exact"]
+                ok = r["lower_bound"] <= truth <= r["upper_bound"] and (not r["exact"] or r["ged"] == truth)
+                if not ok:
+                    bad += 1
+                    print(f"DISAGREE {name} {mode}: HiGHS {truth}, btfsm {r['ged']} "
+                          f"[{r['lower_bound']}, {r['upper_bound']}] exact={r['exact']}\n{ta}\n{tb}")
+    print(f"GED vs HiGHS: {checked} pair-modes, {exact} exact in btfsm, {bad} disagreements")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
