@@ -79,8 +79,11 @@ pub enum Command {
         a: PathBuf,
         /// The new policy
         b: PathBuf,
-        /// Which GED: structural (any vertex to any vertex), labeled (same
-        /// vertex type only), named (by node id / state name), or all three
+        /// Which distance: a GED — structural (any vertex to any vertex),
+        /// labeled (same vertex type only), named (by node id / state name) —
+        /// or tree, the ordered tree edit distance of two BTs (children
+        /// order and node labels count); all: the three GEDs, and tree when
+        /// both policies are BTs
         #[arg(long, value_enum, default_value_t = CompareMode::All)]
         mode: CompareMode,
         /// Time budget per mode, its whole computation (graphs, search, edit
@@ -89,6 +92,11 @@ pub enum Command {
         /// `exact: false`
         #[arg(long, default_value_t = 2000, value_name = "MS")]
         timeout_ms: u64,
+        /// Work budget of the tree edit distance, in table cells (about 2 ns
+        /// each; memory is capped at 2^25 cells, 128 MiB): past it the
+        /// result is an interval with `exact: false`, the same on any machine
+        #[arg(long, default_value_t = crate::metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
+        tree_max_work: u64,
         /// Output format
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
         format: CompareFormat,
@@ -141,6 +149,11 @@ pub enum Command {
     Sim(super::sim::SimArgs),
     /// Ticks a BT against scripted leaf outcomes (BehaviorTree.CPP 4 semantics)
     Tick(super::tick::TickArgs),
+    /// Tree edit distances of trees in bracket notation, one pair per line
+    /// (`{a{b}}<TAB>{a{c}}`): what tests/differential/ted.py and
+    /// bench/ted_vs_apted.py drive
+    #[command(hide = true)]
+    TedPairs(super::ted_pairs::TedPairsArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
     Completions {
@@ -161,18 +174,23 @@ pub enum CompareMode {
     Structural,
     Labeled,
     Named,
+    /// Ordered tree edit distance between two BTs (child order and node
+    /// labels count; BT pairs only)
+    Tree,
+    /// The three GED modes, and `tree` when both policies are BTs
     All,
 }
 
 impl CompareMode {
-    /// The single GED mode selected, or `None` for all three.
-    pub fn selection(self) -> Option<crate::metrics::ged::GedMode> {
+    /// The GED modes selected, in report order (none for `tree`).
+    pub fn ged_modes(self) -> Vec<crate::metrics::ged::GedMode> {
         use crate::metrics::ged::GedMode;
         match self {
-            CompareMode::Structural => Some(GedMode::Structural),
-            CompareMode::Labeled => Some(GedMode::Labeled),
-            CompareMode::Named => Some(GedMode::Named),
-            CompareMode::All => None,
+            CompareMode::Structural => vec![GedMode::Structural],
+            CompareMode::Labeled => vec![GedMode::Labeled],
+            CompareMode::Named => vec![GedMode::Named],
+            CompareMode::Tree => Vec::new(),
+            CompareMode::All => crate::report::compare::modes_of(None),
         }
     }
 }

@@ -145,6 +145,7 @@ pub fn execute(cli: Cli) -> u8 {
             b,
             mode,
             timeout_ms,
+            tree_max_work,
             format,
             dot,
             render,
@@ -154,6 +155,7 @@ pub fn execute(cli: Cli) -> u8 {
             b,
             mode,
             timeout_ms,
+            tree_max_work,
             format,
             dot,
             render,
@@ -243,6 +245,7 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Edit(args) => super::edit::edit(&args),
         Command::Sim(args) => super::sim::execute(args),
         Command::Tick(args) => super::tick::execute(args),
+        Command::TedPairs(args) => super::ted_pairs::execute(args),
         Command::Completions { shell } => {
             use clap::CommandFactory;
             let mut out = Vec::new();

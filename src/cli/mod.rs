@@ -30,6 +30,7 @@ mod edit;
 pub mod out;
 mod paper;
 pub mod sim;
+mod ted_pairs;
 mod tick;
 
 use clap::Parser;

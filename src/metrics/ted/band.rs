@@ -82,6 +82,7 @@ impl Stair {
     }
 
     /// Cells stored.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.data.len()
     }

@@ -17,6 +17,7 @@ mod script;
 #[cfg(test)]
 mod tests;
 mod text;
+pub mod tree;
 
 pub use render::{render_json, render_markdown, render_table};
 use script::{ScriptIndex, key_ids};
@@ -140,6 +141,8 @@ pub struct CompareReport {
     pub a: SideSummary,
     pub b: SideSummary,
     pub modes: Vec<ModeReport>,
+    /// The ordered tree edit distance (`--mode tree`; BT pairs only).
+    pub tree: Option<tree::TreeReport>,
 }
 
 impl CompareReport {
@@ -269,6 +272,7 @@ impl<'a> Pair<'a> {
             a: summary(&self.a, &self.ga),
             b: summary(&self.b, &self.gb),
             modes,
+            tree: None,
         }
     }
 }
