@@ -1,7 +1,8 @@
 //! A "staircase" band of a two-dimensional table: row `r` stores only the
 //! columns `[lo(r), hi(r)]` (inclusive), where `lo` and `hi` never decrease
-//! from one row to the next, as for the cells `|row − column| ≤ u` of a
-//! table clipped to its column range. Cells outside are "infinite" when read.
+//! from one row to the next, as for the cells `dlo ≤ column − row ≤ dhi` of
+//! a table clipped to its column range. Cells outside are "infinite" when
+//! read.
 //! It is how the banded tree edit distance (`zs.rs`) keeps both its
 //! subtree-distance table and its forest tables in O(n·u) cells.
 
@@ -13,36 +14,36 @@ pub const INF: u32 = u32::MAX / 4;
 #[derive(Debug, Default)]
 pub struct Stair {
     /// First row index.
-    row0: usize,
-    lo: Vec<usize>,
-    hi: Vec<usize>,
+    pub row0: usize,
+    pub lo: Vec<usize>,
+    pub hi: Vec<usize>,
     /// Offset of each row's first cell in `data`.
-    off: Vec<usize>,
-    data: Vec<u32>,
+    pub off: Vec<usize>,
+    pub data: Vec<u32>,
 }
 
 impl Stair {
-    /// Cells of the band `|r − c| ≤ u` over rows `rows` and columns
+    /// Cells of the band `dlo ≤ c − r ≤ dhi` over rows `rows` and columns
     /// `cols` (inclusive ranges), without allocating.
-    pub fn cells(rows: (usize, usize), cols: (usize, usize), u: usize) -> u64 {
+    pub fn cells(rows: (usize, usize), cols: (usize, usize), d: (i64, i64)) -> u64 {
         (rows.0..=rows.1)
             .map(|r| {
-                let (lo, hi) = window(r, cols, u);
+                let (lo, hi) = window(r, cols, d);
                 (hi + 1).saturating_sub(lo) as u64
             })
             .sum()
     }
 
     /// Re-shapes the band to rows `rows.0..=rows.1`, columns within `cols`
-    /// and `|r − c| ≤ u`, every cell infinite; reuses the allocation.
-    pub fn reset(&mut self, rows: (usize, usize), cols: (usize, usize), u: usize) {
+    /// and `dlo ≤ c − r ≤ dhi`, every cell infinite; reuses the allocation.
+    pub fn reset(&mut self, rows: (usize, usize), cols: (usize, usize), d: (i64, i64)) {
         self.row0 = rows.0;
         self.lo.clear();
         self.hi.clear();
         self.off.clear();
         let mut total = 0;
         for r in rows.0..=rows.1 {
-            let (lo, hi) = window(r, cols, u);
+            let (lo, hi) = window(r, cols, d);
             self.lo.push(lo);
             self.hi.push(hi);
             self.off.push(total);
@@ -88,12 +89,18 @@ impl Stair {
     }
 }
 
-/// Columns of row `r` in the band: `cols` clipped to `[r − u, r + u]`.
+/// Columns of row `r` in the band: `cols` clipped to `[r + dlo, r + dhi]`
+/// (empty, `lo > hi`, when they miss).
 #[inline]
-fn window(r: usize, cols: (usize, usize), u: usize) -> (usize, usize) {
-    let lo = cols.0.max(r.saturating_sub(u));
-    let hi = cols.1.min(r.saturating_add(u));
-    (lo, hi)
+fn window(r: usize, cols: (usize, usize), d: (i64, i64)) -> (usize, usize) {
+    let r = r as i64;
+    let lo = (cols.0 as i64).max(r + d.0);
+    let hi = (cols.1 as i64).min(r + d.1);
+    if hi < lo || hi < 0 {
+        (1, 0)
+    } else {
+        (lo as usize, hi as usize)
+    }
 }
 
 #[cfg(test)]
@@ -103,11 +110,12 @@ mod tests {
     #[test]
     fn cells_outside_the_band_read_infinite() {
         let mut s = Stair::default();
-        s.reset((2, 5), (0, 9), 1);
+        s.reset((2, 5), (0, 9), (-1, 1));
         assert_eq!(s.row_window(2), (1, 3));
         assert_eq!(s.row_window(5), (4, 6));
         assert_eq!(s.len(), 12);
-        assert_eq!(Stair::cells((2, 5), (0, 9), 1), 12);
+        assert_eq!(Stair::cells((2, 5), (0, 9), (-1, 1)), 12);
+        assert_eq!(Stair::cells((0, 3), (5, 9), (-1, 1)), 0);
         s.set(3, 4, 7);
         assert_eq!(s.get(3, 4), 7);
         assert_eq!(s.get(3, 5), INF);

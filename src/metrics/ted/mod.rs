@@ -141,7 +141,8 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
             band: 0,
         };
     }
-    let full = n1.max(n2);
+    // No mapping costs more than n1 + n2: a band this wide prunes nothing.
+    let full = n1 + n2;
     let mut lower = n1.abs_diff(n2) as u64;
     // A mapping always available: the roots to each other.
     let root_cost = (n1 + n2 - 2) as u64 + u64::from(f.label[n1 - 1] != g.label[n2 - 1]);

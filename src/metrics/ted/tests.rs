@@ -284,3 +284,18 @@ fn mirrored_and_plain_orientations_agree() {
         assert_eq!(ted(&a, &b, &o).upper, ted(&m, &mb, &o).upper);
     }
 }
+
+#[test]
+fn a_distance_above_both_sizes_is_found() {
+    // The distance (26) exceeds both trees' sizes (16, 22): the last band
+    // must be n1 + n2 wide, not max(n1, n2) (found by tests/differential/ted.py).
+    let mut ids = BTreeMap::new();
+    let a = parse("{d{a{c{c}{b}}{b}}{a{a}{b}}{b{a{a}{a{a{d}}}}}{a}}", &mut ids);
+    let b = parse(
+        "{b{b{b{b{d{d{d{b{b{a{c{d{d{a{b{a{d{d{d{c{d{c}}}}}}}}}}}}}}}}}}}}}}",
+        &mut ids,
+    );
+    let r = ted(&a, &b, &TedOptions::default());
+    assert_eq!((r.lower, r.upper), (26, 26));
+    check_mapping(&a, &b, &r);
+}
