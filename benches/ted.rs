@@ -2,7 +2,7 @@
 //! computation (`report::compare::tree::tree_report`: labels, distance,
 //! mapping and edit script) on seeded random Behavior Trees of 10,000 nodes —
 //! a tree against an edited copy (20 and 200 edits: renames, sibling swaps,
-//! deletions, insertions, subtree moves, as a pull request makes them) and
+//! deletions, insertions, leaves moved, as a pull request makes them) and
 //! against an unrelated tree of the same size — and prints each pair's
 //! distance, exactness, cells computed and median time.
 //!
@@ -147,12 +147,13 @@ fn edited(rng: &mut Rng, bt: &Bt, edits: usize) -> Bt {
                 b.nodes[c].children.insert(at, i);
             }
             _ => {
-                // Move the last child's subtree to the front of the root.
-                if c != b.root {
-                    let v = b.nodes[c].children.pop().unwrap_or(c);
-                    if v != c {
-                        b.nodes[b.root].children.insert(0, v);
-                    }
+                // Move a leaf child elsewhere: to the front of another
+                // composite.
+                let v = b.nodes[c].children[rng.below(k)];
+                let to = composites[rng.below(composites.len())];
+                if b.nodes[v].children.is_empty() && to != c {
+                    b.nodes[c].children.retain(|&w| w != v);
+                    b.nodes[to].children.insert(0, v);
                 }
             }
         }
@@ -167,6 +168,8 @@ fn main() {
     let mut rng = Rng(15);
     let a = random_bt(&mut rng, n);
     let pairs = [
+        ("edited copy, 1 edit", edited(&mut rng, &a, 1)),
+        ("edited copy, 5 edits", edited(&mut rng, &a, 5)),
         ("edited copy, 20 edits", edited(&mut rng, &a, 20)),
         ("edited copy, 200 edits", edited(&mut rng, &a, 200)),
         ("unrelated tree", random_bt(&mut rng, n)),

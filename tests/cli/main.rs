@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 mod common;
 mod compare;
+mod compare_tree;
 mod conventions;
 mod formats;
 mod gate;

@@ -54,7 +54,7 @@ impl Stair {
     }
 
     /// The window of row `r`: `(lo, hi)`, empty when `lo > hi`.
-    #[inline]
+    #[cfg(test)]
     pub fn row_window(&self, r: usize) -> (usize, usize) {
         let i = r - self.row0;
         (self.lo[i], self.hi[i])
@@ -72,7 +72,7 @@ impl Stair {
     }
 
     /// Sets a cell inside the band (a cell outside is ignored).
-    #[inline]
+    #[cfg(test)]
     pub fn set(&mut self, r: usize, c: usize, v: u32) {
         let Some(i) = r.checked_sub(self.row0) else {
             return;

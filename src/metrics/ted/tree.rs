@@ -29,6 +29,8 @@ pub struct OrderedTree {
     /// For each node, the keyroot whose leftmost path holds it (the highest
     /// ancestor-or-self with the same leftmost leaf).
     pub keyroot_of: Vec<usize>,
+    /// Depth of each node (the root at 0).
+    pub depth: Vec<usize>,
 }
 
 impl OrderedTree {
@@ -103,12 +105,16 @@ impl OrderedTree {
         // keyroot_of: walk from the top down (reverse postorder): a first
         // child shares its parent's keyroot.
         let mut keyroot_of = vec![0; n];
+        let mut depth = vec![0; n];
         for i in (0..n).rev() {
             keyroot_of[i] = if is_first[i] {
                 keyroot_of[parent[i]]
             } else {
                 i
             };
+            if parent[i] != usize::MAX {
+                depth[i] = depth[parent[i]] + 1;
+            }
         }
         OrderedTree {
             label: order.iter().map(|&a| label[a]).collect(),
@@ -117,7 +123,20 @@ impl OrderedTree {
             arena: order,
             keyroots,
             keyroot_of,
+            depth,
         }
+    }
+
+    /// Nodes left of `x`, above it (ancestors), in its subtree, right of
+    /// it: a mapping that pairs `x` with `y` maps each of these regions of
+    /// one tree into the same region of the other (Zhang & Shasha's
+    /// mapping conditions), so it costs at least the sum of the four size
+    /// differences.
+    pub fn regions(&self, x: usize) -> [usize; 4] {
+        let left = self.lml[x];
+        let above = self.depth[x];
+        let inside = x + 1 - left;
+        [left, above, inside, self.len() - left - above - inside]
     }
 
     pub fn len(&self) -> usize {

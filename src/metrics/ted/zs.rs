@@ -143,7 +143,8 @@ impl<'a> Banded<'a> {
             return;
         };
         // The last rows and columns needed: the highest path pairs (x, y)
-        // with y − x on an allowed diagonal (both paths ascend).
+        // with y − x on an allowed diagonal (both paths ascend) whose four
+        // regions (`OrderedTree::regions`) differ by at most u in all.
         Self::path(f, k1, &mut self.path1);
         Self::path(g, k2, &mut self.path2);
         let (mut rmax, mut cmax) = (None::<usize>, None::<usize>);
@@ -153,9 +154,15 @@ impl<'a> Banded<'a> {
                 j0 += 1;
             }
             let mut j = j0;
+            let rx = f.regions(x);
             while j < self.path2.len() && (self.path2[j] as i64) <= x as i64 + dhi {
-                rmax = Some(x);
-                cmax = Some(cmax.map_or(self.path2[j], |c| c.max(self.path2[j])));
+                let y = self.path2[j];
+                let ry = g.regions(y);
+                let bound: usize = (0..4).map(|k| rx[k].abs_diff(ry[k])).sum();
+                if bound <= u {
+                    rmax = Some(x);
+                    cmax = Some(cmax.map_or(y, |c| c.max(y)));
+                }
                 j += 1;
             }
         }
@@ -207,6 +214,9 @@ impl<'a> Banded<'a> {
                     INF
                 }
             };
+            // td's row x: read and written in place.
+            let ti = x - td.row0;
+            let (tlo, thi, toff) = (td.lo[ti], td.hi[ti], td.off[ti]);
             let mut left = INF;
             for q in lo..=hi {
                 let del = at_prev(q) + 1;
@@ -219,10 +229,17 @@ impl<'a> Banded<'a> {
                     if x_starts && gy == l2 {
                         let rename = u32::from(labx != g.label[y]);
                         let v = del.min(ins).min(at_prev(q - 1) + rename).min(INF);
-                        td.set(x, y, v);
+                        if y >= tlo && y <= thi {
+                            td.data[toff + y - tlo] = v;
+                        }
                         v
                     } else {
-                        del.min(ins).min(above.get(lx, gy) + td.get(x, y))
+                        let t = if y >= tlo && y <= thi {
+                            td.data[toff + y - tlo]
+                        } else {
+                            INF
+                        };
+                        del.min(ins).min(above.get(lx, gy) + t)
                     }
                 };
                 left = v.min(INF);

@@ -73,7 +73,9 @@ pub fn render_table(r: &CompareReport) -> String {
         out.push_str(&render_script(p));
     }
     if let Some(t) = &r.tree {
-        out.push('\n');
+        if !r.modes.is_empty() {
+            out.push('\n');
+        }
         out.push_str(&super::tree::render_text(t));
     }
     out
