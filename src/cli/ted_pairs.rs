@@ -1,7 +1,8 @@
 //! `btfsm ted-pairs FILE` (hidden): the ordered tree edit distance of each
 //! pair of trees in bracket notation (`metrics::ted::tree_text`), one pair
 //! per line separated by a tab, printed as one JSON object per line
-//! (`ted`, `exact`, `script_cost`, `moves`, `work`). It lets
+//! (`ted`, `exact`, `lower_bound`, `script_cost`, `moves`, `work`, and
+//! `micros`, the distance's time, for the benchmark). It lets
 //! tests/differential/ted.py check thousands of pairs against the `apted`
 //! and `zss` packages, and bench/ted_vs_apted.py time them, in one process.
 
@@ -65,7 +66,9 @@ pub fn execute(a: TedPairsArgs) -> u8 {
                 return EXIT_BAD_INPUT;
             }
         };
+        let start = std::time::Instant::now();
         let r = ted::ted(&trees[0], &trees[1], &opts);
+        let micros = start.elapsed().as_micros();
         let script = ted::edit_script(&trees[0], &trees[1], &r.mapping);
         let cost: u64 = script.iter().map(TreeEdit::cost).sum();
         let moves = script
@@ -73,7 +76,7 @@ pub fn execute(a: TedPairsArgs) -> u8 {
             .filter(|e| matches!(e, TreeEdit::Move { .. }))
             .count();
         out.push_str(&format!(
-            "{{\"ted\": {}, \"exact\": {}, \"lower_bound\": {}, \"script_cost\": {cost}, \"moves\": {moves}, \"work\": {}}}\n",
+            "{{\"ted\": {}, \"exact\": {}, \"lower_bound\": {}, \"script_cost\": {cost}, \"moves\": {moves}, \"work\": {}, \"micros\": {micros}}}\n",
             r.upper,
             r.exact(),
             r.lower,

@@ -98,6 +98,9 @@ pub struct TedResult {
     pub work: u64,
     /// Width `u` of the last band that ran to completion (0 when none).
     pub band: usize,
+    /// Most table cells held at once (4 bytes each), never above
+    /// [`TedOptions::max_cells`].
+    pub peak_cells: u64,
 }
 
 impl TedResult {
@@ -139,6 +142,7 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
             mapping: Vec::new(),
             work: 0,
             band: 0,
+            peak_cells: 0,
         };
     }
     // No mapping costs more than n1 + n2: a band this wide prunes nothing.
@@ -148,6 +152,7 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
     let root_cost = (n1 + n2 - 2) as u64 + u64::from(f.label[n1 - 1] != g.label[n2 - 1]);
     let mut best: Option<(u64, Vec<(usize, usize)>)> = None;
     let mut work = 0u64;
+    let mut peak = 0u64;
     let mut done_band = 0;
     let mut u = n1.abs_diff(n2).max(2);
     loop {
@@ -158,6 +163,7 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
         let mut band = Banded::new(&f, &g, u);
         let ran = band.run(opts.max_work.saturating_sub(work));
         work += band.work;
+        peak = peak.max(band.peak);
         if ran.is_err() {
             break;
         }
@@ -173,6 +179,7 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
                 mapping: to_arena(m),
                 work,
                 band: u,
+                peak_cells: peak.max(band.peak),
             };
         }
         // The distance is above u; r, if finite, is a mapping's cost.
@@ -181,6 +188,7 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
             band.work = 0;
             let m = mapping::mapping(&mut band);
             work += band.work;
+            peak = peak.max(band.peak);
             best = Some((r, m));
         }
         // Grow by half: the work grows as about u³, so overshooting the
@@ -202,5 +210,6 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
         mapping: to_arena(m),
         work,
         band: done_band,
+        peak_cells: peak,
     }
 }

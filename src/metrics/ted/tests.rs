@@ -216,6 +216,23 @@ fn past_the_work_budget_the_result_is_an_interval_with_a_script_of_its_upper_bou
     }
 }
 
+/// Memory: two unrelated 10,000-node trees under the default options hold
+/// at most `DEFAULT_MAX_CELLS` cells (128 MiB) at once, whatever the band.
+#[test]
+fn memory_stays_within_max_cells_on_two_10k_node_trees() {
+    let mut rng = Rng(10);
+    let a = random_tree(&mut rng, 10_000, 4);
+    let b = random_tree(&mut rng, 10_000, 4);
+    let opts = TedOptions {
+        max_work: 20_000_000,
+        ..TedOptions::default()
+    };
+    let r = ted(&a, &b, &opts);
+    assert!(r.peak_cells > 0 && r.peak_cells <= DEFAULT_MAX_CELLS, "{}", r.peak_cells);
+    assert!(r.lower <= r.upper && r.upper <= 19_999);
+    assert!(r.work <= opts.max_work + 20_000 * 20_000);
+}
+
 #[test]
 fn past_the_memory_budget_the_result_is_an_interval() {
     let mut rng = Rng(9);
@@ -226,6 +243,7 @@ fn past_the_memory_budget_the_result_is_an_interval() {
         ..TedOptions::default()
     };
     let r = ted(&a, &b, &opts);
+    assert!(r.peak_cells <= 5_000, "{}", r.peak_cells);
     let exact = ted(&a, &b, &TedOptions::default());
     assert!(!r.exact());
     assert!(r.lower <= exact.upper && exact.upper <= r.upper);

@@ -32,6 +32,8 @@ pub struct Banded<'a> {
     pub fd: Stair,
     /// Cells computed so far.
     pub work: u64,
+    /// Most cells held at once (`td` and the largest forest table).
+    pub peak: u64,
     path1: Vec<usize>,
     path2: Vec<usize>,
 }
@@ -81,6 +83,7 @@ impl<'a> Banded<'a> {
             td,
             fd: Stair::default(),
             work: 0,
+            peak: 0,
             path1: Vec::new(),
             path2: Vec::new(),
         }
@@ -171,6 +174,7 @@ impl<'a> Banded<'a> {
             return;
         };
         self.fd.reset((l1, rmax + 1), (l2, cmax + 1), (dlo, dhi));
+        self.peak = self.peak.max((self.td.data.len() + self.fd.data.len()) as u64);
         let fd = &mut self.fd;
         let td = &mut self.td;
         let mut work = 0u64;
