@@ -6,11 +6,12 @@
 //! while the paper's GED (unordered, `metrics::ged`) sees no change.
 //!
 //! The algorithm is Zhang & Shasha's (SIAM J. Comput. 1989; `zs.rs`) run in
-//! a diagonal band of width `u` (Touzet, CPM 2005), with `u` grown by half until
-//! the band's result is at most `u`, which proves it exact: similar trees — the
-//! usual case of a pull request — cost O(n·u·k²) cells and O(n·u) memory
-//! (`k` is the number of keyroots on a root-leaf path), two unrelated trees
-//! the full O(n²·k²). Of the trees' two orientations (as drawn and
+//! a diagonal band of width `u` (Touzet, CPM 2005), with `u` grown by half
+//! (or set to the cost of the quick mapping of `greedy.rs` once close to it)
+//! until the band's result is at most `u`, which proves it exact. Similar
+//! trees — the usual case of a pull request — cost about O(n·k·u²) cells
+//! (`k` the keyroots on a root-leaf path; measured: docs/performance.md) and
+//! O(n·u) memory; two unrelated trees the full O(n²·k²). Of the trees' two orientations (as drawn and
 //! mirrored, same distance) the one with fewer cells is used, the only part
 //! of Pawlik & Augsten's path strategies (RTED/APTED, TODS 2015, Inf. Syst.
 //! 2016) built here; their optimal strategy, worst case O(n³), is not.
@@ -21,6 +22,7 @@
 
 mod band;
 pub mod bt;
+mod greedy;
 mod mapping;
 mod script;
 #[cfg(test)]
@@ -31,7 +33,6 @@ pub mod tree_text;
 pub use script::{TreeEdit, edit_script};
 pub use tree::OrderedTree;
 
-use band::INF;
 use zs::Banded;
 mod zs;
 
@@ -148,14 +149,26 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
     // No mapping costs more than n1 + n2: a band this wide prunes nothing.
     let full = n1 + n2;
     let mut lower = n1.abs_diff(n2) as u64;
-    // A mapping always available: the roots to each other.
+    // A mapping always available: the roots to each other; usually a far
+    // better one: the top-down alignment of `greedy.rs` (arena pairs).
     let root_cost = (n1 + n2 - 2) as u64 + u64::from(f.label[n1 - 1] != g.label[n2 - 1]);
-    let mut best: Option<(u64, Vec<(usize, usize)>)> = None;
+    let (gm, gcost) = greedy::greedy_mapping(a, b);
+    let mut best: (u64, Vec<(usize, usize)>) = if gcost < root_cost {
+        (gcost, gm)
+    } else {
+        (root_cost, vec![(f.arena[n1 - 1], g.arena[n2 - 1])])
+    };
     let mut work = 0u64;
     let mut peak = 0u64;
     let mut done_band = 0;
     let mut u = n1.abs_diff(n2).max(2);
     loop {
+        // A band as wide as a known mapping's cost holds that mapping, so
+        // its result is exact: jump there once the growth comes close.
+        let ub = usize::try_from(best.0).unwrap_or(usize::MAX);
+        if u.saturating_mul(3) >= ub.saturating_mul(2) {
+            u = ub;
+        }
         u = u.min(full);
         if Banded::memory_cells(&f, &g, u) > opts.max_cells {
             break;
@@ -184,30 +197,22 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
         }
         // The distance is above u; r, if finite, is a mapping's cost.
         lower = lower.max(u as u64 + 1);
-        if r < u64::from(INF) && best.as_ref().is_none_or(|(c, _)| r < *c) {
+        if r < best.0 {
             band.work = 0;
             let m = mapping::mapping(&mut band);
             work += band.work;
             peak = peak.max(band.peak);
-            best = Some((r, m));
+            best = (r, to_arena(m));
         }
         // Grow by half: the work grows as about u³, so overshooting the
         // distance by up to 1.5× costs less than doubling's 2×.
-        let next = u.saturating_add(u.div_ceil(2));
-        u = if r < u64::from(INF) {
-            next.min(r as usize)
-        } else {
-            next
-        };
+        u = u.saturating_add(u.div_ceil(2));
     }
-    let (upper, m) = match best {
-        Some((c, m)) if c < root_cost => (c, m),
-        _ => (root_cost, vec![(n1 - 1, n2 - 1)]),
-    };
+    let (upper, m) = best;
     TedResult {
         lower: lower.min(upper),
         upper,
-        mapping: to_arena(m),
+        mapping: m,
         work,
         band: done_band,
         peak_cells: peak,

@@ -228,7 +228,11 @@ fn memory_stays_within_max_cells_on_two_10k_node_trees() {
         ..TedOptions::default()
     };
     let r = ted(&a, &b, &opts);
-    assert!(r.peak_cells > 0 && r.peak_cells <= DEFAULT_MAX_CELLS, "{}", r.peak_cells);
+    assert!(
+        r.peak_cells > 0 && r.peak_cells <= DEFAULT_MAX_CELLS,
+        "{}",
+        r.peak_cells
+    );
     assert!(r.lower <= r.upper && r.upper <= 19_999);
     assert!(r.work <= opts.max_work + 20_000 * 20_000);
 }

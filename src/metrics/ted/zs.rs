@@ -174,7 +174,9 @@ impl<'a> Banded<'a> {
             return;
         };
         self.fd.reset((l1, rmax + 1), (l2, cmax + 1), (dlo, dhi));
-        self.peak = self.peak.max((self.td.data.len() + self.fd.data.len()) as u64);
+        self.peak = self
+            .peak
+            .max((self.td.data.len() + self.fd.data.len()) as u64);
         let fd = &mut self.fd;
         let td = &mut self.td;
         let mut work = 0u64;
