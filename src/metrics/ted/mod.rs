@@ -162,12 +162,23 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
     let mut peak = 0u64;
     let mut done_band = 0;
     let mut u = n1.abs_diff(n2).max(2);
+    let full_cells = u128::from(f.keyroot_weight()) * u128::from(g.keyroot_weight());
+    // The width and work of the last band run.
+    let mut last: Option<(usize, u64)> = None;
     loop {
         // A band as wide as a known mapping's cost holds that mapping, so
         // its result is exact: jump there once the growth comes close.
         let ub = usize::try_from(best.0).unwrap_or(usize::MAX);
         if u.saturating_mul(3) >= ub.saturating_mul(2) {
             u = ub;
+        }
+        // Once a band would cost about as much as Zhang–Shasha's whole
+        // tables (the product of the keyroot weights), run those instead.
+        if let Some((pu, pw)) = last {
+            let grow = (u as f64 / pu as f64).powi(3);
+            if pw as f64 * grow >= full_cells as f64 {
+                u = full;
+            }
         }
         u = u.min(full);
         if Banded::memory_cells(&f, &g, u) > opts.max_cells {
@@ -177,6 +188,7 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
         let ran = band.run(opts.max_work.saturating_sub(work));
         work += band.work;
         peak = peak.max(band.peak);
+        last = Some((u.max(1), band.work.max(1)));
         if ran.is_err() {
             break;
         }
