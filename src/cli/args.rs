@@ -73,7 +73,8 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
-    /// Graph edit distance between two policies, with the edit script
+    /// Graph edit distance between two policies (and, for two BTs, the
+    /// ordered tree edit distance), with the edit script
     Compare {
         /// The old policy
         a: PathBuf,
@@ -92,9 +93,9 @@ pub enum Command {
         /// `exact: false`
         #[arg(long, default_value_t = 2000, value_name = "MS")]
         timeout_ms: u64,
-        /// Work budget of the tree edit distance, in table cells (about 2 ns
-        /// each; memory is capped at 2^25 cells, 128 MiB): past it the
-        /// result is an interval with `exact: false`, the same on any machine
+        /// Work budget of --mode tree, in table cells (the default takes 1-3 s;
+        /// memory is capped at 2^25 cells, 128 MiB): past it the result is an
+        /// interval with `exact: false`, the same on any machine
         #[arg(long, default_value_t = crate::metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
         tree_max_work: u64,
         /// Output format

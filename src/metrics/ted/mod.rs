@@ -68,7 +68,8 @@ impl LabelledTree {
 /// the machine's load.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TedOptions {
-    /// Most table cells computed, over all bands tried (about 2 ns each).
+    /// Most table cells computed, over all bands tried (checked after each
+    /// forest table).
     pub max_work: u64,
     /// Most table cells held at once (4 bytes each).
     pub max_cells: u64,
