@@ -7,7 +7,7 @@ VENV := .venv
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
-.PHONY: build run test bench bench-ged clean paper-docs fuzz mermaid-oracle man differential
+.PHONY: build run test bench bench-ged bench-ted clean paper-docs fuzz mermaid-oracle man differential
 
 build:
 	$(CARGO) build --release --locked
@@ -36,7 +36,7 @@ test:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets --locked -- -D warnings
 	$(CARGO) test --locked
-	$(CARGO) test --locked --bench scale --bench ged --bench sim -- --test
+	$(CARGO) test --locked --bench scale --bench ged --bench sim --bench ted -- --test
 	$(CARGO) run --quiet --locked -- paper --check
 	$(MAKE) --no-print-directory mermaid-oracle
 	$(MAKE) --no-print-directory differential
@@ -52,7 +52,9 @@ test:
 # SARIF log of `lint` against the official schema (sarif_check.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py); and
 # every corpus SCXML file read by btfsm and by an independent SCXML engine
-# (PyPI `scjson`) alike (tests/differential/scxml_engine.py).
+# (PyPI `scjson`) alike (tests/differential/scxml_engine.py); and
+# `compare --mode tree`'s distance against the `apted` and `zss` packages on
+# 3000 seeded random tree pairs (tests/differential/ted.py).
 $(VENV)/.installed: tests/differential/requirements.txt
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/differential/requirements.txt
@@ -61,6 +63,7 @@ $(VENV)/.installed: tests/differential/requirements.txt
 differential: $(VENV)/.installed
 	$(CARGO) build --quiet --locked
 	$(VENV)/bin/python tests/differential/differential.py $(TARGET_DIR)/debug/btfsm --trees 3000
+	$(VENV)/bin/python tests/differential/ted.py $(TARGET_DIR)/debug/btfsm --pairs 3000
 	@mkdir -p $(TARGET_DIR)
 	$(VENV)/bin/python tests/differential/accept_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/accept_btcpp.txt 2>&1 \
 	  || { tail -40 $(TARGET_DIR)/accept_btcpp.txt; exit 1; }
@@ -123,6 +126,12 @@ bench-ged: $(VENV)/.installed
 	python3 bench/ged_vs_networkx.py
 	$(CARGO) build --quiet --locked --release
 	$(VENV)/bin/python bench/ged_vs_highs.py $(BIN)
+
+# btfsm's tree edit distance vs the `apted` package on the same pairs, in one
+# run (docs/performance.md); uses .venv (make differential creates it).
+bench-ted: $(VENV)/.installed
+	$(CARGO) build --release --locked
+	$(VENV)/bin/python bench/ted_vs_apted.py $(BIN)
 
 # Each fuzz target for FUZZ_SECONDS (default 600) with cargo-fuzz on nightly
 # (docs/robustness.md); FUZZ_TARGETS="toml_policy" runs only some.

@@ -73,14 +73,18 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitArgs,
     },
-    /// Graph edit distance between two policies, with the edit script
+    /// Graph edit distance between two policies (and, for two BTs, the
+    /// ordered tree edit distance), with the edit script
     Compare {
         /// The old policy
         a: PathBuf,
         /// The new policy
         b: PathBuf,
-        /// Which GED: structural (any vertex to any vertex), labeled (same
-        /// vertex type only), named (by node id / state name), or all three
+        /// Which distance: a GED — structural (any vertex to any vertex),
+        /// labeled (same vertex type only), named (by node id / state name) —
+        /// or tree, the ordered tree edit distance of two BTs (children
+        /// order and node labels count); all: the three GEDs, and tree when
+        /// both policies are BTs
         #[arg(long, value_enum, default_value_t = CompareMode::All)]
         mode: CompareMode,
         /// Wall-clock safety cap per mode, its whole computation (graphs,
@@ -96,6 +100,11 @@ pub enum Command {
         /// certified interval with `exact: false` and `stopped_by: work`
         #[arg(long, default_value_t = crate::metrics::ged::DEFAULT_WORK, value_name = "UNITS")]
         work: u64,
+        /// Work budget of --mode tree, in table cells (the default takes 1-3 s;
+        /// memory is capped at 2^25 cells, 128 MiB): past it the result is an
+        /// interval with `exact: false`, the same on any machine
+        #[arg(long, default_value_t = crate::metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
+        tree_max_work: u64,
         /// Output format
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
         format: CompareFormat,
@@ -165,6 +174,11 @@ pub enum Command {
     Lint(super::lint::LintArgs),
     /// Reads BehaviorTree.CPP execution logs (.btlog): `log report`
     Log(super::log::LogArgs),
+    /// Tree edit distances of trees in bracket notation, one pair per line
+    /// (`{a{b}}<TAB>{a{c}}`): what tests/differential/ted.py and
+    /// bench/ted_vs_apted.py drive
+    #[command(hide = true)]
+    TedPairs(super::ted_pairs::TedPairsArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
     Completions {
@@ -185,18 +199,23 @@ pub enum CompareMode {
     Structural,
     Labeled,
     Named,
+    /// Ordered tree edit distance between two BTs (child order and node
+    /// labels count; BT pairs only)
+    Tree,
+    /// The three GED modes, and `tree` when both policies are BTs
     All,
 }
 
 impl CompareMode {
-    /// The single GED mode selected, or `None` for all three.
-    pub fn selection(self) -> Option<crate::metrics::ged::GedMode> {
+    /// The GED modes selected, in report order (none for `tree`).
+    pub fn ged_modes(self) -> Vec<crate::metrics::ged::GedMode> {
         use crate::metrics::ged::GedMode;
         match self {
-            CompareMode::Structural => Some(GedMode::Structural),
-            CompareMode::Labeled => Some(GedMode::Labeled),
-            CompareMode::Named => Some(GedMode::Named),
-            CompareMode::All => None,
+            CompareMode::Structural => vec![GedMode::Structural],
+            CompareMode::Labeled => vec![GedMode::Labeled],
+            CompareMode::Named => vec![GedMode::Named],
+            CompareMode::Tree => Vec::new(),
+            CompareMode::All => crate::report::compare::modes_of(None),
         }
     }
 }

@@ -188,6 +188,7 @@ pub fn execute(cli: Cli) -> u8 {
             mode,
             timeout_ms,
             work,
+            tree_max_work,
             format,
             dot,
             render,
@@ -198,6 +199,7 @@ pub fn execute(cli: Cli) -> u8 {
             mode,
             timeout_ms,
             work,
+            tree_max_work,
             format,
             dot,
             render,
@@ -304,6 +306,7 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Plan(args) => super::plan::execute(args),
         Command::Lint(args) => super::lint::execute(args),
         Command::Log(args) => super::log::execute(args),
+        Command::TedPairs(args) => super::ted_pairs::execute(args),
         Command::Completions { shell } => {
             use clap::CommandFactory;
             let mut out = Vec::new();

@@ -2,15 +2,20 @@
 //! (SPEC §3, §7) under the time budget, prints the report, and optionally
 //! draws B with the edits highlighted. While a long search runs, a progress
 //! line on stderr (only when stderr is a terminal) tells which mode is being
-//! computed and how much of its budget is spent.
+//! computed and how much of its budget is spent. `--mode tree` (and the
+//! default, for two BTs) adds the ordered tree edit distance
+//! (`metrics::ted`), bounded by a count of table cells.
 
 use super::args::{CompareFormat, CompareMode};
 use super::commands::{draw, emit_text, load_all};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use crate::format::Limits;
 use crate::metrics::ged::{GedMode, GedOptions};
+use crate::metrics::ted::TedOptions;
+use crate::model::{PolicyBody, PolicyKind};
 use crate::render::dot::RenderFormat;
 use crate::report::compare::{self, Pair, Side};
+use crate::sanitize::shown;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::sync::mpsc;
@@ -24,6 +29,7 @@ pub struct CompareArgs {
     pub timeout_ms: u64,
     /// Work budget (`GedOptions::work`).
     pub work: u64,
+    pub tree_max_work: u64,
     pub format: CompareFormat,
     pub dot: Option<PathBuf>,
     pub render: Option<RenderFormat>,
@@ -34,12 +40,35 @@ pub fn execute(args: CompareArgs) -> u8 {
     if !super::commands::outputs_distinct(&[("--dot", args.dot.as_deref())], true) {
         return EXIT_BAD_INPUT;
     }
+    if args.mode == CompareMode::Tree && args.dot.is_some() {
+        eprintln!(
+            "error: --dot draws a GED edit script, and --mode tree computes none\n  = hint: use --dot with --mode named (or structural, labeled, all)"
+        );
+        return EXIT_BAD_INPUT;
+    }
     let Some(loaded) = load_all(&[args.a.clone(), args.b.clone()], &args.limits) else {
         return EXIT_BAD_INPUT;
     };
     let [la, lb] = loaded.as_slice() else {
         return EXIT_BAD_INPUT;
     };
+    let bts = match (&la.policy.body, &lb.policy.body) {
+        (PolicyBody::Bt(a), PolicyBody::Bt(b)) => Some((a, b)),
+        _ => None,
+    };
+    if args.mode == CompareMode::Tree && bts.is_none() {
+        let other = if la.policy.kind() == PolicyKind::Bt {
+            lb
+        } else {
+            la
+        };
+        eprintln!(
+            "error: --mode tree compares two Behavior Trees, and {} is an {}\n  = hint: FSMs and HFSMs are graphs, not ordered trees: use --mode structural, labeled or named (or leave --mode out)",
+            shown(&other.path),
+            other.policy.kind().as_str().to_uppercase(),
+        );
+        return EXIT_BAD_INPUT;
+    }
     let opts = GedOptions {
         timeout: Duration::from_millis(args.timeout_ms),
         work: args.work,
@@ -55,12 +84,21 @@ pub fn execute(args: CompareArgs) -> u8 {
         },
     );
     let mut results = Vec::new();
-    for mode in compare::modes_of(args.mode.selection()) {
+    for mode in args.mode.ged_modes() {
         let progress = Progress::start(mode, opts.timeout);
         results.push(pair.run(mode, &opts));
         drop(progress);
     }
-    let report = pair.report(results);
+    let mut report = pair.report(results);
+    if matches!(args.mode, CompareMode::Tree | CompareMode::All)
+        && let Some((a, b)) = bts
+    {
+        let topts = TedOptions {
+            max_work: args.tree_max_work,
+            ..TedOptions::default()
+        };
+        report.tree = Some(compare::tree::tree_report(a, b, &topts));
+    }
     if let (Some(path), Some(primary)) = (&args.dot, report.primary()) {
         let opts = pair.dot_options(&primary.edit_script);
         // Graphviz gets the budget of one mode (--timeout-ms).

@@ -33,6 +33,7 @@ pub mod out;
 mod paper;
 mod plan;
 pub mod sim;
+mod ted_pairs;
 mod tick;
 
 use clap::Parser;

@@ -5,3 +5,4 @@ pub mod complexity;
 pub mod counts;
 pub mod effort;
 pub mod ged;
+pub mod ted;

@@ -26,6 +26,13 @@ fn compare(a: &str, b: &str, extra: &[&str]) -> String {
                 .iter()
                 .any(|m| l.starts_with(m) || l.starts_with(&format!("| {m} |")))
                 && l.contains('[');
+            // The tree distance's time, as `… (exact, 3 ms)`.
+            if let Some(at) = l.find(" ms)")
+                && l.starts_with("tree edit distance")
+            {
+                let start = l[..at].rfind(", ").map_or(at, |p| p + 2);
+                return format!("{}ms{}", &l[..start], &l[at + 3..]);
+            }
             match (mode, l.starts_with('|')) {
                 (true, true) => {
                     let cut = l.trim_end_matches('|').trim_end().rfind('|').unwrap_or(0);

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 mod common;
 mod compare;
 mod compare_report;
+mod compare_tree;
 mod conventions;
 mod formats;
 mod gate;

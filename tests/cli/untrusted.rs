@@ -329,21 +329,29 @@ fn control_characters_never_reach_an_output() {
     }
     let r = run_in(&d.0, &["compare", &a, &b, "--format", "markdown"], None);
     check(&r, &d.0, &[0], "markdown");
-    assert!(!r.stdout.contains("<img"), "{}", r.stdout);
-    // The diff block and the Mermaid diagram are each closed only by their
-    // own fence: four fence lines, each block's closing one its opening
-    // one's backticks alone.
-    let fence_lines: Vec<&str> = r
-        .stdout
-        .lines()
-        .filter(|l| l.trim_start().starts_with("```"))
-        .collect();
-    assert_eq!(fence_lines.len(), 4, "{}", r.stdout);
-    for pair in fence_lines.chunks(2) {
-        let fence = pair[0].trim_end_matches(|c: char| c.is_ascii_alphabetic());
-        assert!(pair[0].ends_with("diff") || pair[0].ends_with("mermaid"));
-        assert_eq!(pair[1], fence, "{}", r.stdout);
+    // Three blocks (the named GED script, the Mermaid diff diagram, the tree
+    // edit script): each is closed only by its own fence, and outside them
+    // no HTML is raw (inside, a code block shows HTML as text).
+    let mut outside = String::new();
+    let mut blocks = 0;
+    let mut open: Option<String> = None;
+    for l in r.stdout.lines() {
+        let t = l.trim_start();
+        match &open {
+            None if t.starts_with("```") => {
+                open = Some(t.chars().take_while(|&c| c == '`').collect());
+            }
+            None => outside.push_str(l),
+            Some(f) if t.trim_end() == f.as_str() => {
+                open = None;
+                blocks += 1;
+            }
+            Some(f) => assert!(!t.starts_with(f.as_str()), "{}", r.stdout),
+        }
     }
+    assert!(open.is_none(), "{}", r.stdout);
+    assert_eq!(blocks, 3, "{}", r.stdout);
+    assert!(!outside.contains("<img"), "{}", r.stdout);
 }
 
 /// Parameters doubled level by level, a file of a million TOML errors, the

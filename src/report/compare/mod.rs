@@ -24,6 +24,7 @@ mod script;
 #[cfg(test)]
 mod tests;
 mod text;
+pub mod tree;
 
 pub use changes::{Relabel, Reorder};
 pub use render::{render_json, render_markdown, render_table};
@@ -192,6 +193,8 @@ pub struct CompareReport {
     /// The primary mode's diff as a Mermaid flowchart (`diff_mermaid.rs`),
     /// `Err` with the numbers of nodes and links when it is too large.
     pub diagram: Option<Result<String, (usize, usize)>>,
+    /// The ordered tree edit distance (`--mode tree`; BT pairs only).
+    pub tree: Option<tree::TreeReport>,
 }
 
 impl CompareReport {
@@ -327,6 +330,7 @@ impl<'a> Pair<'a> {
             b: summary(&self.b, &self.gb),
             modes,
             diagram,
+            tree: None,
         }
     }
 }

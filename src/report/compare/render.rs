@@ -18,6 +18,8 @@ pub fn render_json(r: &CompareReport) -> String {
         labeled: Option<&'a ModeReport>,
         #[serde(skip_serializing_if = "Option::is_none")]
         named: Option<&'a ModeReport>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        tree: Option<&'a super::tree::TreeReport>,
     }
     let out = Out {
         a: &r.a.file,
@@ -25,6 +27,7 @@ pub fn render_json(r: &CompareReport) -> String {
         structural: r.mode(GedMode::Structural),
         labeled: r.mode(GedMode::Labeled),
         named: r.mode(GedMode::Named),
+        tree: r.tree.as_ref(),
     };
     let mut s = crate::sanitize::json(serde_json::to_string_pretty(&out).expect("serializable"));
     s.push('\n');
@@ -48,17 +51,19 @@ pub fn render_table(r: &CompareReport) -> String {
         ));
     }
     out.push('\n');
-    let mut t = crate::report::table::Table::new(&["mode", "GED", "exact", "interval", "ms"]);
-    for m in &r.modes {
-        t.row(vec![
-            m.mode.as_str().to_string(),
-            m.ged.to_string(),
-            if m.exact { "yes" } else { "no" }.to_string(),
-            format!("[{}, {}]", m.lower_bound, m.upper_bound),
-            m.millis.to_string(),
-        ]);
+    if !r.modes.is_empty() {
+        let mut t = crate::report::table::Table::new(&["mode", "GED", "exact", "interval", "ms"]);
+        for m in &r.modes {
+            t.row(vec![
+                m.mode.as_str().to_string(),
+                m.ged.to_string(),
+                if m.exact { "yes" } else { "no" }.to_string(),
+                format!("[{}, {}]", m.lower_bound, m.upper_bound),
+                m.millis.to_string(),
+            ]);
+        }
+        out.push_str(&t.render());
     }
-    out.push_str(&t.render());
     for line in stop_notes(r) {
         out.push_str(&format!("note: {line}\n"));
     }
@@ -75,6 +80,12 @@ pub fn render_table(r: &CompareReport) -> String {
     if let Some(p) = r.primary() {
         out.push('\n');
         out.push_str(&render_script(p));
+    }
+    if let Some(t) = &r.tree {
+        if !r.modes.is_empty() {
+            out.push('\n');
+        }
+        out.push_str(&super::tree::render_text(t));
     }
     out
 }
@@ -129,7 +140,9 @@ pub fn render_markdown(r: &CompareReport) -> String {
             s.arcs
         ));
     }
-    out.push_str("\n| mode | GED | exact | interval | ms |\n|---|---:|---|---|---:|\n");
+    if !r.modes.is_empty() {
+        out.push_str("\n| mode | GED | exact | interval | ms |\n|---|---:|---|---|---:|\n");
+    }
     for m in &r.modes {
         out.push_str(&format!(
             "| {} | {} | {} | [{}, {}] | {} |\n",
@@ -166,6 +179,29 @@ pub fn render_markdown(r: &CompareReport) -> String {
         ));
     }
     out.push_str(&super::diff_mermaid::markdown_section(r));
+    if let Some(t) = &r.tree {
+        out.push_str(&tree_markdown(t));
+    }
+    out
+}
+
+/// `--mode tree` in markdown: the distance, then its script as a `diff`
+/// block (deletions red, insertions green) in a collapsible section.
+fn tree_markdown(t: &super::tree::TreeReport) -> String {
+    let cell = crate::sanitize::markdown_cell;
+    let body: String = super::tree::script_lines(t)
+        .into_iter()
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let mut out = format!("\n{}\n", cell(&super::tree::summary(t)));
+    if !body.is_empty() {
+        let fence = crate::sanitize::code_fence(&body);
+        let cost = t.edit_script.cost();
+        out.push_str(&format!(
+            "\n<details><summary>tree edit script ({cost} edit{})</summary>\n\n{fence}diff\n{body}{fence}\n\n</details>\n",
+            if cost == 1 { "" } else { "s" }
+        ));
+    }
     out
 }
 

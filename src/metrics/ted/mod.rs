@@ -1,0 +1,233 @@
+//! Ordered labelled tree edit distance (Tai, J. ACM 1979): the fewest unit
+//! operations — delete a node (its children take its place), insert one,
+//! rename one — that turn tree a into tree b, children order mattering.
+//! `btfsm compare --mode tree` computes it between two Behavior Trees, where
+//! order is priority: swapping two children of a Sequence costs > 0 here,
+//! while the paper's GED (unordered, `metrics::ged`) sees no change.
+//!
+//! The algorithm is Zhang & Shasha's (SIAM J. Comput. 1989; `zs.rs`) run in
+//! a diagonal band of width `u` (Touzet, CPM 2005), with `u` grown by half
+//! (or set to the cost of the quick mapping of `greedy.rs` once close to it)
+//! until the band's result is at most `u`, which proves it exact. Similar
+//! trees — the usual case of a pull request — cost about O(n·k·u²) cells
+//! (`k` the keyroots on a root-leaf path; measured: docs/performance.md) and
+//! O(n·u) memory; two unrelated trees the full O(n²·k²). Of the trees' two orientations (as drawn and
+//! mirrored, same distance) the one with fewer cells is used, the only part
+//! of Pawlik & Augsten's path strategies (RTED/APTED, TODS 2015, Inf. Syst.
+//! 2016) built here; their optimal strategy, worst case O(n³), is not.
+//!
+//! Work and memory are bounded by counts, not time ([`TedOptions`]): past
+//! either, the result is an interval `[lower, upper]` with the script of a
+//! mapping costing `upper`, the same on any machine.
+
+mod band;
+pub mod bt;
+mod greedy;
+mod mapping;
+mod script;
+#[cfg(test)]
+mod tests;
+mod tree;
+pub mod tree_text;
+
+pub use script::{TreeEdit, edit_script};
+pub use tree::OrderedTree;
+
+use zs::Banded;
+mod zs;
+
+/// A tree to compare: an arena of children lists with a label id per node
+/// (ids shared by both trees: equal ids, equal labels).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LabelledTree {
+    pub children: Vec<Vec<usize>>,
+    pub labels: Vec<u32>,
+    pub root: usize,
+}
+
+impl LabelledTree {
+    /// Nodes reachable from the root, parents before children, children
+    /// in order (each node once).
+    pub fn preorder(&self) -> Vec<usize> {
+        let mut seen = vec![false; self.children.len()];
+        let mut out = Vec::new();
+        let mut stack = vec![self.root];
+        while let Some(n) = stack.pop() {
+            if n >= seen.len() || seen[n] {
+                continue;
+            }
+            seen[n] = true;
+            out.push(n);
+            stack.extend(self.children[n].iter().rev().copied());
+        }
+        out
+    }
+}
+
+/// Bounds of one computation, counted so that a result never depends on
+/// the machine's load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TedOptions {
+    /// Most table cells computed, over all bands tried (checked after each
+    /// forest table).
+    pub max_work: u64,
+    /// Most table cells held at once (4 bytes each).
+    pub max_cells: u64,
+}
+
+/// Default [`TedOptions::max_work`]: 3·10⁸ cells, about 1–3 s.
+pub const DEFAULT_MAX_WORK: u64 = 300_000_000;
+/// Default [`TedOptions::max_cells`]: 2²⁵ cells, 128 MiB.
+pub const DEFAULT_MAX_CELLS: u64 = 1 << 25;
+
+impl Default for TedOptions {
+    fn default() -> Self {
+        TedOptions {
+            max_work: DEFAULT_MAX_WORK,
+            max_cells: DEFAULT_MAX_CELLS,
+        }
+    }
+}
+
+/// The distance, or the interval it lies in, with a mapping of cost `upper`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TedResult {
+    pub lower: u64,
+    pub upper: u64,
+    /// Mapped pairs `(node of a, node of b)` in arena indices, sorted.
+    pub mapping: Vec<(usize, usize)>,
+    /// Table cells computed (the work budget's unit).
+    pub work: u64,
+    /// Width `u` of the last band that ran to completion (0 when none).
+    pub band: usize,
+    /// Most table cells held at once (4 bytes each), never above
+    /// [`TedOptions::max_cells`].
+    pub peak_cells: u64,
+}
+
+impl TedResult {
+    pub fn exact(&self) -> bool {
+        self.lower >= self.upper
+    }
+}
+
+/// The ordered tree edit distance of `a` and `b` with unit costs.
+pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
+    // The orientation with fewer cells: same distance, mirrored mapping.
+    let (fa, fb) = (
+        OrderedTree::build(&a.children, &a.labels, a.root, false),
+        OrderedTree::build(&b.children, &b.labels, b.root, false),
+    );
+    let (ma, mb) = (
+        OrderedTree::build(&a.children, &a.labels, a.root, true),
+        OrderedTree::build(&b.children, &b.labels, b.root, true),
+    );
+    let weight = |x: &OrderedTree, y: &OrderedTree| {
+        u128::from(x.keyroot_weight()) * u128::from(y.keyroot_weight())
+    };
+    let mirrored = weight(&ma, &mb) < weight(&fa, &fb);
+    let (f, g) = if mirrored { (ma, mb) } else { (fa, fb) };
+    let to_arena = |pairs: Vec<(usize, usize)>| -> Vec<(usize, usize)> {
+        let mut m: Vec<(usize, usize)> = pairs
+            .into_iter()
+            .map(|(x, y)| (f.arena[x], g.arena[y]))
+            .collect();
+        m.sort_unstable();
+        m
+    };
+    let (n1, n2) = (f.len(), g.len());
+    if n1 == 0 || n2 == 0 {
+        let d = (n1 + n2) as u64;
+        return TedResult {
+            lower: d,
+            upper: d,
+            mapping: Vec::new(),
+            work: 0,
+            band: 0,
+            peak_cells: 0,
+        };
+    }
+    // No mapping costs more than n1 + n2: a band this wide prunes nothing.
+    let full = n1 + n2;
+    let mut lower = n1.abs_diff(n2) as u64;
+    // A mapping always available: the roots to each other; usually a far
+    // better one: the top-down alignment of `greedy.rs` (arena pairs).
+    let root_cost = (n1 + n2 - 2) as u64 + u64::from(f.label[n1 - 1] != g.label[n2 - 1]);
+    let (gm, gcost) = greedy::greedy_mapping(a, b);
+    let mut best: (u64, Vec<(usize, usize)>) = if gcost < root_cost {
+        (gcost, gm)
+    } else {
+        (root_cost, vec![(f.arena[n1 - 1], g.arena[n2 - 1])])
+    };
+    let mut work = 0u64;
+    let mut peak = 0u64;
+    let mut done_band = 0;
+    let mut u = n1.abs_diff(n2).max(2);
+    let full_cells = u128::from(f.keyroot_weight()) * u128::from(g.keyroot_weight());
+    // The width and work of the last band run.
+    let mut last: Option<(usize, u64)> = None;
+    loop {
+        // A band as wide as a known mapping's cost holds that mapping, so
+        // its result is exact: jump there once the growth comes close.
+        let ub = usize::try_from(best.0).unwrap_or(usize::MAX);
+        if u.saturating_mul(3) >= ub.saturating_mul(2) {
+            u = ub;
+        }
+        // Once a band would cost about as much as Zhang–Shasha's whole
+        // tables (the product of the keyroot weights), run those instead.
+        if let Some((pu, pw)) = last {
+            let grow = (u as f64 / pu as f64).powi(3);
+            if pw as f64 * grow >= full_cells as f64 {
+                u = full;
+            }
+        }
+        u = u.min(full);
+        if Banded::memory_cells(&f, &g, u) > opts.max_cells {
+            break;
+        }
+        let mut band = Banded::new(&f, &g, u);
+        let ran = band.run(opts.max_work.saturating_sub(work));
+        work += band.work;
+        peak = peak.max(band.peak);
+        last = Some((u.max(1), band.work.max(1)));
+        if ran.is_err() {
+            break;
+        }
+        done_band = u;
+        let r = u64::from(band.distance());
+        if r <= u as u64 || u == full {
+            band.work = 0;
+            let m = mapping::mapping(&mut band);
+            work += band.work;
+            return TedResult {
+                lower: r,
+                upper: r,
+                mapping: to_arena(m),
+                work,
+                band: u,
+                peak_cells: peak.max(band.peak),
+            };
+        }
+        // The distance is above u; r, if finite, is a mapping's cost.
+        lower = lower.max(u as u64 + 1);
+        if r < best.0 {
+            band.work = 0;
+            let m = mapping::mapping(&mut band);
+            work += band.work;
+            peak = peak.max(band.peak);
+            best = (r, to_arena(m));
+        }
+        // Grow by half: the work grows as about u³, so overshooting the
+        // distance by up to 1.5× costs less than doubling's 2×.
+        u = u.saturating_add(u.div_ceil(2));
+    }
+    let (upper, m) = best;
+    TedResult {
+        lower: lower.min(upper),
+        upper,
+        mapping: m,
+        work,
+        band: done_band,
+        peak_cells: peak,
+    }
+}
