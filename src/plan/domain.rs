@@ -165,7 +165,8 @@ pub struct Predicate {
     pub name: String,
     pub params: Vec<Param>,
     /// The condition skill that checks it (its arguments are the
-    /// parameters, by name).
+    /// parameters, by name): a library skill, or the domain's own
+    /// `domain:Name`; `None` only while a domain with errors is read.
     pub skill: Option<String>,
     /// The parameter whose different values make facts exclude each other
     /// (`Robot-At(a)` and `Robot-At(b)`): an action adding one deletes the
@@ -842,6 +843,17 @@ impl Domain {
 }
 
 impl Domain {
+    /// The condition a fact stands for: its predicate's skill with the
+    /// fact's objects as arguments.
+    pub fn fact_condition(&self, f: &Fact) -> crate::model::skill::SkillCall {
+        let pred = self.predicate(&f.pred).expect("a fact of the domain");
+        let skill = pred
+            .skill
+            .as_deref()
+            .expect("a valid domain's predicates have skills");
+        Domain::skill_call(skill, &pred.params, &f.args)
+    }
+
     /// The skill call of `skill` with `params` bound to `objects` (numbers
     /// and booleans as such: `Battery-Level(20)` is `min = 20`).
     pub fn skill_call(

@@ -33,8 +33,6 @@ use crate::model::{
 pub enum FsmError {
     #[error("the plan has no step: the goal holds by itself or no action achieves it")]
     NoStep,
-    #[error("predicate `{0}` has no `skill`, so the SELECTOR cannot check it")]
-    NoSkill(String),
 }
 
 /// The plan's steps in nominal execution order.
@@ -91,13 +89,8 @@ fn state_name(d: &Domain, s: &Step<'_>) -> String {
 }
 
 fn term(d: &Domain, f: &Fact, negate: bool) -> Result<GuardTerm, FsmError> {
-    let pred = d.predicate(&f.pred).expect("validated");
-    let skill = pred
-        .skill
-        .clone()
-        .ok_or_else(|| FsmError::NoSkill(pred.name.clone()))?;
     Ok(GuardTerm {
-        condition: Domain::skill_call(&skill, &pred.params, &f.args),
+        condition: d.fact_condition(f),
         negate,
     })
 }

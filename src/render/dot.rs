@@ -1418,32 +1418,7 @@ on = { SUCCESS = "SUCCESS", FAILURE = "FAILURE", RUNNING = "RUNNING" }
     /// A parallel state (TOML `parallel = true`): its regions are dashed
     /// clusters inside its box, one initial arc to each; `/done` is the
     /// machine's outcome, taken from inside a region.
-    const PARALLEL: &str = r#"kind = "hfsm"
-name = "arm-and-base"
-initial = "both"
-outcomes = ["done"]
-
-[states.both]
-parallel = true
-guards = [{ to = "done", label = "done.state.both" }]
-
-[states.both.states.arm]
-initial = "tuck"
-outcomes = ["arm-ok"]
-
-[states.both.states.arm.states.tuck]
-on = { SUCCESS = "arm-ok" }
-
-[states.both.states.base]
-initial = "move"
-outcomes = ["base-ok"]
-
-[states.both.states.base.states.move]
-on = { SUCCESS = "dock", FAILURE = "/done" }
-
-[states.both.states.base.states.dock]
-on = { SUCCESS = "base-ok" }
-"#;
+    const PARALLEL: &str = include_str!("../../tests/fixtures/valid/parallel-regions.toml");
 
     #[test]
     fn parallel_golden() {

@@ -320,32 +320,7 @@ mod tests {
     fn parallel_regions_are_separated_by_dashes() {
         let l = crate::format::toml::parse_str(
             "p.toml",
-            r#"kind = "hfsm"
-name = "arm-and-base"
-initial = "both"
-outcomes = ["done"]
-
-[states.both]
-parallel = true
-guards = [{ to = "done", label = "done.state.both" }]
-
-[states.both.states.arm]
-initial = "tuck"
-outcomes = ["arm-ok"]
-
-[states.both.states.arm.states.tuck]
-on = { SUCCESS = "arm-ok" }
-
-[states.both.states.base]
-initial = "move"
-outcomes = ["base-ok"]
-
-[states.both.states.base.states.move]
-on = { SUCCESS = "dock", FAILURE = "/done" }
-
-[states.both.states.base.states.dock]
-on = { SUCCESS = "base-ok" }
-"#,
+            include_str!("../../tests/fixtures/valid/parallel-regions.toml"),
             Path::new("."),
             &Default::default(),
         )

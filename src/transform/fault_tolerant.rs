@@ -107,10 +107,6 @@ pub enum FaultTolerantError {
         skill: String,
         domain: String,
     },
-    #[error(
-        "predicate `{predicate}` of domain `{domain}` has no `skill`, so the SELECTOR cannot check it"
-    )]
-    Unchecked { predicate: String, domain: String },
 }
 
 /// The built-in domain (`policies/domains/moma.toml`): the shared skill
@@ -150,16 +146,8 @@ pub fn step_of<'d>(d: &'d Domain, call: &SkillCall) -> Option<Step<'d>> {
 
 /// A fact as a guard term (its predicate's condition skill).
 fn fact_term(d: &Domain, f: &Fact, negate: bool) -> Result<GuardTerm, FaultTolerantError> {
-    let pred = d.predicate(&f.pred).expect("validated domain");
-    let skill = pred
-        .skill
-        .as_deref()
-        .ok_or_else(|| FaultTolerantError::Unchecked {
-            predicate: pred.name.clone(),
-            domain: d.name.clone(),
-        })?;
     Ok(GuardTerm {
-        condition: Domain::skill_call(skill, &pred.params, &f.args),
+        condition: d.fact_condition(f),
         negate,
     })
 }

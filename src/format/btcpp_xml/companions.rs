@@ -76,7 +76,7 @@ impl Companions {
 /// when it cannot be read or is not a BehaviorTree.CPP document).
 fn trees_of(path: &Path, limits: &Limits) -> Vec<String> {
     let shown = path.display().to_string();
-    let Ok(file) = source::read(path, &shown, limits, true) else {
+    let Ok(file) = source::read(path, &shown, limits, false) else {
         return Vec::new();
     };
     let Ok((doc, _)) = xml::parse_lenient(&file, limits.max_nodes, limits.max_nodes) else {
@@ -148,20 +148,8 @@ impl super::loader::Loader<'_> {
     /// Reads one companion file and its includes, and collects their
     /// definitions.
     fn read_companion(&mut self, path: &Path) {
-        let shown = path.display().to_string();
-        let file = match source::read(path, &shown, self.limits, true) {
-            Ok(f) => f,
-            Err(ds) => {
-                self.diags.extend(ds);
-                return;
-            }
-        };
-        let doc = match self.parse_charged(&file) {
-            Ok(doc) => doc,
-            Err(d) => {
-                self.diags.push(d);
-                return;
-            }
+        let Some(doc) = self.read_named(path) else {
+            return;
         };
         let first = self.docs.len();
         self.first_companion = self.first_companion.min(first);

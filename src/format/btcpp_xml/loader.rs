@@ -266,23 +266,32 @@ impl Loader<'_> {
         }
     }
 
-    /// Reads a `--nodes-model` file: a `<root>` holding a `<TreeNodesModel>`, or a
-    /// bare `<TreeNodesModel>`.
-    pub(super) fn nodes_model_file(&mut self, path: &Path) {
+    /// Reads and parses a file named on the command line (a `--nodes-model`
+    /// file, a companion), its elements charged to the element budget; its
+    /// problems go to the diagnostics.
+    pub(super) fn read_named(&mut self, path: &Path) -> Option<XDoc> {
         let shown = path.display().to_string();
-        let file = match crate::format::toml::read_source(path, &shown, self.limits) {
+        let file = match crate::format::source::read(path, &shown, self.limits, false) {
             Ok(f) => f,
             Err(ds) => {
                 self.diags.extend(ds);
-                return;
+                return None;
             }
         };
-        let doc = match self.parse_charged(&file) {
-            Ok(doc) => doc,
+        match self.parse_charged(&file) {
+            Ok(doc) => Some(doc),
             Err(d) => {
                 self.diags.push(d);
-                return;
+                None
             }
+        }
+    }
+
+    /// Reads a `--nodes-model` file: a `<root>` holding a `<TreeNodesModel>`, or a
+    /// bare `<TreeNodesModel>`.
+    pub(super) fn nodes_model_file(&mut self, path: &Path) {
+        let Some(doc) = self.read_named(path) else {
+            return;
         };
         let root = doc.root;
         let models: Vec<usize> = if doc.elems[root].name == "TreeNodesModel" {

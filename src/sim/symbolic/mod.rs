@@ -14,4 +14,4 @@ pub mod world;
 #[cfg(test)]
 mod tests;
 
-pub use scenario::{SymScenario, load, looks_symbolic};
+pub use scenario::{SymScenario, looks_symbolic};

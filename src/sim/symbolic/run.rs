@@ -24,26 +24,7 @@ use crate::sim::skills::Status;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-/// How a run ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Outcome {
-    Success,
-    Failure,
-    Chattering,
-    Timeout,
-}
-
-impl Outcome {
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Outcome::Success => "success",
-            Outcome::Failure => "failure",
-            Outcome::Chattering => "chattering",
-            Outcome::Timeout => "timeout",
-        }
-    }
-}
+pub use crate::sim::trace::Outcome;
 
 /// One policy's run.
 #[derive(Debug, Clone, serde::Serialize)]

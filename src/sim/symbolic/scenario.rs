@@ -145,16 +145,8 @@ pub fn looks_symbolic(text: &str) -> bool {
     false
 }
 
-/// Reads a symbolic scenario, its domain and its policies (paths relative
-/// to the scenario, confined as every file a file names).
-pub fn load(path: &Path, limits: &Limits) -> Result<SymScenario, Vec<Diagnostic>> {
-    let shown = path.display().to_string();
-    let file = format::toml::read_source(path, &shown, limits)?;
-    let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    parse(&file, &base, limits)
-}
-
-/// Parses a symbolic scenario from its text; files resolve against `base`.
+/// Parses a symbolic scenario from its text (its domain and policies too:
+/// paths relative to `base`, confined as every file a file names).
 pub fn parse(
     file: &Arc<SourceFile>,
     base: &Path,
