@@ -129,3 +129,31 @@ fn the_paper_policies_have_one_lint_error_fig_3() {
         ["\"policies/paper/fig03-bt.toml\" \"chattering-precondition-order\""]
     );
 }
+
+#[test]
+fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
+    // docs/lint.md, "Findings on the bundled real files": two, both
+    // explained there; none on a state a sibling parallel region leaves.
+    let (_, out, _) = btfsm(&["lint", "tests/fixtures/corpus", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let found: Vec<String> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            format!(
+                "{} {} {}",
+                f["code"].as_str().unwrap(),
+                f["file"].as_str().unwrap().rsplit('/').next().unwrap(),
+                f["at"].as_str().unwrap()
+            )
+        })
+        .collect();
+    assert_eq!(
+        found,
+        [
+            "state-without-exit parallel-01.scxml end",
+            "state-without-exit deep-initial.scxml uber/s2"
+        ]
+    );
+}
