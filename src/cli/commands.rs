@@ -239,7 +239,9 @@ pub fn execute(cli: Cli) -> u8 {
                 }
                 ConvertTarget::FaultTolerant => {
                     use crate::transform::fault_tolerant as ft;
-                    let d = domain.as_ref().unwrap_or_else(|| ft::builtin_domain());
+                    let d = domain
+                        .as_ref()
+                        .unwrap_or_else(|| crate::plan::domain::builtin());
                     match ft::fault_tolerant_policy_with(&l.policy, d) {
                         Ok(p) => p,
                         Err(errs) => {

@@ -8,8 +8,6 @@ use super::{Level, Rule, Sink};
 use crate::model::{Bt, BtNodeKind, Policy, PolicyBody, StateBody, Trigger};
 use crate::plan::Domain;
 use crate::plan::fact::Fact;
-use crate::sim::symbolic::world::{Binding, binding};
-use crate::transform::fault_tolerant::{builtin_domain, step_of};
 use std::collections::{BTreeMap, HashMap};
 
 pub const CHATTERING_PRECONDITION_ORDER: Rule = Rule {
@@ -31,10 +29,7 @@ fn ensured(d: &Domain, bt: &Bt, n: usize) -> Option<Fact> {
         }
         _ => return None,
     };
-    match binding(d, bt.nodes[cond].skill.as_ref()?)? {
-        Binding::Fact(f) => Some(f),
-        Binding::Action(..) => None,
-    }
+    d.fact_of(bt.nodes[cond].skill.as_ref()?)
 }
 
 /// What the actions of a subtree undo: facts they delete, and per
@@ -95,7 +90,7 @@ impl Undoes {
 /// The undoes of one action node.
 fn of_action(d: &Domain, node: &crate::model::BtNode) -> Undoes {
     let mut u = Undoes::default();
-    let Some(step) = node.skill.as_ref().and_then(|c| step_of(d, c)) else {
+    let Some(step) = node.skill.as_ref().and_then(|c| d.step_of(c)) else {
         return u;
     };
     let adds = step.adds();
@@ -123,7 +118,7 @@ fn of_action(d: &Domain, node: &crate::model::BtNode) -> Undoes {
 
 fn chattering(p: &Policy, out: &mut Sink) {
     let PolicyBody::Bt(bt) = &p.body else { return };
-    let d = builtin_domain();
+    let d = crate::plan::domain::builtin();
     // Post-order: each subtree's undoes, built from its children's (small
     // into large), checked at each Sequence before they merge.
     let mut undoes: Vec<Option<Undoes>> = (0..bt.nodes.len()).map(|_| None).collect();

@@ -68,7 +68,7 @@ pub struct Action {
     pub sequence_id: String,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Goal {
     pub id: String,
     /// The actions the planner may use for this goal (`use`; `None`: all).
@@ -80,7 +80,7 @@ pub struct Goal {
 }
 
 /// A validated action domain.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Domain {
     pub name: String,
     pub description: Option<String>,
@@ -219,7 +219,81 @@ impl Domain {
     }
 }
 
+/// The built-in domain (`policies/domains/moma.toml`): the shared skill
+/// library's preconditions and effects, for `convert --to fault-tolerant`
+/// and `lint`.
+pub fn builtin() -> &'static Domain {
+    static D: std::sync::OnceLock<Domain> = std::sync::OnceLock::new();
+    D.get_or_init(|| {
+        let file = SourceFile::new(
+            "policies/domains/moma.toml",
+            include_str!("../../policies/domains/moma.toml"),
+        );
+        load(&file).expect("the built-in domain is valid (plan tests)")
+    })
+}
+
+/// An argument of a skill call as an object name.
+fn object(v: &crate::model::skill::ArgValue) -> String {
+    match v {
+        crate::model::skill::ArgValue::Str(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
 impl Domain {
+    /// The fact a condition call checks: of the first predicate whose skill
+    /// the call runs, its parameters taken from the call's arguments by
+    /// name; `None` when no predicate has the skill or an argument is
+    /// missing.
+    pub fn fact_of(&self, c: &crate::model::skill::SkillCall) -> Option<Fact> {
+        let p = self
+            .predicates
+            .iter()
+            .find(|p| p.skill.as_deref() == Some(&c.skill))?;
+        let args = p
+            .params
+            .iter()
+            .map(|q| c.args.get(&q.name).map(object))
+            .collect::<Option<Vec<_>>>()?;
+        Some(Fact {
+            pred: p.name.clone(),
+            args,
+        })
+    }
+
+    /// The action (its index) that runs a call's skill, its parameters
+    /// bound to the call's arguments by name: the first action with the
+    /// skill and every argument; `None` when there is none.
+    pub fn action_of(
+        &self,
+        c: &crate::model::skill::SkillCall,
+    ) -> Option<(usize, BTreeMap<String, String>)> {
+        self.actions.iter().enumerate().find_map(|(i, a)| {
+            if a.skill.as_deref() != Some(c.skill.as_str()) {
+                return None;
+            }
+            let bind = a
+                .params
+                .iter()
+                .map(|q| c.args.get(&q.name).map(|v| (q.name.clone(), object(v))))
+                .collect::<Option<BTreeMap<_, _>>>()?;
+            Some((i, bind))
+        })
+    }
+
+    /// [`Domain::action_of`] as a ground step.
+    pub fn step_of(
+        &self,
+        c: &crate::model::skill::SkillCall,
+    ) -> Option<super::backchain::Step<'_>> {
+        let (i, bind) = self.action_of(c)?;
+        Some(super::backchain::Step {
+            action: &self.actions[i],
+            bind,
+        })
+    }
+
     /// The condition a fact stands for: its predicate's skill with the
     /// fact's objects as arguments.
     pub fn fact_condition(&self, f: &Fact) -> crate::model::skill::SkillCall {

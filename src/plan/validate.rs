@@ -201,7 +201,10 @@ impl Validator {
                     format!("{n} {what}, more than {MAX_DECLARATIONS}"),
                     "split the domain",
                 );
-                return empty(raw.name.into_inner());
+                return Domain {
+                    name: raw.name.into_inner(),
+                    ..Domain::default()
+                };
             }
         }
         if !fact::is_name(raw.name.get_ref()) {
@@ -215,16 +218,7 @@ impl Validator {
             name: raw.name.get_ref().clone(),
             description: raw.description.clone(),
             objects,
-            predicates: Vec::new(),
-            actions: Vec::new(),
-            goal: Goal {
-                id: String::new(),
-                actions: None,
-                facts: Vec::new(),
-                ids: BTreeMap::new(),
-                labels: BTreeMap::new(),
-            },
-            tasks: Vec::new(),
+            ..Domain::default()
         };
         for (name, p) in raw.predicates.0 {
             let p = p.into_inner();
@@ -612,24 +606,6 @@ fn default_id(name: &str, params: &[Param]) -> String {
         id.push_str(&format!("-{{{}:short}}", p.name));
     }
     id
-}
-
-fn empty(name: String) -> Domain {
-    Domain {
-        name,
-        description: None,
-        objects: BTreeMap::new(),
-        predicates: Vec::new(),
-        actions: Vec::new(),
-        goal: Goal {
-            id: String::new(),
-            actions: None,
-            facts: Vec::new(),
-            ids: BTreeMap::new(),
-            labels: BTreeMap::new(),
-        },
-        tasks: Vec::new(),
-    }
 }
 
 /// One `--goal` fact checked as a goal fact of `d` is: the pattern and the

@@ -580,7 +580,7 @@ fn random_worlds_and_disturbances_never_panic() {
 fn the_built_in_domain_describes_the_planar_skills() {
     use crate::plan::Domain;
     use crate::plan::fact::Fact;
-    let d = crate::transform::fault_tolerant::builtin_domain();
+    let d = crate::plan::domain::builtin();
     let mut r = robot(world(), 1);
     let holds = |r: &Robot, f: &Fact| -> bool {
         let pred = d.predicate(&f.pred).expect("domain predicate");

@@ -29,13 +29,12 @@
 //! generated machine: the structure is the paper's.
 
 use crate::model::{
-    ArgValue, Guard, GuardTerm, Policy, PolicyBody, SkillCall, State, StateBody, StateMachine,
-    Target, Transition, Trigger,
+    Guard, GuardTerm, Policy, PolicyBody, State, StateBody, StateMachine, Target, Transition,
+    Trigger,
 };
 use crate::plan::Domain;
 use crate::plan::backchain::Step;
 use crate::plan::fact::Fact;
-use std::collections::BTreeMap;
 
 const SUCCESS: &str = "SUCCESS";
 const FAILURE: &str = "FAILURE";
@@ -109,41 +108,6 @@ pub enum FaultTolerantError {
     },
 }
 
-/// The built-in domain (`policies/domains/moma.toml`): the shared skill
-/// library's preconditions and effects.
-pub fn builtin_domain() -> &'static Domain {
-    static D: std::sync::OnceLock<Domain> = std::sync::OnceLock::new();
-    D.get_or_init(|| {
-        let file = crate::diagnostic::SourceFile::new(
-            "policies/domains/moma.toml",
-            include_str!("../../policies/domains/moma.toml"),
-        );
-        crate::plan::load(&file).expect("the built-in domain is valid (plan tests)")
-    })
-}
-
-/// The domain action that runs `call`'s skill, with its parameters bound to
-/// the call's arguments; `None` when no action runs it or an argument is
-/// missing.
-pub fn step_of<'d>(d: &'d Domain, call: &SkillCall) -> Option<Step<'d>> {
-    d.actions.iter().find_map(|a| {
-        if a.skill.as_deref() != Some(call.skill.as_str()) {
-            return None;
-        }
-        let mut bind = BTreeMap::new();
-        for p in &a.params {
-            let v = match call.args.get(&p.name)? {
-                ArgValue::Str(s) => s.clone(),
-                ArgValue::Int(i) => i.to_string(),
-                ArgValue::Float(x) => x.to_string(),
-                ArgValue::Bool(b) => b.to_string(),
-            };
-            bind.insert(p.name.clone(), v);
-        }
-        Some(Step { action: a, bind })
-    })
-}
-
 /// A fact as a guard term (its predicate's condition skill).
 fn fact_term(d: &Domain, f: &Fact, negate: bool) -> Result<GuardTerm, FaultTolerantError> {
     Ok(GuardTerm {
@@ -178,7 +142,7 @@ fn guards_first(s: &mut State) {
 
 /// The fault-tolerant version of a policy (see the module documentation).
 pub fn fault_tolerant_policy(p: &Policy) -> Result<Policy, Vec<FaultTolerantError>> {
-    fault_tolerant_policy_with(p, builtin_domain())
+    fault_tolerant_policy_with(p, crate::plan::domain::builtin())
 }
 
 /// [`fault_tolerant_policy`] with the skills' preconditions and effects
@@ -214,7 +178,7 @@ pub fn fault_tolerant(
     let mut errors = Vec::new();
     let step = |i: usize| -> Option<Step<'_>> {
         match &m.states[i].body {
-            StateBody::Task(Some(call)) => step_of(domain, call),
+            StateBody::Task(Some(call)) => domain.step_of(call),
             _ => None,
         }
     };

@@ -8,7 +8,6 @@
 //! action has no effect. Nothing else changes the facts but disturbances.
 
 use crate::model::SkillCall;
-use crate::model::skill::ArgValue;
 use crate::plan::Domain;
 use crate::plan::backchain::Step;
 use crate::plan::fact::Fact;
@@ -26,43 +25,18 @@ pub enum Binding {
     Action(usize, BTreeMap<String, String>),
 }
 
-fn text(v: &ArgValue) -> String {
-    match v {
-        ArgValue::Str(s) => s.clone(),
-        other => other.to_string(),
-    }
-}
-
 /// The binding of a skill call: the predicate or else the action of the
 /// domain that names the skill (a library skill, or the domain's own
-/// `domain:Name`), its parameters taken from the call's arguments by name.
+/// `domain:Name`), its parameters taken from the call's arguments by name
+/// ([`Domain::fact_of`], [`Domain::action_of`]).
 pub fn binding(d: &Domain, c: &SkillCall) -> Option<Binding> {
-    if let Some(p) = d
-        .predicates
+    if d.predicates
         .iter()
-        .find(|p| p.skill.as_deref() == Some(&c.skill))
+        .any(|p| p.skill.as_deref() == Some(&c.skill))
     {
-        let args = p
-            .params
-            .iter()
-            .map(|q| c.args.get(&q.name).map(text))
-            .collect::<Option<Vec<_>>>()?;
-        return Some(Binding::Fact(Fact {
-            pred: p.name.clone(),
-            args,
-        }));
+        return d.fact_of(c).map(Binding::Fact);
     }
-    let (i, a) = d
-        .actions
-        .iter()
-        .enumerate()
-        .find(|(_, a)| a.skill.as_deref() == Some(&c.skill))?;
-    let bind = a
-        .params
-        .iter()
-        .map(|q| c.args.get(&q.name).map(|v| (q.name.clone(), text(v))))
-        .collect::<Option<BTreeMap<_, _>>>()?;
-    Some(Binding::Action(i, bind))
+    d.action_of(c).map(|(i, bind)| Binding::Action(i, bind))
 }
 
 /// An action instance of a leaf.
