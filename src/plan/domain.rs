@@ -187,23 +187,35 @@ impl Domain {
         }
     }
 
+    /// A ground fact of the domain from its text (`Object-At(cube2,
+    /// delivery)`), checked as a goal fact is (predicate, arity, objects of
+    /// the parameters' types); the error: what is wrong and a hint.
+    pub fn ground_fact(&self, text: &str) -> Result<Fact, (String, String)> {
+        let file = SourceFile::new("fact", String::new());
+        let (found, diags) = super::validate::goal_fact(&file, text, self);
+        match (found.into_iter().next(), diags.into_iter().next()) {
+            (Some(p), None) => Ok(p.ground(&|_| None)),
+            (_, Some(d)) => Err((d.message, d.hint.unwrap_or_default())),
+            (None, None) => Err((
+                "not a fact".into(),
+                "a fact is `Predicate(object, ...)`".into(),
+            )),
+        }
+    }
+
     /// Replaces the goal by `facts` (`--goal`), each checked as a goal fact
     /// of the domain is; the errors say what is wrong with each.
     pub fn set_goal(&mut self, facts: &[String]) -> Result<(), Vec<String>> {
         let mut errors = Vec::new();
         let mut goal = Vec::new();
-        let file = SourceFile::new("--goal", String::new());
         for text in facts {
-            let (found, diags) = super::validate::goal_fact(&file, text, self);
-            errors.extend(diags.into_iter().map(|d| match d.hint {
-                Some(h) => format!(
-                    "--goal `{}`: {} ({h})",
-                    crate::sanitize::shown(text),
-                    d.message
-                ),
-                None => format!("--goal `{}`: {}", crate::sanitize::shown(text), d.message),
-            }));
-            goal.extend(found.into_iter().map(|p| p.ground(&|_| None)));
+            match self.ground_fact(text) {
+                Ok(f) => goal.push(f),
+                Err((msg, hint)) => errors.push(format!(
+                    "--goal `{}`: {msg} ({hint})",
+                    crate::sanitize::shown(text)
+                )),
+            }
         }
         if goal.len() > MAX_SIBLINGS {
             errors.push(format!(

@@ -7,7 +7,7 @@ use crate::diagnostic::{Diagnostic, SourceFile, suggest};
 use crate::format::{self, Limits};
 use crate::model::{Policy, PolicyBody};
 use crate::plan::Domain;
-use crate::plan::fact::{self, Fact};
+use crate::plan::fact::Fact;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -204,7 +204,7 @@ pub fn parse(
      -> Vec<Fact> {
         let mut out = Vec::new();
         for f in list {
-            match ground(&domain, f.get_ref()) {
+            match domain.ground_fact(f.get_ref()) {
                 Ok(g) => out.push(g),
                 Err((m, h)) => diags_err(f.span(), m, h),
             }
@@ -367,40 +367,6 @@ pub fn parse(
         disturbances,
         mc,
     })
-}
-
-/// A ground fact of the domain from its text.
-pub fn ground(d: &Domain, text: &str) -> Result<Fact, (String, String)> {
-    let p = fact::parse(text).map_err(|e| (e, "a fact is `Predicate(object, ...)`".to_string()))?;
-    let Some(pred) = d.predicate(&p.pred) else {
-        return Err((
-            format!("unknown predicate `{}`", crate::sanitize::shown(&p.pred)),
-            suggest(&p.pred, d.predicates.iter().map(|q| q.name.as_str())),
-        ));
-    };
-    if pred.params.len() != p.args.len() {
-        return Err((
-            format!(
-                "`{}` takes {} argument(s), found {}",
-                pred.name,
-                pred.params.len(),
-                p.args.len()
-            ),
-            "give one object per parameter".into(),
-        ));
-    }
-    for a in &p.args {
-        if !d.objects.contains_key(a) {
-            return Err((
-                format!(
-                    "`{}` is not an object of the domain",
-                    crate::sanitize::shown(a)
-                ),
-                suggest(a, d.objects.keys().map(String::as_str)),
-            ));
-        }
-    }
-    Ok(p.ground(&|_| None))
 }
 
 /// Why a policy cannot run in the domain's world (a leaf or guard bound to

@@ -92,7 +92,7 @@ fn monte_carlo_is_reproducible_and_counts_every_episode() {
 #[test]
 fn scenario_errors_are_reported_together() {
     let text = format!(
-        "name = \"t\"\ndomain = \"moma.toml\"\nfacts = [\"Robot-Art(cube2)\"]\ndurations = {{ Pik = 2 }}\n{}",
+        "name = \"t\"\ndomain = \"moma.toml\"\nfacts = [\"Robot-Art(cube2)\", \"Robot-At(20)\"]\ndurations = {{ Pik = 2 }}\n{}",
         policies(&["fig01-bt"])
     );
     let e = parse(
