@@ -53,6 +53,9 @@ pub struct DotArgs {
 pub enum LogFormat {
     Table,
     Json,
+    /// One row per node: uid, node, type, activations, status changes by
+    /// status, seconds RUNNING
+    Csv,
 }
 
 #[derive(Debug, Args)]
@@ -115,6 +118,7 @@ pub fn execute(a: LogArgs) -> u8 {
             s
         }
         LogFormat::Table => report::render_table(&r),
+        LogFormat::Csv => report::render_csv(&r),
     };
     let code = emit_text(None, text);
     if code != EXIT_OK {

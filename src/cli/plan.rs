@@ -50,7 +50,8 @@ pub struct PlanArgs {
     /// Deepest nesting of achievers below a goal condition (1 to 256)
     #[arg(long, default_value_t = 16, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
     pub max_plan_depth: u16,
-    /// Output format of the report (table or json)
+    /// Output format of the report: table, json, or csv (the metrics rows,
+    /// as `analyze` writes them; the conflicts are in table and json)
     #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
     pub format: OutputFormat,
     #[command(flatten)]
@@ -78,10 +79,6 @@ pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> 
 }
 
 pub fn execute(a: PlanArgs) -> u8 {
-    if a.format == OutputFormat::Csv {
-        eprintln!("error: `plan` prints `table` or `json`, not `csv`");
-        return EXIT_BAD_INPUT;
-    }
     let limits = a.limits.limits();
     let shown = a.domain.display().to_string();
     let Some(mut domain) = read_domain(&a.domain, &limits) else {
@@ -167,6 +164,7 @@ pub fn execute(a: PlanArgs) -> u8 {
         })
         .collect();
     let text = match a.format {
+        OutputFormat::Csv => report::render_analysis(&rows, OutputFormat::Csv),
         OutputFormat::Json => {
             #[derive(serde::Serialize)]
             struct Out<'a> {

@@ -229,3 +229,27 @@ pub fn render_table(r: &LogReport) -> String {
     }
     out
 }
+
+/// The per-node figures as CSV (the coverage is in table and JSON).
+pub fn render_csv(r: &LogReport) -> String {
+    let cell = crate::report::csv_field;
+    let mut out =
+        String::from("uid,node,type,activations,RUNNING,SUCCESS,FAILURE,IDLE,SKIPPED,running_s\n");
+    for n in &r.nodes {
+        let k = |s: &str| n.statuses.get(s).copied().unwrap_or(0);
+        out.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{:.6}\n",
+            n.uid,
+            cell(&n.name),
+            cell(&n.tag),
+            n.activations,
+            k("RUNNING"),
+            k("SUCCESS"),
+            k("FAILURE"),
+            k("IDLE"),
+            k("SKIPPED"),
+            n.running_usec as f64 / 1e6
+        ));
+    }
+    out
+}

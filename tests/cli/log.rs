@@ -147,3 +147,25 @@ fn log_dot_colours_each_node_by_its_status_at_the_step() {
         "the log's bookkeeping is not drawn as ports"
     );
 }
+
+#[test]
+fn log_report_csv_has_a_row_per_node_with_every_record() {
+    let (code, csv, err) = btfsm(&["log", "report", FIG01, "--format", "csv"]);
+    assert_eq!(code, 0, "{err}");
+    let (_, json, _) = btfsm(&["log", "report", FIG01, "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), v["nodes"].as_array().unwrap().len());
+    // Columns 5 to 9 are the status changes: together, every record.
+    let sum: u64 = rows
+        .iter()
+        .map(|r| {
+            let f: Vec<&str> = r.rsplitn(7, ',').collect();
+            f[1..6]
+                .iter()
+                .map(|x| x.parse::<u64>().unwrap())
+                .sum::<u64>()
+        })
+        .sum();
+    assert_eq!(sum, v["records"].as_u64().unwrap());
+}

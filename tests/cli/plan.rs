@@ -336,3 +336,22 @@ fn validate_checks_action_domains_and_symbolic_scenarios() {
     assert_eq!(code, 2);
     assert!(err.contains("an action domain, not a policy"), "{err}");
 }
+
+#[test]
+fn plan_csv_is_the_analyze_csv_of_the_planned_policies() {
+    // SPEC §7: `--format csv` wherever figures are printed.
+    let d = scratch("plan-csv");
+    let dir = d.to_str().expect("utf-8");
+    let (code, csv, err) = btfsm(&["plan", MOMA, "--format", "csv", "-o", dir]);
+    assert_eq!(code, 0, "{err}");
+    let files: Vec<String> = ["bt", "fsm", "hfsm"]
+        .iter()
+        .map(|t| format!("{dir}/moma-{t}.toml"))
+        .collect();
+    let (code, analyzed, err) = btfsm(&[
+        "analyze", &files[0], &files[1], &files[2], "--format", "csv",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(csv, analyzed);
+    let _ = std::fs::remove_dir_all(&d);
+}
