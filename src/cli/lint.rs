@@ -112,8 +112,14 @@ pub fn execute(a: LintArgs) -> u8 {
         match format::load_read(file.clone(), &input.path, fmt, &limits) {
             Ok(l) => findings.extend(lint::lint(&l.policy, Some(&file), &l.path, &cfg)),
             Err(d) => {
-                failed = true;
-                print_diagnostics(&mut err, &d);
+                // Coded load errors are findings (lint::load); the others
+                // mean the input does not load.
+                let (coded, rest) = lint::load::findings(&d, &file.path, &cfg);
+                findings.extend(coded);
+                if rest.iter().any(|d| d.is_error()) {
+                    failed = true;
+                    print_diagnostics(&mut err, &rest);
+                }
             }
         }
     }

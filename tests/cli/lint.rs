@@ -102,10 +102,11 @@ fn lint_exit_codes_levels_and_sarif() {
         r["locations"][0]["physicalLocation"]["region"]["startLine"],
         10
     );
-    // A file that does not load: exit 2, the others still linted.
+    // A file that does not load (for a reason no rule names): exit 2, the
+    // others still linted.
     let (code, out, err) = btfsm(&[
         "lint",
-        "tests/fixtures/invalid/control-no-children.toml",
+        "tests/fixtures/invalid/dangling-target.toml",
         &bad,
     ]);
     assert_eq!(code, 2, "{err}");
@@ -156,4 +157,49 @@ fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
             "state-without-exit deep-initial.scxml uber/s2"
         ]
     );
+}
+
+#[test]
+fn a_load_error_with_a_code_is_a_finding() {
+    let dir = std::env::temp_dir().join(format!("btfsm-lint-load-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join("empty.toml");
+    std::fs::write(
+        &toml,
+        "kind = \"bt\"\nroot = \"r\"\n[nodes]\nr = { sequence = [\"a\", \"f\"] }\na = { action = \"A\" }\nf = { fallback = [] }\n",
+    )
+    .unwrap();
+    let par = fixture("parallel-threshold", "bad");
+    // A coded load error alone: a finding, exit 1, in JSON and SARIF too.
+    for (file, code) in [
+        (par.as_str(), "parallel-threshold"),
+        (toml.to_str().unwrap(), "empty-composite"),
+    ] {
+        let (rc, out, err) = btfsm(&["lint", file, "--format", "json"]);
+        assert_eq!(rc, 1, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v[0]["code"], code, "{out}");
+        assert_eq!(v[0]["level"], "error");
+        assert!(v[0]["line"].as_u64().is_some_and(|l| l > 0), "{out}");
+        assert!(err.is_empty(), "{err}");
+        let (rc, sarif, _) = btfsm(&["lint", file, "--format", "sarif"]);
+        assert_eq!(rc, 1);
+        assert!(
+            sarif.contains(&format!("\"ruleId\": \"{code}\"")),
+            "{sarif}"
+        );
+    }
+    // Allowed: not reported (the file is not linted further).
+    let (rc, out, _) = btfsm(&["lint", &par, "--allow", "parallel-threshold"]);
+    assert_eq!(rc, 0, "{out}");
+    // A load error no rule names still means exit 2, beside the finding.
+    let broken = dir.join("broken.xml");
+    std::fs::write(&broken, "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\">").unwrap();
+    let (rc, out, err) = btfsm(&["lint", &par, broken.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(rc, 2, "{out}{err}");
+    assert!(
+        out.contains("parallel-threshold") && err.contains("broken.xml"),
+        "{out}{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

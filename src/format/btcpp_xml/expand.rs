@@ -133,6 +133,7 @@ impl Loader<'_> {
                         cycle.insert(0, "...".into());
                     }
                     self.err(it.d, el.span.clone(), format!("recursive subtree: {}", cycle.join(" -> ")))
+                        .set_code("subtree-recursion")
                         .hint = Some("a tree must not contain itself as a `<SubTree>`, directly or through others".into());
                     failed = true;
                     continue;

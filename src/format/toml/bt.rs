@@ -222,6 +222,7 @@ impl Loader {
                             kind.keyword()
                         ),
                     )
+                    .set_code("wrong-child-count")
                     .hint = Some(format!(
                         "write `{} = \"child\"`; wrap several children in a sequence or fallback",
                         kind.keyword()
@@ -237,6 +238,7 @@ impl Loader {
                             kind.keyword()
                         ),
                     )
+                    .set_code("empty-composite")
                     .hint = Some(format!(
                         "write `{} = [\"child1\", \"child2\"]`",
                         kind.keyword()
