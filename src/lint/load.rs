@@ -29,7 +29,7 @@ pub const EMPTY_COMPOSITE: Rule = Rule {
 pub const WRONG_CHILD_COUNT: Rule = Rule {
     code: "wrong-child-count",
     level: Level::Error,
-    summary: "a decorator without exactly one child, a leaf with children, an IfThenElse or Switch with the wrong number: the file does not load",
+    summary: "a decorator without one child, a leaf with children, an IfThenElse or SwitchN with a wrong count: does not load",
     check: found_by_the_reader,
 };
 

@@ -112,7 +112,7 @@ fn unreachable_child(p: &Policy, out: &mut Sink) {
 pub const REACTIVE_ASYNC_SIBLINGS: Rule = Rule {
     code: "reactive-async-siblings",
     level: Level::Warning,
-    summary: "more than one action under a reactive Sequence or Fallback: BehaviorTree.CPP warns that asynchronous siblings there halt each other",
+    summary: "more than one action under a reactive Sequence or Fallback: BehaviorTree.CPP warns they halt each other",
     check: reactive_async_siblings,
 };
 

@@ -104,11 +104,7 @@ fn lint_exit_codes_levels_and_sarif() {
     );
     // A file that does not load (for a reason no rule names): exit 2, the
     // others still linted.
-    let (code, out, err) = btfsm(&[
-        "lint",
-        "tests/fixtures/invalid/dangling-target.toml",
-        &bad,
-    ]);
+    let (code, out, err) = btfsm(&["lint", "tests/fixtures/invalid/dangling-target.toml", &bad]);
     assert_eq!(code, 2, "{err}");
     assert!(out.contains("chattering-precondition-order"), "{out}");
 }
