@@ -131,7 +131,12 @@ fn the_paper_policies_have_one_lint_error_fig_3() {
 fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
     // docs/lint.md, "Findings on the bundled real files": two, both
     // explained there; none on a state a sibling parallel region leaves.
-    let (_, out, _) = btfsm(&["lint", "tests/fixtures/corpus", "--format", "json"]);
+    // Every file loads (Nav2's trees with the nav2_tree_nodes.xml beside
+    // them, unknown leaves as actions): no error on stderr, exit 1 for the
+    // two error-level findings, not 2.
+    let (code, out, err) = btfsm(&["lint", "tests/fixtures/corpus", "--format", "json"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.is_empty(), "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let found: Vec<String> = v
         .as_array()
@@ -197,5 +202,29 @@ fn a_load_error_with_a_code_is_a_finding() {
         out.contains("parallel-threshold") && err.contains("broken.xml"),
         "{out}{err}"
     );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn reactive_siblings_known_to_return_at_once_do_not_count() {
+    // Nav2's CheckIfNewPathNeeded: TruncatePathLocal returns at once, so one
+    // action under the ReactiveSequence may run; two planners may both run.
+    let dir = std::env::temp_dir().join(format!("btfsm-lint-sync-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let tree = |a: &str, b: &str| {
+        format!(
+            r#"<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M"><ReactiveSequence><{a}/><{b}/></ReactiveSequence></BehaviorTree></root>"#
+        )
+    };
+    let quiet = dir.join("quiet.xml");
+    std::fs::write(&quiet, tree("TruncatePathLocal", "ComputePathToPose")).unwrap();
+    let loud = dir.join("loud.xml");
+    std::fs::write(&loud, tree("ComputePathToPose", "FollowPath")).unwrap();
+    let (code, out, err) = btfsm(&["lint", quiet.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!out.contains("reactive-async-siblings"), "{out}");
+    let (code, out, err) = btfsm(&["lint", loud.to_str().unwrap()]);
+    assert_eq!(code, 0, "a warning: {out}{err}");
+    assert!(out.contains("warning[reactive-async-siblings]"), "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
