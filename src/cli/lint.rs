@@ -97,10 +97,24 @@ pub fn execute(a: LintArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    // BehaviorTree.CPP files given together resolve each other's SubTrees,
+    // as for every command (README "BehaviorTree.CPP projects").
+    let (limits, only) = match super::commands::with_companions(&inputs, &limits) {
+        Ok(x) => x,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return EXIT_BAD_INPUT;
+        }
+    };
     let mut findings = Vec::new();
     let mut failed = false;
     let mut models = SiblingModels::default();
     for input in &inputs {
+        if only.as_ref().is_some_and(|o| !o.contains(&input.path))
+            && super::commands::is_btcpp_candidate(&input.path)
+        {
+            continue; // a companion of the files that define `--tree`
+        }
         let (file, fmt) = match format::discover::read(input, &limits) {
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
             Ok(_) => continue,

@@ -228,3 +228,17 @@ fn reactive_siblings_known_to_return_at_once_do_not_count() {
     assert!(out.contains("warning[reactive-async-siblings]"), "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn lint_resolves_subtrees_across_the_files_given_together() {
+    // tests/fixtures/btcpp-projects/pick: pick.xml uses `Approach`, which
+    // subtrees/approach.xml defines (and that one uses `Localize`).
+    let (code, out, err) = btfsm(&["lint", "tests/fixtures/btcpp-projects/pick"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(err.is_empty(), "{err}");
+    assert!(out.contains("in 3 files"), "{out}");
+    // Alone, pick.xml does not load: its SubTree is in another file.
+    let (code, _, err) = btfsm(&["lint", "tests/fixtures/btcpp-projects/pick/pick.xml"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unknown tree `Approach`"), "{err}");
+}
