@@ -76,6 +76,8 @@ struct PanelData<'a> {
     /// Per step: `[node, status, node, status, ...]`.
     deltas: Vec<Vec<u32>>,
     axis: Axis,
+    /// Decimals of the times shown.
+    digits: usize,
 }
 
 #[derive(Serialize)]
@@ -142,6 +144,7 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
                 .map(|d| d.iter().flat_map(|&(n, s)| [n, s as u32]).collect())
                 .collect(),
             axis,
+            digits: timeline::digits(t_end / 100.0).max(2),
         });
     }
     let divergences: Vec<Divergence> = r
@@ -204,7 +207,7 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
 <body>
 <header><h1>{title}</h1><p class="sub">{sub}</p>{divs}</header>
 <nav class="controls">
-<button id="first" title="first step (Home)">⏮</button><button id="prev" title="previous step (←)">◀</button><button id="play" title="play / pause (space)">▶</button><button id="next" title="next step (→)">▶▮</button><button id="last" title="last step (End)">⏭</button>
+<button id="first" title="first step (Home)">|◀ first</button><button id="prev" title="previous step (←)">◀ prev</button><button id="play" title="play / pause (space)">play</button><button id="next" title="next step (→)">next ▶</button><button id="last" title="last step (End)">last ▶|</button>
 <input id="slider" type="range" min="0" max="{max}" value="0" step="1" aria-label="step">
 <span id="pos"></span>
 <span class="legend">{r}{s}{f}</span>

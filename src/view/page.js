@@ -87,7 +87,7 @@
       for (var n = 0; n < P.cur.length && running.length < 8; n++) {
         if (P.cur[n] === 1) running.push(P.p.keys[n]);
       }
-      P.now.textContent = 't = ' + t.toFixed(2) + ' s' + (k < current ? ' (ended at step ' + k + ')' : '') +
+      P.now.textContent = 't = ' + t.toFixed(P.p.digits) + ' s' + (k < current ? ' (ended at step ' + k + ')' : '') +
         (running.length ? ' · RUNNING: ' + running.join(', ') : '');
     }
   }
@@ -99,7 +99,7 @@
     slider.value = k;
     for (var i = 0; i < panels.length; i++) goPanel(panels[i], k);
     var t = panels.length && panels[0].p.times.length ? panels[0].p.times[Math.min(k, panels[0].p.times.length - 1)] : 0;
-    pos.textContent = 'step ' + k + ' / ' + (total - 1) + ' · t = ' + t.toFixed(2) + ' s';
+    pos.textContent = 'step ' + k + ' / ' + (total - 1) + ' · t = ' + t.toFixed(panels.length ? panels[0].p.digits : 2) + ' s';
     document.body.setAttribute('data-step', k);
     if (history.replaceState) history.replaceState(null, '', '#step=' + k);
   }
@@ -125,6 +125,7 @@
     gos[g].onclick = function () { go(D.divergences[+this.getAttribute('data-div')].step); };
   }
   document.addEventListener('keydown', function (e) {
+    if (e.target === slider && e.key.indexOf('Arrow') === 0) return;
     var k = { ArrowRight: 1, ArrowLeft: -1, PageDown: 10, PageUp: -10 }[e.key];
     if (k) { go(current + k); e.preventDefault(); }
     else if (e.key === 'Home') { go(0); e.preventDefault(); }

@@ -56,12 +56,21 @@ fn tick_step(t: f64) -> f64 {
         .unwrap_or(10.0 * p)
 }
 
-fn num(x: f64) -> String {
-    let r = (x * 100.0).round() / 100.0;
-    if r == r.trunc() {
-        format!("{}", r as i64)
+/// Decimals that tell apart times `step` apart (at least 2 for spans).
+pub fn digits(step: f64) -> usize {
+    if !(step.is_finite() && step > 0.0) {
+        return 2;
+    }
+    (-step.log10().floor()).clamp(0.0, 9.0) as usize
+}
+
+/// `x` with at most `d` decimals, trailing zeros dropped.
+fn num_with(x: f64, d: usize) -> String {
+    let s = format!("{x:.d$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
     } else {
-        format!("{r}")
+        s
     }
 }
 
@@ -97,6 +106,8 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
         LABEL_W + PLOT_W
     );
     let step = tick_step(t_end);
+    let d = digits(step);
+    let num = |x: f64| num_with(x, d + 2);
     let mut k = 0u32;
     while (k as f64) * step <= t_end + 1e-9 && k <= 20 {
         let t = k as f64 * step;
@@ -106,7 +117,7 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
             r##"<line x1="{xt}" y1="{TOP}" x2="{xt}" y2="{}" stroke="#ddd"/><text x="{xt}" y="{}" text-anchor="middle" fill="#444">{}</text>"##,
             bottom + 4.0,
             bottom + 15.0,
-            num(t)
+            num_with(t, d)
         );
         k += 1;
     }
@@ -204,6 +215,11 @@ mod tests {
         assert_eq!(tick_step(7.0), 2.0);
         assert_eq!(tick_step(0.3), 0.05);
         assert_eq!(tick_step(0.0), 1.0);
+        assert_eq!(tick_step(0.0046), 0.001);
+        assert_eq!(digits(0.001), 3);
+        assert_eq!(digits(10.0), 0);
+        assert_eq!(num_with(0.0030, 3), "0.003");
+        assert_eq!(num_with(20.0, 0), "20");
     }
 
     #[test]
