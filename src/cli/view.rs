@@ -169,14 +169,16 @@ pub fn execute(a: ViewArgs) -> u8 {
         }
     };
     let code = emit_text(a.output.as_deref(), page);
-    if code == EXIT_OK && a.output.is_some() {
+    if code == EXIT_OK
+        && let Some(out) = &a.output
+    {
         let steps = (replay.panels.iter())
             .map(|p| p.rec.times.len())
             .max()
             .unwrap_or(0);
         eprintln!(
             "wrote {} ({} panel{}, {steps} steps)",
-            crate::sanitize::shown(&a.output.as_ref().expect("given").display().to_string()),
+            crate::sanitize::shown(&out.display().to_string()),
             replay.panels.len(),
             if replay.panels.len() == 1 { "" } else { "s" }
         );

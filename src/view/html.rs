@@ -109,7 +109,12 @@ fn round(t: f64) -> f64 {
 pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
     let mut body = String::new();
     let mut panels = Vec::new();
-    let steps = r.panels.iter().map(|p| p.rec.times.len()).max().unwrap_or(0);
+    let steps = r
+        .panels
+        .iter()
+        .map(|p| p.rec.times.len())
+        .max()
+        .unwrap_or(0);
     for (i, p) in r.panels.iter().enumerate() {
         let prefix = format!("p{i}");
         let opts = DotOptions {
@@ -255,6 +260,9 @@ mod tests {
 
     #[test]
     fn esc_escapes_markup_and_controls() {
-        assert_eq!(esc("<a href='x'>&\"\u{1b}"), "&lt;a href=&#39;x&#39;&gt;&amp;&quot;\\u{1b}");
+        assert_eq!(
+            esc("<a href='x'>&\"\u{1b}"),
+            "&lt;a href=&#39;x&#39;&gt;&amp;&quot;\\u{1b}"
+        );
     }
 }

@@ -37,7 +37,9 @@ pub const MAX_CHANGES: usize = 2_000_000;
 pub enum ViewError {
     #[error("{0}")]
     Input(String),
-    #[error("the run of `{policy}` has more than {limit} {what}; `btfsm view` shows at most that many")]
+    #[error(
+        "the run of `{policy}` has more than {limit} {what}; `btfsm view` shows at most that many"
+    )]
     TooLarge {
         policy: String,
         what: &'static str,
@@ -275,7 +277,9 @@ impl Recorder {
 /// them (an HFSM state's full path, which the simulator's trace uses).
 pub fn drawn_keys(policy: &crate::model::Policy) -> (Vec<String>, Vec<(String, usize)>) {
     match &policy.body {
-        crate::model::PolicyBody::Bt(bt) => (bt.nodes.iter().map(|n| n.id.clone()).collect(), vec![]),
+        crate::model::PolicyBody::Bt(bt) => {
+            (bt.nodes.iter().map(|n| n.id.clone()).collect(), vec![])
+        }
         crate::model::PolicyBody::Machine(m) => {
             let keys = m.keys();
             let alias = (0..m.states.len()).map(|i| (m.path(i), i)).collect();

@@ -56,10 +56,13 @@ fn status_code(s: &str) -> u8 {
     code(Status::from_outcome(s))
 }
 
+/// A policy's vertex keys, their other names, and the policy's name.
+type Drawn = (Vec<String>, Vec<(String, usize)>, String);
+
 /// Collects each run's statuses as the runs are made (`TraceOut`).
 struct Collect {
     recorders: Vec<Recorder>,
-    keys: Vec<(Vec<String>, Vec<(String, usize)>, String)>,
+    keys: Vec<Drawn>,
     err: Option<ViewError>,
 }
 
@@ -215,9 +218,9 @@ pub fn from_trace(
         for st in run["trace"].as_array().unwrap_or(&empty) {
             let t = st["t"].as_f64().unwrap_or(f64::NAN);
             let pairs = st["statuses"].as_array().unwrap_or(&empty);
-            let statuses = pairs.iter().filter_map(|p| {
-                Some((p[0].as_str()?, status_code(p[1].as_str().unwrap_or(""))))
-            });
+            let statuses = pairs
+                .iter()
+                .filter_map(|p| Some((p[0].as_str()?, status_code(p[1].as_str().unwrap_or("")))));
             rec.snapshot(name, t, statuses)?;
         }
         let skills = run["skills"].as_array().unwrap_or(&empty);

@@ -83,10 +83,7 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
         1.0
     };
     let scale = PLOT_W / t_end;
-    let axis = Axis {
-        x0: LABEL_W,
-        scale,
-    };
+    let axis = Axis { x0: LABEL_W, scale };
     let x = |t: f64| LABEL_W + t.clamp(0.0, t_end) * scale;
     let shown_rows = rows.len().min(MAX_ROWS);
     let extra_row = rows.len() > MAX_ROWS;
@@ -183,7 +180,11 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
             LABEL_W,
             y + ROW_H - 4.0,
             rows.len() - shown_rows,
-            spans_cut + rows[shown_rows..].iter().map(|r| r.spans.len()).sum::<usize>()
+            spans_cut
+                + rows[shown_rows..]
+                    .iter()
+                    .map(|r| r.spans.len())
+                    .sum::<usize>()
         );
     }
     for m in marks {
@@ -227,7 +228,12 @@ mod tests {
         let span = |i: usize| Span {
             start: i as f64,
             end: Some(i as f64 + 0.5),
-            outcome: if i % 2 == 0 { "success" } else { "failure" }.into(),
+            outcome: if i.is_multiple_of(2) {
+                "success"
+            } else {
+                "failure"
+            }
+            .into(),
             index: i,
         };
         let rows: Vec<Row> = (0..MAX_ROWS + 5)

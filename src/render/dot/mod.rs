@@ -37,8 +37,8 @@ mod graphviz;
 mod tests;
 
 use attrs::*;
-use builder::*;
 pub use attrs::{svg_cluster_id, svg_id};
+use builder::*;
 pub use graphviz::*;
 
 use crate::model::{Policy, PolicyBody, StateBody};
