@@ -60,50 +60,40 @@ fn fail(e: ViewError) -> Option<Replay> {
     None
 }
 
-/// One input's replay; `None` after printing why not.
+/// One input's replay; `None` after printing why not. Every input is read
+/// once through `format::source` (bounded, never blocking on a FIFO).
 fn replay_of(path: &Path, a: &ViewArgs, limits: &crate::format::Limits) -> Option<Replay> {
     let shown = path.display().to_string();
     let diags = |d: Vec<crate::diagnostic::Diagnostic>| {
         print_diagnostics(&mut std::io::stderr().lock(), &d);
         None
     };
-    let head = {
-        use std::io::Read;
-        let mut b = [0u8; 32];
-        let n = std::fs::File::open(path)
-            .and_then(|mut f| f.read(&mut b))
-            .unwrap_or(0);
-        b[..n].to_vec()
+    let bytes = match crate::format::source::read_bytes(path, &shown, limits, false) {
+        Ok(b) => b,
+        Err(d) => return diags(d),
     };
-    match kind_of(path, &head) {
-        Kind::Log => {
-            let file = match std::fs::File::open(path) {
-                Ok(f) => f,
-                Err(e) => {
-                    eprintln!(
-                        "error: {}: cannot read this file: {e}",
-                        crate::sanitize::shown(&shown)
-                    );
-                    return None;
-                }
-            };
-            crate::view::log::from_log(file, &shown, limits).map_or_else(fail, Some)
+    let text = |bytes: Vec<u8>| match String::from_utf8(bytes) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            eprintln!(
+                "error: {}: byte {}: not UTF-8 text\n  = hint: a scenario (.toml) or a trace (.json) is UTF-8 text",
+                crate::sanitize::shown(&shown),
+                e.utf8_error().valid_up_to()
+            );
+            None
         }
+    };
+    match kind_of(path, &bytes[..bytes.len().min(32)]) {
+        Kind::Log => crate::view::log::from_log(&bytes[..], &shown, limits).map_or_else(fail, Some),
         Kind::Trace => {
-            let text = match crate::format::source::read(path, &shown, limits, false) {
-                Ok(t) => t,
-                Err(d) => return diags(d),
-            };
+            let text = text(bytes)?;
             let dir = path.parent().unwrap_or(Path::new(""));
             let root = crate::format::source::root_for(limits, dir);
-            crate::view::sim::from_trace(&text.text, &shown, root.as_deref(), limits)
+            crate::view::sim::from_trace(&text, &shown, root.as_deref(), limits)
                 .map_or_else(fail, Some)
         }
         Kind::Scenario => {
-            let file = match crate::format::toml::read_source(path, &shown, limits) {
-                Ok(f) => f,
-                Err(d) => return diags(d),
-            };
+            let file = crate::diagnostic::SourceFile::new(&shown, text(bytes)?);
             if crate::sim::symbolic::looks_symbolic(&file.text) {
                 eprintln!(
                     "error: {}: a symbolic scenario (with `domain`) has no trace to replay\n  = hint: `btfsm view` replays the planar simulator's scenarios, `sim --trace` files and .btlog logs",

@@ -228,6 +228,17 @@ fn view_refuses_bad_inputs_with_exit_2() {
     assert!(stderr.contains("symbolic scenario"), "{stderr}");
     let (code, _, stderr) = btfsm(&["view", "tests/fixtures/sim-invalid/does-not-exist.toml"]);
     assert_eq!(code, 2, "{stderr}");
+    // A FIFO with no writer, as a log or a scenario: an answer at once.
+    for name in ["f.btlog", "f.toml"] {
+        let fifo = dir.join(name);
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let t0 = std::time::Instant::now();
+        let (code, _, stderr) = btfsm(&["view", fifo.to_str().unwrap()]);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(t0.elapsed() < std::time::Duration::from_secs(20));
+    }
 }
 
 /// A trace names an HFSM's states by their path (`moma/deliver/.../pick`);
