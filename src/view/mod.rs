@@ -330,6 +330,57 @@ mod tests {
         assert_eq!(r.changes, 2);
     }
 
+    /// `DotOptions::svg_ids` gives every vertex (and every HFSM container's
+    /// cluster) the id the page looks it up by, one-to-one.
+    #[test]
+    fn svg_ids_name_every_vertex_of_the_rendered_svg() {
+        use crate::render::dot::{DotOptions, RenderFormat, render, svg_cluster_id, svg_id};
+        let keys = ["a-b", "a_b", "a b", "\"a\"", "<x>", "é", "a-2db"];
+        let ids: std::collections::HashSet<String> = keys.iter().map(|k| svg_id(k)).collect();
+        assert_eq!(ids.len(), keys.len(), "{ids:?}");
+        for id in &ids {
+            assert!(
+                id.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+            );
+        }
+        let l = crate::format::load(
+            std::path::Path::new("policies/paper/fig06-hfsm.toml"),
+            &Default::default(),
+        )
+        .unwrap();
+        let opts = DotOptions {
+            svg_ids: true,
+            ..Default::default()
+        };
+        let dot = crate::render::dot::policy_dot(&l.policy, &opts);
+        let svg = render(&dot, RenderFormat::Svg, std::time::Duration::from_secs(60)).unwrap();
+        let svg = String::from_utf8(svg).unwrap().replace("&#45;", "-");
+        let (keys, _) = drawn_keys(&l.policy);
+        for k in &keys {
+            assert!(svg.contains(&format!("id=\"{}\"", svg_id(k))), "{k}");
+        }
+        let crate::model::PolicyBody::Machine(m) = &l.policy.body else {
+            panic!("an HFSM")
+        };
+        let containers = (0..m.states.len())
+            .filter(|&i| matches!(m.states[i].body, crate::model::StateBody::Container(_)))
+            .count();
+        assert!(containers > 0);
+        let mkeys = m.keys();
+        for (i, k) in mkeys.iter().enumerate() {
+            if matches!(m.states[i].body, crate::model::StateBody::Container(_)) {
+                assert!(
+                    svg.contains(&format!("id=\"{}\"", svg_cluster_id(k))),
+                    "{k}"
+                );
+            }
+        }
+        // Without the option the drawing is unchanged: no ids.
+        let plain = crate::render::dot::policy_dot(&l.policy, &DotOptions::default());
+        assert!(!plain.contains("id=") && dot.contains("id="));
+    }
+
     #[test]
     fn a_run_past_the_step_cap_is_refused() {
         let mut r = Recorder::new(vec![], &[]);
