@@ -113,7 +113,10 @@ pub fn from_log(r: impl std::io::Read, shown: &str, limits: &Limits) -> Result<R
     let title = policy.name.clone();
     Ok(Replay {
         title: format!("{shown}: {title}"),
-        subtitle: format!("BehaviorTree.CPP log, {steps} status changes over {t:.3} s"),
+        subtitle: format!(
+            "BehaviorTree.CPP log, {steps} status changes over {} s",
+            (t * 1e6).round() / 1e6
+        ),
         step_name: "status change".into(),
         panels: vec![Panel {
             title,

@@ -206,12 +206,14 @@ pub fn from_trace(
             ))
         })?;
         let loaded = crate::format::load(&path, limits).map_err(ViewError::Diagnostics)?;
-        let policy = if run["convert"] == "hfsm" {
+        let mut policy = if run["convert"] == "hfsm" {
             crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&loaded.policy)
                 .map_err(|e| ViewError::Input(format!("{file}: {}", e[0])))?
         } else {
             loaded.policy
         };
+        // Named as it ran (a scenario may rename it).
+        policy.name = name.to_string();
         let (keys, alias) = drawn_keys(&policy);
         let mut rec = Recorder::new(keys, &alias);
         let empty = Vec::new();

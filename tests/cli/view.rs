@@ -153,6 +153,29 @@ fn a_sim_trace_replays_as_its_scenario() {
     assert_eq!(steps(&from_trace), steps(&from_scenario));
 }
 
+/// `--seed S` replays the episode `sim --seed S` runs.
+#[test]
+fn view_seed_runs_the_episode_of_sim_seed() {
+    let scenario = "policies/scenarios/exp1-pick-fails.toml";
+    let html = page("seed", &[scenario, "--seed", "17"]);
+    assert!(html.contains("<h1>exp1-pick-fails (seed 17)</h1>"));
+    let (code, json, stderr) = btfsm(&["sim", scenario, "--seed", "17", "--format", "json"]);
+    assert!(code == 0 || code == 1, "{stderr}");
+    let sim: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let d = data(&html);
+    for (p, run) in d["panels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(sim["policies"].as_array().unwrap())
+    {
+        assert_eq!(
+            p["times"].as_array().unwrap().len() as u64,
+            run["steps"].as_u64().unwrap()
+        );
+    }
+}
+
 #[test]
 fn a_btlog_replays_record_by_record() {
     let html = page("log", &["tests/fixtures/logs/fig01.btlog"]);
