@@ -115,6 +115,14 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
         .map(|p| p.rec.times.len())
         .max()
         .unwrap_or(0);
+    // One time axis for all the timelines, so that their cursors line up.
+    let t_end = (r.panels.iter())
+        .flat_map(|p| {
+            (p.rec.times.iter().copied())
+                .chain(p.rows.iter().flat_map(|r| r.spans.iter().map(|s| s.start)))
+        })
+        .filter(|t| t.is_finite())
+        .fold(0.0f64, f64::max);
     for (i, p) in r.panels.iter().enumerate() {
         let prefix = format!("p{i}");
         let opts = DotOptions {
@@ -123,14 +131,6 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
         };
         let svg = render(&policy_dot(&p.policy, &opts), RenderFormat::Svg, timeout)?;
         let svg = inline_svg(&String::from_utf8_lossy(&svg), &prefix);
-        let t_end = p
-            .rec
-            .times
-            .iter()
-            .copied()
-            .chain(p.rows.iter().flat_map(|r| r.spans.iter().map(|s| s.start)))
-            .filter(|t| t.is_finite())
-            .fold(0.0f64, f64::max);
         let (tl, axis) = timeline::svg(&prefix, &p.rows, &p.marks, t_end);
         let _ = write!(
             body,
@@ -218,7 +218,7 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
 <span class="legend">{r}{s}{f}</span>
 <span class="hint">one step: {step_name}</span>
 </nav>
-<main class="panels">{body}</main>
+<main class="panels cols-{cols}">{body}</main>
 <script type="application/json" id="btfsm-data">{json}</script>
 <script>{SCRIPT}</script>
 </body></html>
@@ -231,6 +231,12 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
         f = swatch(Status::Failure, "FAILURE"),
         step_name = esc(&r.step_name),
         json = script_json(&data),
+        // Four panels as two rows of two, more in rows of three.
+        cols = match r.panels.len() {
+            0 | 1 => 1,
+            2 | 4 => 2,
+            _ => 3,
+        },
     );
     Ok(html)
 }

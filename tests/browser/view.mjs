@@ -144,12 +144,12 @@ async function drive(name, html, oracleArgv, lengths, shots) {
   const mid = await stepOf(page);
   if (Math.abs(mid - 0.6 * (total - 1)) > 0.05 * total + 2) fail(`${name}: a click at 60% of the slider went to step ${mid} of ${total}`);
   await at('slider');
-  if (shots) await page.screenshot({ path: join(opt.out, `${basename(html, '.html')}-slider.png`) });
+  if (shots) await page.screenshot({ path: join(opt.out, `${basename(html, '.html')}-slider.png`), fullPage: true });
   const gos = await page.$$('button.go');
   if (gos.length) {
     await gos[0].click();
     await at('divergence button');
-    if (shots) await page.screenshot({ path: join(opt.out, `${basename(html, '.html')}-divergence.png`) });
+    if (shots) await page.screenshot({ path: join(opt.out, `${basename(html, '.html')}-divergence.png`), fullPage: true });
   }
   await page.keyboard.press('End');
   if ((await stepOf(page)) !== total - 1) fail(`${name}: End did not reach the last step`);
