@@ -103,7 +103,7 @@ pub struct Panel {
     pub policy: crate::model::Policy,
     /// Statuses over the steps.
     pub rec: Recorder,
-    /// The timeline's rows, and the time its axis ends at.
+    /// The timeline's rows.
     pub rows: Vec<Row>,
     pub marks: Vec<Mark>,
 }

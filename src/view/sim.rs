@@ -296,3 +296,36 @@ pub fn from_trace(
         divergences: divs,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A trace from a stranger: wrong types, missing fields, hostile
+    /// values give an error or a replay, never a panic.
+    #[test]
+    fn malformed_traces_never_panic() {
+        let fig = "policies/paper/fig01-bt.toml";
+        let cases = [
+            "{}".to_string(),
+            "[]".into(),
+            r#"{"policies": 3}"#.into(),
+            r#"{"policies": [{}]}"#.into(),
+            format!(r#"{{"policies": [{{"policy": 1, "file": "{fig}"}}]}}"#),
+            format!(
+                r#"{{"policies": [{{"policy": "p", "file": "{fig}", "trace": [{{"t": "x", "statuses": [[1, 2], ["moma"], ["moma", "RUNNING", 3], "s"]}}, 7, {{"t": 1e308}}], "skills": [{{"skill": 3, "args": [1], "start": null, "end": "x"}}, 5]}}], "verdicts": [{{"a": "p", "b": "p", "first_divergence": {{"t": -1e308, "index": 18446744073709551615}}}}, 3]}}"#
+            ),
+            format!(
+                r#"{{"policies": [{{"policy": "p", "file": "{fig}", "convert": "hfsm", "trace": [{{"t": 0, "statuses": [["moma/deliver", "SUCCESS"]]}}]}}]}}"#
+            ),
+        ];
+        for c in &cases {
+            let _ = from_trace(c, "t.json", None, &Limits::default());
+        }
+        let ok = from_trace(&cases[5], "t.json", None, &Limits::default()).unwrap();
+        assert_eq!(ok.panels[0].rec.times.len(), 3);
+        assert_eq!(ok.divergences.len(), 1);
+        let html = super::super::html::page(&ok, std::time::Duration::from_secs(60)).unwrap();
+        assert!(html.contains("btfsm-data"));
+    }
+}
