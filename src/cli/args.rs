@@ -174,6 +174,11 @@ pub enum Command {
     Lint(super::lint::LintArgs),
     /// Reads BehaviorTree.CPP execution logs (.btlog): `log report`
     Log(super::log::LogArgs),
+    /// Writes one self-contained HTML page replaying runs: each policy's
+    /// diagram coloured by status at a step (RUNNING yellow, SUCCESS green,
+    /// FAILURE red), a timeline of the actions, a slider and step buttons;
+    /// from a scenario (run here), a `sim --trace` file or a .btlog
+    View(super::view::ViewArgs),
     /// Tree edit distances of trees in bracket notation, one pair per line
     /// (`{a{b}}<TAB>{a{c}}`): what tests/differential/ted.py and
     /// bench/ted_vs_apted.py drive

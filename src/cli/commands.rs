@@ -308,6 +308,7 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Plan(args) => super::plan::execute(args),
         Command::Lint(args) => super::lint::execute(args),
         Command::Log(args) => super::log::execute(args),
+        Command::View(args) => super::view::execute(args),
         Command::TedPairs(args) => super::ted_pairs::execute(args),
         Command::Completions { shell } => {
             use clap::CommandFactory;

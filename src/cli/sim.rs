@@ -413,10 +413,18 @@ pub fn dot_trace(
         policy
     };
     let mut opts = crate::render::dot::DotOptions::default();
+    // A trace names an (H)FSM's states by their full path; the drawing by
+    // their vertex key (the name, unless it repeats).
+    let (keys, paths) = crate::view::drawn_keys(&policy);
+    let key_of: std::collections::HashMap<&str, &str> = paths
+        .iter()
+        .map(|(p, i)| (p.as_str(), keys[*i].as_str()))
+        .collect();
     for pair in st["statuses"].as_array().unwrap_or(&empty) {
         if let (Some(k), Some(s)) = (pair[0].as_str(), pair[1].as_str())
             && let Some(s) = Status::from_outcome(s)
         {
+            let k = key_of.get(k).copied().unwrap_or(k);
             opts.highlight.insert(k.to_string(), Highlight::Status(s));
         }
     }

@@ -18,6 +18,7 @@ mod plan;
 mod sim;
 mod tick;
 mod untrusted;
+mod view;
 
 use common::btfsm;
 

@@ -258,3 +258,58 @@ pub(super) fn bt_node_attrs(n: &BtNode) -> Attrs {
     a.set("tooltip", &tip);
     a
 }
+
+// ---------------------------------------------------------------------------
+// Ids of the SVG elements (`btfsm view`)
+
+/// `prefix` and the bytes of `s`: ASCII letters and digits kept, every other
+/// byte as `-` and two hex digits; one-to-one, and a valid HTML/SVG id.
+fn encoded_id(prefix: &str, s: &str) -> String {
+    let mut out = String::with_capacity(prefix.len() + s.len());
+    out.push_str(prefix);
+    for b in s.bytes() {
+        if b.is_ascii_alphanumeric() {
+            out.push(b as char);
+        } else {
+            out.push_str(&format!("-{b:02x}"));
+        }
+    }
+    out
+}
+
+/// The text of a DOT id as printed (quoted when it is not plain).
+fn id_text(id: &Id) -> &str {
+    match id {
+        Id::Plain(s) | Id::Escaped(s) | Id::Html(s) | Id::Anonymous(s) => s,
+    }
+}
+
+/// The SVG element id of the DOT node of a vertex key (with
+/// [`DotOptions::svg_ids`]): distinct keys give distinct ids.
+pub fn svg_id(key: &str) -> String {
+    encoded_id("v_", id_text(&dot_id(key)))
+}
+
+/// The SVG element id of an HFSM container's cluster, by its key.
+pub fn svg_cluster_id(key: &str) -> String {
+    encoded_id("c_", id_text(&dot_id(key)))
+}
+
+/// Sets `id` on every DOT node below `stmts` (clusters included, walked
+/// with a stack).
+pub(super) fn set_svg_ids(stmts: &mut [Stmt]) {
+    let mut stack: Vec<&mut [Stmt]> = vec![stmts];
+    while let Some(list) = stack.pop() {
+        for s in list {
+            match s {
+                Stmt::Node(n) => {
+                    let id = encoded_id("v_", id_text(&n.id.0));
+                    n.attributes
+                        .push(Attribute(Id::Plain("id".into()), dot_id(&id)));
+                }
+                Stmt::Subgraph(sg) => stack.push(&mut sg.stmts),
+                _ => {}
+            }
+        }
+    }
+}

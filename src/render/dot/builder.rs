@@ -428,6 +428,9 @@ impl<'o> Builder<'o> {
             None => {}
         }
         ca.changed(self.opts.changed.get(key));
+        if self.opts.svg_ids {
+            ca.set("id", &svg_cluster_id(key));
+        }
         let mut header: Vec<Stmt> = ca.into_vec().into_iter().map(Stmt::Attribute).collect();
         let mut ea = Attrs::default();
         ea.set("shape", "point")

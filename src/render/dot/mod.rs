@@ -37,6 +37,7 @@ mod graphviz;
 mod tests;
 
 use attrs::*;
+pub use attrs::{svg_cluster_id, svg_id};
 use builder::*;
 pub use graphviz::*;
 
@@ -73,8 +74,9 @@ impl Status {
         }
     }
 
-    /// Fill of a node highlighted with this status.
-    fn fill_color(self) -> &'static str {
+    /// Fill of a node highlighted with this status (an SVG/CSS colour name
+    /// too: `btfsm view` paints with it).
+    pub fn fill_color(self) -> &'static str {
         match self {
             Status::Running => "gold",
             Status::Success => "palegreen",
@@ -130,6 +132,10 @@ pub struct DotOptions {
     pub title: Option<String>,
     /// Adds a legend of the diff colours (added, removed, changed).
     pub legend: bool,
+    /// Gives every DOT node the attribute `id` = [`svg_id`] of its DOT node
+    /// id, and every HFSM container's cluster [`svg_cluster_id`] of its key,
+    /// so that the SVG Graphviz renders can be scripted (`btfsm view`).
+    pub svg_ids: bool,
 }
 
 const FONT: &str = "Helvetica";
@@ -174,6 +180,9 @@ pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     }
     b.ghosts();
     b.assemble();
+    if opts.svg_ids {
+        set_svg_ids(&mut b.root);
+    }
     if opts.legend {
         let legend = b.legend();
         b.root.push(legend);
