@@ -135,10 +135,13 @@ impl<'o> Builder<'o> {
 
     // --- Behavior Trees -----------------------------------------------------
 
-    pub(super) fn bt(&mut self, bt: &Bt) {
+    pub(super) fn bt(&mut self, bt: &Bt, view: &super::bt::View) {
         let ids: Vec<String> = bt.nodes.iter().map(|n| self.vertex(&n.id)).collect();
-        for (n, id) in bt.nodes.iter().zip(&ids) {
-            let mut a = bt_node_attrs(n);
+        // In arena order (pre-order for a file read), hidden nodes left out.
+        let drawn: Vec<usize> = (0..bt.nodes.len()).filter(|&i| view.shown[i]).collect();
+        for &i in &drawn {
+            let (n, id) = (&bt.nodes[i], &ids[i]);
+            let mut a = super::bt::bt_node_attrs(n, view.folded[i], self.opts.ports);
             a.node_highlight(self.vhl(&n.id));
             a.changed(self.opts.changed.get(&n.id));
             self.root.push(node_stmt(id, a));
@@ -150,7 +153,11 @@ impl<'o> Builder<'o> {
                 slotted.entry(from.as_str()).or_default().push((slot, g));
             }
         }
-        for (n, id) in bt.nodes.iter().zip(&ids) {
+        for &i in &drawn {
+            if view.folded[i].is_some() {
+                continue;
+            }
+            let (n, id) = (&bt.nodes[i], &ids[i]);
             let mut ghosts = slotted.remove(n.id.as_str()).unwrap_or_default();
             ghosts.sort_unstable();
             let mut ghosts = ghosts.into_iter().peekable();

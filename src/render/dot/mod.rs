@@ -31,12 +31,14 @@
 //! neither the printer nor Graphviz recurse without bound.
 
 mod attrs;
+mod bt;
 mod builder;
 mod graphviz;
 #[cfg(test)]
 mod tests;
 
 use attrs::*;
+pub use bt::{FoldError, MAX_ASPECT, RankDir, check_fold};
 use builder::*;
 pub use graphviz::*;
 
@@ -130,9 +132,25 @@ pub struct DotOptions {
     pub title: Option<String>,
     /// Adds a legend of the diff colours (added, removed, changed).
     pub legend: bool,
+    /// BT: draws each node's ports under its label (they are always in its
+    /// tooltip).
+    pub ports: bool,
+    /// BT: nodes drawn folded, by id: one node standing for the subtree.
+    pub collapse: std::collections::BTreeSet<String>,
+    /// BT: folds every node at this depth (the root is at depth 0).
+    pub depth: Option<usize>,
+    /// BT: folds the root of every SubTree (BehaviorTree.CPP `<SubTree>`,
+    /// TOML `subtree` include).
+    pub fold_subtrees: bool,
+    /// BT: the direction of the layout.
+    pub rankdir: RankDir,
 }
 
 const FONT: &str = "Helvetica";
+/// The font of the lines under a label (a node's type, ports, a folded
+/// subtree's size).
+const SUB_FONT_SIZE: &str = "8";
+const SUB_COLOR: &str = "#555555";
 const ACTION_FILL: &str = "#dce8f7";
 const DECISION_FILL: &str = "#eeeeee";
 const ADDED: &str = "magenta";
@@ -155,10 +173,15 @@ pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     graph_attrs.set("fontsize", "14");
     match &policy.body {
         PolicyBody::Bt(bt) => {
+            let view = bt::View::new(bt, opts);
             graph_attrs.set("ordering", "out");
+            let rankdir = view.rankdir(bt, opts);
+            if rankdir != "TB" {
+                graph_attrs.set("rankdir", rankdir);
+            }
             graph_attrs.set("nodesep", "0.25");
             graph_attrs.set("ranksep", "0.45");
-            b.bt(bt);
+            b.bt(bt, &view);
         }
         PolicyBody::Machine(m) => {
             graph_attrs.set("nodesep", "0.4");
