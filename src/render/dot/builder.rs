@@ -290,6 +290,23 @@ impl<'o> Builder<'o> {
             self.top_tail.push(rank_group("sink", &top_outcome_id));
         }
         self.top_states = m.top.states.clone();
+        // The top level's initial state, as UML marks it: a filled dot and
+        // an arrow (containers mark theirs with their own dot, a vertex).
+        // Neither is a vertex nor an arc of the graph.
+        if let Target::State(j) = m.top.initial {
+            let start = self.fresh(START);
+            let mut a = Attrs::default();
+            a.set("shape", "point")
+                .set("width", "0.15")
+                .set("tooltip", "initial state");
+            self.top_tail.push(node_stmt(&start, a));
+            let mut e = Attrs::default();
+            if region(j).is_some() {
+                e.set("lhead", &cluster_name(j));
+            }
+            e.set("class", "start");
+            self.edges.push(edge_stmt(&start, &state_id[j], e));
+        }
 
         // Clusters, deepest first; below MAX_CLUSTER_NESTING a cluster goes
         // beside its parent's instead of inside it.

@@ -5,27 +5,41 @@
 //! DOT edge per arc, so that a picture can be counted like the paper counts:
 //!
 //! - BT (Fig. 1): control nodes are boxes labelled `→` (Sequence), `?` (Fallback),
-//!   `→*` / `?*` (with memory) and `⇉ k/N` (Parallel with its success threshold);
-//!   decorators are diamonds with their name and parameter; actions are filled
-//!   ovals, conditions white ovals in italics. The tree is drawn top-down with
-//!   children in order (`ordering=out`).
+//!   `→*` / `?*` (with memory) and `⇉ k/N` (Parallel with its success threshold),
+//!   other control types boxes with their type; decorators are hexagons with
+//!   their name and parameter; actions are filled rounded boxes, conditions
+//!   white ellipses in italics (Groot's convention). A node with a name of
+//!   its own shows its type in small grey under it; ports are in the
+//!   tooltip (under the label with [`DotOptions::ports`]). Subtrees can be
+//!   folded into one double-bordered node with their size (see `bt.rs`).
+//!   The tree is drawn with children in order (`ordering=out`), top-down, or
+//!   left-to-right when top-down would be too wide ([`RankDir`]).
 //! - FSM (Fig. 4): states are ovals, decision states (SELECTOR) diamonds, the
-//!   initial state has a bold border, terminal outcomes are double circles. Arcs
-//!   carry their outcome or guard label and are coloured like the paper's Fig. 4:
-//!   RUNNING goldenrod, SUCCESS green, FAILURE red, guards blue. A decision
-//!   state's self-loop hangs below it, clear of its guard arcs.
+//!   initial state has a bold border and, as in UML, an arrow from a filled
+//!   dot (the start dot, DOT node [`START`], neither a vertex nor an arc:
+//!   its edge has `class=start`); terminal outcomes are double circles.
+//!   Arcs carry their outcome or guard label and are coloured like the
+//!   paper's Fig. 4: RUNNING goldenrod, SUCCESS green, FAILURE red, guards
+//!   blue (the label says what the colour means, so no legend is drawn). A
+//!   decision state's self-loop hangs below it, clear of its guard arcs.
 //! - HFSM (Fig. 6): every container is a cluster holding its states. The
 //!   container's own vertex is the small dot at the top of its cluster (arcs into
 //!   the container end at the cluster's border; the dot's arc goes to the initial
-//!   child). The container's outcomes are small boxes at the bottom of the
-//!   cluster: a transition to a container outcome points at that box, and the
-//!   container's own transitions leave from it. These outcome boxes are the only
-//!   DOT nodes that are not graph vertices.
+//!   child, so every level marks its initial state as UML does). The regions
+//!   of a parallel state are dashed clusters inside it. The container's
+//!   outcomes are small boxes at the bottom of the cluster: a transition to
+//!   a container outcome points at that box, and the container's own
+//!   transitions leave from it. These outcome boxes and the start dot are
+//!   the only DOT nodes that are not graph vertices.
 //!
 //! DOT node ids are the graph's vertex keys (BT node id, state path
 //! `Container/Child`, outcome name), quoted and escaped, so that a diagram can be
 //! matched with `compare`'s edit scripts ([`DotOptions`] highlights vertices
-//! and arcs by key and draws removed ones as dashed grey ghosts). Output is
+//! and arcs by key and draws removed ones as dashed grey ghosts). Every node
+//! also has the DOT attribute `id` set to its node id, so that in Graphviz's
+//! SVG the node's `<g>` element has `id` = the vertex key (control
+//! characters and bidirectional controls replaced by spaces, as every
+//! string is; a page colours nodes by `getElementById(key)`). Output is
 //! deterministic: everything is emitted in model order. HFSM clusters nested
 //! deeper than 48 levels are drawn beside their parent's cluster, so that
 //! neither the printer nor Graphviz recurse without bound.
@@ -147,6 +161,8 @@ pub struct DotOptions {
 }
 
 const FONT: &str = "Helvetica";
+/// The DOT node id of an FSM's start dot (made unique if a state has it).
+pub const START: &str = "__start";
 /// The font of the lines under a label (a node's type, ports, a folded
 /// subtree's size).
 const SUB_FONT_SIZE: &str = "8";
@@ -184,7 +200,9 @@ pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
             b.bt(bt, &view);
         }
         PolicyBody::Machine(m) => {
-            graph_attrs.set("nodesep", "0.4");
+            // Room between states for the arcs' labels of dense machines
+            // (the paper's Fig. 8e, 16b), looked at in PNG.
+            graph_attrs.set("nodesep", "0.6");
             graph_attrs.set("ranksep", "0.5");
             if m.states
                 .iter()
