@@ -319,10 +319,16 @@ fn texts(n: &BtNode, folded: Option<usize>, ports: bool) -> (String, Vec<String>
         .unwrap_or_else(|| n.kind.default_label().to_string());
     let mut sub = Vec::new();
     if let Some(size) = folded {
-        // Its own name, else the SubTree's, else an id a person wrote.
+        // The SubTree's ID (its root's own name under it), else the root's
+        // own name, else an id a person wrote, else its type.
         let name = match (&n.subtree, custom) {
-            (_, true) => n.label.clone(),
-            (Some(t), false) => t.clone(),
+            (Some(t), _) => {
+                if custom && n.label != *t {
+                    sub.push(n.label.clone());
+                }
+                t.clone()
+            }
+            (None, true) => n.label.clone(),
             (None, false) if !n.id.contains(['/', '#', '~']) => n.id.clone(),
             (None, false) => symbol(n).unwrap_or(ty),
         };
@@ -425,4 +431,76 @@ pub(super) fn bt_node_attrs(n: &BtNode, folded: Option<usize>, ports: bool) -> A
     }
     a.set("tooltip", &tip);
     a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn node(id: &str, kind: BtNodeKind, children: Vec<usize>) -> BtNode {
+        BtNode {
+            id: id.into(),
+            label: id.into(),
+            kind,
+            children,
+            skill: None,
+            type_name: None,
+            ports: Default::default(),
+            subtree: None,
+            span: None,
+        }
+    }
+
+    /// A root Sequence over `k` actions.
+    fn flat(k: usize) -> Bt {
+        let mut nodes = vec![node("root", BtNodeKind::Sequence, (1..=k).collect())];
+        nodes.extend((1..=k).map(|i| node(&format!("a{i}"), BtNodeKind::Action, vec![])));
+        Bt { nodes, root: 0 }
+    }
+
+    #[test]
+    fn siblings_are_packed_side_by_side_and_parents_centred() {
+        let bt = flat(2);
+        let view = View::new(&bt, &DotOptions::default());
+        let sizes = [30.0, 40.0, 60.0];
+        // The two leaves side by side with one separation; the root above.
+        assert_eq!(view.tidy_extent(&bt, &sizes), 40.0 + 60.0 + NODESEP_PT);
+        let wide_root = [200.0, 40.0, 60.0];
+        assert_eq!(view.tidy_extent(&bt, &wide_root), 200.0);
+    }
+
+    #[test]
+    fn a_wide_flat_tree_is_drawn_left_to_right_and_a_deep_one_top_down() {
+        let opts = DotOptions::default();
+        let bt = flat(40);
+        assert_eq!(View::new(&bt, &opts).rankdir(&bt, &opts), "LR");
+        let bt = flat(2);
+        assert_eq!(View::new(&bt, &opts).rankdir(&bt, &opts), "TB");
+        let forced = DotOptions {
+            rankdir: RankDir::TopDown,
+            ..Default::default()
+        };
+        let bt = flat(40);
+        assert_eq!(View::new(&bt, &forced).rankdir(&bt, &forced), "TB");
+        // A chain of a thousand decorators: tall, never turned.
+        let mut nodes: Vec<BtNode> = (0..1000)
+            .map(|i| node(&format!("d{i}"), BtNodeKind::Inverter, vec![i + 1]))
+            .collect();
+        nodes.push(node("leaf", BtNodeKind::Action, vec![]));
+        let bt = Bt { nodes, root: 0 };
+        assert_eq!(View::new(&bt, &opts).rankdir(&bt, &opts), "TB");
+    }
+
+    #[test]
+    fn folded_nodes_hide_their_subtree_and_count_it() {
+        let bt = flat(3);
+        let opts = DotOptions {
+            collapse: ["root".to_string()].into(),
+            ..Default::default()
+        };
+        let view = View::new(&bt, &opts);
+        assert_eq!(view.order, vec![0]);
+        assert_eq!(view.folded[0], Some(4));
+        assert!(!view.shown[1]);
+    }
 }
