@@ -16,6 +16,7 @@ mod lint;
 mod log;
 mod paper;
 mod plan;
+mod provenance;
 mod sim;
 mod tick;
 mod untrusted;
