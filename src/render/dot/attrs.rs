@@ -80,6 +80,9 @@ pub(super) struct Attrs {
     /// Lines drawn under the label in a smaller grey font (a BT node's type
     /// under its custom name, its ports): the label becomes HTML-like.
     sub: Vec<String>,
+    /// A line over the label in a larger font (a control node's symbol over
+    /// its name): the label becomes HTML-like.
+    head: Option<String>,
 }
 
 impl Attrs {
@@ -88,6 +91,12 @@ impl Attrs {
             Some(slot) => slot.1 = value.to_string(),
             None => self.list.push((key, value.to_string())),
         }
+        self
+    }
+
+    /// Sets a line over the label, larger.
+    pub(super) fn head(&mut self, line: String) -> &mut Self {
+        self.head = Some(line);
         self
     }
 
@@ -167,18 +176,35 @@ impl Attrs {
     }
 
     pub(super) fn into_vec(self) -> Vec<Attribute> {
-        let sub = self.sub;
+        let (sub, head) = (self.sub, self.head);
         let mut v: Vec<Attribute> = self
             .list
             .into_iter()
             .map(|(k, val)| {
-                let value = if k == "label" && !sub.is_empty() {
-                    let lines: Vec<String> = sub.iter().map(|l| html(l)).collect();
-                    Id::Html(format!(
-                        "<{}<BR/><FONT POINT-SIZE=\"{SUB_FONT_SIZE}\" COLOR=\"{SUB_COLOR}\">{}</FONT>>",
-                        html(&val),
-                        lines.join("<BR/>")
-                    ))
+                let value = if k == "label" && (!sub.is_empty() || head.is_some()) {
+                    let mut text = String::from("<");
+                    if let Some(h) = &head {
+                        text.push_str(&format!(
+                            "<FONT POINT-SIZE=\"{HEAD_FONT_SIZE}\">{}</FONT><BR/>",
+                            html(h)
+                        ));
+                    }
+                    if sub.is_empty() {
+                        // Ends as `</FONT>>`, as HTML-like labels usually
+                        // do (some DOT readers look for `>>`).
+                        text.push_str(&format!("<FONT>{}</FONT>", html(&val)));
+                    } else {
+                        text.push_str(&html(&val));
+                    }
+                    if !sub.is_empty() {
+                        let lines: Vec<String> = sub.iter().map(|l| html(l)).collect();
+                        text.push_str(&format!(
+                            "<BR/><FONT POINT-SIZE=\"{SUB_FONT_SIZE}\" COLOR=\"{SUB_COLOR}\">{}</FONT>",
+                            lines.join("<BR/>")
+                        ));
+                    }
+                    text.push('>');
+                    Id::Html(text)
                 } else {
                     dot_id(&val)
                 };

@@ -15,8 +15,9 @@
 //! double border standing for its whole subtree, labelled with its size.
 //!
 //! Layout: a tree is drawn top-down unless the estimated drawing is wider
-//! than a screen and than [`MAX_ASPECT`] times its height, and
-//! left-to-right is closer to square; the estimate counts label characters (Helvetica's average width)
+//! than [`SWITCH_ASPECT`] times its height and left-to-right is closer to
+//! square (the switch is under the promised [`MAX_ASPECT`], a margin for the
+//! estimate's error); the estimate counts label characters (Helvetica's average width)
 //! and Graphviz's separations, so no Graphviz is needed to decide.
 
 use super::attrs::Attrs;
@@ -24,14 +25,18 @@ use super::*;
 use crate::model::BtNodeKind;
 use crate::model::bt::{Bt, BtNode, NodeIdx};
 
-/// Widest drawing (width / height) kept top-down under [`RankDir::Auto`].
+/// The widest aspect (width / height) [`RankDir::Auto`] aims for.
 pub const MAX_ASPECT: f64 = 2.5;
+/// The estimated aspect above which [`RankDir::Auto`] turns a tree
+/// left-to-right: under [`MAX_ASPECT`] by the estimate's error (label
+/// widths from average character widths, Graphviz's own packing).
+pub const SWITCH_ASPECT: f64 = 2.2;
 
 /// The direction of a BT's layout.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum RankDir {
-    /// Top-down, or left-to-right when top-down is wider than a screen and
-    /// than [`MAX_ASPECT`], and left-to-right is closer to square.
+    /// Top-down, or left-to-right when top-down is estimated wider than
+    /// [`SWITCH_ASPECT`] and left-to-right is closer to square.
     #[default]
     Auto,
     /// Root at the top, children left to right (the paper's figures).
@@ -132,7 +137,7 @@ impl View {
     }
 
     /// The layout direction for [`RankDir::Auto`]: `LR` when top-down is
-    /// estimated wider than [`MAX_ASPECT`] and left-to-right closer to
+    /// estimated wider than [`SWITCH_ASPECT`] and left-to-right closer to
     /// square, else `TB`.
     pub(super) fn rankdir(&self, bt: &Bt, opts: &DotOptions) -> &'static str {
         match opts.rankdir {
@@ -158,7 +163,7 @@ impl View {
         let ranks = RANKSEP_PT * (levels - 1) as f64;
         let tb_width = self.tidy_extent(bt, &w);
         let tb = tb_width / (max_h.iter().sum::<f64>() + ranks);
-        if tb <= MAX_ASPECT {
+        if tb <= SWITCH_ASPECT {
             return "TB";
         }
         let lr = (max_w.iter().sum::<f64>() + ranks) / self.tidy_extent(bt, &h);
@@ -262,6 +267,7 @@ const RANKSEP_PT: f64 = 0.45 * 72.0;
 
 /// Estimated size in points of a node's drawing: Helvetica averages about
 /// 0.55 em per character; lines are 1.2 em; margins as Graphviz pads.
+/// Sizes rather over than under: the switch to left-to-right has a margin.
 fn estimate(n: &BtNode, folded: Option<usize>, ports: bool) -> (f64, f64) {
     let (label, sub) = texts(n, folded, ports);
     let width = |s: &str, size: f64| {
@@ -272,7 +278,10 @@ fn estimate(n: &BtNode, folded: Option<usize>, ports: bool) -> (f64, f64) {
     let lines = |s: &str| s.lines().count().max(1) as f64;
     let sub_w = sub.iter().map(|l| width(l, 8.0)).fold(0.0, f64::max);
     let w = width(&label, 11.0).max(sub_w) + 22.0;
-    let h = lines(&label) * 13.2 + sub.len() as f64 * 9.6 + 12.0;
+    let head = folded.is_none() && symbol(n).is_some() && !names_a_type(n);
+    // Lines are 1.2 x their font size (11, 8 under, 15 for a symbol over a
+    // name); about 8 pt of margin; Graphviz's minimum height 0.4 in.
+    let h = lines(&label) * 13.2 + sub.len() as f64 * 9.6 + if head { 18.0 } else { 0.0 } + 8.0;
     let shape = if n.kind == BtNodeKind::Condition || is_decorator(n) {
         1.4
     } else {
@@ -336,8 +345,8 @@ fn texts(n: &BtNode, folded: Option<usize>, ports: bool) -> (String, Vec<String>
         return (name, sub);
     }
     let label = match symbol(n) {
-        // The paper's symbol, the node's name under it.
-        Some(sym) if custom => format!("{sym}\n{}", n.label),
+        // The paper's symbol over the node's name (see `bt_node_attrs`).
+        Some(_) if custom => n.label.clone(),
         Some(sym) => sym,
         None => {
             if custom && n.type_name.is_some() {
@@ -378,7 +387,10 @@ pub(super) fn bt_node_attrs(n: &BtNode, folded: Option<usize>, ports: bool) -> A
             .style("rounded")
             .style("filled");
     } else if let Some(sym) = symbol(n) {
-        let big = !sym.contains('\n') && label == sym;
+        let big = label == sym;
+        if !big {
+            a.head(sym);
+        }
         a.set("shape", "box")
             .set("fontsize", if big { "15" } else { "11" })
             .set("width", "0.45")
@@ -489,6 +501,34 @@ mod tests {
         nodes.push(node("leaf", BtNodeKind::Action, vec![]));
         let bt = Bt { nodes, root: 0 };
         assert_eq!(View::new(&bt, &opts).rankdir(&bt, &opts), "TB");
+    }
+
+    #[test]
+    fn names_types_and_ports_are_escaped_in_html_labels() {
+        let mut n = node("x", BtNodeKind::Action, vec![]);
+        n.label = "<b>&\"x\"</b>\u{202e}\n>>".into();
+        n.type_name = Some("T<>".into());
+        n.ports.insert("p".into(), "{a}>>".into());
+        let attrs = bt_node_attrs(&n, None, true).into_vec();
+        let label = attrs
+            .iter()
+            .find(|a| a.0 == graphviz_rust::dot_structures::Id::Plain("label".into()))
+            .expect("a label");
+        let graphviz_rust::dot_structures::Id::Html(text) = &label.1 else {
+            panic!("not HTML: {label:?}")
+        };
+        assert!(
+            text.starts_with("<&lt;b&gt;&amp;&quot;x&quot;&lt;/b&gt; <BR/>&gt;&gt;<BR/>"),
+            "{text}"
+        );
+        assert!(
+            text.contains(">T&lt;&gt;<BR/>p={a}&gt;&gt;</FONT>>"),
+            "{text}"
+        );
+        // No raw `>` or `<` from the input: only the label's own tags.
+        let inner = &text[1..text.len() - 1];
+        let tags = inner.matches('<').count();
+        assert_eq!(tags, inner.matches('>').count(), "{text}");
     }
 
     #[test]

@@ -167,6 +167,8 @@ pub const START: &str = "__start";
 /// subtree's size).
 const SUB_FONT_SIZE: &str = "8";
 const SUB_COLOR: &str = "#555555";
+/// The font of a control node's symbol over its name.
+const HEAD_FONT_SIZE: &str = "15";
 const ACTION_FILL: &str = "#dce8f7";
 const DECISION_FILL: &str = "#eeeeee";
 const ADDED: &str = "magenta";
