@@ -532,6 +532,28 @@ mod tests {
     }
 
     #[test]
+    fn a_legend_only_where_fills_carry_a_status() {
+        let policy = crate::model::Policy {
+            name: "t".into(),
+            description: None,
+            body: PolicyBody::Bt(flat(2)),
+        };
+        let plain = policy_dot(&policy, &DotOptions::default());
+        assert!(!plain.contains("legend"), "{plain}");
+        let traced = DotOptions {
+            highlight: [("a1".to_string(), Highlight::Status(Status::Running))].into(),
+            ..Default::default()
+        };
+        let dot = policy_dot(&policy, &traced);
+        assert!(dot.contains("subgraph \"cluster legend\""), "{dot}");
+        for s in ["RUNNING", "SUCCESS", "FAILURE"] {
+            assert!(dot.contains(&format!("\"legend: {s}\"[label={s}")), "{dot}");
+        }
+        // One node is gold: the legend's sample is written otherwise.
+        assert_eq!(dot.matches("fillcolor=gold").count(), 1, "{dot}");
+    }
+
+    #[test]
     fn folded_nodes_hide_their_subtree_and_count_it() {
         let bt = flat(3);
         let opts = DotOptions {

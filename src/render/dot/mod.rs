@@ -20,7 +20,8 @@
 //!   its edge has `class=start`); terminal outcomes are double circles.
 //!   Arcs carry their outcome or guard label and are coloured like the
 //!   paper's Fig. 4: RUNNING goldenrod, SUCCESS green, FAILURE red, guards
-//!   blue (the label says what the colour means, so no legend is drawn). A
+//!   blue (the label says what the colour means, so no legend is drawn; a
+//!   drawing with status fills, `dot --trace`, has a status legend). A
 //!   decision state's self-loop hangs below it, clear of its guard arcs.
 //! - HFSM (Fig. 6): every container is a cluster holding its states. The
 //!   container's own vertex is the small dot at the top of its cluster (arcs into
@@ -181,6 +182,42 @@ const GUARD: &str = "blue";
 /// instead of inside it (Graphviz and the printer recurse on nesting).
 const MAX_CLUSTER_NESTING: usize = 48;
 
+/// The legend of a drawing coloured by status: one sample node per status,
+/// side by side in a cluster of their own. The fills are written in hex
+/// (the same colours), so that a count of `fillcolor=gold` counts nodes.
+fn status_legend(b: &mut Builder) -> Stmt {
+    let mut ca = Attrs::default();
+    ca.set("label", "status at this step")
+        .set("fontname", FONT)
+        .set("fontsize", "9")
+        .set("color", "grey70")
+        .style("rounded");
+    let mut stmts: Vec<Stmt> = ca.into_vec().into_iter().map(Stmt::Attribute).collect();
+    let mut ids = Vec::new();
+    for (name, fill) in [
+        ("RUNNING", "#ffd700"),
+        ("SUCCESS", "#98fb98"),
+        ("FAILURE", "#ff6347"),
+    ] {
+        let id = b.fresh(&format!("legend: {name}"));
+        let mut a = Attrs::default();
+        a.set("label", name)
+            .set("shape", "box")
+            .set("fontsize", "9")
+            .set("height", "0.3")
+            .set("fillcolor", fill)
+            .style("rounded")
+            .style("filled");
+        stmts.push(node_stmt(&id, a));
+        ids.push(id);
+    }
+    stmts.push(rank_group("same", &ids));
+    Stmt::Subgraph(graphviz_rust::dot_structures::Subgraph {
+        id: dot_id("cluster legend"),
+        stmts,
+    })
+}
+
 /// DOT text of a policy in the paper's visual language.
 pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     let mut b = Builder::new(opts);
@@ -219,6 +256,14 @@ pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     b.assemble();
     if opts.legend {
         let legend = b.legend();
+        b.root.push(legend);
+    } else if opts
+        .highlight
+        .values()
+        .any(|h| matches!(h, Highlight::Status(_)))
+    {
+        // Fills say a status no label writes (`dot --trace`): say which.
+        let legend = status_legend(&mut b);
         b.root.push(legend);
     }
 

@@ -421,9 +421,10 @@ fn highlights_and_ghosts() {
         line("\"Pick cube2\" -> \"Tuck arm\"").contains("style=dashed"),
         "{dot}"
     );
-    // Ghosts add to the drawing, never to the policy's own elements.
+    // Ghosts add to the drawing, never to the policy's own elements; a
+    // status fill adds the status legend's three samples.
     let (ids, edges) = census(&dot);
-    assert_eq!((ids.len(), edges), (4 + 2, 10 + 2));
+    assert_eq!((ids.len(), edges), (4 + 2 + 3, 10 + 2));
 }
 
 #[test]
