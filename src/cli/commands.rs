@@ -169,16 +169,22 @@ pub fn execute(cli: Cli) -> u8 {
             render,
             timeout_ms,
             trace,
+            look,
             limits,
         } => {
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let Some((policy, opts)) =
+            let Some((policy, mut opts)) =
                 super::sim::dot_trace(&trace, &file, l.policy, &limits.limits())
             else {
                 return EXIT_BAD_INPUT;
             };
+            look.apply(&mut opts);
+            if let Err(e) = crate::render::dot::check_fold(&policy, &opts) {
+                eprintln!("error: {e}");
+                return EXIT_BAD_INPUT;
+            }
             let timeout = std::time::Duration::from_millis(timeout_ms);
             draw(&policy, &opts, output.as_deref(), render, timeout)
         }

@@ -376,9 +376,12 @@ mod tests {
                 );
             }
         }
-        // Without the option the drawing is unchanged: no ids.
+        // Without the option a node's id is its key as Graphviz writes it
+        // (`dot`'s own drawing); with it, the encoded id above, once.
         let plain = crate::render::dot::policy_dot(&l.policy, &DotOptions::default());
-        assert!(!plain.contains("id=") && dot.contains("id="));
+        let k = &keys[0];
+        assert!(!plain.contains(&svg_id(k)) && dot.contains(&svg_id(k)));
+        assert!(svg.matches(&format!("id=\"{}\"", svg_id(k))).count() == 1);
     }
 
     #[test]

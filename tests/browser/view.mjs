@@ -63,7 +63,9 @@ const fillsIn = (root) => {
   const out = {};
   for (const g of root.querySelectorAll('g.node')) {
     const t = g.querySelector('title');
-    if (!t) continue;
+    // `dot --trace` adds a legend of the status fills (nodes `legend: ...`),
+    // which is not a vertex: the page has its own legend.
+    if (!t || t.textContent.startsWith('legend: ')) continue;
     out[t.textContent] = [...g.querySelectorAll('ellipse, polygon, path')].map((s) => getComputedStyle(s).fill).join(' ');
   }
   return out;

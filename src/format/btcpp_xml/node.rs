@@ -238,6 +238,7 @@ impl Loader<'_> {
             // (the same node; an export says BTCPP_format="4").
             type_name: type_kept.then(|| v4_name(&ty).to_string()),
             ports,
+            subtree: None,
             span: Some(el.span.clone()),
         })
     }

@@ -311,6 +311,8 @@ impl Loader {
                     let offset = out.len();
                     for (j, mut n) in sub.nodes.into_iter().enumerate() {
                         n.id = if j == sub.root {
+                            // The boundary of the inclusion, for drawing it folded.
+                            n.subtree = n.subtree.or(Some(ids[i].0.to_string()));
                             id.clone()
                         } else {
                             format!("{id}/{}", n.id)
@@ -332,6 +334,7 @@ impl Loader {
                     skill: raw.skill.take(),
                     type_name: raw.type_name.take(),
                     ports: std::mem::take(&mut raw.ports),
+                    subtree: None,
                     span: Some(ids[i].1.clone()),
                 }),
             }
