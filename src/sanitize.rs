@@ -172,6 +172,34 @@ pub fn code_fence(body: &str) -> String {
     "`".repeat((longest_backtick_run(body) + 1).max(3))
 }
 
+/// The entity of one of XML's four characters that text or a double-quoted
+/// attribute value must not hold as they are (`&`, `<`, `>`, `"`).
+pub fn entity(c: char) -> Option<&'static str> {
+    match c {
+        '&' => Some("&amp;"),
+        '<' => Some("&lt;"),
+        '>' => Some("&gt;"),
+        '"' => Some("&quot;"),
+        _ => None,
+    }
+}
+
+/// A user string as XML, SVG or HTML text or attribute value: control
+/// characters escaped and the length cut at `max_chars` ([`shown_max`]),
+/// then `&`, `<`, `>`, `"` and `'` as entities.
+pub fn markup(s: &str, max_chars: usize) -> String {
+    let s = shown_max(s, max_chars);
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match (entity(c), c) {
+            (Some(e), _) => out.push_str(e),
+            (None, '\'') => out.push_str("&#39;"),
+            (None, c) => out.push(c),
+        }
+    }
+    out
+}
+
 /// A CSV cell: control characters escaped, quoted when it holds a comma, a
 /// quote or a newline, and prefixed with `'` when it starts with `=`, `+`,
 /// `-`, `@` (or a tab or carriage return), which spreadsheets would run as

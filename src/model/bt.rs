@@ -41,6 +41,24 @@ pub struct BtNode {
     pub span: Option<Span>,
 }
 
+impl BtNode {
+    /// A node with only an id, a label, a kind and children (no skill,
+    /// type name, ports, subtree or position).
+    pub fn bare(id: String, label: String, kind: BtNodeKind, children: Vec<NodeIdx>) -> Self {
+        BtNode {
+            id,
+            label,
+            kind,
+            children,
+            skill: None,
+            type_name: None,
+            ports: Default::default(),
+            subtree: None,
+            span: None,
+        }
+    }
+}
+
 /// Every node type the tool knows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BtNodeKind {
@@ -215,17 +233,7 @@ mod tests {
     use super::*;
 
     fn leaf(id: &str) -> BtNode {
-        BtNode {
-            id: id.into(),
-            label: id.into(),
-            kind: BtNodeKind::Action,
-            children: vec![],
-            skill: None,
-            type_name: None,
-            ports: BTreeMap::new(),
-            subtree: None,
-            span: None,
-        }
+        BtNode::bare(id.into(), id.into(), BtNodeKind::Action, vec![])
     }
 
     #[test]

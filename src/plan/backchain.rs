@@ -185,15 +185,8 @@ impl<'d> Planner<'d, '_> {
             steps.extend(self.steps[c].iter().cloned());
         }
         self.nodes.push(BtNode {
-            id,
-            label,
-            kind,
-            children,
             skill,
-            type_name: None,
-            ports: BTreeMap::new(),
-            subtree: None,
-            span: None,
+            ..BtNode::bare(id, label, kind, children)
         });
         self.ensured.push(None);
         self.steps.push(steps);

@@ -157,17 +157,7 @@ mod tests {
     use crate::model::BtNode;
 
     fn node(id: String, kind: BtNodeKind, children: Vec<usize>) -> BtNode {
-        BtNode {
-            id,
-            label: String::new(),
-            kind,
-            children,
-            skill: None,
-            type_name: None,
-            ports: Default::default(),
-            subtree: None,
-            span: None,
-        }
+        BtNode::bare(id, String::new(), kind, children)
     }
 
     /// A Sequence of 100,000 actions: each goes on SUCCESS to the next

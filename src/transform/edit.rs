@@ -195,17 +195,12 @@ pub fn wrap_root(
             Some("choose an unused id for the new root".into()),
         ));
     }
-    bt.nodes.push(BtNode {
-        id: id.to_string(),
-        label: label.unwrap_or(kind.default_label()).to_string(),
+    bt.nodes.push(BtNode::bare(
+        id.to_string(),
+        label.unwrap_or(kind.default_label()).to_string(),
         kind,
-        children: vec![bt.root],
-        skill: None,
-        type_name: None,
-        ports: Default::default(),
-        subtree: None,
-        span: None,
-    });
+        vec![bt.root],
+    ));
     bt.root = bt.nodes.len() - 1;
     Ok(Touched {
         added: 1,

@@ -21,19 +21,7 @@ const STYLE: &str = include_str!("page.css");
 /// An input string as HTML text or attribute value: control characters
 /// escaped (`sanitize`), then `&`, `<`, `>`, `"`, `'` as entities.
 pub fn esc(s: &str) -> String {
-    let s = crate::sanitize::shown_max(s, 400);
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
+    crate::sanitize::markup(s, 400)
 }
 
 /// JSON that can sit in a `<script>` block: no `<`, `>` or `&` (outside

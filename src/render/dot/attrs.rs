@@ -33,11 +33,11 @@ pub(super) fn quote(s: &str) -> String {
 pub(super) fn html(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
+        if let Some(e) = crate::sanitize::entity(c) {
+            out.push_str(e);
+            continue;
+        }
         match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
             '\n' => out.push_str("<BR/>"),
             '\r' => {}
             c if c.is_control() || crate::sanitize::is_unsafe(c, false) => out.push(' '),

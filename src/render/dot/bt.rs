@@ -450,17 +450,7 @@ mod tests {
     use super::*;
 
     fn node(id: &str, kind: BtNodeKind, children: Vec<usize>) -> BtNode {
-        BtNode {
-            id: id.into(),
-            label: id.into(),
-            kind,
-            children,
-            skill: None,
-            type_name: None,
-            ports: Default::default(),
-            subtree: None,
-            span: None,
-        }
+        BtNode::bare(id.into(), id.into(), kind, children)
     }
 
     /// A root Sequence over `k` actions.

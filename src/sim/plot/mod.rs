@@ -43,11 +43,7 @@ const HALO: &str =
 /// the length cut as in every report ([`sanitize::shown`]), then XML's
 /// special characters.
 fn esc(s: &str) -> String {
-    sanitize::shown(s)
-        .replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
+    sanitize::markup(s, sanitize::SHOWN_CHARS)
 }
 
 /// Metres to pixels.
