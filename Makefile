@@ -50,7 +50,8 @@ test:
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
 # SubTrees are spread over files given together (projects_btcpp.py); every
 # SARIF log of `lint` against the official schema (sarif_check.py); logs
-# BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py); and
+# BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
+# compared by `log compare` as its Python leaves saw them (btlog_compare.py); and
 # every corpus SCXML file read by btfsm and by an independent SCXML engine
 # (PyPI `scjson`) alike (tests/differential/scxml_engine.py); and
 # `compare --mode tree`'s distance against the `apted` and `zss` packages on
@@ -75,6 +76,9 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/btlog_check.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_check.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_check.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_check.txt
+	$(VENV)/bin/python tests/differential/btlog_compare.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_compare.txt 2>&1 \
+	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_compare.txt | tail -40; exit 1; }
+	@tail -1 $(TARGET_DIR)/btlog_compare.txt
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
 	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24
 

@@ -22,6 +22,40 @@ pub enum LogCommand {
     /// Draws the log's tree with each node coloured by its status at a
     /// moment (RUNNING yellow, SUCCESS green, FAILURE red), as `dot --trace`
     Dot(DotArgs),
+    /// The first divergence between two runs' sequences of executed actions
+    /// (a .btlog or a `btfsm sim --format json`/`--trace` file each); exit 0
+    /// the same, 1 diverged
+    Compare(CompareArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The first run: a BehaviorTree.CPP log (.btlog) or a simulator JSON
+    pub a: PathBuf,
+    /// The second run, as the first
+    pub b: PathBuf,
+    /// The simulator's policy, for a simulator JSON with several
+    #[arg(long, value_name = "NAME")]
+    pub policy: Option<String>,
+    /// Also require the same action to start at most this many seconds
+    /// apart (default: compare the order only)
+    #[arg(long, value_name = "SECONDS")]
+    pub tolerance: Option<f64>,
+    /// Compare skills and outcomes, not arguments (ports)
+    #[arg(long)]
+    pub ignore_args: bool,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
+    pub format: CompareFormat,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompareFormat {
+    Table,
+    Json,
+    Markdown,
 }
 
 #[derive(Debug, Args)]
@@ -76,6 +110,7 @@ pub fn execute(a: LogArgs) -> u8 {
     let a = match a.command {
         LogCommand::Report(a) => a,
         LogCommand::Dot(d) => return dot(d),
+        LogCommand::Compare(c) => return compare(c),
     };
     if let Some(x) = a.min_coverage
         && !(0.0..=1.0).contains(&x)
@@ -194,4 +229,83 @@ fn dot(a: DotArgs) -> u8 {
         a.render,
         std::time::Duration::from_secs(60),
     )
+}
+
+fn open_input(path: &std::path::Path) -> Result<Box<dyn std::io::Read>, u8> {
+    if path.as_os_str() == "-" {
+        return Ok(Box::new(std::io::stdin()));
+    }
+    match std::fs::File::open(path) {
+        Ok(f) if f.metadata().is_ok_and(|m| m.is_dir()) => {
+            eprintln!(
+                "error: {}: is a directory",
+                crate::sanitize::shown(&path.display().to_string())
+            );
+            Err(EXIT_BAD_INPUT)
+        }
+        Ok(f) => Ok(Box::new(f)),
+        Err(e) => {
+            eprintln!(
+                "error: {}: cannot read this file: {e}",
+                crate::sanitize::shown(&path.display().to_string())
+            );
+            Err(EXIT_BAD_INPUT)
+        }
+    }
+}
+
+fn compare(a: CompareArgs) -> u8 {
+    use crate::log::compare as c;
+    if let Some(t) = a.tolerance
+        && !(t.is_finite() && t >= 0.0)
+    {
+        eprintln!("error: --tolerance must be a number of seconds from 0, found {t}");
+        return EXIT_BAD_INPUT;
+    }
+    if a.a.as_os_str() == "-" && a.b.as_os_str() == "-" {
+        eprintln!("error: only one of the two runs can be `-` (stdin)");
+        return EXIT_BAD_INPUT;
+    }
+    let limits = a.limits.limits();
+    let mut sides = Vec::new();
+    for p in [&a.a, &a.b] {
+        let r = match open_input(p) {
+            Ok(r) => r,
+            Err(code) => return code,
+        };
+        let shown = p.display().to_string();
+        match c::open(&shown, r, a.policy.as_deref(), limits.max_file_bytes) {
+            Ok(s) => sides.push(s),
+            Err(e) => return bad_run(&e),
+        }
+    }
+    let b = sides.pop().expect("two");
+    let first = sides.pop().expect("two");
+    let r = match c::compare(first, b, a.tolerance, a.ignore_args) {
+        Ok(r) => r,
+        Err(e) => return bad_run(&e),
+    };
+    let text = match a.format {
+        CompareFormat::Json => {
+            let mut s =
+                crate::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
+            s.push('\n');
+            s
+        }
+        CompareFormat::Table => c::render_table(&r),
+        CompareFormat::Markdown => c::render_markdown(&r),
+    };
+    let code = emit_text(None, text);
+    if code != EXIT_OK {
+        return code;
+    }
+    if r.same { EXIT_OK } else { EXIT_CHECK_FAILED }
+}
+
+fn bad_run(e: &crate::log::compare::CompareError) -> u8 {
+    eprintln!(
+        "error: {}\n  = hint: each run is a BehaviorTree.CPP 4 FileLogger2 log (.btlog) or what `btfsm sim --format json` or `--trace` writes",
+        crate::sanitize::shown_max(&e.to_string(), 4000)
+    );
+    EXIT_BAD_INPUT
 }

@@ -1,9 +1,13 @@
 //! BehaviorTree.CPP execution logs (issue 18): `btlog.rs` reads
 //! `FileLogger2` `.btlog` files as a stream (both record layouts), `tree.rs`
 //! the tree a log embeds, `report.rs` per-node figures and node and branch
-//! coverage (`btfsm log report`).
+//! coverage (`btfsm log report`), `replay.rs` the statuses at a moment
+//! (`btfsm log dot`), `actions.rs` the actions a log executed and
+//! `compare.rs` the first divergence of two runs (`btfsm log compare`).
 
+pub mod actions;
 pub mod btlog;
+pub mod compare;
 pub mod replay;
 pub mod report;
 pub mod tree;

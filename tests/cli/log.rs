@@ -169,3 +169,160 @@ fn log_report_csv_has_a_row_per_node_with_every_record() {
         .sum();
     assert_eq!(sum, v["records"].as_u64().unwrap());
 }
+
+const NOMINAL: &str = "tests/fixtures/logs/compare-nominal.btlog";
+const PICK_FAILS: &str = "tests/fixtures/logs/compare-pick-fails.btlog";
+
+/// What the Python leaves saw when BehaviorTree.CPP ran them (the oracle,
+/// written beside the logs by tests/differential/btlog_compare.py).
+fn oracle(log: &str) -> Vec<String> {
+    let v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string("tests/fixtures/logs/compare-oracle.json").unwrap(),
+    )
+    .unwrap();
+    let name = std::path::Path::new(log)
+        .file_name()
+        .unwrap()
+        .to_str()
+        .unwrap();
+    v[name]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap().replace(" ->", "() ->"))
+        .collect()
+}
+
+#[test]
+fn log_compare_finds_where_the_leaves_of_two_real_runs_diverged() {
+    let (a, b) = (oracle(NOMINAL), oracle(PICK_FAILS));
+    let want = (0..a.len().max(b.len()))
+        .find(|&i| a.get(i) != b.get(i))
+        .expect("the runs differ");
+    let (code, out, err) = btfsm(&["log", "compare", NOMINAL, PICK_FAILS, "--format", "json"]);
+    assert_eq!(code, 1, "diverged, like diff: {err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let d = &v["first_divergence"];
+    assert_eq!(d["index"], want as u64);
+    assert_eq!(d["a"], a[want].as_str());
+    assert_eq!(d["b"], b[want].as_str());
+    assert_eq!(d["kind"], "skill");
+    assert_eq!(v["a"]["actions"], a.len() as u64);
+    assert_eq!(v["b"]["actions"], b.len() as u64);
+    assert_eq!(v["b"]["node"], "Pick cube2! (uid 10)");
+    // The time is the diverging Pick's start record, read here from the bytes.
+    let bytes = std::fs::read(PICK_FAILS).unwrap();
+    let xml = i32::from_le_bytes(bytes[19..23].try_into().unwrap()) as usize;
+    let first_pick = bytes[23 + xml + 8..]
+        .chunks(9)
+        .find(|r| u16::from_le_bytes([r[6], r[7]]) == 10 && r[8] == 1)
+        .map(|r| {
+            let mut t = [0u8; 8];
+            t[..6].copy_from_slice(&r[..6]);
+            u64::from_le_bytes(t)
+        })
+        .unwrap();
+    let t = d["t"].as_f64().unwrap();
+    assert!(t <= first_pick as f64 / 1e6 + 1e-9, "{t} {first_pick}");
+    // A run with itself: the same, exit 0; the table says so.
+    let (code, out, err) = btfsm(&["log", "compare", PICK_FAILS, PICK_FAILS]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains(&format!("same: {} actions in the same order", b.len())),
+        "{out}"
+    );
+    let (code, md, _) = btfsm(&[
+        "log", "compare", NOMINAL, PICK_FAILS, "--format", "markdown",
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        md.contains("**Diverged**")
+            && md.contains("| b | Pick() -&gt; failure | Pick cube2! (uid 10) |"),
+        "{md}"
+    );
+}
+
+#[test]
+fn log_compare_matches_a_simulator_run_with_the_robots_log() {
+    // The simulator's Fig. 1 run of exp1-pick-fails (the first Pick fails)
+    // against BehaviorTree.CPP's run of the same tree with the same failure.
+    let d = scratch("btlog-sim");
+    let sim = d.join("sim.json");
+    let (code, json, err) = btfsm(&[
+        "sim",
+        "policies/scenarios/exp1-pick-fails.toml",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(&sim, &json).unwrap();
+    let sim = sim.to_str().unwrap();
+    let p = "Fig. 1 BT baseline";
+    let args = |log: &'static str| {
+        vec![
+            "log",
+            "compare",
+            sim,
+            log,
+            "--policy",
+            p,
+            "--ignore-args",
+            "--format",
+            "json",
+        ]
+    };
+    let (code, out, err) = btfsm(&args(PICK_FAILS));
+    assert_eq!(code, 0, "{out}{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["a"]["kind"], "sim");
+    assert_eq!(v["a"]["actions"], oracle(PICK_FAILS).len() as u64);
+    let (code, out, _) = btfsm(&args(NOMINAL));
+    assert_eq!(code, 1, "{out}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["first_divergence"]["index"], 1);
+    assert_eq!(v["first_divergence"]["a"], "Pick() -> failure");
+    // The arguments count unless told not to: the log's leaves have no ports.
+    let (code, _, _) = btfsm(&["log", "compare", sim, PICK_FAILS, "--policy", p]);
+    assert_eq!(code, 1);
+    // Several policies and none named; a name not there: exit 2, listed.
+    let (code, _, err) = btfsm(&["log", "compare", sim, PICK_FAILS]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("name one with --policy") && err.contains("`Fig. 2 FSM sequential`"),
+        "{err}"
+    );
+    let (code, _, err) = btfsm(&["log", "compare", sim, PICK_FAILS, "--policy", "nope"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no policy `nope`"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn log_compare_refuses_bad_runs_with_exit_2() {
+    let d = scratch("btlog-compare-bad");
+    let bytes = std::fs::read(PICK_FAILS).unwrap();
+    let cut = d.join("cut.btlog");
+    std::fs::write(&cut, &bytes[..bytes.len() - 3]).unwrap();
+    let (code, _, err) = btfsm(&["log", "compare", NOMINAL, cut.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(&format!(
+            "byte {}: the log ends inside a record",
+            bytes.len() - 9
+        )),
+        "{err}"
+    );
+    let json = d.join("bad.json");
+    std::fs::write(&json, "{\"policies\": [{\"policy\": 3}]}").unwrap();
+    let (code, _, err) = btfsm(&["log", "compare", json.to_str().unwrap(), NOMINAL]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("1:") && err.contains("not a btfsm simulator JSON"),
+        "{err}"
+    );
+    let (code, _, err) = btfsm(&["log", "compare", NOMINAL, NOMINAL, "--tolerance", "-1"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, _) = btfsm(&["log", "compare", NOMINAL, "tests/fixtures/logs"]);
+    assert_eq!(code, 2);
+    let _ = std::fs::remove_dir_all(&d);
+}
