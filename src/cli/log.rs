@@ -26,6 +26,23 @@ pub enum LogCommand {
     /// (a .btlog or a `btfsm sim --format json`/`--trace` file each); exit 0
     /// the same, 1 diverged
     Compare(CompareArgs),
+    /// Draws the log as an SVG timeline: a row per leaf ticked, bars where
+    /// it was RUNNING, its status changes marked, a time axis in seconds
+    Timeline(TimelineArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct TimelineArgs {
+    /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog; a file: it is read twice)
+    pub log: PathBuf,
+    /// Output SVG file (default: stdout)
+    #[arg(short, long, value_name = "OUT.svg")]
+    pub output: Option<PathBuf>,
+    /// Width of the time axis, in pixels (100 to 20000)
+    #[arg(long, value_name = "PX", default_value_t = 1000)]
+    pub width: u32,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
 }
 
 #[derive(Debug, Args)]
@@ -111,6 +128,7 @@ pub fn execute(a: LogArgs) -> u8 {
         LogCommand::Report(a) => a,
         LogCommand::Dot(d) => return dot(d),
         LogCommand::Compare(c) => return compare(c),
+        LogCommand::Timeline(t) => return timeline(t),
     };
     if let Some(x) = a.min_coverage
         && !(0.0..=1.0).contains(&x)
@@ -308,4 +326,41 @@ fn bad_run(e: &crate::log::compare::CompareError) -> u8 {
         crate::sanitize::shown_max(&e.to_string(), 4000)
     );
     EXIT_BAD_INPUT
+}
+
+fn timeline(a: TimelineArgs) -> u8 {
+    use crate::log::timeline::MAX_WIDTH;
+    if !(100..=MAX_WIDTH).contains(&a.width) {
+        eprintln!(
+            "error: --width must be from 100 to {MAX_WIDTH} pixels, found {}",
+            a.width
+        );
+        return EXIT_BAD_INPUT;
+    }
+    if a.log.as_os_str() == "-" {
+        eprintln!("error: log timeline reads its log twice: give a file, not `-`");
+        return EXIT_BAD_INPUT;
+    }
+    if let Err(code) = open_input(&a.log) {
+        return code;
+    }
+    let shown = a.log.display().to_string();
+    let limits = a.limits.limits();
+    let t = crate::log::timeline::timeline(
+        &shown,
+        || std::fs::File::open(&a.log),
+        limits.max_file_bytes,
+        a.width,
+    );
+    match t {
+        Ok(t) => emit_text(a.output.as_deref(), t.svg),
+        Err(e) => {
+            eprintln!(
+                "error: {}: {}",
+                crate::sanitize::shown(&shown),
+                crate::sanitize::shown(&e.to_string())
+            );
+            EXIT_BAD_INPUT
+        }
+    }
 }

@@ -326,3 +326,65 @@ fn log_compare_refuses_bad_runs_with_exit_2() {
     assert_eq!(code, 2);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn log_timeline_draws_a_row_per_leaf_ticked_and_parses_as_xml() {
+    let d = scratch("btlog-timeline");
+    let out = d.join("t.svg");
+    let (code, _, err) = btfsm(&[
+        "log",
+        "timeline",
+        PICK_FAILS,
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "600",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let svg = std::fs::read_to_string(&out).unwrap();
+    let doc = roxmltree::Document::parse(&svg).expect("well-formed SVG");
+    // Rows: the leaves that left IDLE, counted here from the raw records
+    // (UIDs 2, 5, 8, 9, 10, 12, 13, 14 are Fig. 1's leaves).
+    let bytes = std::fs::read(PICK_FAILS).unwrap();
+    let xml = i32::from_le_bytes(bytes[19..23].try_into().unwrap()) as usize;
+    let recs: Vec<(u16, u8)> = bytes[23 + xml + 8..]
+        .chunks(9)
+        .map(|r| (u16::from_le_bytes([r[6], r[7]]), r[8]))
+        .collect();
+    let leaves = [2u16, 5, 8, 9, 10, 12, 13, 14];
+    let ticked = leaves
+        .iter()
+        .filter(|u| recs.iter().any(|&(x, s)| x == **u && s != 0))
+        .count();
+    let labels: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text") && n.attribute("x") == Some("8"))
+        .filter_map(|n| n.text())
+        .skip(2)
+        .collect();
+    assert_eq!(labels.len(), ticked, "{labels:?}");
+    assert!(labels.contains(&"Pick cube2! (Pick)"), "{labels:?}");
+    // Pick went RUNNING twice (the failed grasp and the retry): two bars.
+    let bars = doc
+        .descendants()
+        .filter(|n| n.attribute("fill") == Some("gold") && n.attribute("height") == Some("10"))
+        .count();
+    let runs = recs.iter().filter(|&&(_, s)| s == 1).count();
+    let pick_runs = recs.iter().filter(|&&(u, s)| u == 10 && s == 1).count();
+    assert_eq!(pick_runs, 2);
+    assert!(
+        bars <= runs && bars >= 4,
+        "{bars} bars, {runs} RUNNING records"
+    );
+    let fails = doc
+        .descendants()
+        .filter(|n| n.attribute("fill") == Some("tomato"))
+        .count();
+    assert!(fails >= 1);
+    // Bad input: exit 2.
+    let (code, _, err) = btfsm(&["log", "timeline", PICK_FAILS, "--width", "5"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, _) = btfsm(&["log", "timeline", "-"]);
+    assert_eq!(code, 2);
+    let _ = std::fs::remove_dir_all(&d);
+}
