@@ -51,7 +51,8 @@ test:
 # SubTrees are spread over files given together (projects_btcpp.py); every
 # SARIF log of `lint` against the official schema (sarif_check.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
-# compared by `log compare` as its Python leaves saw them (btlog_compare.py); and
+# compared by `log compare` as its Python leaves saw them (btlog_compare.py),
+# and as SqliteLogger .db3 sessions counted by SQL (btlog_db3.py); and
 # every corpus SCXML file read by btfsm and by an independent SCXML engine
 # (PyPI `scjson`) alike (tests/differential/scxml_engine.py); and
 # `compare --mode tree`'s distance against the `apted` and `zss` packages on
@@ -79,6 +80,7 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/btlog_compare.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_compare.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_compare.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_compare.txt
+	$(VENV)/bin/python tests/differential/btlog_db3.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
 	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24
 

@@ -35,6 +35,9 @@ pub enum LogCommand {
 pub struct TimelineArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog; a file: it is read twice)
     pub log: PathBuf,
+    /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
+    #[arg(long, value_name = "N")]
+    pub session: Option<i64>,
     /// Output SVG file (default: stdout)
     #[arg(short, long, value_name = "OUT.svg")]
     pub output: Option<PathBuf>,
@@ -51,6 +54,12 @@ pub struct CompareArgs {
     pub a: PathBuf,
     /// The second run, as the first
     pub b: PathBuf,
+    /// The session of A when it is a .db3 (default: its last)
+    #[arg(long, value_name = "N")]
+    pub session_a: Option<i64>,
+    /// The session of B when it is a .db3 (default: its last)
+    #[arg(long, value_name = "N")]
+    pub session_b: Option<i64>,
     /// The simulator's policy, for a simulator JSON with several
     #[arg(long, value_name = "NAME")]
     pub policy: Option<String>,
@@ -79,6 +88,9 @@ pub enum CompareFormat {
 pub struct DotArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog)
     pub log: PathBuf,
+    /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
+    #[arg(long, value_name = "N")]
+    pub session: Option<i64>,
     /// The moment: this many seconds after the log's first timestamp
     #[arg(
         long,
@@ -113,6 +125,9 @@ pub enum LogFormat {
 pub struct ReportArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog), or `-` for stdin
     pub log: PathBuf,
+    /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
+    #[arg(long, value_name = "N")]
+    pub session: Option<i64>,
     /// Output format
     #[arg(long, value_enum, default_value_t = LogFormat::Table)]
     pub format: LogFormat,
@@ -137,32 +152,25 @@ pub fn execute(a: LogArgs) -> u8 {
         return EXIT_BAD_INPUT;
     }
     let shown = a.log.display().to_string();
-    let reader: Box<dyn std::io::Read> = if a.log.as_os_str() == "-" {
-        Box::new(std::io::stdin())
-    } else {
-        match std::fs::File::open(&a.log) {
-            Ok(f) => Box::new(f),
-            Err(e) => {
-                eprintln!(
-                    "error: {}: cannot read this file: {e}",
-                    crate::sanitize::shown(&shown)
-                );
-                return EXIT_BAD_INPUT;
-            }
-        }
-    };
     let limits = a.limits.limits();
-    let r = match report::report(&shown, reader, limits.max_file_bytes) {
+    let opened = match crate::log::open(&a.log, a.session, limits.max_file_bytes) {
+        Ok(o) => o,
+        Err(e) => return bad_log(&shown, &e),
+    };
+    let mut r = match report::report(&shown, opened.reader, limits.max_file_bytes) {
         Ok(r) => r,
         Err(e) => {
             eprintln!(
-                "error: {}: {}\n  = hint: a BehaviorTree.CPP 4 FileLogger2 log (.btlog) is the header `BTCPP4-FileLogger2`, the tree XML, a timestamp and 9-byte records",
+                "error: {}: {}\n  = hint: a BehaviorTree.CPP 4 FileLogger2 log (.btlog) is the header `BTCPP4-FileLogger2`, the tree XML, a timestamp and 9-byte records; a SqliteLogger log (.db3) an SQLite database",
                 crate::sanitize::shown(&shown),
                 crate::sanitize::shown(&e.to_string())
             );
             return EXIT_BAD_INPUT;
         }
     };
+    r.session = opened.session;
+    r.sessions = opened.sessions;
+    r.more_sessions = opened.more_sessions;
     let text = match a.format {
         LogFormat::Json => {
             let mut s =
@@ -202,17 +210,11 @@ fn dot(a: DotArgs) -> u8 {
         (None, None) => unreachable!("clap requires one"),
     };
     let shown = a.log.display().to_string();
-    let file = match std::fs::File::open(&a.log) {
-        Ok(f) => f,
-        Err(e) => {
-            eprintln!(
-                "error: {}: cannot read this file: {e}",
-                crate::sanitize::shown(&shown)
-            );
-            return EXIT_BAD_INPUT;
-        }
-    };
     let limits = a.limits.limits();
+    let file = match crate::log::open(&a.log, a.session, limits.max_file_bytes) {
+        Ok(o) => o.reader,
+        Err(e) => return bad_log(&shown, &e),
+    };
     let r = match replay(file, at, &limits) {
         Ok(r) => r,
         Err(e) => {
@@ -249,27 +251,13 @@ fn dot(a: DotArgs) -> u8 {
     )
 }
 
-fn open_input(path: &std::path::Path) -> Result<Box<dyn std::io::Read>, u8> {
-    if path.as_os_str() == "-" {
-        return Ok(Box::new(std::io::stdin()));
-    }
-    match std::fs::File::open(path) {
-        Ok(f) if f.metadata().is_ok_and(|m| m.is_dir()) => {
-            eprintln!(
-                "error: {}: is a directory",
-                crate::sanitize::shown(&path.display().to_string())
-            );
-            Err(EXIT_BAD_INPUT)
-        }
-        Ok(f) => Ok(Box::new(f)),
-        Err(e) => {
-            eprintln!(
-                "error: {}: cannot read this file: {e}",
-                crate::sanitize::shown(&path.display().to_string())
-            );
-            Err(EXIT_BAD_INPUT)
-        }
-    }
+fn bad_log(shown: &str, e: &str) -> u8 {
+    eprintln!(
+        "error: {}: {}",
+        crate::sanitize::shown(shown),
+        crate::sanitize::shown_max(e, 1000)
+    );
+    EXIT_BAD_INPUT
 }
 
 fn compare(a: CompareArgs) -> u8 {
@@ -286,12 +274,12 @@ fn compare(a: CompareArgs) -> u8 {
     }
     let limits = a.limits.limits();
     let mut sides = Vec::new();
-    for p in [&a.a, &a.b] {
-        let r = match open_input(p) {
-            Ok(r) => r,
-            Err(code) => return code,
-        };
+    for (p, session) in [(&a.a, a.session_a), (&a.b, a.session_b)] {
         let shown = p.display().to_string();
+        let r = match crate::log::open(p, session, limits.max_file_bytes) {
+            Ok(o) => o.reader,
+            Err(e) => return bad_log(&shown, &e),
+        };
         match c::open(&shown, r, a.policy.as_deref(), limits.max_file_bytes) {
             Ok(s) => sides.push(s),
             Err(e) => return bad_run(&e),
@@ -341,17 +329,17 @@ fn timeline(a: TimelineArgs) -> u8 {
         eprintln!("error: log timeline reads its log twice: give a file, not `-`");
         return EXIT_BAD_INPUT;
     }
-    if let Err(code) = open_input(&a.log) {
-        return code;
-    }
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
-    let t = crate::log::timeline::timeline(
-        &shown,
-        || std::fs::File::open(&a.log),
-        limits.max_file_bytes,
-        a.width,
-    );
+    let open = || {
+        crate::log::open(&a.log, a.session, limits.max_file_bytes)
+            .map(|o| o.reader)
+            .map_err(std::io::Error::other)
+    };
+    if let Err(e) = open() {
+        return bad_log(&shown, &e.to_string());
+    }
+    let t = crate::log::timeline::timeline(&shown, open, limits.max_file_bytes, a.width);
     match t {
         Ok(t) => emit_text(a.output.as_deref(), t.svg),
         Err(e) => {

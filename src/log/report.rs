@@ -44,6 +44,13 @@ pub struct LogReport {
     /// Branches not covered, as `Fallback name -> child name` or
     /// `condition name: SUCCESS|FAILURE`.
     pub uncovered: Vec<String>,
+    /// For a `.db3`: the session read, and the file's sessions.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub session: Option<i64>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sessions: Vec<super::Session>,
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub more_sessions: bool,
 }
 
 /// Covered items out of all.
@@ -172,6 +179,9 @@ pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogEr
         node_coverage: nodes_cov,
         branch_coverage: Coverage::of(covered, total),
         uncovered,
+        session: None,
+        sessions: Vec::new(),
+        more_sessions: false,
     })
 }
 
@@ -179,11 +189,13 @@ pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogEr
 pub fn render_table(r: &LogReport) -> String {
     use crate::sanitize::shown;
     let mut out = format!(
-        "log {} ({} records, {:.3} s)\n\n",
+        "log {} ({} records, {:.3} s)\n",
         shown(&r.file),
         r.records,
         r.duration_usec as f64 / 1e6
     );
+    out.push_str(&sessions_line(r));
+    out.push('\n');
     let mut t = crate::report::table::Table::new(&[
         "uid",
         "node",
@@ -252,4 +264,19 @@ pub fn render_csv(r: &LogReport) -> String {
         ));
     }
     out
+}
+
+/// For a `.db3`: `session 2 (sessions: 1 (2026-01-01 10:00:00), 2 (...))`.
+fn sessions_line(r: &LogReport) -> String {
+    let Some(s) = r.session else {
+        return String::new();
+    };
+    let list: Vec<String> = (r.sessions.iter())
+        .map(|x| format!("{} ({})", x.id, crate::sanitize::shown(&x.date)))
+        .collect();
+    format!(
+        "session {s} (sessions: {}{})\n",
+        list.join(", "),
+        if r.more_sessions { ", ..." } else { "" }
+    )
 }

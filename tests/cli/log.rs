@@ -388,3 +388,139 @@ fn log_timeline_draws_a_row_per_leaf_ticked_and_parses_as_xml() {
     assert_eq!(code, 2);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[cfg(feature = "sqlite")]
+const DB3: &str = "tests/fixtures/logs/sessions.db3";
+
+#[cfg(feature = "sqlite")]
+#[test]
+fn log_report_reads_each_session_of_a_db3_as_sql_counts_it() {
+    let db = rusqlite::Connection::open_with_flags(DB3, rusqlite::OpenFlags::SQLITE_OPEN_READ_ONLY)
+        .unwrap();
+    for session in [1i64, 2] {
+        let mut want = std::collections::BTreeMap::new();
+        let mut st = db
+            .prepare("SELECT uid, state, COUNT(*) FROM Transitions WHERE session_id = ?1 GROUP BY uid, state")
+            .unwrap();
+        let rows = st
+            .query_map([session], |r| {
+                Ok((
+                    r.get::<_, i64>(0)? as u64,
+                    r.get::<_, u8>(1)?,
+                    r.get::<_, i64>(2)? as u64,
+                ))
+            })
+            .unwrap();
+        let names = ["IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED"];
+        for r in rows {
+            let (u, s, k) = r.unwrap();
+            want.insert((u, names[s as usize].to_string()), k);
+        }
+        let (code, out, err) = btfsm(&[
+            "log",
+            "report",
+            DB3,
+            "--session",
+            &session.to_string(),
+            "--format",
+            "json",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let mut got = std::collections::BTreeMap::new();
+        for n in v["nodes"].as_array().unwrap() {
+            for (s, k) in n["statuses"].as_object().unwrap() {
+                got.insert((n["uid"].as_u64().unwrap(), s.clone()), k.as_u64().unwrap());
+            }
+        }
+        assert_eq!(got, want, "session {session}");
+        assert_eq!(v["session"], session);
+        assert_eq!(v["sessions"].as_array().unwrap().len(), 2);
+    }
+    // The default is the last session; the table lists them all.
+    let (code, out, _) = btfsm(&["log", "report", DB3]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("session 2 (sessions: 1 (2026-11-20 10:00:00), 2 (2026-11-21 10:00:00))"),
+        "{out}"
+    );
+    // Two sessions of one file compared: where the runs' logs diverge.
+    let (code, out, _) = btfsm(&[
+        "log",
+        "compare",
+        DB3,
+        DB3,
+        "--session-a",
+        "1",
+        "--session-b",
+        "2",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (_, logs, _) = btfsm(&["log", "compare", NOMINAL, PICK_FAILS, "--format", "json"]);
+    let w: serde_json::Value = serde_json::from_str(&logs).unwrap();
+    assert_eq!(
+        v["first_divergence"]["index"],
+        w["first_divergence"]["index"]
+    );
+    assert_eq!(v["first_divergence"]["b"], w["first_divergence"]["b"]);
+    let (code, svg, err) = btfsm(&["log", "timeline", DB3, "--session", "1"]);
+    assert_eq!(code, 0, "{err}");
+    roxmltree::Document::parse(&svg).unwrap();
+}
+
+#[cfg(feature = "sqlite")]
+#[test]
+fn a_hostile_db3_is_refused_with_exit_2() {
+    let d = scratch("db3-bad");
+    // Not SQLite at all (a .db3 by name only), SQLite's magic then garbage.
+    let fake = d.join("fake.db3");
+    std::fs::write(&fake, b"SQLite format 3\0not a database at all").unwrap();
+    let (code, _, err) = btfsm(&["log", "report", fake.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("not a readable SqliteLogger database"),
+        "{err}"
+    );
+    // A database without the tables.
+    let empty = d.join("empty.db3");
+    rusqlite::Connection::open(&empty)
+        .unwrap()
+        .execute_batch("CREATE TABLE Other (x INTEGER);")
+        .unwrap();
+    let (code, _, err) = btfsm(&["log", "report", empty.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no table `Definitions`"), "{err}");
+    // A row larger than --max-file-bytes (SQLite's length limit).
+    let big = d.join("big.db3");
+    std::fs::copy(DB3, &big).unwrap();
+    rusqlite::Connection::open(&big)
+        .unwrap()
+        .execute(
+            "UPDATE Definitions SET xml_tree = ?1 WHERE session_id = 2",
+            ["x".repeat(300_000)],
+        )
+        .unwrap();
+    let (code, _, err) = btfsm(&[
+        "log",
+        "report",
+        big.to_str().unwrap(),
+        "--max-file-bytes",
+        "100000",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("too big"), "{err}");
+    // A session that is not there; --session on a .btlog.
+    let (code, _, err) = btfsm(&["log", "report", DB3, "--session", "9"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("no session 9 (the sessions are 1, 2)"),
+        "{err}"
+    );
+    let (code, _, err) = btfsm(&["log", "report", FIG01, "--session", "1"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--session is for a .db3"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
