@@ -36,7 +36,7 @@ test:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets --locked -- -D warnings
 	$(CARGO) test --locked
-	$(CARGO) test --locked --bench scale --bench ged --bench sim --bench ted -- --test
+	$(CARGO) test --locked --bench scale --bench ged --bench sim --bench ted --bench log -- --test
 	$(CARGO) run --quiet --locked -- paper --check
 	$(MAKE) --no-print-directory mermaid-oracle
 	$(MAKE) --no-print-directory differential

@@ -119,6 +119,8 @@ pub enum LogFormat {
     /// One row per node: uid, node, type, activations, status changes by
     /// status, seconds RUNNING
     Csv,
+    /// GitHub-flavoured markdown: coverage, branches not covered, the nodes
+    Markdown,
 }
 
 #[derive(Debug, Args)]
@@ -180,6 +182,7 @@ pub fn execute(a: LogArgs) -> u8 {
         }
         LogFormat::Table => report::render_table(&r),
         LogFormat::Csv => report::render_csv(&r),
+        LogFormat::Markdown => report::render_markdown(&r),
     };
     let code = emit_text(None, text);
     if code != EXIT_OK {

@@ -280,3 +280,50 @@ fn sessions_line(r: &LogReport) -> String {
         if r.more_sessions { ", ..." } else { "" }
     )
 }
+
+/// The report as GitHub-flavoured markdown: the coverage first (what a
+/// pull request's reviewer reads), then the per-node table.
+pub fn render_markdown(r: &LogReport) -> String {
+    use crate::sanitize::{markdown_cell as md, markdown_code};
+    let pct = |c: &Coverage| format!("{}/{} ({:.1} %)", c.covered, c.total, 100.0 * c.ratio);
+    let mut out = format!(
+        "### Log {}\n\n{} records, {:.3} s{}\n\n| coverage | covered |\n|---|---:|\n| nodes | {} |\n| branches | {} |\n\n",
+        markdown_code(&r.file),
+        r.records,
+        r.duration_usec as f64 / 1e6,
+        match r.session {
+            Some(s) => format!(", session {s} of {}", r.sessions.len()),
+            None => String::new(),
+        },
+        pct(&r.node_coverage),
+        pct(&r.branch_coverage)
+    );
+    if !r.uncovered.is_empty() {
+        out.push_str("Not covered:\n\n");
+        for u in r.uncovered.iter().take(50) {
+            out.push_str(&format!("- {}\n", md(u)));
+        }
+        if r.uncovered.len() > 50 {
+            out.push_str(&format!("- ... and {} more\n", r.uncovered.len() - 50));
+        }
+        out.push('\n');
+    }
+    out.push_str("| uid | node | type | activations | RUNNING | SUCCESS | FAILURE | IDLE | SKIPPED | running s |\n|---:|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    for n in &r.nodes {
+        let k = |s: &str| n.statuses.get(s).copied().unwrap_or(0);
+        out.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} |\n",
+            n.uid,
+            md(&n.name),
+            md(&n.tag),
+            n.activations,
+            k("RUNNING"),
+            k("SUCCESS"),
+            k("FAILURE"),
+            k("IDLE"),
+            k("SKIPPED"),
+            n.running_usec as f64 / 1e6
+        ));
+    }
+    out
+}

@@ -524,3 +524,39 @@ fn a_hostile_db3_is_refused_with_exit_2() {
     assert!(err.contains("--session is for a .db3"), "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn log_report_markdown_has_the_coverage_and_a_row_per_node() {
+    let sub = "tests/fixtures/logs/subtree.btlog";
+    let (code, md, err) = btfsm(&["log", "report", sub, "--format", "markdown"]);
+    assert_eq!(code, 0, "{err}");
+    let (_, json, _) = btfsm(&["log", "report", sub, "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let c = &v["node_coverage"];
+    assert!(
+        md.contains(&format!(
+            "| nodes | {}/{} (",
+            c["covered"].as_u64().unwrap(),
+            c["total"].as_u64().unwrap()
+        )),
+        "{md}"
+    );
+    let nodes = v["nodes"].as_array().unwrap();
+    let rows: Vec<&str> = md
+        .lines()
+        .skip_while(|l| !l.starts_with("| uid |"))
+        .skip(2)
+        .collect();
+    assert_eq!(rows.len(), nodes.len(), "{md}");
+    for (row, n) in rows.iter().zip(nodes) {
+        assert!(row.starts_with(&format!("| {} | ", n["uid"])), "{row} {n}");
+        assert!(
+            row.contains(&format!(" | {} | ", n["activations"])),
+            "{row} {n}"
+        );
+    }
+    for u in v["uncovered"].as_array().unwrap() {
+        let u = u.as_str().unwrap().replace('>', "&gt;");
+        assert!(md.contains(&format!("- {u}")), "{u}\n{md}");
+    }
+}
