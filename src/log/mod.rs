@@ -86,3 +86,50 @@ fn open_db3(path: &Path, session: Option<i64>, max_bytes: u64) -> Result<OpenedL
 fn open_db3(_: &Path, _: Option<i64>, _: u64) -> Result<OpenedLog, String> {
     Err("a .db3 (SqliteLogger) log, and this btfsm was built without the `sqlite` feature".into())
 }
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    /// fig01.btlog's header (BehaviorTree.CPP wrote it) and its records.
+    fn fig01() -> (Vec<u8>, Vec<u8>) {
+        let b = std::fs::read("tests/fixtures/logs/fig01.btlog").unwrap();
+        let xml = i32::from_le_bytes(b[19..23].try_into().unwrap()) as usize;
+        let (h, r) = b.split_at(23 + xml + 8);
+        (h.to_vec(), r.to_vec())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+        /// Records mutated, cut or appended never panic any log command:
+        /// each reads them or says what is wrong.
+        #[test]
+        fn mutated_logs_never_panic(
+            cut in 0usize..4000,
+            flips in proptest::collection::vec((0usize..4000, any::<u8>()), 0..8),
+            tail in proptest::collection::vec(any::<u8>(), 0..64),
+        ) {
+            let (h, mut r) = fig01();
+            for (i, v) in flips {
+                let n = r.len();
+                r[i % n] = v;
+            }
+            r.truncate(cut.min(r.len()));
+            r.extend(tail);
+            let mut b = h;
+            b.extend(r);
+            let _ = super::report::report("t", &b[..], 1 << 20);
+            let _ = super::timeline::timeline("t", || Ok(&b[..]), 1 << 20, 200);
+            let _ = super::replay::replay(&b[..], super::replay::At::Step(50), &crate::format::Limits::default());
+            let x = super::compare::open("a", std::io::Cursor::new(b.clone()), None, 1 << 20);
+            let y = super::compare::open("b", std::io::Cursor::new(b.clone()), None, 1 << 20);
+            if let (Ok(x), Ok(y)) = (x, y) {
+                let c = super::compare::compare(x, y, None, false);
+                if let Ok(c) = c {
+                    prop_assert!(c.same, "a log is the same as itself");
+                }
+            }
+        }
+    }
+}

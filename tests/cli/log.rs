@@ -1,5 +1,6 @@
-//! `btfsm log report` on logs BehaviorTree.CPP wrote (tests/fixtures/logs/):
-//! figures, coverage gate, and corrupt logs refused with the byte offset.
+//! `btfsm log` on logs BehaviorTree.CPP wrote (tests/fixtures/logs/): report,
+//! coverage gate, markdown, dot, compare (with the simulator), timeline,
+//! .db3 sessions; corrupt or hostile logs refused with exit 2.
 
 use super::*;
 use common::scratch;
