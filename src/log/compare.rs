@@ -7,7 +7,7 @@
 //! and with a tolerance, start times.
 
 use super::actions::Executions;
-use super::btlog::{LogError, MAGIC, Records, read_header};
+use super::btlog::{LogError, Records, read_header};
 use super::tree::parse;
 use crate::sim::trace::{Divergence, SkillRecord, SkillSeq, first_divergence};
 use std::collections::BTreeMap;
@@ -81,10 +81,12 @@ pub fn open(
     let head = r
         .fill_buf()
         .map_err(|e| input(format!("cannot read: {e}")))?;
+    // JSON opens with `{`; an older-layout log opens with its XML's length,
+    // whose low byte may be `{` but whose high bytes are zeros.
     let json = head
         .iter()
-        .find(|b| !b.is_ascii_whitespace())
-        .is_some_and(|&b| b == b'{');
+        .position(|b| !b.is_ascii_whitespace())
+        .is_some_and(|i| head[i] == b'{' && !head[i..(i + 4).min(head.len())].contains(&0));
     let side = |src, policy| Side {
         file: file.to_string(),
         policy,
@@ -93,7 +95,7 @@ pub fn open(
         yielded: 0,
         last_node: None,
     };
-    if json && !head.starts_with(MAGIC) {
+    if json {
         let mut bytes = Vec::new();
         r.take(max_bytes.saturating_add(1))
             .read_to_end(&mut bytes)
@@ -377,4 +379,25 @@ pub fn render_markdown(r: &CompareReport) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    /// An older-layout log whose XML length's low byte is `{` is a log.
+    #[test]
+    fn a_legacy_log_opening_with_a_brace_is_not_json() {
+        let xml = format!(
+            r#"<root><BehaviorTree ID="M" _fullpath=""><Go _uid="1"/></BehaviorTree></root>{}"#,
+            " ".repeat(0x7b - 76)
+        );
+        assert_eq!(xml.len(), 0x7b);
+        let mut b = (xml.len() as i32).to_le_bytes().to_vec();
+        b.extend(xml.as_bytes());
+        b.extend(0i64.to_le_bytes());
+        b.extend((5u64 | (1u64 << 45) | (2u64 << 61)).to_le_bytes());
+        let a = super::open("old", std::io::Cursor::new(b.clone()), None, 1 << 20).unwrap();
+        let c = super::open("old", std::io::Cursor::new(b), None, 1 << 20).unwrap();
+        let r = super::compare(a, c, None, false).unwrap();
+        assert_eq!((r.a.kind, r.a.actions, r.same), ("btlog", 1, true));
+    }
 }

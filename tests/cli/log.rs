@@ -277,6 +277,25 @@ fn log_compare_matches_a_simulator_run_with_the_robots_log() {
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["a"]["kind"], "sim");
     assert_eq!(v["a"]["actions"], oracle(PICK_FAILS).len() as u64);
+    // The --trace file (every step too) is read as well.
+    let trace = d.join("trace.json");
+    let (code, _, err) = btfsm(&[
+        "sim",
+        "policies/scenarios/exp1-pick-fails.toml",
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = btfsm(&[
+        "log",
+        "compare",
+        trace.to_str().unwrap(),
+        PICK_FAILS,
+        "--policy",
+        p,
+        "--ignore-args",
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
     let (code, out, _) = btfsm(&args(NOMINAL));
     assert_eq!(code, 1, "{out}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
