@@ -8,7 +8,8 @@
 //! end, the second places every record at its pixel column). Bars that
 //! touch within a pixel are one bar, marks of one status in one pixel
 //! column one mark: a row holds at most `width` bars and `3 x width` marks,
-//! so the SVG grows with rows x width, never with the number of records
+//! so the SVG grows with rows x width, never with the number of records,
+//! and at most [`MAX_ELEMENTS`] bars and marks are drawn (more is an error)
 //! (a record older than one before it is drawn at the later time).
 
 use super::btlog::{LogError, Records, Status, read_header};
@@ -20,6 +21,8 @@ use std::io::{BufReader, Read};
 
 /// Widest plot area, px.
 pub const MAX_WIDTH: u32 = 20_000;
+/// Most bars and marks in one drawing (about 100 bytes of SVG each).
+pub const MAX_ELEMENTS: usize = 1_000_000;
 const ROW_H: u32 = 18;
 const TOP: u32 = 44;
 const AXIS_H: u32 = 44;
@@ -173,6 +176,21 @@ pub fn timeline<R: Read>(
         }
     }
     rows.retain(|_, r| r.ticked);
+    let elements: usize = (rows.values())
+        .map(|r| {
+            r.bars.len()
+                + r.marks
+                    .iter()
+                    .map(|m| m.1.count_ones() as usize)
+                    .sum::<usize>()
+        })
+        .sum();
+    if elements > MAX_ELEMENTS {
+        return Err(LogError::Limit(format!(
+            "the timeline would draw {elements} bars and marks in {} rows, more than {MAX_ELEMENTS}: draw it narrower (--width)",
+            rows.len()
+        )));
+    }
     // The drawing.
     let label_w = 280u32;
     let (w, h_px) = (
@@ -346,6 +364,38 @@ mod tests {
         assert!(t.bars <= 2 * 300 && t.marks <= 2 * 3 * 300, "{t:?}");
         assert!(t.svg.len() < 2 * 4 * 300 * 160 + 10_000, "{}", t.svg.len());
         roxmltree::Document::parse(&t.svg).expect("well-formed XML");
+    }
+
+    #[test]
+    fn past_the_element_bound_a_timeline_is_refused() {
+        // 18 leaves changing status in every pixel column of 20,000: 1.08
+        // million marks, more than the bound.
+        let leaves: String = (2..20).map(|u| format!(r#"<Go _uid="{u}"/>"#)).collect();
+        let xml = format!(
+            r#"<root><BehaviorTree ID="M" _fullpath=""><Parallel _uid="1">{leaves}</Parallel></BehaviorTree><TreeNodesModel><Action ID="Go"/></TreeNodesModel></root>"#
+        );
+        let mut b = MAGIC.to_vec();
+        b.push(1);
+        b.extend((xml.len() as i32).to_le_bytes());
+        b.extend(xml.as_bytes());
+        b.extend(0i64.to_le_bytes());
+        for col in 0..20_000u64 {
+            for u in 2..20u16 {
+                for s in [1u8, 2, 3] {
+                    b.extend(&(col * 10).to_le_bytes()[..6]);
+                    b.extend(u.to_le_bytes());
+                    b.push(s);
+                }
+            }
+        }
+        let e = match timeline("t", || Ok(&b[..]), 1 << 20, MAX_WIDTH) {
+            Ok(t) => panic!("drawn: {} marks", t.marks),
+            Err(e) => e.to_string(),
+        };
+        assert!(e.contains("1080018 bars and marks in 18 rows"), "{e}");
+        // Narrower, it fits.
+        let t = timeline("t", || Ok(&b[..]), 1 << 20, 1000).unwrap();
+        assert!(t.marks + t.bars <= MAX_ELEMENTS && t.rows == 18);
     }
 
     #[test]
