@@ -70,12 +70,22 @@ pub struct Opened {
 
 /// Opens a `.db3` for session `session` (default: the last one).
 pub fn open(path: &Path, session: Option<i64>, max_bytes: u64) -> Result<Opened, Db3Error> {
+    open_within(path, session, max_bytes, DEADLINE)
+}
+
+/// [`open`] with every query interrupted after `deadline`.
+fn open_within(
+    path: &Path,
+    session: Option<i64>,
+    max_bytes: u64,
+    deadline: std::time::Duration,
+) -> Result<Opened, Db3Error> {
     let flags = OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX;
     let conn = Connection::open_with_flags(path, flags).map_err(sql)?;
     let len = i32::try_from(max_bytes).unwrap_or(i32::MAX).max(1024);
     conn.set_limit(rusqlite::limits::Limit::SQLITE_LIMIT_LENGTH, len)
         .map_err(sql)?;
-    let deadline = std::time::Instant::now() + DEADLINE;
+    let deadline = std::time::Instant::now() + deadline;
     conn.progress_handler(10_000, Some(move || std::time::Instant::now() > deadline))
         .map_err(sql)?;
     let _ = conn.execute_batch("PRAGMA trusted_schema = OFF;");
@@ -349,6 +359,14 @@ mod tests {
             .collect();
         assert_eq!(recs.len(), PAGE + 10);
         assert_eq!((recs[3].t_usec, recs[3].uid), (6, 2));
+        // Every query runs under the deadline: with none left, reading the
+        // transitions is interrupted (an error, not a hang).
+        let mut out = Vec::new();
+        let e = match open_within(&p, None, 1 << 20, std::time::Duration::ZERO) {
+            Ok(mut o) => o.stream.read_to_end(&mut out).unwrap_err().to_string(),
+            Err(e) => e.0,
+        };
+        assert!(e.contains("interrupted"), "{e}");
         std::fs::remove_dir_all(p.parent().unwrap()).unwrap();
     }
 
