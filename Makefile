@@ -7,7 +7,7 @@ VENV := .venv
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
-.PHONY: build run test bench bench-ged bench-ted clean paper-docs fuzz mermaid-oracle man differential
+.PHONY: build run test bench bench-ged bench-ted clean paper-docs fuzz mermaid-oracle man differential browser-test view-screenshots
 
 build:
 	$(CARGO) build --release --locked
@@ -40,6 +40,7 @@ test:
 	$(CARGO) run --quiet --locked -- paper --check
 	$(MAKE) --no-print-directory mermaid-oracle
 	$(MAKE) --no-print-directory differential
+	$(MAKE) --no-print-directory browser-test
 
 # `btfsm tick` against BehaviorTree.CPP 4 (behaviortreepy, pinned in
 # tests/differential/requirements.txt, installed into .venv) on 3000 seeded
@@ -107,6 +108,26 @@ DIFF_PAIRS := $(DP)/fig01-bt.toml $(DP)/fig03-bt.toml $(DP)/fig07a-bt.toml $(DP)
   $(DM)/labels-bt.toml $(DP)/fig01-bt.toml $(DP)/fig01-bt.toml $(DM)/labels-bt.toml \
   $(DM)/labels-fsm.toml $(DP)/fig04-fsm.toml $(DP)/fig04-fsm.toml $(DM)/labels-fsm.toml \
   $(DP)/fig06-hfsm.toml $(DP)/fig05-bt.toml $(DP)/fig01-bt.toml $(DP)/fig06-hfsm.toml
+
+# `btfsm view` pages driven in headless Chromium (Debian package `chromium`;
+# puppeteer-core pinned in tests/browser/package-lock.json; Node.js 18+):
+# every bundled scenario, the two BT.CPP logs and the hostile-names
+# scenario, each node's fill at each step reached checked against
+# `dot --trace` / `log dot` drawings of that step; the 10,000-step page's
+# size, load and jump times printed (docs/view.md). Pages and screenshots in
+# $(TARGET_DIR)/view-browser/.
+VIEW_LOGS := tests/fixtures/logs/fig01.btlog tests/fixtures/logs/subtree.btlog
+browser-test: build
+	cd tests/browser && npm ci --silent --no-audit --no-fund
+	node tests/browser/view.mjs --btfsm $(BIN) --out $(TARGET_DIR)/view-browser \
+	  --scale tests/fixtures/view/five-cubes-10k.toml $(addprefix --log ,$(VIEW_LOGS)) \
+	  $(SCENARIOS) tests/fixtures/view/hostile.toml
+
+# The README's screenshots of a replay page (docs/img/view-*.png).
+view-screenshots: build
+	cd tests/browser && npm ci --silent --no-audit --no-fund
+	node tests/browser/view.mjs --btfsm $(BIN) --out $(TARGET_DIR)/view-browser \
+	  --screenshots docs/img policies/scenarios/exp1-pick-fails.toml
 
 # Man pages from the argument definitions: target/man/btfsm.1 and one
 # btfsm-SUBCOMMAND.1 per subcommand (`man -l target/man/btfsm.1`).

@@ -40,6 +40,7 @@ fn node(id: String, kind: BtNodeKind, label: String, skill: Option<SkillCall>) -
         skill,
         type_name: None,
         ports: BTreeMap::new(),
+        subtree: None,
         span: None,
     }
 }

@@ -78,6 +78,9 @@ pub struct Diagnostic {
     pub file: Option<Arc<SourceFile>>,
     pub span: Option<Range<usize>>,
     pub hint: Option<String>,
+    /// The lint rule this load error is (`empty-composite`, ...): `lint`
+    /// reports a coded load error as a finding of that rule (docs/lint.md).
+    pub code: Option<&'static str>,
 }
 
 impl Diagnostic {
@@ -88,6 +91,7 @@ impl Diagnostic {
             file: None,
             span: None,
             hint: None,
+            code: None,
         }
     }
 
@@ -111,6 +115,17 @@ impl Diagnostic {
 
     pub fn hint(mut self, hint: impl Into<String>) -> Self {
         self.hint = Some(hint.into());
+        self
+    }
+
+    pub fn with_code(mut self, code: &'static str) -> Self {
+        self.code = Some(code);
+        self
+    }
+
+    /// [`Diagnostic::with_code`] on a diagnostic already pushed.
+    pub fn set_code(&mut self, code: &'static str) -> &mut Self {
+        self.code = Some(code);
         self
     }
 

@@ -378,6 +378,19 @@ pub fn exercise(l: &Loaded) {
         let _ = crate::report::render_analysis(std::slice::from_ref(&row), f);
     }
     let _ = crate::render::dot::policy_dot(&l.policy, &Default::default());
+    // Folded, with ports, in both directions: every drawing path.
+    if let crate::model::PolicyBody::Bt(bt) = &l.policy.body {
+        let folded = crate::render::dot::DotOptions {
+            ports: true,
+            depth: Some(2),
+            fold_subtrees: true,
+            collapse: bt.nodes.iter().step_by(3).map(|n| n.id.clone()).collect(),
+            rankdir: crate::render::dot::RankDir::LeftRight,
+            ..Default::default()
+        };
+        assert!(crate::render::dot::check_fold(&l.policy, &folded).is_ok());
+        let _ = crate::render::dot::policy_dot(&l.policy, &folded);
+    }
     let text = crate::format::toml_write::write_policy(&l.policy);
     let again = crate::format::toml::parse_str("written.toml", &text, include_base(), &limits())
         .unwrap_or_else(|e| panic!("written TOML does not read back: {}\n{text}", e[0]));

@@ -23,5 +23,6 @@ pub mod sanitize;
 pub mod sim;
 pub mod tick;
 pub mod transform;
+pub mod view;
 
 pub use cli::run;

@@ -71,6 +71,8 @@ pub enum Command {
         #[command(flatten)]
         trace: super::sim::DotTraceArgs,
         #[command(flatten)]
+        look: DotLookArgs,
+        #[command(flatten)]
         limits: LimitArgs,
     },
     /// Graph edit distance between two policies (and, for two BTs, the
@@ -174,6 +176,11 @@ pub enum Command {
     Lint(super::lint::LintArgs),
     /// Reads BehaviorTree.CPP execution logs (.btlog): `log report`
     Log(super::log::LogArgs),
+    /// Writes one self-contained HTML page replaying runs: each policy's
+    /// diagram coloured by status at a step (RUNNING yellow, SUCCESS green,
+    /// FAILURE red), a timeline of the actions, a slider and step buttons;
+    /// from a scenario (run here), a `sim --trace` file or a .btlog
+    View(super::view::ViewArgs),
     /// Tree edit distances of trees in bracket notation, one pair per line
     /// (`{a{b}}<TAB>{a{c}}`): what tests/differential/ted.py and
     /// bench/ted_vs_apted.py drive
@@ -294,6 +301,48 @@ pub struct LimitArgs {
     /// out of the root): for trusted local files only
     #[arg(long)]
     pub allow_outside_root: bool,
+}
+
+/// How `dot` draws a Behavior Tree: ports, folded subtrees, direction.
+#[derive(clap::Args, Debug, Clone)]
+pub struct DotLookArgs {
+    /// Draw each BT node's ports under its label (by default they are in
+    /// its tooltip only)
+    #[arg(long)]
+    pub ports: bool,
+    /// Draw the subtree of the BT node with this id as one node labelled
+    /// with its size (repeatable; ids as `analyze --format json` and
+    /// `compare` print them)
+    #[arg(long, value_name = "ID", num_args = 1..)]
+    pub collapse: Vec<String>,
+    /// Fold every BT node at this depth (the root is at depth 0)
+    #[arg(long, value_name = "N")]
+    pub depth: Option<usize>,
+    /// BT SubTrees (BehaviorTree.CPP `<SubTree>`, TOML `subtree`
+    /// includes): drawn expanded, or folded into one node each
+    #[arg(long, value_enum, default_value_t = SubtreesArg::Expanded)]
+    pub subtrees: SubtreesArg,
+    /// Layout direction of a BT: auto is top-down unless that is wider than
+    /// 2.5:1 and left-to-right is closer to square
+    #[arg(long, value_enum, default_value_t = crate::render::dot::RankDir::Auto)]
+    pub rankdir: crate::render::dot::RankDir,
+}
+
+#[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SubtreesArg {
+    Expanded,
+    Folded,
+}
+
+impl DotLookArgs {
+    /// Sets the look on drawing options.
+    pub fn apply(&self, opts: &mut crate::render::dot::DotOptions) {
+        opts.ports = self.ports;
+        opts.collapse = self.collapse.iter().cloned().collect();
+        opts.depth = self.depth;
+        opts.fold_subtrees = self.subtrees == SubtreesArg::Folded;
+        opts.rankdir = self.rankdir;
+    }
 }
 
 impl LimitArgs {

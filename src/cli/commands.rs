@@ -169,16 +169,22 @@ pub fn execute(cli: Cli) -> u8 {
             render,
             timeout_ms,
             trace,
+            look,
             limits,
         } => {
             let Some(l) = load_one(&file, &limits.limits()) else {
                 return EXIT_BAD_INPUT;
             };
-            let Some((policy, opts)) =
+            let Some((policy, mut opts)) =
                 super::sim::dot_trace(&trace, &file, l.policy, &limits.limits())
             else {
                 return EXIT_BAD_INPUT;
             };
+            look.apply(&mut opts);
+            if let Err(e) = crate::render::dot::check_fold(&policy, &opts) {
+                eprintln!("error: {e}");
+                return EXIT_BAD_INPUT;
+            }
             let timeout = std::time::Duration::from_millis(timeout_ms);
             draw(&policy, &opts, output.as_deref(), render, timeout)
         }
@@ -308,6 +314,7 @@ pub fn execute(cli: Cli) -> u8 {
         Command::Plan(args) => super::plan::execute(args),
         Command::Lint(args) => super::lint::execute(args),
         Command::Log(args) => super::log::execute(args),
+        Command::View(args) => super::view::execute(args),
         Command::TedPairs(args) => super::ted_pairs::execute(args),
         Command::Completions { shell } => {
             use clap::CommandFactory;
@@ -463,7 +470,7 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
 /// May `path` be a BehaviorTree.CPP file given together with others (a
 /// regular `.xml` or Groot2 `.btproj` file; a pipe is read once, as the
 /// input it is)?
-fn is_btcpp_candidate(path: &Path) -> bool {
+pub(super) fn is_btcpp_candidate(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("btproj"))
@@ -476,7 +483,7 @@ fn is_btcpp_candidate(path: &Path) -> bool {
 /// `--tree ID` and several such files, the files that define `ID` (the
 /// others are read only as companions). No file defining `ID`: an error
 /// listing the trees there are.
-fn with_companions(
+pub(super) fn with_companions(
     inputs: &[format::discover::Input],
     limits: &Limits,
 ) -> Result<(Limits, Option<Vec<PathBuf>>), Diagnostic> {

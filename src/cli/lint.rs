@@ -97,9 +97,24 @@ pub fn execute(a: LintArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    // BehaviorTree.CPP files given together resolve each other's SubTrees,
+    // as for every command (README "BehaviorTree.CPP projects").
+    let (limits, only) = match super::commands::with_companions(&inputs, &limits) {
+        Ok(x) => x,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return EXIT_BAD_INPUT;
+        }
+    };
     let mut findings = Vec::new();
     let mut failed = false;
+    let mut models = SiblingModels::default();
     for input in &inputs {
+        if only.as_ref().is_some_and(|o| !o.contains(&input.path))
+            && super::commands::is_btcpp_candidate(&input.path)
+        {
+            continue; // a companion of the files that define `--tree`
+        }
         let (file, fmt) = match format::discover::read(input, &limits) {
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
             Ok(_) => continue,
@@ -109,11 +124,18 @@ pub fn execute(a: LintArgs) -> u8 {
                 continue;
             }
         };
+        let limits = models.limits_for(&input.path, fmt, &limits);
         match format::load_read(file.clone(), &input.path, fmt, &limits) {
             Ok(l) => findings.extend(lint::lint(&l.policy, Some(&file), &l.path, &cfg)),
             Err(d) => {
-                failed = true;
-                print_diagnostics(&mut err, &d);
+                // Coded load errors are findings (lint::load); the others
+                // mean the input does not load.
+                let (coded, rest) = lint::load::findings(&d, &file.path, &cfg);
+                findings.extend(coded);
+                if rest.iter().any(|d| d.is_error()) {
+                    failed = true;
+                    print_diagnostics(&mut err, &rest);
+                }
             }
         }
     }
@@ -151,5 +173,65 @@ pub fn execute(a: LintArgs) -> u8 {
         EXIT_CHECK_FAILED
     } else {
         EXIT_OK
+    }
+}
+
+/// Most `*tree_nodes*.xml` files taken from one folder.
+const MAX_SIBLING_MODELS: usize = 8;
+
+/// The node models `lint` reads beside a BehaviorTree.CPP file when the
+/// command names none (`--nodes-model`): the `*tree_nodes*.xml` files of its
+/// folder (Nav2 keeps `nav2_tree_nodes.xml` beside its trees, as Groot
+/// projects do), at most [`MAX_SIBLING_MODELS`], sorted; each folder listed
+/// once. Unknown leaves are read as actions unless `--assume-leaf` says
+/// otherwise: their C++ registers them, and lint checks what it can.
+#[derive(Default)]
+struct SiblingModels {
+    by_dir: std::collections::HashMap<PathBuf, Vec<PathBuf>>,
+}
+
+impl SiblingModels {
+    fn limits_for(
+        &mut self,
+        path: &std::path::Path,
+        fmt: format::FileFormat,
+        limits: &format::Limits,
+    ) -> format::Limits {
+        let mut l = limits.clone();
+        if fmt != format::FileFormat::BtcppXml {
+            return l;
+        }
+        l.assume_leaf = l.assume_leaf.or(Some(format::AssumeLeaf::Action));
+        if !l.nodes_models.is_empty() {
+            return l;
+        }
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."))
+            .to_path_buf();
+        let found = self.by_dir.entry(dir.clone()).or_insert_with(|| {
+            let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+                .into_iter()
+                .flatten()
+                .flatten()
+                .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+                .map(|e| e.path())
+                .filter(|p| {
+                    p.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(|n| n.contains("tree_nodes") && n.ends_with(".xml"))
+                })
+                .collect();
+            v.sort();
+            v.truncate(MAX_SIBLING_MODELS);
+            v
+        });
+        l.nodes_models = found
+            .iter()
+            .filter(|m| m.as_path() != path)
+            .cloned()
+            .collect();
+        l
     }
 }

@@ -35,6 +35,7 @@ mod plan;
 pub mod sim;
 mod ted_pairs;
 mod tick;
+mod view;
 
 use clap::Parser;
 use std::ffi::OsString;

@@ -19,8 +19,7 @@ pub enum OutputFormat {
     Json,
     /// GitHub-flavoured markdown tables (with --runs)
     Markdown,
-    /// Refused: `sim` has no CSV (kept for its message)
-    #[value(hide = true)]
+    /// One row per policy (figures only: the verdicts are in table and json)
     Csv,
 }
 
@@ -28,7 +27,7 @@ pub enum OutputFormat {
 pub struct SimArgs {
     /// Scenario file (TOML)
     pub scenario: PathBuf,
-    /// Output format (table or json; markdown with --runs)
+    /// Output format (table, json or csv; markdown with --runs)
     #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
     pub format: OutputFormat,
     /// Write the full trace (every step of every run) as JSON
@@ -63,10 +62,6 @@ pub struct SimArgs {
 }
 
 pub fn execute(a: SimArgs) -> u8 {
-    if a.format == OutputFormat::Csv {
-        eprintln!("error: `sim` prints `table` or `json`, not `csv`");
-        return EXIT_BAD_INPUT;
-    }
     let outputs = [
         ("--trace", a.trace.as_deref()),
         ("--plot", a.plot.as_deref()),
@@ -148,6 +143,7 @@ pub fn execute(a: SimArgs) -> u8 {
             &rep,
             a.format,
             McReport::json,
+            McReport::csv,
             if a.format == OutputFormat::Markdown {
                 McReport::markdown
             } else {
@@ -234,6 +230,7 @@ pub fn execute(a: SimArgs) -> u8 {
         &rep,
         a.format,
         SimReport::json,
+        SimReport::csv,
         SimReport::table,
         &budget,
         note,
@@ -280,6 +277,7 @@ fn render<R: serde::Serialize>(
     rep: &R,
     format: OutputFormat,
     json: fn(&R) -> String,
+    csv: fn(&R) -> String,
     table: fn(&R) -> String,
     budget: &Option<Budget>,
     note: &str,
@@ -287,6 +285,16 @@ fn render<R: serde::Serialize>(
     match (format, budget) {
         (OutputFormat::Json, None) => json(rep),
         (OutputFormat::Json, Some(b)) => with_budget(rep, b),
+        // The note goes to stderr: the CSV stays one table.
+        (OutputFormat::Csv, b) => {
+            if let Some(b) = b.as_ref().filter(|b| b.exhausted) {
+                eprintln!(
+                    "note: the wall-clock budget of {} ms ran out: {note}",
+                    b.timeout_ms
+                );
+            }
+            csv(rep)
+        }
         (_, None) => table(rep),
         (_, Some(b)) => {
             let mut t = table(rep);
@@ -405,10 +413,18 @@ pub fn dot_trace(
         policy
     };
     let mut opts = crate::render::dot::DotOptions::default();
+    // A trace names an (H)FSM's states by their full path; the drawing by
+    // their vertex key (the name, unless it repeats).
+    let (keys, paths) = crate::view::drawn_keys(&policy);
+    let key_of: std::collections::HashMap<&str, &str> = paths
+        .iter()
+        .map(|(p, i)| (p.as_str(), keys[*i].as_str()))
+        .collect();
     for pair in st["statuses"].as_array().unwrap_or(&empty) {
         if let (Some(k), Some(s)) = (pair[0].as_str(), pair[1].as_str())
             && let Some(s) = Status::from_outcome(s)
         {
+            let k = key_of.get(k).copied().unwrap_or(k);
             opts.highlight.insert(k.to_string(), Highlight::Status(s));
         }
     }
@@ -435,9 +451,12 @@ fn symbolic(
     limits: &crate::format::Limits,
 ) -> u8 {
     use crate::sim::symbolic::{report, run};
-    if a.trace.is_some() || a.plot.is_some() || a.format == OutputFormat::Markdown {
+    if a.trace.is_some()
+        || a.plot.is_some()
+        || matches!(a.format, OutputFormat::Markdown | OutputFormat::Csv)
+    {
         eprintln!(
-            "error: a symbolic scenario has no trace, plot or markdown report\n  = hint: print `table` or `json`"
+            "error: a symbolic scenario has no trace, plot, markdown or csv report\n  = hint: print `table` or `json`"
         );
         return EXIT_BAD_INPUT;
     }

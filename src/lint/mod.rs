@@ -8,9 +8,11 @@
 //!
 //! Rules: [`structure`] (BT and FSM shape), [`paper`] (the paper's notions:
 //! chattering-prone precondition order, unguarded actions, fault tolerance,
-//! fully connected states).
+//! fully connected states), [`load`] (what makes a file not load: the
+//! readers find it, lint reports it with a code).
 
 pub mod config;
+pub mod load;
 pub mod paper;
 pub mod sarif;
 pub mod structure;
@@ -60,6 +62,11 @@ pub const RULES: &[Rule] = &[
     paper::UNGUARDED_FALLBACK_ACTION,
     paper::NOT_FAULT_TOLERANT,
     paper::FULLY_CONNECTED_STATE,
+    load::EMPTY_COMPOSITE,
+    load::WRONG_CHILD_COUNT,
+    load::PARALLEL_THRESHOLD,
+    load::SUBTREE_RECURSION,
+    load::INCLUDE_CYCLE,
 ];
 
 /// The rule of `code`.

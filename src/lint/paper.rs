@@ -13,7 +13,7 @@ use std::collections::{BTreeMap, HashMap};
 pub const CHATTERING_PRECONDITION_ORDER: Rule = Rule {
     code: "chattering-precondition-order",
     level: Level::Error,
-    summary: "in a Sequence, a later child's actions undo the condition an earlier child ensures: the robot goes back and forth (the paper's Fig. 3)",
+    summary: "in a Sequence, a later child's actions undo an earlier child's condition: the robot goes back and forth (Fig. 3)",
     check: chattering,
 };
 

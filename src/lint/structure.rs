@@ -112,9 +112,42 @@ fn unreachable_child(p: &Policy, out: &mut Sink) {
 pub const REACTIVE_ASYNC_SIBLINGS: Rule = Rule {
     code: "reactive-async-siblings",
     level: Level::Warning,
-    summary: "more than one action under a reactive Sequence or Fallback: BehaviorTree.CPP warns that asynchronous siblings there halt each other",
+    summary: "more than one action under a reactive Sequence or Fallback: BehaviorTree.CPP warns they halt each other",
     check: reactive_async_siblings,
 };
+
+/// Action types known to return at once (never RUNNING), which cannot halt
+/// a sibling: BehaviorTree.CPP 4's synchronous built-ins, and Nav2's
+/// plugins that derive `BT::SyncActionNode`, or `BT::ActionNodeBase` with an
+/// empty `halt()` and a `tick()` that returns SUCCESS or FAILURE (navigation2,
+/// nav2_behavior_tree/include/nav2_behavior_tree/plugins/action/: the
+/// selectors, `TruncatePath`, `TruncatePathLocal`, `RemovePassedGoals`).
+/// BehaviorTree.CPP XML does not say whether an action is asynchronous; an
+/// action of another type may be, and counts.
+const SYNCHRONOUS_ACTIONS: &[&str] = &[
+    "Script",
+    "SetBlackboard",
+    "UnsetBlackboard",
+    "ControllerSelector",
+    "PlannerSelector",
+    "GoalCheckerSelector",
+    "ProgressCheckerSelector",
+    "SmootherSelector",
+    "TruncatePath",
+    "TruncatePathLocal",
+    "RemovePassedGoals",
+];
+
+/// Whether a leaf action may return RUNNING.
+fn may_run(bt: &Bt, c: usize) -> bool {
+    let n = &bt.nodes[c];
+    n.kind == BtNodeKind::Action
+        && always(bt, c).is_none()
+        && !n
+            .type_name
+            .as_deref()
+            .is_some_and(|t| SYNCHRONOUS_ACTIONS.contains(&t))
+}
 
 fn reactive_async_siblings(p: &Policy, out: &mut Sink) {
     let PolicyBody::Bt(bt) = &p.body else { return };
@@ -125,7 +158,7 @@ fn reactive_async_siblings(p: &Policy, out: &mut Sink) {
         let actions: Vec<&str> = node
             .children
             .iter()
-            .filter(|&&c| bt.nodes[c].kind == BtNodeKind::Action && always(bt, c).is_none())
+            .filter(|&&c| may_run(bt, c))
             .map(|&c| bt.nodes[c].id.as_str())
             .collect();
         if actions.len() > 1 {

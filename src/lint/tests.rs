@@ -76,3 +76,17 @@ fn levels_follow_the_configuration() {
             .contains("did you mean `chattering-precondition-order`?")
     );
 }
+
+#[test]
+fn every_summary_prints_whole_in_the_rule_list() {
+    // `lint --list` and SARIF show the summary; a table cuts cells at
+    // sanitize::SHOWN_CHARS.
+    for r in super::RULES {
+        assert!(
+            r.summary.chars().count() <= crate::sanitize::SHOWN_CHARS,
+            "{}: {} chars",
+            r.code,
+            r.summary.chars().count()
+        );
+    }
+}

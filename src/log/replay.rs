@@ -53,8 +53,16 @@ fn preorder_without_subtrees(t: &Tree) -> Vec<u16> {
     out
 }
 
-/// Replays a log up to `at`.
-pub fn replay(r: impl Read, at: At, limits: &Limits) -> Result<Replayed, ReplayError> {
+/// A log opened for replay: its tree as a policy, the btfsm node id of each
+/// UID, and its records still to read (`btfsm view` streams them).
+pub struct Opened<R> {
+    pub policy: Policy,
+    pub id_of: BTreeMap<u16, String>,
+    pub records: Records<std::io::BufReader<R>>,
+}
+
+/// Reads a log's header and tree, leaving its records to read.
+pub fn open<R: Read>(r: R, limits: &Limits) -> Result<Opened<R>, ReplayError> {
     let mut r = std::io::BufReader::new(r);
     let h = read_header(&mut r, limits.max_file_bytes)?;
     let tree = parse(&h.xml).map_err(ReplayError::Tree)?;
@@ -91,10 +99,24 @@ pub fn replay(r: impl Read, at: At, limits: &Limits) -> Result<Replayed, ReplayE
         .zip(&order)
         .map(|(&u, &n)| (u, bt.nodes[n].id.clone()))
         .collect();
+    Ok(Opened {
+        policy: loaded.policy,
+        id_of,
+        records: Records::new(r, &h),
+    })
+}
+
+/// Replays a log up to `at`.
+pub fn replay(r: impl Read, at: At, limits: &Limits) -> Result<Replayed, ReplayError> {
+    let Opened {
+        policy,
+        id_of,
+        records,
+    } = open(r, limits)?;
     let mut status: BTreeMap<u16, Status> = BTreeMap::new();
     let mut applied = 0u64;
     let mut t_usec = 0u64;
-    for rec in Records::new(r, &h) {
+    for rec in records {
         let Record {
             t_usec: t,
             uid,
@@ -116,7 +138,7 @@ pub fn replay(r: impl Read, at: At, limits: &Limits) -> Result<Replayed, ReplayE
         .filter_map(|(u, s)| id_of.get(&u).map(|id| (id.clone(), s)))
         .collect();
     Ok(Replayed {
-        policy: loaded.policy,
+        policy,
         statuses,
         applied,
         t_usec,

@@ -32,6 +32,12 @@ pub struct BtNode {
     /// as `num_cycles="3"`), in name order; empty for skill-bound leaves, whose
     /// arguments are in `skill`.
     pub ports: BTreeMap<String, String>,
+    /// The subtree this node is the root of, where the file drew a
+    /// boundary: the tree ID of a BehaviorTree.CPP `<SubTree>` (the
+    /// outermost, when a SubTree's root is itself a SubTree), or the id of
+    /// the TOML node that includes a `subtree` file. Kept for drawing
+    /// (`dot --subtrees folded`); the graph and the metrics ignore it.
+    pub subtree: Option<String>,
     pub span: Option<Span>,
 }
 
@@ -217,6 +223,7 @@ mod tests {
             skill: None,
             type_name: None,
             ports: BTreeMap::new(),
+            subtree: None,
             span: None,
         }
     }

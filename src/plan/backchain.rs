@@ -192,6 +192,7 @@ impl<'d> Planner<'d, '_> {
             skill,
             type_name: None,
             ports: BTreeMap::new(),
+            subtree: None,
             span: None,
         });
         self.ensured.push(None);

@@ -4,6 +4,7 @@
 //! behavior-match verdict, SVG plots in the style of the paper's Fig. 17, and
 //! Monte Carlo episodes.
 
+mod csv;
 pub mod exec;
 mod livelock;
 pub mod monte_carlo;

@@ -165,6 +165,7 @@ mod tests {
             skill: None,
             type_name: None,
             ports: Default::default(),
+            subtree: None,
             span: None,
         }
     }

@@ -162,6 +162,7 @@ pub fn insert_subtree(
             skill: n.skill.clone(),
             type_name: n.type_name.clone(),
             ports: n.ports.clone(),
+            subtree: n.subtree.clone(),
             span: None,
         });
     }
@@ -202,6 +203,7 @@ pub fn wrap_root(
         skill: None,
         type_name: None,
         ports: Default::default(),
+        subtree: None,
         span: None,
     });
     bt.root = bt.nodes.len() - 1;

@@ -102,12 +102,9 @@ fn lint_exit_codes_levels_and_sarif() {
         r["locations"][0]["physicalLocation"]["region"]["startLine"],
         10
     );
-    // A file that does not load: exit 2, the others still linted.
-    let (code, out, err) = btfsm(&[
-        "lint",
-        "tests/fixtures/invalid/control-no-children.toml",
-        &bad,
-    ]);
+    // A file that does not load (for a reason no rule names): exit 2, the
+    // others still linted.
+    let (code, out, err) = btfsm(&["lint", "tests/fixtures/invalid/dangling-target.toml", &bad]);
     assert_eq!(code, 2, "{err}");
     assert!(out.contains("chattering-precondition-order"), "{out}");
 }
@@ -134,7 +131,12 @@ fn the_paper_policies_have_one_lint_error_fig_3() {
 fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
     // docs/lint.md, "Findings on the bundled real files": two, both
     // explained there; none on a state a sibling parallel region leaves.
-    let (_, out, _) = btfsm(&["lint", "tests/fixtures/corpus", "--format", "json"]);
+    // Every file loads (Nav2's trees with the nav2_tree_nodes.xml beside
+    // them, unknown leaves as actions): no error on stderr, exit 1 for the
+    // two error-level findings, not 2.
+    let (code, out, err) = btfsm(&["lint", "tests/fixtures/corpus", "--format", "json"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.is_empty(), "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let found: Vec<String> = v
         .as_array()
@@ -156,4 +158,87 @@ fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
             "state-without-exit deep-initial.scxml uber/s2"
         ]
     );
+}
+
+#[test]
+fn a_load_error_with_a_code_is_a_finding() {
+    let dir = std::env::temp_dir().join(format!("btfsm-lint-load-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = dir.join("empty.toml");
+    std::fs::write(
+        &toml,
+        "kind = \"bt\"\nroot = \"r\"\n[nodes]\nr = { sequence = [\"a\", \"f\"] }\na = { action = \"A\" }\nf = { fallback = [] }\n",
+    )
+    .unwrap();
+    let par = fixture("parallel-threshold", "bad");
+    // A coded load error alone: a finding, exit 1, in JSON and SARIF too.
+    for (file, code) in [
+        (par.as_str(), "parallel-threshold"),
+        (toml.to_str().unwrap(), "empty-composite"),
+    ] {
+        let (rc, out, err) = btfsm(&["lint", file, "--format", "json"]);
+        assert_eq!(rc, 1, "{out}{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v[0]["code"], code, "{out}");
+        assert_eq!(v[0]["level"], "error");
+        assert!(v[0]["line"].as_u64().is_some_and(|l| l > 0), "{out}");
+        assert!(err.is_empty(), "{err}");
+        let (rc, sarif, _) = btfsm(&["lint", file, "--format", "sarif"]);
+        assert_eq!(rc, 1);
+        assert!(
+            sarif.contains(&format!("\"ruleId\": \"{code}\"")),
+            "{sarif}"
+        );
+    }
+    // Allowed: not reported (the file is not linted further).
+    let (rc, out, _) = btfsm(&["lint", &par, "--allow", "parallel-threshold"]);
+    assert_eq!(rc, 0, "{out}");
+    // A load error no rule names still means exit 2, beside the finding.
+    let broken = dir.join("broken.xml");
+    std::fs::write(&broken, "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\">").unwrap();
+    let (rc, out, err) = btfsm(&["lint", &par, broken.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(rc, 2, "{out}{err}");
+    assert!(
+        out.contains("parallel-threshold") && err.contains("broken.xml"),
+        "{out}{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn reactive_siblings_known_to_return_at_once_do_not_count() {
+    // Nav2's CheckIfNewPathNeeded: TruncatePathLocal returns at once, so one
+    // action under the ReactiveSequence may run; two planners may both run.
+    let dir = std::env::temp_dir().join(format!("btfsm-lint-sync-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let tree = |a: &str, b: &str| {
+        format!(
+            r#"<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M"><ReactiveSequence><{a}/><{b}/></ReactiveSequence></BehaviorTree></root>"#
+        )
+    };
+    let quiet = dir.join("quiet.xml");
+    std::fs::write(&quiet, tree("TruncatePathLocal", "ComputePathToPose")).unwrap();
+    let loud = dir.join("loud.xml");
+    std::fs::write(&loud, tree("ComputePathToPose", "FollowPath")).unwrap();
+    let (code, out, err) = btfsm(&["lint", quiet.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!out.contains("reactive-async-siblings"), "{out}");
+    let (code, out, err) = btfsm(&["lint", loud.to_str().unwrap()]);
+    assert_eq!(code, 0, "a warning: {out}{err}");
+    assert!(out.contains("warning[reactive-async-siblings]"), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn lint_resolves_subtrees_across_the_files_given_together() {
+    // tests/fixtures/btcpp-projects/pick: pick.xml uses `Approach`, which
+    // subtrees/approach.xml defines (and that one uses `Localize`).
+    let (code, out, err) = btfsm(&["lint", "tests/fixtures/btcpp-projects/pick"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(err.is_empty(), "{err}");
+    assert!(out.contains("in 3 files"), "{out}");
+    // Alone, pick.xml does not load: its SubTree is in another file.
+    let (code, _, err) = btfsm(&["lint", "tests/fixtures/btcpp-projects/pick/pick.xml"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unknown tree `Approach`"), "{err}");
 }

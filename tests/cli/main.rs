@@ -8,6 +8,7 @@ mod compare;
 mod compare_report;
 mod compare_tree;
 mod conventions;
+mod dot;
 mod formats;
 mod gate;
 mod hostile;
@@ -15,9 +16,11 @@ mod lint;
 mod log;
 mod paper;
 mod plan;
+mod provenance;
 mod sim;
 mod tick;
 mod untrusted;
+mod view;
 
 use common::btfsm;
 
@@ -309,7 +312,17 @@ fn dot_draws_every_vertex_and_writes_files_whole() {
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.starts_with("digraph"));
     assert!(stdout.contains("SELECTOR[") && stdout.contains("shape=doublecircle"));
-    assert_eq!(stdout.matches(" -> ").count(), 18, "one DOT edge per arc");
+    // One DOT edge per arc, and the arrow from the start dot to the
+    // initial state (UML), which is none.
+    let edges: Vec<&str> = stdout.lines().filter(|l| l.contains(" -> ")).collect();
+    assert_eq!(edges.len(), 19, "{stdout}");
+    let start: Vec<&&str> = edges.iter().filter(|l| l.contains("class=start")).collect();
+    assert_eq!(start.len(), 1, "{stdout}");
+    assert!(
+        start[0].contains("__start -> \"Move-To cube2\""),
+        "{}",
+        start[0]
+    );
     let dir = std::env::temp_dir().join(format!("btfsm-dot-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("tmp");
     let out = dir.join("fig01.dot").display().to_string();

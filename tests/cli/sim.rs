@@ -403,12 +403,10 @@ fn sim_monte_carlo_names_the_first_diverging_episode_and_its_seed_replays_it() {
         md.contains("| pair | behavior match rate | 95% CI | first diverging episode (seed) |"),
         "{md}"
     );
-    // One run prints a table or JSON: markdown and CSV are refused.
-    for fmt in ["markdown", "csv"] {
-        let (code, out, err) = btfsm(&["sim", f, "--format", fmt]);
-        assert_eq!((code, out.as_str()), (2, ""), "{fmt}: {err}");
-        assert!(err.starts_with("error: `sim`"), "{err}");
-    }
+    // One run prints a table, JSON or CSV: markdown is refused.
+    let (code, out, err) = btfsm(&["sim", f, "--format", "markdown"]);
+    assert_eq!((code, out.as_str()), (2, ""), "{err}");
+    assert!(err.starts_with("error: `sim`"), "{err}");
 }
 
 /// Recording a trace makes the executors note every node's status: every
@@ -1004,5 +1002,52 @@ mod hostile {
             "{err}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn sim_csv_has_the_figures_of_the_json_report() {
+    // SPEC §7: --format csv wherever figures are printed. The CSV's rows
+    // carry the JSON report's figures, policy by policy.
+    let s = "policies/scenarios/exp1-cube-moved-during.toml";
+    let (code, csv, err) = btfsm(&["sim", s, "--format", "csv"]);
+    assert_eq!(code, 0, "{err}");
+    let (_, json, _) = btfsm(&["sim", s, "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let pols = v["policies"].as_array().unwrap();
+    assert_eq!(rows.len(), pols.len());
+    for (r, p) in rows.iter().zip(pols) {
+        assert_eq!(r.len(), head.len(), "{r:?}");
+        assert_eq!(r[col("policy")], p["policy"].as_str().unwrap());
+        assert_eq!(r[col("outcome")], p["outcome"].as_str().unwrap());
+        let num = |c: &str| r[col(c)].parse::<f64>().unwrap();
+        assert_eq!(num("duration_s"), p["duration_s"].as_f64().unwrap());
+        assert_eq!(num("distance_m"), p["distance_m"].as_f64().unwrap());
+        assert_eq!(
+            num("skills") as usize,
+            p["skills"].as_array().unwrap().len()
+        );
+        assert_eq!(num("steps") as u64, p["steps"].as_u64().unwrap());
+    }
+    // The sequential FSM fails here, the others succeed.
+    assert!(csv.contains(",failure,") && csv.contains(",success,"));
+    // --runs: one row per policy with the Monte Carlo figures.
+    let (code, csv, err) = btfsm(&["sim", s, "--format", "csv", "--runs", "8"]);
+    assert_eq!(code, 0, "{err}");
+    let (_, json, _) = btfsm(&["sim", s, "--format", "json", "--runs", "8"]);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let sr = head.iter().position(|h| *h == "success_rate").unwrap();
+    for (l, p) in lines.zip(v["policies"].as_array().unwrap()) {
+        let r: Vec<&str> = l.split(',').collect();
+        assert_eq!(
+            r[sr].parse::<f64>().unwrap(),
+            p["success_rate"].as_f64().unwrap()
+        );
     }
 }

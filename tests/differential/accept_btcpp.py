@@ -4,7 +4,8 @@ compared with the real BehaviorTree.CPP 4 engine (Python bindings
 `behaviortreepy`, see README "Differential tests" below).
 
 For every BT XML fixture (tests/fixtures/corpus*/bt-xml/**/*.xml,
-tests/fixtures/valid/**/*.xml, tests/fixtures/invalid/**/*.xml; a file that
+tests/fixtures/valid/**/*.xml, tests/fixtures/invalid/**/*.xml,
+tests/fixtures/lint/**/*.xml; a file that
 only holds a <TreeNodesModel> is skipped):
 
 1. BehaviorTree.CPP decides. Every leaf type the file (with its <include>s)
@@ -618,6 +619,7 @@ def fixture_files():
         out += sorted((corpus / "bt-xml").rglob("*.xml")) if (corpus / "bt-xml").is_dir() else []
     out += sorted((FIXTURES / "valid").rglob("*.xml"))
     out += sorted((FIXTURES / "invalid").rglob("*.xml"))
+    out += sorted((FIXTURES / "lint").rglob("*.xml"))
     return [p for p in out if not is_nodes_model_only(parse(p))]
 
 

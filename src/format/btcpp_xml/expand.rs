@@ -25,6 +25,8 @@ impl Loader<'_> {
             frame: usize,
             /// `name` of the SubTree element this root replaces.
             name_override: Option<String>,
+            /// ID of the (outermost) SubTree this root replaces.
+            subtree: Option<String>,
         }
         let mut frames: Vec<Frame> = vec![Frame {
             id: tree_id.to_string(),
@@ -44,6 +46,7 @@ impl Loader<'_> {
             depth: 0,
             frame: 0,
             name_override: None,
+            subtree: None,
         }];
         let mut nodes: Vec<BtNode> = Vec::new();
         let mut names: Vec<Option<String>> = Vec::new();
@@ -133,6 +136,7 @@ impl Loader<'_> {
                         cycle.insert(0, "...".into());
                     }
                     self.err(it.d, el.span.clone(), format!("recursive subtree: {}", cycle.join(" -> ")))
+                        .set_code("subtree-recursion")
                         .hint = Some("a tree must not contain itself as a `<SubTree>`, directly or through others".into());
                     failed = true;
                     continue;
@@ -186,6 +190,7 @@ impl Loader<'_> {
                     depth: it.depth,
                     frame: frames.len() - 1,
                     name_override: el.attr("name").map(str::to_string).or(it.name_override),
+                    subtree: it.subtree.or(Some(frames[frames.len() - 1].id.clone())),
                 });
                 continue;
             }
@@ -199,10 +204,11 @@ impl Loader<'_> {
                 return None;
             }
             budget -= 1;
-            let Some(node) = self.node(it.d, &el, |v| chain.resolve(&frames, v)) else {
+            let Some(mut node) = self.node(it.d, &el, |v| chain.resolve(&frames, v)) else {
                 failed = true;
                 continue;
             };
+            node.subtree = it.subtree;
             let idx = nodes.len();
             if let Some(p) = it.parent {
                 nodes[p].children.push(idx);
@@ -221,6 +227,7 @@ impl Loader<'_> {
                     depth: it.depth + 1,
                     frame: it.frame,
                     name_override: None,
+                    subtree: None,
                 });
             }
         }

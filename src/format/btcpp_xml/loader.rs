@@ -209,6 +209,7 @@ impl Loader<'_> {
                     .collect();
                 names.push(shown(&full.display().to_string()).into_owned());
                 self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
+                    .set_code("include-cycle")
                     .hint =
                     Some("a file must not include itself, directly or through others".into());
                 continue;

@@ -131,13 +131,19 @@ pub fn v4_name(t: &str) -> &str {
 }
 
 /// A rule BehaviorTree.CPP 4 enforces on a built-in node with `n`
-/// children (at load or at its first tick): the message and a hint.
-fn builtin_rule(ty: &str, el: &XElem, n: usize) -> Option<(String, &'static str)> {
+/// children (at load or at its first tick): the message, a hint, and the
+/// lint code when the problem is one (docs/lint.md).
+fn builtin_rule(
+    ty: &str,
+    el: &XElem,
+    n: usize,
+) -> Option<(String, &'static str, Option<&'static str>)> {
     let int = |a: &str| el.attr(a).and_then(|v| v.trim().parse::<i64>().ok());
     match ty {
         "IfThenElse" | "WhileDoElse" if !(2..=3).contains(&n) => Some((
             format!("`{ty}` takes 2 or 3 children, found {n}"),
             "a condition, a branch and an optional else branch",
+            Some("wrong-child-count"),
         )),
         "Switch2" | "Switch3" | "Switch4" | "Switch5" | "Switch6" => {
             let cases: usize = ty[6..].parse().unwrap_or(0);
@@ -148,6 +154,7 @@ fn builtin_rule(ty: &str, el: &XElem, n: usize) -> Option<(String, &'static str)
                         cases + 1
                     ),
                     "one child per case, then the default",
+                    Some("wrong-child-count"),
                 )
             })
         }
@@ -157,10 +164,12 @@ fn builtin_rule(ty: &str, el: &XElem, n: usize) -> Option<(String, &'static str)
                 (Some(k), _) if over(k) => Some((
                     format!("`Parallel` success_count={k} with {n} children can never succeed"),
                     "at most the number of children (-1: all)",
+                    Some("parallel-threshold"),
                 )),
                 (_, Some(k)) if over(k) => Some((
                     format!("`Parallel` failure_count={k} with {n} children can never fail"),
                     "at most the number of children (-1: all)",
+                    Some("parallel-threshold"),
                 )),
                 _ => None,
             }
@@ -168,6 +177,7 @@ fn builtin_rule(ty: &str, el: &XElem, n: usize) -> Option<(String, &'static str)
         "RetryUntilSuccessful" if el.attr("num_attempts").is_none() => Some((
             "`RetryUntilSuccessful` needs `num_attempts`".into(),
             "write num_attempts=\"3\" (-1: forever)",
+            None,
         )),
         _ => None,
     }

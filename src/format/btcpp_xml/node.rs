@@ -151,6 +151,11 @@ impl Loader<'_> {
                     cat.tag().to_lowercase()
                 ),
             )
+            .set_code(if cat == Category::Control {
+                "empty-composite"
+            } else {
+                "wrong-child-count"
+            })
             .hint = Some(match cat {
                 Category::Decorator => "wrap several children in a `<Sequence>`".into(),
                 Category::Control => "give it children, or use a leaf".into(),
@@ -163,9 +168,11 @@ impl Loader<'_> {
         // there): child counts, thresholds, required ports.
         if builtin(&ty).is_some()
             && !self.models.contains_key(&ty)
-            && let Some((msg, hint)) = builtin_rule(&ty, el, n)
+            && let Some((msg, hint, code)) = builtin_rule(&ty, el, n)
         {
-            self.err(d, el.span.clone(), msg).hint = Some(hint.into());
+            let e = self.err(d, el.span.clone(), msg);
+            e.hint = Some(hint.into());
+            e.code = code;
             return None;
         }
         let mut ports: BTreeMap<String, String> = el
@@ -231,6 +238,7 @@ impl Loader<'_> {
             // (the same node; an export says BTCPP_format="4").
             type_name: type_kept.then(|| v4_name(&ty).to_string()),
             ports,
+            subtree: None,
             span: Some(el.span.clone()),
         })
     }

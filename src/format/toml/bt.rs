@@ -222,6 +222,7 @@ impl Loader {
                             kind.keyword()
                         ),
                     )
+                    .set_code("wrong-child-count")
                     .hint = Some(format!(
                         "write `{} = \"child\"`; wrap several children in a sequence or fallback",
                         kind.keyword()
@@ -237,6 +238,7 @@ impl Loader {
                             kind.keyword()
                         ),
                     )
+                    .set_code("empty-composite")
                     .hint = Some(format!(
                         "write `{} = [\"child1\", \"child2\"]`",
                         kind.keyword()
@@ -309,6 +311,8 @@ impl Loader {
                     let offset = out.len();
                     for (j, mut n) in sub.nodes.into_iter().enumerate() {
                         n.id = if j == sub.root {
+                            // The boundary of the inclusion, for drawing it folded.
+                            n.subtree = n.subtree.or(Some(ids[i].0.to_string()));
                             id.clone()
                         } else {
                             format!("{id}/{}", n.id)
@@ -330,6 +334,7 @@ impl Loader {
                     skill: raw.skill.take(),
                     type_name: raw.type_name.take(),
                     ports: std::mem::take(&mut raw.ports),
+                    subtree: None,
                     span: Some(ids[i].1.clone()),
                 }),
             }

@@ -47,6 +47,7 @@ impl Loader {
                 tval.span(),
                 format!("cyclic subtree include: {}", chain.join(" -> ")),
             )
+            .set_code("subtree-recursion")
             .hint = Some("a subtree must not include itself, directly or through others".into());
             return None;
         }

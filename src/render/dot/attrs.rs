@@ -1,9 +1,8 @@
-//! DOT statements and attributes: quoting and escaping of ids and labels,
-//! the attribute lists of nodes and edges, and a BT node's look.
+//! DOT statements and attributes: quoting and escaping of ids and labels
+//! (Graphviz's "DOT language" and "HTML-like labels" grammars), the
+//! attribute lists of nodes and edges.
 
 use super::*;
-use crate::model::BtNodeKind;
-use crate::model::bt::BtNode;
 use graphviz_rust::dot_structures::{
     Attribute, Edge, EdgeTy, Id, Node, NodeId, Stmt, Subgraph, Vertex,
 };
@@ -25,6 +24,26 @@ pub(super) fn quote(s: &str) -> String {
         }
     }
     out.push('"');
+    out
+}
+
+/// `s` as text of a Graphviz HTML-like label: `&`, `<`, `>` and `"` as
+/// entities, line breaks as `<BR/>`, other control characters and
+/// bidirectional controls as spaces.
+pub(super) fn html(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\n' => out.push_str("<BR/>"),
+            '\r' => {}
+            c if c.is_control() || crate::sanitize::is_unsafe(c, false) => out.push(' '),
+            c => out.push(c),
+        }
+    }
     out
 }
 
@@ -58,6 +77,12 @@ pub(super) fn node_id(s: &str) -> NodeId {
 pub(super) struct Attrs {
     list: Vec<(&'static str, String)>,
     styles: Vec<&'static str>,
+    /// Lines drawn under the label in a smaller grey font (a BT node's type
+    /// under its custom name, its ports): the label becomes HTML-like.
+    sub: Vec<String>,
+    /// A line over the label in a larger font (a control node's symbol over
+    /// its name): the label becomes HTML-like.
+    head: Option<String>,
 }
 
 impl Attrs {
@@ -66,6 +91,18 @@ impl Attrs {
             Some(slot) => slot.1 = value.to_string(),
             None => self.list.push((key, value.to_string())),
         }
+        self
+    }
+
+    /// Sets a line over the label, larger.
+    pub(super) fn head(&mut self, line: String) -> &mut Self {
+        self.head = Some(line);
+        self
+    }
+
+    /// Adds a line under the label, smaller and grey.
+    pub(super) fn sub(&mut self, line: String) -> &mut Self {
+        self.sub.push(line);
         self
     }
 
@@ -139,10 +176,40 @@ impl Attrs {
     }
 
     pub(super) fn into_vec(self) -> Vec<Attribute> {
+        let (sub, head) = (self.sub, self.head);
         let mut v: Vec<Attribute> = self
             .list
             .into_iter()
-            .map(|(k, val)| Attribute(Id::Plain(k.to_string()), dot_id(&val)))
+            .map(|(k, val)| {
+                let value = if k == "label" && (!sub.is_empty() || head.is_some()) {
+                    let mut text = String::from("<");
+                    if let Some(h) = &head {
+                        text.push_str(&format!(
+                            "<FONT POINT-SIZE=\"{HEAD_FONT_SIZE}\">{}</FONT><BR/>",
+                            html(h)
+                        ));
+                    }
+                    if sub.is_empty() {
+                        // Ends as `</FONT>>`, as HTML-like labels usually
+                        // do (some DOT readers look for `>>`).
+                        text.push_str(&format!("<FONT>{}</FONT>", html(&val)));
+                    } else {
+                        text.push_str(&html(&val));
+                    }
+                    if !sub.is_empty() {
+                        let lines: Vec<String> = sub.iter().map(|l| html(l)).collect();
+                        text.push_str(&format!(
+                            "<BR/><FONT POINT-SIZE=\"{SUB_FONT_SIZE}\" COLOR=\"{SUB_COLOR}\">{}</FONT>",
+                            lines.join("<BR/>")
+                        ));
+                    }
+                    text.push('>');
+                    Id::Html(text)
+                } else {
+                    dot_id(&val)
+                };
+                Attribute(Id::Plain(k.to_string()), value)
+            })
             .collect();
         if !self.styles.is_empty() {
             v.push(Attribute(
@@ -154,7 +221,10 @@ impl Attrs {
     }
 }
 
-pub(super) fn node_stmt(id: &str, attrs: Attrs) -> Stmt {
+/// A node statement; its SVG element's `id` is its DOT node id (the vertex
+/// key for vertices), so that a page can find it.
+pub(super) fn node_stmt(id: &str, mut attrs: Attrs) -> Stmt {
+    attrs.set("id", id);
     Stmt::Node(Node::new(node_id(id), attrs.into_vec()))
 }
 
@@ -182,79 +252,58 @@ pub(super) fn rank_group(rank: &str, ids: &[String]) -> Stmt {
 }
 
 // ---------------------------------------------------------------------------
-// Building the diagram
+// Ids of the SVG elements (`btfsm view`)
 
-/// Shape and label of a BT node.
-pub(super) fn bt_node_attrs(n: &BtNode) -> Attrs {
-    let mut a = Attrs::default();
-    let custom = n.label != n.kind.default_label() && Some(&n.label) != n.type_name.as_ref();
-    // Ports of imported nodes (BehaviorTree.CPP), one `name=value` line each.
-    let ports: String = n.ports.iter().map(|(k, v)| format!("\n{k}={v}")).collect();
-    let control = |a: &mut Attrs, symbol: String| {
-        let label = if custom {
-            format!("{symbol}\n{}{ports}", n.label)
+/// `prefix` and the bytes of `s`: ASCII letters and digits kept, every other
+/// byte as `-` and two hex digits; one-to-one, and a valid HTML/SVG id.
+fn encoded_id(prefix: &str, s: &str) -> String {
+    let mut out = String::with_capacity(prefix.len() + s.len());
+    out.push_str(prefix);
+    for b in s.bytes() {
+        if b.is_ascii_alphanumeric() {
+            out.push(b as char);
         } else {
-            format!("{symbol}{ports}")
-        };
-        a.set("label", &label)
-            .set("shape", "box")
-            .set("fontsize", if custom { "11" } else { "15" })
-            .set("width", "0.45")
-            .set("height", "0.4")
-            .set("margin", "0.06,0.03");
-    };
-    match n.kind {
-        BtNodeKind::Sequence => control(&mut a, "→".into()),
-        BtNodeKind::Fallback => control(&mut a, "?".into()),
-        BtNodeKind::SequenceMemory => control(&mut a, "→*".into()),
-        BtNodeKind::FallbackMemory => control(&mut a, "?*".into()),
-        BtNodeKind::Parallel { success } => {
-            control(&mut a, format!("⇉ {success}/{}", n.children.len()))
-        }
-        BtNodeKind::Control => control(
-            &mut a,
-            n.type_name.clone().unwrap_or_else(|| n.label.clone()),
-        ),
-        BtNodeKind::Inverter
-        | BtNodeKind::ForceSuccess
-        | BtNodeKind::ForceFailure
-        | BtNodeKind::Repeat { .. }
-        | BtNodeKind::Retry { .. }
-        | BtNodeKind::Timeout { .. }
-        | BtNodeKind::Decorator => {
-            let param = match n.kind {
-                BtNodeKind::Repeat { times: Some(t) } | BtNodeKind::Retry { times: t } => {
-                    format!("\n×{t}")
-                }
-                BtNodeKind::Repeat { times: None } => "\n×∞".to_string(),
-                BtNodeKind::Timeout { ms } => format!("\n{ms} ms"),
-                _ => String::new(),
-            };
-            a.set("label", &format!("{}{param}{ports}", n.label))
-                .set("shape", "diamond")
-                .set("fillcolor", DECISION_FILL)
-                .set("fontsize", "9")
-                .set("margin", "0.02,0.02")
-                .style("filled");
-        }
-        BtNodeKind::Action => {
-            a.set("label", &format!("{}{ports}", n.label))
-                .set("shape", "ellipse")
-                .set("fillcolor", ACTION_FILL)
-                .style("filled");
-        }
-        BtNodeKind::Condition => {
-            a.set("label", &format!("{}{ports}", n.label))
-                .set("shape", "ellipse")
-                .set("fillcolor", "white")
-                .set("fontname", "Helvetica-Oblique")
-                .style("filled");
+            out.push_str(&format!("-{b:02x}"));
         }
     }
-    let tip = match &n.skill {
-        Some(c) => format!("{}: {c}", n.id),
-        None => n.id.clone(),
-    };
-    a.set("tooltip", &tip);
-    a
+    out
+}
+
+/// The text of a DOT id as printed (quoted when it is not plain).
+fn id_text(id: &Id) -> &str {
+    match id {
+        Id::Plain(s) | Id::Escaped(s) | Id::Html(s) | Id::Anonymous(s) => s,
+    }
+}
+
+/// The SVG element id of the DOT node of a vertex key (with
+/// [`DotOptions::svg_ids`]): distinct keys give distinct ids.
+pub fn svg_id(key: &str) -> String {
+    encoded_id("v_", id_text(&dot_id(key)))
+}
+
+/// The SVG element id of an HFSM container's cluster, by its key.
+pub fn svg_cluster_id(key: &str) -> String {
+    encoded_id("c_", id_text(&dot_id(key)))
+}
+
+/// Sets `id` on every DOT node below `stmts` (clusters included, walked
+/// with a stack).
+pub(super) fn set_svg_ids(stmts: &mut [Stmt]) {
+    let mut stack: Vec<&mut [Stmt]> = vec![stmts];
+    while let Some(list) = stack.pop() {
+        for s in list {
+            match s {
+                Stmt::Node(n) => {
+                    // Replaces the plain `id` every node has (the key).
+                    let id = encoded_id("v_", id_text(&n.id.0));
+                    n.attributes.retain(|Attribute(k, _)| id_text(k) != "id");
+                    n.attributes
+                        .push(Attribute(Id::Plain("id".into()), dot_id(&id)));
+                }
+                Stmt::Subgraph(sg) => stack.push(&mut sg.stmts),
+                _ => {}
+            }
+        }
+    }
 }

@@ -135,10 +135,13 @@ impl<'o> Builder<'o> {
 
     // --- Behavior Trees -----------------------------------------------------
 
-    pub(super) fn bt(&mut self, bt: &Bt) {
+    pub(super) fn bt(&mut self, bt: &Bt, view: &super::bt::View) {
         let ids: Vec<String> = bt.nodes.iter().map(|n| self.vertex(&n.id)).collect();
-        for (n, id) in bt.nodes.iter().zip(&ids) {
-            let mut a = bt_node_attrs(n);
+        // In arena order (pre-order for a file read), hidden nodes left out.
+        let drawn: Vec<usize> = (0..bt.nodes.len()).filter(|&i| view.shown[i]).collect();
+        for &i in &drawn {
+            let (n, id) = (&bt.nodes[i], &ids[i]);
+            let mut a = super::bt::bt_node_attrs(n, view.folded[i], self.opts.ports);
             a.node_highlight(self.vhl(&n.id));
             a.changed(self.opts.changed.get(&n.id));
             self.root.push(node_stmt(id, a));
@@ -150,7 +153,11 @@ impl<'o> Builder<'o> {
                 slotted.entry(from.as_str()).or_default().push((slot, g));
             }
         }
-        for (n, id) in bt.nodes.iter().zip(&ids) {
+        for &i in &drawn {
+            if view.folded[i].is_some() {
+                continue;
+            }
+            let (n, id) = (&bt.nodes[i], &ids[i]);
             let mut ghosts = slotted.remove(n.id.as_str()).unwrap_or_default();
             ghosts.sort_unstable();
             let mut ghosts = ghosts.into_iter().peekable();
@@ -283,6 +290,23 @@ impl<'o> Builder<'o> {
             self.top_tail.push(rank_group("sink", &top_outcome_id));
         }
         self.top_states = m.top.states.clone();
+        // The top level's initial state, as UML marks it: a filled dot and
+        // an arrow (containers mark theirs with their own dot, a vertex).
+        // Neither is a vertex nor an arc of the graph.
+        if let Target::State(j) = m.top.initial {
+            let start = self.fresh(START);
+            let mut a = Attrs::default();
+            a.set("shape", "point")
+                .set("width", "0.15")
+                .set("tooltip", "initial state");
+            self.top_tail.push(node_stmt(&start, a));
+            let mut e = Attrs::default();
+            if region(j).is_some() {
+                e.set("lhead", &cluster_name(j));
+            }
+            e.set("class", "start");
+            self.edges.push(edge_stmt(&start, &state_id[j], e));
+        }
 
         // Clusters, deepest first; below MAX_CLUSTER_NESTING a cluster goes
         // beside its parent's instead of inside it.
@@ -428,6 +452,9 @@ impl<'o> Builder<'o> {
             None => {}
         }
         ca.changed(self.opts.changed.get(key));
+        if self.opts.svg_ids {
+            ca.set("id", &svg_cluster_id(key));
+        }
         let mut header: Vec<Stmt> = ca.into_vec().into_iter().map(Stmt::Attribute).collect();
         let mut ea = Attrs::default();
         ea.set("shape", "point")

@@ -5,38 +5,56 @@
 //! DOT edge per arc, so that a picture can be counted like the paper counts:
 //!
 //! - BT (Fig. 1): control nodes are boxes labelled `→` (Sequence), `?` (Fallback),
-//!   `→*` / `?*` (with memory) and `⇉ k/N` (Parallel with its success threshold);
-//!   decorators are diamonds with their name and parameter; actions are filled
-//!   ovals, conditions white ovals in italics. The tree is drawn top-down with
-//!   children in order (`ordering=out`).
+//!   `→*` / `?*` (with memory) and `⇉ k/N` (Parallel with its success threshold),
+//!   other control types boxes with their type; decorators are hexagons with
+//!   their name and parameter; actions are filled rounded boxes, conditions
+//!   white ellipses in italics (Groot's convention). A node with a name of
+//!   its own shows its type in small grey under it; ports are in the
+//!   tooltip (under the label with [`DotOptions::ports`]). Subtrees can be
+//!   folded into one double-bordered node with their size (see `bt.rs`).
+//!   The tree is drawn with children in order (`ordering=out`), top-down, or
+//!   left-to-right when top-down would be too wide ([`RankDir`]).
 //! - FSM (Fig. 4): states are ovals, decision states (SELECTOR) diamonds, the
-//!   initial state has a bold border, terminal outcomes are double circles. Arcs
-//!   carry their outcome or guard label and are coloured like the paper's Fig. 4:
-//!   RUNNING goldenrod, SUCCESS green, FAILURE red, guards blue. A decision
-//!   state's self-loop hangs below it, clear of its guard arcs.
+//!   initial state has a bold border and, as in UML, an arrow from a filled
+//!   dot (the start dot, DOT node [`START`], neither a vertex nor an arc:
+//!   its edge has `class=start`); terminal outcomes are double circles.
+//!   Arcs carry their outcome or guard label and are coloured like the
+//!   paper's Fig. 4: RUNNING goldenrod, SUCCESS green, FAILURE red, guards
+//!   blue (the label says what the colour means, so no legend is drawn; a
+//!   drawing with status fills, `dot --trace`, has a status legend). A
+//!   decision state's self-loop hangs below it, clear of its guard arcs.
 //! - HFSM (Fig. 6): every container is a cluster holding its states. The
 //!   container's own vertex is the small dot at the top of its cluster (arcs into
 //!   the container end at the cluster's border; the dot's arc goes to the initial
-//!   child). The container's outcomes are small boxes at the bottom of the
-//!   cluster: a transition to a container outcome points at that box, and the
-//!   container's own transitions leave from it. These outcome boxes are the only
-//!   DOT nodes that are not graph vertices.
+//!   child, so every level marks its initial state as UML does). The regions
+//!   of a parallel state are dashed clusters inside it. The container's
+//!   outcomes are small boxes at the bottom of the cluster: a transition to
+//!   a container outcome points at that box, and the container's own
+//!   transitions leave from it. These outcome boxes and the start dot are
+//!   the only DOT nodes that are not graph vertices.
 //!
 //! DOT node ids are the graph's vertex keys (BT node id, state path
 //! `Container/Child`, outcome name), quoted and escaped, so that a diagram can be
 //! matched with `compare`'s edit scripts ([`DotOptions`] highlights vertices
-//! and arcs by key and draws removed ones as dashed grey ghosts). Output is
+//! and arcs by key and draws removed ones as dashed grey ghosts). Every node
+//! also has the DOT attribute `id` set to its node id, so that in Graphviz's
+//! SVG the node's `<g>` element has `id` = the vertex key (control
+//! characters and bidirectional controls replaced by spaces, as every
+//! string is; a page colours nodes by `getElementById(key)`). Output is
 //! deterministic: everything is emitted in model order. HFSM clusters nested
 //! deeper than 48 levels are drawn beside their parent's cluster, so that
 //! neither the printer nor Graphviz recurse without bound.
 
 mod attrs;
+mod bt;
 mod builder;
 mod graphviz;
 #[cfg(test)]
 mod tests;
 
 use attrs::*;
+pub use attrs::{svg_cluster_id, svg_id};
+pub use bt::{FoldError, MAX_ASPECT, RankDir, check_fold};
 use builder::*;
 pub use graphviz::*;
 
@@ -73,8 +91,9 @@ impl Status {
         }
     }
 
-    /// Fill of a node highlighted with this status.
-    fn fill_color(self) -> &'static str {
+    /// Fill of a node highlighted with this status (an SVG/CSS colour name
+    /// too: `btfsm view` paints with it).
+    pub fn fill_color(self) -> &'static str {
         match self {
             Status::Running => "gold",
             Status::Success => "palegreen",
@@ -130,9 +149,33 @@ pub struct DotOptions {
     pub title: Option<String>,
     /// Adds a legend of the diff colours (added, removed, changed).
     pub legend: bool,
+    /// Gives every DOT node the attribute `id` = [`svg_id`] of its DOT node
+    /// id, and every HFSM container's cluster [`svg_cluster_id`] of its key,
+    /// so that the SVG Graphviz renders can be scripted (`btfsm view`).
+    pub svg_ids: bool,
+    /// BT: draws each node's ports under its label (they are always in its
+    /// tooltip).
+    pub ports: bool,
+    /// BT: nodes drawn folded, by id: one node standing for the subtree.
+    pub collapse: std::collections::BTreeSet<String>,
+    /// BT: folds every node at this depth (the root is at depth 0).
+    pub depth: Option<usize>,
+    /// BT: folds the root of every SubTree (BehaviorTree.CPP `<SubTree>`,
+    /// TOML `subtree` include).
+    pub fold_subtrees: bool,
+    /// BT: the direction of the layout.
+    pub rankdir: RankDir,
 }
 
 const FONT: &str = "Helvetica";
+/// The DOT node id of an FSM's start dot (made unique if a state has it).
+pub const START: &str = "__start";
+/// The font of the lines under a label (a node's type, ports, a folded
+/// subtree's size).
+const SUB_FONT_SIZE: &str = "8";
+const SUB_COLOR: &str = "#555555";
+/// The font of a control node's symbol over its name.
+const HEAD_FONT_SIZE: &str = "15";
 const ACTION_FILL: &str = "#dce8f7";
 const DECISION_FILL: &str = "#eeeeee";
 const ADDED: &str = "magenta";
@@ -145,6 +188,42 @@ const GUARD: &str = "blue";
 /// instead of inside it (Graphviz and the printer recurse on nesting).
 const MAX_CLUSTER_NESTING: usize = 48;
 
+/// The legend of a drawing coloured by status: one sample node per status,
+/// side by side in a cluster of their own. The fills are written in hex
+/// (the same colours), so that a count of `fillcolor=gold` counts nodes.
+fn status_legend(b: &mut Builder) -> Stmt {
+    let mut ca = Attrs::default();
+    ca.set("label", "status at this step")
+        .set("fontname", FONT)
+        .set("fontsize", "9")
+        .set("color", "grey70")
+        .style("rounded");
+    let mut stmts: Vec<Stmt> = ca.into_vec().into_iter().map(Stmt::Attribute).collect();
+    let mut ids = Vec::new();
+    for (name, fill) in [
+        ("RUNNING", "#ffd700"),
+        ("SUCCESS", "#98fb98"),
+        ("FAILURE", "#ff6347"),
+    ] {
+        let id = b.fresh(&format!("legend: {name}"));
+        let mut a = Attrs::default();
+        a.set("label", name)
+            .set("shape", "box")
+            .set("fontsize", "9")
+            .set("height", "0.3")
+            .set("fillcolor", fill)
+            .style("rounded")
+            .style("filled");
+        stmts.push(node_stmt(&id, a));
+        ids.push(id);
+    }
+    stmts.push(rank_group("same", &ids));
+    Stmt::Subgraph(graphviz_rust::dot_structures::Subgraph {
+        id: dot_id("cluster legend"),
+        stmts,
+    })
+}
+
 /// DOT text of a policy in the paper's visual language.
 pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     let mut b = Builder::new(opts);
@@ -155,13 +234,20 @@ pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     graph_attrs.set("fontsize", "14");
     match &policy.body {
         PolicyBody::Bt(bt) => {
+            let view = bt::View::new(bt, opts);
             graph_attrs.set("ordering", "out");
+            let rankdir = view.rankdir(bt, opts);
+            if rankdir != "TB" {
+                graph_attrs.set("rankdir", rankdir);
+            }
             graph_attrs.set("nodesep", "0.25");
             graph_attrs.set("ranksep", "0.45");
-            b.bt(bt);
+            b.bt(bt, &view);
         }
         PolicyBody::Machine(m) => {
-            graph_attrs.set("nodesep", "0.4");
+            // Room between states for the arcs' labels of dense machines
+            // (the paper's Fig. 8e, 16b), looked at in PNG.
+            graph_attrs.set("nodesep", "0.6");
             graph_attrs.set("ranksep", "0.5");
             if m.states
                 .iter()
@@ -174,8 +260,19 @@ pub fn policy_dot(policy: &Policy, opts: &DotOptions) -> String {
     }
     b.ghosts();
     b.assemble();
+    if opts.svg_ids {
+        set_svg_ids(&mut b.root);
+    }
     if opts.legend {
         let legend = b.legend();
+        b.root.push(legend);
+    } else if opts
+        .highlight
+        .values()
+        .any(|h| matches!(h, Highlight::Status(_)))
+    {
+        // Fills say a status no label writes (`dot --trace`): say which.
+        let legend = status_legend(&mut b);
         b.root.push(legend);
     }
 

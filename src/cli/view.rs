@@ -1,0 +1,177 @@
+//! `btfsm view INPUT... -o page.html`: one self-contained HTML page replaying
+//! runs (src/view/): a simulator scenario (run here as `btfsm sim` runs it),
+//! a trace written by `btfsm sim --trace`, or a BehaviorTree.CPP `.btlog`;
+//! several inputs share one slider.
+
+use super::commands::{emit_text, print_diagnostics};
+use super::{EXIT_BAD_INPUT, EXIT_OK};
+use crate::view::{Replay, ViewError};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// Scenario (.toml, run with its seed), trace of `btfsm sim --trace`
+    /// (.json; the policy files it names are read, relative to the current
+    /// directory and inside the root) or BehaviorTree.CPP log (.btlog)
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// The HTML file to write (default: stdout)
+    #[arg(short, long, value_name = "OUT.html")]
+    pub output: Option<PathBuf>,
+    /// Run the scenarios' episode with seed S, as `sim --seed S` does
+    #[arg(long, value_name = "S")]
+    pub seed: Option<u64>,
+    /// Graphviz's time budget per diagram, ms; past it `dot` is killed and
+    /// the run exits 2
+    #[arg(long, default_value_t = crate::render::dot::DEFAULT_RENDER_TIMEOUT_MS, value_name = "MS")]
+    pub timeout_ms: u64,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+/// Which kind of input a file is: by extension, else by its first bytes.
+enum Kind {
+    Scenario,
+    Trace,
+    Log,
+}
+
+fn kind_of(path: &Path, head: &[u8]) -> Kind {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("btlog") => Kind::Log,
+        Some("json") => Kind::Trace,
+        Some("toml") => Kind::Scenario,
+        _ if head.starts_with(crate::log::btlog::MAGIC) => Kind::Log,
+        _ if head.trim_ascii_start().starts_with(b"{") => Kind::Trace,
+        _ => Kind::Scenario,
+    }
+}
+
+fn fail(e: ViewError) -> Option<Replay> {
+    match e {
+        ViewError::Diagnostics(d) => print_diagnostics(&mut std::io::stderr().lock(), &d),
+        e => eprintln!("error: {e}"),
+    }
+    None
+}
+
+/// One input's replay; `None` after printing why not. Every input is read
+/// once through `format::source` (bounded, never blocking on a FIFO).
+fn replay_of(path: &Path, a: &ViewArgs, limits: &crate::format::Limits) -> Option<Replay> {
+    let shown = path.display().to_string();
+    let diags = |d: Vec<crate::diagnostic::Diagnostic>| {
+        print_diagnostics(&mut std::io::stderr().lock(), &d);
+        None
+    };
+    let bytes = match crate::format::source::read_bytes(path, &shown, limits, false) {
+        Ok(b) => b,
+        Err(d) => return diags(d),
+    };
+    let text = |bytes: Vec<u8>| match String::from_utf8(bytes) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            eprintln!(
+                "error: {}: byte {}: not UTF-8 text\n  = hint: a scenario (.toml) or a trace (.json) is UTF-8 text",
+                crate::sanitize::shown(&shown),
+                e.utf8_error().valid_up_to()
+            );
+            None
+        }
+    };
+    match kind_of(path, &bytes[..bytes.len().min(32)]) {
+        Kind::Log => crate::view::log::from_log(&bytes[..], &shown, limits).map_or_else(fail, Some),
+        Kind::Trace => {
+            let text = text(bytes)?;
+            let dir = path.parent().unwrap_or(Path::new(""));
+            let root = crate::format::source::root_for(limits, dir);
+            crate::view::sim::from_trace(&text, &shown, root.as_deref(), limits)
+                .map_or_else(fail, Some)
+        }
+        Kind::Scenario => {
+            let file = crate::diagnostic::SourceFile::new(&shown, text(bytes)?);
+            if crate::sim::symbolic::looks_symbolic(&file.text) {
+                eprintln!(
+                    "error: {}: a symbolic scenario (with `domain`) has no trace to replay\n  = hint: `btfsm view` replays the planar simulator's scenarios, `sim --trace` files and .btlog logs",
+                    crate::sanitize::shown(&shown)
+                );
+                return None;
+            }
+            let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+            let mut s = match crate::sim::scenario::parse(&file, &base, limits) {
+                Ok(s) => s,
+                Err(d) => return diags(d),
+            };
+            if !s.warnings.is_empty() {
+                print_diagnostics(&mut std::io::stderr().lock(), &s.warnings);
+            }
+            if let Some(seed) = a.seed {
+                let (ds, rates) = crate::sim::monte_carlo::episode(&s, seed);
+                s.seed = seed;
+                s.disturbances = ds;
+                s.rates = rates;
+            }
+            crate::view::sim::from_scenario(&s, &shown).map_or_else(fail, Some)
+        }
+    }
+}
+
+pub fn execute(a: ViewArgs) -> u8 {
+    let limits = a.limits.limits();
+    let mut all: Option<Replay> = None;
+    for path in &a.inputs {
+        let Some(r) = replay_of(path, &a, &limits) else {
+            return EXIT_BAD_INPUT;
+        };
+        all = Some(match all {
+            None => r,
+            Some(mut acc) => {
+                let off = acc.panels.len();
+                acc.title = format!("{} + {}", acc.title, r.title);
+                acc.subtitle = format!("{}; {}", acc.subtitle, r.subtitle);
+                if acc.step_name != r.step_name {
+                    acc.step_name = format!("{}; {}", acc.step_name, r.step_name);
+                }
+                acc.panels.extend(r.panels);
+                acc.divergences
+                    .extend(r.divergences.into_iter().map(|mut d| {
+                        d.a += off;
+                        d.b += off;
+                        d
+                    }));
+                acc
+            }
+        });
+    }
+    let Some(replay) = all else {
+        return EXIT_BAD_INPUT;
+    };
+    let timeout = std::time::Duration::from_millis(a.timeout_ms);
+    let page = match crate::view::html::page(&replay, timeout) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let code = emit_text(a.output.as_deref(), page);
+    if code == EXIT_OK
+        && let Some(out) = &a.output
+    {
+        let steps = (replay.panels.iter())
+            .map(|p| p.rec.times.len())
+            .max()
+            .unwrap_or(0);
+        eprintln!(
+            "wrote {} ({} panel{}, {steps} steps)",
+            crate::sanitize::shown(&out.display().to_string()),
+            replay.panels.len(),
+            if replay.panels.len() == 1 { "" } else { "s" }
+        );
+    }
+    code
+}
