@@ -36,7 +36,7 @@ test:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets --locked -- -D warnings
 	$(CARGO) test --locked
-	$(CARGO) test --locked --bench scale --bench ged --bench sim --bench ted -- --test
+	$(CARGO) test --locked --bench scale --bench ged --bench sim --bench ted --bench log -- --test
 	$(CARGO) run --quiet --locked -- paper --check
 	$(MAKE) --no-print-directory mermaid-oracle
 	$(MAKE) --no-print-directory differential
@@ -51,7 +51,9 @@ test:
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
 # SubTrees are spread over files given together (projects_btcpp.py); every
 # SARIF log of `lint` against the official schema (sarif_check.py); logs
-# BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py); and
+# BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
+# compared by `log compare` as its Python leaves saw them (btlog_compare.py),
+# and as SqliteLogger .db3 sessions counted by SQL (btlog_db3.py); and
 # every corpus SCXML file read by btfsm and by an independent SCXML engine
 # (PyPI `scjson`) alike (tests/differential/scxml_engine.py); and
 # `compare --mode tree`'s distance against the `apted` and `zss` packages on
@@ -76,6 +78,10 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/btlog_check.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_check.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_check.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_check.txt
+	$(VENV)/bin/python tests/differential/btlog_compare.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_compare.txt 2>&1 \
+	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_compare.txt | tail -40; exit 1; }
+	@tail -1 $(TARGET_DIR)/btlog_compare.txt
+	$(VENV)/bin/python tests/differential/btlog_db3.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
 	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24
 

@@ -22,12 +22,75 @@ pub enum LogCommand {
     /// Draws the log's tree with each node coloured by its status at a
     /// moment (RUNNING yellow, SUCCESS green, FAILURE red), as `dot --trace`
     Dot(DotArgs),
+    /// The first divergence between two runs' sequences of executed actions
+    /// (a .btlog or a `btfsm sim --format json`/`--trace` file each); exit 0
+    /// the same, 1 diverged
+    Compare(CompareArgs),
+    /// Draws the log as an SVG timeline: a row per leaf ticked, bars where
+    /// it was RUNNING, its status changes marked, a time axis in seconds
+    Timeline(TimelineArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct TimelineArgs {
+    /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog; a file: it is read twice)
+    pub log: PathBuf,
+    /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
+    #[arg(long, value_name = "N")]
+    pub session: Option<i64>,
+    /// Output SVG file (default: stdout)
+    #[arg(short, long, value_name = "OUT.svg")]
+    pub output: Option<PathBuf>,
+    /// Width of the time axis, in pixels (100 to 20000)
+    #[arg(long, value_name = "PX", default_value_t = 1000)]
+    pub width: u32,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The first run: a BehaviorTree.CPP log (.btlog) or a simulator JSON
+    pub a: PathBuf,
+    /// The second run, as the first
+    pub b: PathBuf,
+    /// The session of A when it is a .db3 (default: its last)
+    #[arg(long, value_name = "N")]
+    pub session_a: Option<i64>,
+    /// The session of B when it is a .db3 (default: its last)
+    #[arg(long, value_name = "N")]
+    pub session_b: Option<i64>,
+    /// The simulator's policy, for a simulator JSON with several
+    #[arg(long, value_name = "NAME")]
+    pub policy: Option<String>,
+    /// Also require the same action to start at most this many seconds
+    /// apart (default: compare the order only)
+    #[arg(long, value_name = "SECONDS")]
+    pub tolerance: Option<f64>,
+    /// Compare skills and outcomes, not arguments (ports)
+    #[arg(long)]
+    pub ignore_args: bool,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
+    pub format: CompareFormat,
+    #[command(flatten)]
+    pub limits: super::args::LimitArgs,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CompareFormat {
+    Table,
+    Json,
+    Markdown,
 }
 
 #[derive(Debug, Args)]
 pub struct DotArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog)
     pub log: PathBuf,
+    /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
+    #[arg(long, value_name = "N")]
+    pub session: Option<i64>,
     /// The moment: this many seconds after the log's first timestamp
     #[arg(
         long,
@@ -56,12 +119,17 @@ pub enum LogFormat {
     /// One row per node: uid, node, type, activations, status changes by
     /// status, seconds RUNNING
     Csv,
+    /// GitHub-flavoured markdown: coverage, branches not covered, the nodes
+    Markdown,
 }
 
 #[derive(Debug, Args)]
 pub struct ReportArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog), or `-` for stdin
     pub log: PathBuf,
+    /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
+    #[arg(long, value_name = "N")]
+    pub session: Option<i64>,
     /// Output format
     #[arg(long, value_enum, default_value_t = LogFormat::Table)]
     pub format: LogFormat,
@@ -76,6 +144,8 @@ pub fn execute(a: LogArgs) -> u8 {
     let a = match a.command {
         LogCommand::Report(a) => a,
         LogCommand::Dot(d) => return dot(d),
+        LogCommand::Compare(c) => return compare(c),
+        LogCommand::Timeline(t) => return timeline(t),
     };
     if let Some(x) = a.min_coverage
         && !(0.0..=1.0).contains(&x)
@@ -84,32 +154,25 @@ pub fn execute(a: LogArgs) -> u8 {
         return EXIT_BAD_INPUT;
     }
     let shown = a.log.display().to_string();
-    let reader: Box<dyn std::io::Read> = if a.log.as_os_str() == "-" {
-        Box::new(std::io::stdin())
-    } else {
-        match std::fs::File::open(&a.log) {
-            Ok(f) => Box::new(f),
-            Err(e) => {
-                eprintln!(
-                    "error: {}: cannot read this file: {e}",
-                    crate::sanitize::shown(&shown)
-                );
-                return EXIT_BAD_INPUT;
-            }
-        }
-    };
     let limits = a.limits.limits();
-    let r = match report::report(&shown, reader, limits.max_file_bytes) {
+    let opened = match crate::log::open(&a.log, a.session, limits.max_file_bytes) {
+        Ok(o) => o,
+        Err(e) => return bad_log(&shown, &e),
+    };
+    let mut r = match report::report(&shown, opened.reader, limits.max_file_bytes) {
         Ok(r) => r,
         Err(e) => {
             eprintln!(
-                "error: {}: {}\n  = hint: a BehaviorTree.CPP 4 FileLogger2 log (.btlog) is the header `BTCPP4-FileLogger2`, the tree XML, a timestamp and 9-byte records",
+                "error: {}: {}\n  = hint: a BehaviorTree.CPP 4 FileLogger2 log (.btlog) is the header `BTCPP4-FileLogger2`, the tree XML, a timestamp and 9-byte records; a SqliteLogger log (.db3) an SQLite database",
                 crate::sanitize::shown(&shown),
                 crate::sanitize::shown(&e.to_string())
             );
             return EXIT_BAD_INPUT;
         }
     };
+    r.session = opened.session;
+    r.sessions = opened.sessions;
+    r.more_sessions = opened.more_sessions;
     let text = match a.format {
         LogFormat::Json => {
             let mut s =
@@ -119,6 +182,7 @@ pub fn execute(a: LogArgs) -> u8 {
         }
         LogFormat::Table => report::render_table(&r),
         LogFormat::Csv => report::render_csv(&r),
+        LogFormat::Markdown => report::render_markdown(&r),
     };
     let code = emit_text(None, text);
     if code != EXIT_OK {
@@ -149,17 +213,11 @@ fn dot(a: DotArgs) -> u8 {
         (None, None) => unreachable!("clap requires one"),
     };
     let shown = a.log.display().to_string();
-    let file = match std::fs::File::open(&a.log) {
-        Ok(f) => f,
-        Err(e) => {
-            eprintln!(
-                "error: {}: cannot read this file: {e}",
-                crate::sanitize::shown(&shown)
-            );
-            return EXIT_BAD_INPUT;
-        }
-    };
     let limits = a.limits.limits();
+    let file = match crate::log::open(&a.log, a.session, limits.max_file_bytes) {
+        Ok(o) => o.reader,
+        Err(e) => return bad_log(&shown, &e),
+    };
     let r = match replay(file, at, &limits) {
         Ok(r) => r,
         Err(e) => {
@@ -194,4 +252,106 @@ fn dot(a: DotArgs) -> u8 {
         a.render,
         std::time::Duration::from_secs(60),
     )
+}
+
+fn bad_log(shown: &str, e: &str) -> u8 {
+    eprintln!(
+        "error: {}: {}",
+        crate::sanitize::shown(shown),
+        crate::sanitize::shown_max(e, 1000)
+    );
+    EXIT_BAD_INPUT
+}
+
+fn compare(a: CompareArgs) -> u8 {
+    use crate::log::compare as c;
+    if let Some(t) = a.tolerance
+        && !(t.is_finite() && t >= 0.0)
+    {
+        eprintln!("error: --tolerance must be a number of seconds from 0, found {t}");
+        return EXIT_BAD_INPUT;
+    }
+    if a.a.as_os_str() == "-" && a.b.as_os_str() == "-" {
+        eprintln!("error: only one of the two runs can be `-` (stdin)");
+        return EXIT_BAD_INPUT;
+    }
+    let limits = a.limits.limits();
+    let mut sides = Vec::new();
+    for (p, session) in [(&a.a, a.session_a), (&a.b, a.session_b)] {
+        let shown = p.display().to_string();
+        let r = match crate::log::open(p, session, limits.max_file_bytes) {
+            Ok(o) => o.reader,
+            Err(e) => return bad_log(&shown, &e),
+        };
+        match c::open(&shown, r, a.policy.as_deref(), limits.max_file_bytes) {
+            Ok(s) => sides.push(s),
+            Err(e) => return bad_run(&e),
+        }
+    }
+    let b = sides.pop().expect("two");
+    let first = sides.pop().expect("two");
+    let r = match c::compare(first, b, a.tolerance, a.ignore_args) {
+        Ok(r) => r,
+        Err(e) => return bad_run(&e),
+    };
+    let text = match a.format {
+        CompareFormat::Json => {
+            let mut s =
+                crate::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
+            s.push('\n');
+            s
+        }
+        CompareFormat::Table => c::render_table(&r),
+        CompareFormat::Markdown => c::render_markdown(&r),
+    };
+    let code = emit_text(None, text);
+    if code != EXIT_OK {
+        return code;
+    }
+    if r.same { EXIT_OK } else { EXIT_CHECK_FAILED }
+}
+
+fn bad_run(e: &crate::log::compare::CompareError) -> u8 {
+    eprintln!(
+        "error: {}\n  = hint: each run is a BehaviorTree.CPP 4 FileLogger2 log (.btlog) or what `btfsm sim --format json` or `--trace` writes",
+        crate::sanitize::shown_max(&e.to_string(), 4000)
+    );
+    EXIT_BAD_INPUT
+}
+
+fn timeline(a: TimelineArgs) -> u8 {
+    use crate::log::timeline::MAX_WIDTH;
+    if !(100..=MAX_WIDTH).contains(&a.width) {
+        eprintln!(
+            "error: --width must be from 100 to {MAX_WIDTH} pixels, found {}",
+            a.width
+        );
+        return EXIT_BAD_INPUT;
+    }
+    if a.log.as_os_str() == "-" {
+        eprintln!("error: log timeline reads its log twice: give a file, not `-`");
+        return EXIT_BAD_INPUT;
+    }
+    let shown = a.log.display().to_string();
+    let limits = a.limits.limits();
+    let open = || {
+        crate::log::open(&a.log, a.session, limits.max_file_bytes)
+            .map(|o| o.reader)
+            .map_err(std::io::Error::other)
+    };
+    if let Err(e) = open() {
+        return bad_log(&shown, &e.to_string());
+    }
+    let t = crate::log::timeline::timeline(&shown, open, limits.max_file_bytes, a.width);
+    match t {
+        Ok(t) => emit_text(a.output.as_deref(), t.svg),
+        Err(e) => {
+            eprintln!(
+                "error: {}: {}",
+                crate::sanitize::shown(&shown),
+                crate::sanitize::shown(&e.to_string())
+            );
+            EXIT_BAD_INPUT
+        }
+    }
 }

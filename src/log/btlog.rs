@@ -82,6 +82,9 @@ pub enum LogError {
     Bad { offset: u64, what: String },
     #[error("cannot read the log: {0}")]
     Io(String),
+    /// A bound of the output reached (not a fault of the log's bytes).
+    #[error("{0}")]
+    Limit(String),
 }
 
 /// A log's header: its layout, tree XML and first timestamp, and where its

@@ -44,6 +44,13 @@ pub struct LogReport {
     /// Branches not covered, as `Fallback name -> child name` or
     /// `condition name: SUCCESS|FAILURE`.
     pub uncovered: Vec<String>,
+    /// For a `.db3`: the session read, and the file's sessions.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub session: Option<i64>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sessions: Vec<super::Session>,
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub more_sessions: bool,
 }
 
 /// Covered items out of all.
@@ -172,6 +179,9 @@ pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogEr
         node_coverage: nodes_cov,
         branch_coverage: Coverage::of(covered, total),
         uncovered,
+        session: None,
+        sessions: Vec::new(),
+        more_sessions: false,
     })
 }
 
@@ -179,11 +189,13 @@ pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogEr
 pub fn render_table(r: &LogReport) -> String {
     use crate::sanitize::shown;
     let mut out = format!(
-        "log {} ({} records, {:.3} s)\n\n",
+        "log {} ({} records, {:.3} s)\n",
         shown(&r.file),
         r.records,
         r.duration_usec as f64 / 1e6
     );
+    out.push_str(&sessions_line(r));
+    out.push('\n');
     let mut t = crate::report::table::Table::new(&[
         "uid",
         "node",
@@ -242,6 +254,68 @@ pub fn render_csv(r: &LogReport) -> String {
             n.uid,
             cell(&n.name),
             cell(&n.tag),
+            n.activations,
+            k("RUNNING"),
+            k("SUCCESS"),
+            k("FAILURE"),
+            k("IDLE"),
+            k("SKIPPED"),
+            n.running_usec as f64 / 1e6
+        ));
+    }
+    out
+}
+
+/// For a `.db3`: `session 2 (sessions: 1 (2026-01-01 10:00:00), 2 (...))`.
+fn sessions_line(r: &LogReport) -> String {
+    let Some(s) = r.session else {
+        return String::new();
+    };
+    let list: Vec<String> = (r.sessions.iter())
+        .map(|x| format!("{} ({})", x.id, crate::sanitize::shown(&x.date)))
+        .collect();
+    format!(
+        "session {s} (sessions: {}{})\n",
+        list.join(", "),
+        if r.more_sessions { ", ..." } else { "" }
+    )
+}
+
+/// The report as GitHub-flavoured markdown: the coverage first (what a
+/// pull request's reviewer reads), then the per-node table.
+pub fn render_markdown(r: &LogReport) -> String {
+    use crate::sanitize::{markdown_cell as md, markdown_code};
+    let pct = |c: &Coverage| format!("{}/{} ({:.1} %)", c.covered, c.total, 100.0 * c.ratio);
+    let mut out = format!(
+        "### Log {}\n\n{} records, {:.3} s{}\n\n| coverage | covered |\n|---|---:|\n| nodes | {} |\n| branches | {} |\n\n",
+        markdown_code(&r.file),
+        r.records,
+        r.duration_usec as f64 / 1e6,
+        match r.session {
+            Some(s) => format!(", session {s} of {}", r.sessions.len()),
+            None => String::new(),
+        },
+        pct(&r.node_coverage),
+        pct(&r.branch_coverage)
+    );
+    if !r.uncovered.is_empty() {
+        out.push_str("Not covered:\n\n");
+        for u in r.uncovered.iter().take(50) {
+            out.push_str(&format!("- {}\n", md(u)));
+        }
+        if r.uncovered.len() > 50 {
+            out.push_str(&format!("- ... and {} more\n", r.uncovered.len() - 50));
+        }
+        out.push('\n');
+    }
+    out.push_str("| uid | node | type | activations | RUNNING | SUCCESS | FAILURE | IDLE | SKIPPED | running s |\n|---:|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    for n in &r.nodes {
+        let k = |s: &str| n.statuses.get(s).copied().unwrap_or(0);
+        out.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} |\n",
+            n.uid,
+            md(&n.name),
+            md(&n.tag),
             n.activations,
             k("RUNNING"),
             k("SUCCESS"),

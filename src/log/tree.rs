@@ -3,6 +3,7 @@
 //! `<TreeNodesModel>`'s), its parent and its children in order. A SubTree
 //! node's child is the root of the `<BehaviorTree>` whose `_fullpath` is
 //! the SubTree's (BehaviorTree.CPP's `WriteTreeToXML` with metadata).
+//! Each node keeps its ports (the attributes the XML gives it).
 
 use crate::format::btcpp_xml::{Category, builtin};
 use std::collections::BTreeMap;
@@ -16,6 +17,9 @@ pub struct Node {
     pub category: Option<Category>,
     pub parent: Option<u16>,
     pub children: Vec<u16>,
+    /// The node's ports as the XML gives them (its attributes but `name`,
+    /// `ID` and the logger's `_uid` and `_fullpath`).
+    pub ports: BTreeMap<String, String>,
 }
 
 /// The logged tree, by UID.
@@ -91,6 +95,11 @@ pub fn parse(xml: &str) -> Result<Tree, String> {
                     category,
                     parent,
                     children: Vec::new(),
+                    ports: e
+                        .attributes()
+                        .filter(|a| !matches!(a.name(), "name" | "ID" | "_uid" | "_fullpath"))
+                        .map(|a| (a.name().to_string(), a.value().to_string()))
+                        .collect(),
                 },
             );
             if let Some(p) = parent {

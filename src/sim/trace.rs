@@ -9,6 +9,9 @@
 //! (Eiter and Mannila 1994).
 
 use super::world::{P2, Place, World, dist};
+
+mod divergence;
+pub use divergence::{SkillSeq, SkillSlice, first_divergence};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -341,29 +344,12 @@ pub fn behavior_matches(a: &Run, b: &Run) -> bool {
 
 fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
     let tol = a.dt.max(b.dt) + 1e-6;
-    let n = a.skills.len().max(b.skills.len());
-    let end = |r: &Run| r.duration_s;
-    let first = (0..n).find_map(|i| {
-        let (x, y) = (a.skills.get(i), b.skills.get(i));
-        let (kind, t, starts) = match (x, y) {
-            (Some(x), Some(y)) if !x.same(y) => ("skill", x.start.min(y.start), None),
-            (Some(x), Some(y)) if (x.start - y.start).abs() > tol => {
-                ("start", x.start.min(y.start), Some([x.start, y.start]))
-            }
-            (Some(_), Some(_)) => return None,
-            (Some(x), None) => ("missing", x.start.min(end(b)), None),
-            (None, Some(y)) => ("missing", y.start.min(end(a)), None),
-            (None, None) => return None,
-        };
-        Some(Divergence {
-            index: i,
-            a: x.map(SkillRecord::text),
-            b: y.map(SkillRecord::text),
-            t,
-            kind,
-            starts,
-        })
-    });
+    let mut sa = SkillSlice::new(&a.skills, a.duration_s);
+    let mut sb = SkillSlice::new(&b.skills, b.duration_s);
+    let first = match first_divergence(&mut sa, &mut sb, tol) {
+        Ok(d) => d,
+        Err(e) => match e {},
+    };
     let same_world = a.final_world.same_state(&b.final_world);
     let same_outcome = a.outcome == b.outcome && a.goal_met == b.goal_met;
     Verdict {
