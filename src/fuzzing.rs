@@ -169,6 +169,7 @@ pub fn domain(data: &[u8]) {
                 path: "planned".into(),
                 policy,
                 warnings: Vec::new(),
+                dataflow: None,
             });
         }
     }

@@ -463,7 +463,7 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
 /// May `path` be a BehaviorTree.CPP file given together with others (a
 /// regular `.xml` or Groot2 `.btproj` file; a pipe is read once, as the
 /// input it is)?
-fn is_btcpp_candidate(path: &Path) -> bool {
+pub(super) fn is_btcpp_candidate(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("xml") || e.eq_ignore_ascii_case("btproj"))
@@ -476,7 +476,7 @@ fn is_btcpp_candidate(path: &Path) -> bool {
 /// `--tree ID` and several such files, the files that define `ID` (the
 /// others are read only as companions). No file defining `ID`: an error
 /// listing the trees there are.
-fn with_companions(
+pub(super) fn with_companions(
     inputs: &[format::discover::Input],
     limits: &Limits,
 ) -> Result<(Limits, Option<Vec<PathBuf>>), Diagnostic> {

@@ -97,9 +97,24 @@ pub fn execute(a: LintArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    // BehaviorTree.CPP files given together resolve each other's SubTrees
+    // (and models), as `analyze` reads them.
+    let (limits, only) = match super::commands::with_companions(&inputs, &limits) {
+        Ok(x) => x,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return EXIT_BAD_INPUT;
+        }
+    };
     let mut findings = Vec::new();
     let mut failed = false;
     for input in &inputs {
+        if let Some(only) = &only
+            && super::commands::is_btcpp_candidate(&input.path)
+            && !only.contains(&input.path)
+        {
+            continue;
+        }
         let (file, fmt) = match format::discover::read(input, &limits) {
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
             Ok(_) => continue,
@@ -110,7 +125,13 @@ pub fn execute(a: LintArgs) -> u8 {
             }
         };
         match format::load_read(file.clone(), &input.path, fmt, &limits) {
-            Ok(l) => findings.extend(lint::lint(&l.policy, Some(&file), &l.path, &cfg)),
+            Ok(l) => {
+                let subject = lint::Subject {
+                    policy: &l.policy,
+                    dataflow: l.dataflow.as_deref(),
+                };
+                findings.extend(lint::lint_subject(&subject, Some(&file), &l.path, &cfg))
+            }
             Err(d) => {
                 failed = true;
                 print_diagnostics(&mut err, &d);

@@ -28,15 +28,18 @@
 
 mod companions;
 mod expand;
+mod flow;
 mod ids;
 mod loader;
 mod node;
+pub mod ports;
 #[cfg(test)]
 mod tests;
 
 pub use companions::Companions;
 pub use ids::derive_ids;
 use loader::load;
+pub use ports::{Dataflow, builtin_ports};
 
 use super::xml::XElem;
 use super::{AssumeLeaf, Limits, Loaded};
