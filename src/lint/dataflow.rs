@@ -48,6 +48,18 @@ fn id_of<'a>(s: &'a Subject, i: usize) -> &'a str {
     }
 }
 
+/// Node `i` as a reader sees it: `label` (`id`), or `id` when they agree.
+fn who(s: &Subject, i: usize) -> String {
+    let PolicyBody::Bt(bt) = &s.policy.body else {
+        return String::new();
+    };
+    match bt.nodes.get(i) {
+        Some(n) if n.label != n.id => format!("`{}` (`{}`)", n.label, n.id),
+        Some(n) => format!("`{}`", n.id),
+        None => String::new(),
+    }
+}
+
 /// Per declared type, its ports by name (built once per type).
 fn port_maps(df: &Dataflow) -> Vec<HashMap<&str, &PortDecl>> {
     df.decls
@@ -339,10 +351,10 @@ fn read_before_write(s: &Subject, out: &mut Sink) {
             Some((w, _)) if w < r => continue,
             Some((w, wi)) if w > r => (
                 format!(
-                    "`{}` reads {} before any node writes it: the first writer, `{}`, comes later in tick order",
-                    id_of(s, fi),
+                    "{} reads {} before any node writes it: the first writer, {}, comes later in tick order",
+                    who(s, fi),
                     key_shown(df, k),
-                    id_of(s, wi)
+                    who(s, wi)
                 ),
                 "move the writer before the reader, or give the entry a value first (SetBlackboard, Script `key := ...`)".to_string(),
             ),
@@ -355,8 +367,8 @@ fn read_before_write(s: &Subject, out: &mut Sink) {
                 }
                 (
                     format!(
-                        "`{}` reads {}, which no node writes before it and nothing gives",
-                        id_of(s, fi),
+                        "{} reads {}, which no node writes before it and nothing gives",
+                        who(s, fi),
                         key_shown(df, k)
                     ),
                     if k.scope == 0 {
@@ -410,8 +422,8 @@ fn key_never_read(s: &Subject, out: &mut Sink) {
             id_of(s, wi),
             span,
             format!(
-                "`{}` writes {}, which no node of the tree reads{at}",
-                id_of(s, wi),
+                "{} writes {}, which no node of the tree reads{at}",
+                who(s, wi),
                 key_shown(df, k)
             ),
             if k.scope == 0 {
@@ -480,12 +492,12 @@ fn port_type_mismatch(s: &Subject, out: &mut Sink) {
             id_of(s, nf.node),
             span,
             format!(
-                "`{}` of `{}` reads {} as `{}`, but `{}` writes it as `{}` (port `{}`){at}",
+                "`{}` of `{}` reads {} as `{}`, but {} writes it as `{}` (port `{}`){at}",
                 u.port,
                 nf.ty,
                 key_shown(df, &u.key),
                 u.ty.as_deref().unwrap_or(""),
-                id_of(s, wi),
+                who(s, wi),
                 w.ty.as_deref().unwrap_or(""),
                 w.port
             ),

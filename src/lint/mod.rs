@@ -226,4 +226,6 @@ pub fn render_text(f: &Finding) -> String {
 }
 
 #[cfg(test)]
+mod dataflow_tests;
+#[cfg(test)]
 mod tests;
