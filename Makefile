@@ -72,6 +72,9 @@ differential: $(VENV)/.installed
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
 	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
+	$(VENV)/bin/python tests/differential/dataflow_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm --trees 1000 > $(TARGET_DIR)/dataflow_btcpp.txt 2>&1 \
+	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/dataflow_btcpp.txt | tail -40; exit 1; }
+	@tail -1 $(TARGET_DIR)/dataflow_btcpp.txt
 	$(VENV)/bin/python tests/differential/btlog_check.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_check.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_check.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_check.txt

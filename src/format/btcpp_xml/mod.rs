@@ -172,6 +172,30 @@ fn builtin_rule(ty: &str, el: &XElem, n: usize) -> Option<(String, &'static str)
             "`RetryUntilSuccessful` needs `num_attempts`".into(),
             "write num_attempts=\"3\" (-1: forever)",
         )),
+        // Ports these built-ins read when they are created: BehaviorTree.CPP
+        // 4 refuses the tree without them ("Missing port [code] in Script").
+        "Script" | "ScriptCondition" if el.attr("code").is_none() => Some((
+            format!("`{ty}` needs `code`"),
+            "write code=\"key := 1\" (the script to run)",
+        )),
+        "Precondition" if el.attr("if").is_none() => Some((
+            "`Precondition` needs `if`".into(),
+            "write if=\"battery > 20\" (the condition script)",
+        )),
+        "WasEntryUpdated" | "SkipUnlessUpdated" | "WaitValueUpdate"
+            if el.attr("entry").is_none() =>
+        {
+            Some((
+                format!("`{ty}` needs `entry`"),
+                "write entry=\"{key}\" (the blackboard entry to watch)",
+            ))
+        }
+        "LoopInt" | "LoopDouble" | "LoopString" | "LoopBool" if el.attr("queue").is_none() => {
+            Some((
+                format!("`{ty}` needs `queue`"),
+                "write queue=\"{key}\" or queue=\"1;2;3\"",
+            ))
+        }
         _ => None,
     }
 }
