@@ -49,7 +49,9 @@ test:
 # mismatches in accept_btcpp_known.txt, which must not go stale); then the
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
 # SubTrees are spread over files given together (projects_btcpp.py); every
-# SARIF log of `lint` against the official schema (sarif_check.py); logs
+# SARIF log of `lint` against the official schema (sarif_check.py); the
+# port rules of `lint` against BehaviorTree.CPP 4 creating 1000 seeded
+# random trees (dataflow_btcpp.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py); and
 # every corpus SCXML file read by btfsm and by an independent SCXML engine
 # (PyPI `scjson`) alike (tests/differential/scxml_engine.py); and

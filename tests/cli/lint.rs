@@ -158,3 +158,33 @@ fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
         ]
     );
 }
+
+#[test]
+fn lint_on_nav2_with_its_model_reports_what_docs_lint_md_lists() {
+    // docs/lint.md, "Findings on the bundled real files", Nav2 with its
+    // model: no error; the model's optional ports; the application's
+    // entries; three selectors whose output FollowPath does not take.
+    let (code, out, err) = btfsm(&[
+        "lint",
+        "tests/fixtures/corpus/bt-xml/nav2",
+        "--nodes-model",
+        "tests/fixtures/corpus/bt-xml/nav2/nav2_tree_nodes.xml",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let found = v.as_array().unwrap();
+    let count = |c: &str| found.iter().filter(|f| f["code"] == c).count();
+    assert_eq!(found.iter().filter(|f| f["level"] == "error").count(), 0);
+    assert_eq!(count("missing-required-port"), 82);
+    assert_eq!(count("key-never-read"), 46);
+    assert_eq!(count("read-before-write"), 0);
+    let selectors: Vec<&str> = found
+        .iter()
+        .filter(|f| f["code"] == "key-never-read")
+        .filter_map(|f| f["message"].as_str())
+        .filter(|m| m.contains("{selected_"))
+        .collect();
+    assert_eq!(selectors.len(), 3, "{selectors:?}");
+}
