@@ -379,6 +379,12 @@ pub fn exercise(l: &Loaded) {
         let _ = crate::report::render_analysis(std::slice::from_ref(&row), f);
     }
     let _ = crate::render::dot::policy_dot(&l.policy, &Default::default());
+    // Every lint rule, the dataflow ones on a BehaviorTree.CPP tree's ports.
+    let subject = crate::lint::Subject {
+        policy: &l.policy,
+        dataflow: l.dataflow.as_deref(),
+    };
+    let _ = crate::lint::lint_subject(&subject, None, "fuzzed", &Default::default());
     let text = crate::format::toml_write::write_policy(&l.policy);
     let again = crate::format::toml::parse_str("written.toml", &text, include_base(), &limits())
         .unwrap_or_else(|e| panic!("written TOML does not read back: {}\n{text}", e[0]));

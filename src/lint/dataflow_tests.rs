@@ -193,3 +193,53 @@ fn dataflow_rules_are_linear_in_nodes_and_ports() {
     );
     assert!(t.elapsed().as_secs() < 20, "{:?}", t.elapsed());
 }
+
+/// A tree with every dataflow feature: models with ports, SubTrees with
+/// remaps, literals and `_autoremap`, scripts, `{@key}`, built-ins.
+const SEED: &str = r#"<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence _skipIf="stop == true">
+      <Script code="n := 1; m += n"/>
+      <Detect pose="{pose}"/>
+      <SubTree ID="Sub" target="{pose}" count="3" out="{res}"/>
+      <SubTree ID="Sub" _autoremap="true"/>
+      <LoopInt queue="1;2" value="{v}"><Sleep msec="{v}"/></LoopInt>
+      <SetBlackboard value="{res}" output_key="copy"/>
+      <Pick pose="{@pose}" extra="1"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Sub">
+    <Fallback>
+      <Pick pose="{target}"/>
+      <Detect pose="{out}"/>
+      <Precondition if="count > 1"><Repeat num_cycles="{count}"><AlwaysSuccess/></Repeat></Precondition>
+    </Fallback>
+  </BehaviorTree>
+  <TreeNodesModel>
+    <SubTree ID="Main"><input_port name="stop"/></SubTree>
+    <Action ID="Detect"><output_port name="pose" type="Pose"/></Action>
+    <Condition ID="Pick"><input_port name="pose" type="Pose" default="{x}"/><inout_port name="io"/></Condition>
+  </TreeNodesModel>
+</root>"#;
+
+#[test]
+fn the_seed_tree_reads_and_lints() {
+    let found = codes(SEED);
+    assert!(found.contains(&"undeclared-port".to_string()), "{found:?}");
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
+
+    /// Mutated dataflow trees never panic the rules.
+    #[test]
+    fn mutated_dataflow_trees_never_panic(
+        cuts in proptest::collection::vec((0usize..2000, 0usize..8, "[<>/={}@:;\" a-zA-Z_]{0,3}"), 1..4)
+    ) {
+        let text = crate::format::xml::mutate(SEED, &cuts);
+        if let Ok(l) = crate::format::btcpp_xml::parse_str("t.xml", &text, Path::new("."), &Default::default()) {
+            let s = Subject { policy: &l.policy, dataflow: l.dataflow.as_deref() };
+            let _ = lint_subject(&s, None, "t.xml", &config::Config::default());
+        }
+    }
+}
