@@ -243,21 +243,21 @@ struct KeyFacts {
 /// Every key's facts, the keys SubTrees remap to, and the keys provided
 /// from outside the nodes (literals given by SubTrees, the tree's declared
 /// inputs).
-struct Facts {
-    keys: HashMap<Key, KeyFacts>,
-    remapped: HashSet<Key>,
+struct Facts<'a> {
+    keys: HashMap<&'a Key, KeyFacts>,
+    remapped: HashSet<&'a Key>,
     provided: HashSet<Key>,
     /// Keys of the tree's own blackboard the application reads (its
     /// declared outputs).
     exported: HashSet<Key>,
 }
 
-fn facts(df: &Dataflow) -> Facts {
-    let mut keys: HashMap<Key, KeyFacts> = HashMap::new();
+fn facts(df: &Dataflow) -> Facts<'_> {
+    let mut keys: HashMap<&Key, KeyFacts> = HashMap::new();
     // Flows are in expansion order, which is the tree's preorder.
     for (pos, nf) in df.nodes.iter().enumerate() {
         for (u, k) in nf.keys.iter().enumerate() {
-            let f = keys.entry(k.key.clone()).or_default();
+            let f = keys.entry(&k.key).or_default();
             let reads = matches!(k.access, Access::Read | Access::ReadWrite);
             let writes = matches!(k.access, Access::Write | Access::ReadWrite);
             f.read |= reads || matches!(k.access, Access::ScriptRead | Access::Unknown);
@@ -278,7 +278,7 @@ fn facts(df: &Dataflow) -> Facts {
     let remapped = df
         .subtrees
         .iter()
-        .flat_map(|st| st.remap.iter().filter_map(|r| r.2.clone()))
+        .flat_map(|st| st.remap.iter().filter_map(|r| r.2.as_ref()))
         .collect();
     let mut provided: HashSet<Key> = df.given.iter().cloned().collect();
     let mut exported = HashSet::new();
@@ -303,8 +303,8 @@ fn facts(df: &Dataflow) -> Facts {
 }
 
 /// The keys of `df` in a deterministic order (scope, name).
-fn sorted(f: &Facts) -> Vec<(&Key, &KeyFacts)> {
-    let mut v: Vec<_> = f.keys.iter().collect();
+fn sorted<'a>(f: &'a Facts) -> Vec<(&'a Key, &'a KeyFacts)> {
+    let mut v: Vec<_> = f.keys.iter().map(|(k, kf)| (*k, kf)).collect();
     v.sort_by(|a, b| a.0.cmp(b.0));
     v
 }
