@@ -48,12 +48,10 @@ impl SourceFile {
     fn chars_before(&self, offset: usize) -> usize {
         let steps = self.char_steps.get_or_init(|| {
             let mut v = vec![0];
-            let mut n = 0;
-            for (i, _) in self.text.char_indices() {
+            for (n, (i, _)) in self.text.char_indices().enumerate() {
                 while i >= v.len() * CHAR_STEP {
                     v.push(n);
                 }
-                n += 1;
             }
             v
         });
