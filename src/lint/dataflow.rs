@@ -13,7 +13,7 @@
 
 use super::{Level, Rule, Sink, Subject};
 use crate::format::btcpp_xml::Dataflow;
-use crate::format::btcpp_xml::ports::{Access, Key, PortDecl, PortDir, is_pointer};
+use crate::format::btcpp_xml::ports::{Access, Key, KeyUse, PortDecl, PortDir, is_pointer};
 use crate::model::{BtNodeKind, PolicyBody};
 use std::collections::{HashMap, HashSet};
 use std::ops::Range;
@@ -254,8 +254,20 @@ struct Facts<'a> {
 
 fn facts(df: &Dataflow) -> Facts<'_> {
     let mut keys: HashMap<&Key, KeyFacts> = HashMap::new();
+    // The scripts of SubTree elements run at their subtree's root.
+    let mut at_root: HashMap<usize, Vec<&KeyUse>> = HashMap::new();
+    for st in &df.subtrees {
+        at_root.entry(st.node).or_default().extend(&st.keys);
+    }
     // Flows are in expansion order, which is the tree's preorder.
     for (pos, nf) in df.nodes.iter().enumerate() {
+        for k in at_root.get(&pos).into_iter().flatten() {
+            let f = keys.entry(&k.key).or_default();
+            f.read |= matches!(k.access, Access::ScriptRead | Access::ReadWrite);
+            if matches!(k.access, Access::Write | Access::ReadWrite) && f.first_write.is_none() {
+                f.first_write = Some((pos, pos));
+            }
+        }
         for (u, k) in nf.keys.iter().enumerate() {
             let f = keys.entry(&k.key).or_default();
             let reads = matches!(k.access, Access::Read | Access::ReadWrite);

@@ -111,6 +111,12 @@ fn scripts_and_set_blackboard_write_entries() {
         "",
     );
     assert_eq!(codes(&late), ["read-before-write"]);
+    // A SubTree element's scripts use the enclosing tree's entries.
+    let sub = tree(
+        r#"<Sequence><Script code="done := false"/><SubTree ID="S" _skipIf="done"/></Sequence>"#,
+        r#"<BehaviorTree ID="S"><AlwaysSuccess/></BehaviorTree>"#,
+    );
+    assert_eq!(codes(&sub), Vec::<String>::new());
     // Names a script only reads may be enums: never "read before write".
     let enums = tree(
         r#"<Sequence><Script code="mode == IDLE"/><AlwaysSuccess _onSuccess="mode = BUSY"/></Sequence>"#,

@@ -6,7 +6,7 @@
 use super::super::xml::shown;
 use super::derive_ids;
 use super::loader::Loader;
-use super::ports::{Key, SubTreeFlow};
+use super::ports::{Key, KeyUse, SCRIPT_ATTRS, SubTreeFlow};
 use crate::diagnostic::suggest;
 use crate::model::{Bt, BtNode};
 use std::collections::{BTreeMap, HashMap};
@@ -194,12 +194,29 @@ impl Loader<'_> {
                     .iter()
                     .any(|k| el.attr(k) == Some("true") || el.attr(k) == Some("1"));
                 pending.push(self.flow.subtrees.len());
+                let mut script_keys = Vec::new();
+                for a in el
+                    .attrs
+                    .iter()
+                    .filter(|a| a.ns.is_none() && SCRIPT_ATTRS.contains(&a.name.as_str()))
+                {
+                    for (name, access) in super::ports::script_keys(&a.value) {
+                        script_keys.push(KeyUse {
+                            key: chain.resolve_key(&frames, &name),
+                            access,
+                            port: a.name.clone(),
+                            ty: None,
+                            span: a.span.clone(),
+                        });
+                    }
+                }
                 self.flow.subtrees.push(SubTreeFlow {
                     id: id.clone(),
                     doc: it.d,
                     span: el.span.clone(),
                     node: usize::MAX,
                     remap: flow_remap,
+                    keys: script_keys,
                 });
                 frames.push(Frame {
                     id,

@@ -135,6 +135,9 @@ pub struct SubTreeFlow {
     /// Port name, value as written, the outer key it maps to (`None`: a
     /// literal), attribute span.
     pub remap: Vec<(String, String, Option<Key>, Range<usize>)>,
+    /// The entries its pre- and post-condition scripts (`_skipIf`,
+    /// `_onSuccess`, ...) use, in the enclosing tree's blackboard.
+    pub keys: Vec<KeyUse>,
 }
 
 /// Blackboard dataflow of an expanded BehaviorTree.CPP tree.
