@@ -50,7 +50,9 @@ test:
 # mismatches in accept_btcpp_known.txt, which must not go stale); then the
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
 # SubTrees are spread over files given together (projects_btcpp.py); every
-# SARIF log of `lint` against the official schema (sarif_check.py); logs
+# SARIF log of `lint` against the official schema (sarif_check.py); the
+# port rules of `lint` against BehaviorTree.CPP 4 creating 1000 seeded
+# random trees (dataflow_btcpp.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
 # compared by `log compare` as its Python leaves saw them (btlog_compare.py),
 # and as SqliteLogger .db3 sessions counted by SQL (btlog_db3.py); and
@@ -75,6 +77,9 @@ differential: $(VENV)/.installed
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
 	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
+	$(VENV)/bin/python tests/differential/dataflow_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm --trees 1000 > $(TARGET_DIR)/dataflow_btcpp.txt 2>&1 \
+	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/dataflow_btcpp.txt | tail -40; exit 1; }
+	@tail -1 $(TARGET_DIR)/dataflow_btcpp.txt
 	$(VENV)/bin/python tests/differential/btlog_check.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/btlog_check.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_check.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_check.txt

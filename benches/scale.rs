@@ -1,8 +1,11 @@
 //! Scale benchmark (issue: large inputs): a BT with 100,000 nodes, a BT nested
 //! 100,000 levels deep, a chain of 100,000 Sequences each guarding a Move-To
 //! (every level a chattering-order finding for `lint`) and a fault-tolerant
-//! FSM with 10,000 states are parsed, validated, analyzed and linted; prints
-//! the time of each phase. Target: under 1 s per input, end to end, and
+//! FSM with 10,000 states are parsed, validated, analyzed and linted, and a
+//! BehaviorTree.CPP tree of 100,000 nodes with a `<TreeNodesModel>` (every
+//! node reading or writing blackboard entries, a dataflow finding at most
+//! levels) is read and linted with its dataflow; prints the time of each
+//! phase. Target: under 1 s per input, end to end, and
 //! under 1 s for `lint` (issue 17). Run with `cargo bench --bench scale`.
 
 use btfsm::format::{Limits, Loaded, toml::parse_str};
@@ -162,6 +165,54 @@ fn run(name: &str, text: &str) {
     );
 }
 
+/// A BehaviorTree.CPP tree: a root Sequence of Fallbacks, each (Pick
+/// reading `{k<i>}`, Detect writing `{k<i+1>}`, a Script writing `s<i>`),
+/// 1 + 4k nodes; every Pick reads an entry written only later.
+pub fn btcpp_dataflow(nodes: usize) -> String {
+    let k = (nodes - 1) / 4;
+    let mut s = String::from(
+        r#"<root BTCPP_format="4" main_tree_to_execute="Main"><BehaviorTree ID="Main"><Sequence>"#,
+    );
+    for i in 0..k {
+        let _ = write!(
+            s,
+            r#"<Fallback><Pick pose="{{k{i}}}" speed="1"/><Detect pose="{{k{}}}"/><Script code="s{i} := {i}"/></Fallback>"#,
+            i + 1
+        );
+    }
+    s.push_str(
+        r#"</Sequence></BehaviorTree><TreeNodesModel><Action ID="Detect"><output_port name="pose" type="Pose"/></Action><Condition ID="Pick"><input_port name="pose" type="Point"/></Condition></TreeNodesModel></root>"#,
+    );
+    s
+}
+
+fn run_btcpp(name: &str, text: &str) {
+    let t0 = Instant::now();
+    let loaded =
+        btfsm::format::btcpp_xml::parse_str(name, text, Path::new("."), &Limits::default())
+            .unwrap_or_else(|e| panic!("{name}: {}", e[0]));
+    let t_parse = t0.elapsed();
+    let t1 = Instant::now();
+    let subject = btfsm::lint::Subject {
+        policy: &loaded.policy,
+        dataflow: loaded.dataflow.as_deref(),
+    };
+    let findings = btfsm::lint::lint_subject(&subject, None, name, &Default::default());
+    let t_lint = t1.elapsed();
+    println!(
+        "{name:<22} parse {:>7.1} ms  lint {:>7.1} ms ({} findings)  {}",
+        t_parse.as_secs_f64() * 1e3,
+        t_lint.as_secs_f64() * 1e3,
+        findings.len(),
+        if t_lint.as_secs_f64() < 1.0 {
+            "ok (< 1 s)"
+        } else {
+            "SLOW (target < 1 s)"
+        }
+    );
+    assert!(!findings.is_empty());
+}
+
 fn main() {
     // `cargo test --benches` runs this too: keep it quick there.
     let quick = std::env::args().any(|a| a == "--test");
@@ -174,4 +225,5 @@ fn main() {
     run("bt 100k levels deep", &deep_bt(d));
     run("bt 100k chain of seqs", &chain_bt(d));
     run("fsm 10k states", &big_fsm(m));
+    run_btcpp("bt.cpp 100k dataflow", &btcpp_dataflow(n));
 }

@@ -15,7 +15,15 @@ pub struct SourceFile {
     /// Byte offset of each line's start, computed on first use, so that
     /// positioning many messages in a large file stays linear.
     line_starts: std::sync::OnceLock<Vec<usize>>,
+    /// Characters before every [`CHAR_STEP`]-th byte, computed on first
+    /// use, so that a column on a very long line (a one-line XML file with
+    /// thousands of findings) is counted from the nearest step, not from
+    /// the line's start.
+    char_steps: std::sync::OnceLock<Vec<usize>>,
 }
+
+/// Bytes between two entries of `SourceFile::char_steps`.
+const CHAR_STEP: usize = 4096;
 
 impl SourceFile {
     pub fn new(path: impl Into<String>, text: impl Into<String>) -> Arc<Self> {
@@ -23,6 +31,7 @@ impl SourceFile {
             path: path.into(),
             text: text.into(),
             line_starts: std::sync::OnceLock::new(),
+            char_steps: std::sync::OnceLock::new(),
         })
     }
 
@@ -34,14 +43,52 @@ impl SourceFile {
         })
     }
 
+    /// Characters in `text[..offset]` (`offset` on a char boundary), from
+    /// the nearest step below it: at most [`CHAR_STEP`] bytes counted.
+    fn chars_before(&self, offset: usize) -> usize {
+        let steps = self.char_steps.get_or_init(|| {
+            let mut v = vec![0];
+            for (n, (i, _)) in self.text.char_indices().enumerate() {
+                while i >= v.len() * CHAR_STEP {
+                    v.push(n);
+                }
+            }
+            v
+        });
+        let k = (offset / CHAR_STEP).min(steps.len() - 1);
+        // The step's byte may fall inside a character: the step counts the
+        // characters before the first boundary at or after it.
+        let mut from = k * CHAR_STEP;
+        while from < self.text.len() && !self.text.is_char_boundary(from) {
+            from += 1;
+        }
+        let from = from.min(offset);
+        steps[k] + self.text[from..offset].chars().count()
+    }
+
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: usize) -> (usize, usize) {
         let offset = floor_char_boundary(&self.text, offset.min(self.text.len()));
         let starts = self.line_starts();
         let line = starts.partition_point(|&s| s <= offset);
         let line_start = starts[line - 1];
-        let col = self.text[line_start..offset].chars().count() + 1;
+        let col = if offset - line_start <= CHAR_STEP {
+            self.text[line_start..offset].chars().count() + 1
+        } else {
+            self.chars_before(offset) - self.chars_before(line_start) + 1
+        };
         (line, col)
+    }
+
+    /// Characters of a 1-based line (without its newline), counted from
+    /// the nearest steps on a long line.
+    pub fn line_chars(&self, line: usize) -> usize {
+        let text = self.line_text(line);
+        if text.len() <= 2 * CHAR_STEP {
+            return text.chars().count();
+        }
+        let start = self.line_starts()[line - 1];
+        self.chars_before(start + text.len()) - self.chars_before(start)
     }
 
     /// The text of a 1-based line, without its newline.
@@ -173,7 +220,7 @@ impl fmt::Display for Diagnostic {
                     writeln!(f, "{pad}--> {path}:{line}:{col}")?;
                     let text = file.line_text(line);
                     // Underline the span, clipped to this line.
-                    let line_chars = text.chars().count();
+                    let line_chars = file.line_chars(line);
                     let span_chars =
                         file.text[floor_char_boundary(&file.text, span.start.min(file.text.len()))
                             ..floor_char_boundary(&file.text, span.end.min(file.text.len()))]
@@ -293,6 +340,28 @@ pub fn suggest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn columns_on_long_lines_count_characters_from_the_line_start() {
+        // Mixed 1- to 4-byte characters on lines longer than CHAR_STEP,
+        // every offset checked against counting from the line's start.
+        let unit = "ab\u{e9}\u{20ac}\u{1f600}<x y=\"{k}\"/>";
+        let text = format!("{}\n{}\n\u{e9}", unit.repeat(900), unit.repeat(1200));
+        let f = SourceFile::new("long.xml", text.clone());
+        let naive = |o: usize| {
+            let start = text[..o].rfind('\n').map_or(0, |i| i + 1);
+            (
+                text[..o].matches('\n').count() + 1,
+                text[start..o].chars().count() + 1,
+            )
+        };
+        for (o, _) in text.char_indices().step_by(7).chain([(text.len(), ' ')]) {
+            assert_eq!(f.line_col(o), naive(o), "offset {o}");
+        }
+        for (l, t) in text.split('\n').enumerate() {
+            assert_eq!(f.line_chars(l + 1), t.chars().count());
+        }
+    }
 
     #[test]
     fn line_and_column() {

@@ -169,6 +169,7 @@ pub fn domain(data: &[u8]) {
                 path: "planned".into(),
                 policy,
                 warnings: Vec::new(),
+                dataflow: None,
             });
         }
     }
@@ -391,6 +392,12 @@ pub fn exercise(l: &Loaded) {
         assert!(crate::render::dot::check_fold(&l.policy, &folded).is_ok());
         let _ = crate::render::dot::policy_dot(&l.policy, &folded);
     }
+    // Every lint rule, the dataflow ones on a BehaviorTree.CPP tree's ports.
+    let subject = crate::lint::Subject {
+        policy: &l.policy,
+        dataflow: l.dataflow.as_deref(),
+    };
+    let _ = crate::lint::lint_subject(&subject, None, "fuzzed", &Default::default());
     let text = crate::format::toml_write::write_policy(&l.policy);
     let again = crate::format::toml::parse_str("written.toml", &text, include_base(), &limits())
         .unwrap_or_else(|e| panic!("written TOML does not read back: {}\n{text}", e[0]));

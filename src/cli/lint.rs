@@ -97,8 +97,8 @@ pub fn execute(a: LintArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
-    // BehaviorTree.CPP files given together resolve each other's SubTrees,
-    // as for every command (README "BehaviorTree.CPP projects").
+    // BehaviorTree.CPP files given together resolve each other's SubTrees
+    // (and models), as `analyze` reads them.
     let (limits, only) = match super::commands::with_companions(&inputs, &limits) {
         Ok(x) => x,
         Err(d) => {
@@ -110,10 +110,11 @@ pub fn execute(a: LintArgs) -> u8 {
     let mut failed = false;
     let mut models = SiblingModels::default();
     for input in &inputs {
-        if only.as_ref().is_some_and(|o| !o.contains(&input.path))
+        if let Some(only) = &only
             && super::commands::is_btcpp_candidate(&input.path)
+            && !only.contains(&input.path)
         {
-            continue; // a companion of the files that define `--tree`
+            continue;
         }
         let (file, fmt) = match format::discover::read(input, &limits) {
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
@@ -126,7 +127,13 @@ pub fn execute(a: LintArgs) -> u8 {
         };
         let limits = models.limits_for(&input.path, fmt, &limits);
         match format::load_read(file.clone(), &input.path, fmt, &limits) {
-            Ok(l) => findings.extend(lint::lint(&l.policy, Some(&file), &l.path, &cfg)),
+            Ok(l) => {
+                let subject = lint::Subject {
+                    policy: &l.policy,
+                    dataflow: l.dataflow.as_deref(),
+                };
+                findings.extend(lint::lint_subject(&subject, Some(&file), &l.path, &cfg))
+            }
             Err(d) => {
                 // Coded load errors are findings (lint::load); the others
                 // mean the input does not load.

@@ -160,6 +160,7 @@ pub fn execute(a: PlanArgs) -> u8 {
                 path,
                 policy: (*p).clone(),
                 warnings: Vec::new(),
+                dataflow: None,
             })
         })
         .collect();

@@ -24,6 +24,9 @@ pub struct Loaded {
     pub path: String,
     pub policy: Policy,
     pub warnings: Vec<Diagnostic>,
+    /// A BehaviorTree.CPP tree's blackboard dataflow (ports, keys,
+    /// SubTree remappings), for `lint`; `None` for other formats.
+    pub dataflow: Option<Arc<btcpp_xml::Dataflow>>,
 }
 
 /// Resource limits on input (hostile or accidental). Each is an error with
@@ -348,6 +351,7 @@ pub(crate) fn finish(
             path: file.path.clone(),
             policy,
             warnings,
+            dataflow: None,
         }),
         _ => {
             let mut all = errors;

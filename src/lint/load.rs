@@ -11,13 +11,12 @@
 //! and `ParallelNode::tick` thresholds, its recursive-SubTree check in
 //! `XMLParser`, and its include handling.
 
-use super::{Finding, Level, Rule, Sink, config};
+use super::{Finding, Level, Rule, Sink, Subject, config};
 use crate::diagnostic::Diagnostic;
-use crate::model::Policy;
 
 /// Nothing to check on a loaded policy: these rules are found by the
 /// readers.
-fn found_by_the_reader(_: &Policy, _: &mut Sink) {}
+fn found_by_the_reader(_: &Subject, _: &mut Sink) {}
 
 pub const EMPTY_COMPOSITE: Rule = Rule {
     code: "empty-composite",

@@ -8,10 +8,12 @@
 //!
 //! Rules: [`structure`] (BT and FSM shape), [`paper`] (the paper's notions:
 //! chattering-prone precondition order, unguarded actions, fault tolerance,
-//! fully connected states), [`load`] (what makes a file not load: the
-//! readers find it, lint reports it with a code).
+//! fully connected states), [`dataflow`] (BehaviorTree.CPP ports and
+//! blackboard keys), [`load`] (what makes a file not load: the readers
+//! find it, lint reports it with a code).
 
 pub mod config;
+pub mod dataflow;
 pub mod load;
 pub mod paper;
 pub mod sarif;
@@ -49,7 +51,21 @@ pub struct Rule {
     pub code: &'static str,
     pub level: Level,
     pub summary: &'static str,
-    pub check: fn(&Policy, &mut Sink),
+    pub check: fn(&Subject, &mut Sink),
+}
+
+/// What a rule checks: the policy and, for a BehaviorTree.CPP tree, its
+/// blackboard dataflow. Dereferences to the policy.
+pub struct Subject<'a> {
+    pub policy: &'a Policy,
+    pub dataflow: Option<&'a crate::format::btcpp_xml::Dataflow>,
+}
+
+impl std::ops::Deref for Subject<'_> {
+    type Target = Policy;
+    fn deref(&self) -> &Policy {
+        self.policy
+    }
 }
 
 /// Every rule, in docs/lint.md order.
@@ -62,6 +78,13 @@ pub const RULES: &[Rule] = &[
     paper::UNGUARDED_FALLBACK_ACTION,
     paper::NOT_FAULT_TOLERANT,
     paper::FULLY_CONNECTED_STATE,
+    dataflow::OUTPUT_PORT_LITERAL,
+    dataflow::UNDECLARED_PORT,
+    dataflow::MISSING_REQUIRED_PORT,
+    dataflow::READ_BEFORE_WRITE,
+    dataflow::KEY_NEVER_READ,
+    dataflow::PORT_TYPE_MISMATCH,
+    dataflow::SUBTREE_REMAP_UNPROVIDED,
     load::EMPTY_COMPOSITE,
     load::WRONG_CHILD_COUNT,
     load::PARALLEL_THRESHOLD,
@@ -127,6 +150,21 @@ pub fn lint(
     display: &str,
     cfg: &config::Config,
 ) -> Vec<Finding> {
+    let subject = Subject {
+        policy,
+        dataflow: None,
+    };
+    lint_subject(&subject, file, display, cfg)
+}
+
+/// [`lint`] of a policy with its dataflow (a loaded BehaviorTree.CPP tree:
+/// [`crate::format::Loaded::dataflow`]).
+pub fn lint_subject(
+    subject: &Subject,
+    file: Option<&Arc<SourceFile>>,
+    display: &str,
+    cfg: &config::Config,
+) -> Vec<Finding> {
     let mut out = Vec::new();
     for r in RULES {
         let level = cfg.level(r);
@@ -134,7 +172,7 @@ pub fn lint(
             continue;
         }
         let mut sink = Sink::default();
-        (r.check)(policy, &mut sink);
+        (r.check)(subject, &mut sink);
         for raw in sink.found {
             let source = match (file, raw.span) {
                 (Some(f), Some(sp))
@@ -194,5 +232,7 @@ pub fn render_text(f: &Finding) -> String {
     }
 }
 
+#[cfg(test)]
+mod dataflow_tests;
 #[cfg(test)]
 mod tests;

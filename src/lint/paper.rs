@@ -4,8 +4,8 @@
 //! effort they cost (Eq. 4). Skills' effects come from the built-in action
 //! domain, `policies/domains/moma.toml` (README "Action domains").
 
-use super::{Level, Rule, Sink};
-use crate::model::{Bt, BtNodeKind, Policy, PolicyBody, StateBody, Trigger};
+use super::{Level, Rule, Sink, Subject};
+use crate::model::{Bt, BtNodeKind, PolicyBody, StateBody, Trigger};
 use crate::plan::Domain;
 use crate::plan::fact::Fact;
 use std::collections::{BTreeMap, HashMap};
@@ -116,7 +116,7 @@ fn of_action(d: &Domain, node: &crate::model::BtNode) -> Undoes {
     u
 }
 
-fn chattering(p: &Policy, out: &mut Sink) {
+fn chattering(p: &Subject, out: &mut Sink) {
     let PolicyBody::Bt(bt) = &p.body else { return };
     let d = crate::plan::domain::builtin();
     // Post-order: each subtree's undoes, built from its children's (small
@@ -222,7 +222,7 @@ pub const UNGUARDED_FALLBACK_ACTION: Rule = Rule {
     check: unguarded,
 };
 
-fn unguarded(p: &Policy, out: &mut Sink) {
+fn unguarded(p: &Subject, out: &mut Sink) {
     let PolicyBody::Bt(bt) = &p.body else { return };
     for node in &bt.nodes {
         if !matches!(node.kind, BtNodeKind::Fallback | BtNodeKind::FallbackMemory) {
@@ -253,7 +253,7 @@ pub const NOT_FAULT_TOLERANT: Rule = Rule {
     check: not_fault_tolerant,
 };
 
-fn not_fault_tolerant(p: &Policy, out: &mut Sink) {
+fn not_fault_tolerant(p: &Subject, out: &mut Sink) {
     let PolicyBody::Machine(m) = &p.body else {
         return;
     };
@@ -293,7 +293,7 @@ pub const FULLY_CONNECTED_STATE: Rule = Rule {
     check: fully_connected,
 };
 
-fn fully_connected(p: &Policy, out: &mut Sink) {
+fn fully_connected(p: &Subject, out: &mut Sink) {
     let PolicyBody::Machine(m) = &p.body else {
         return;
     };

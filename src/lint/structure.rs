@@ -5,8 +5,8 @@
 //! without one child, recursive SubTrees, includes too deep — is a load
 //! error (exit 2), which `lint` reports as `validate` does.
 
-use super::{Level, Rule, Sink};
-use crate::model::{Bt, BtNodeKind, Policy, PolicyBody, StateBody, Target};
+use super::{Level, Rule, Sink, Subject};
+use crate::model::{Bt, BtNodeKind, PolicyBody, StateBody, Target};
 
 /// How a subtree always ends, when its shape decides it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,7 +57,7 @@ pub const UNREACHABLE_CHILD: Rule = Rule {
     check: unreachable_child,
 };
 
-fn unreachable_child(p: &Policy, out: &mut Sink) {
+fn unreachable_child(p: &Subject, out: &mut Sink) {
     let PolicyBody::Bt(bt) = &p.body else { return };
     for node in &bt.nodes {
         let stop = if is_fallback(node.kind) {
@@ -149,7 +149,7 @@ fn may_run(bt: &Bt, c: usize) -> bool {
             .is_some_and(|t| SYNCHRONOUS_ACTIONS.contains(&t))
 }
 
-fn reactive_async_siblings(p: &Policy, out: &mut Sink) {
+fn reactive_async_siblings(p: &Subject, out: &mut Sink) {
     let PolicyBody::Bt(bt) = &p.body else { return };
     for node in &bt.nodes {
         if !matches!(node.kind, BtNodeKind::Sequence | BtNodeKind::Fallback) {
@@ -184,7 +184,7 @@ pub const STATE_WITHOUT_EXIT: Rule = Rule {
     check: state_without_exit,
 };
 
-fn state_without_exit(p: &Policy, out: &mut Sink) {
+fn state_without_exit(p: &Subject, out: &mut Sink) {
     let PolicyBody::Machine(m) = &p.body else {
         return;
     };
@@ -228,7 +228,7 @@ pub const OUTCOME_NEVER_REACHED: Rule = Rule {
     check: outcome_never_reached,
 };
 
-fn outcome_never_reached(p: &Policy, out: &mut Sink) {
+fn outcome_never_reached(p: &Subject, out: &mut Sink) {
     let PolicyBody::Machine(m) = &p.body else {
         return;
     };

@@ -129,7 +129,7 @@ fn the_paper_policies_have_one_lint_error_fig_3() {
 
 #[test]
 fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
-    // docs/lint.md, "Findings on the bundled real files": two, both
+    // docs/lint.md, "Findings on the bundled real files": three, each
     // explained there; none on a state a sibling parallel region leaves.
     // Every file loads (Nav2's trees with the nav2_tree_nodes.xml beside
     // them, unknown leaves as actions): no error on stderr, exit 1 for the
@@ -138,10 +138,26 @@ fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
     assert_eq!(code, 1, "{err}");
     assert!(err.is_empty(), "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let found: Vec<String> = v
-        .as_array()
-        .unwrap()
+    // Nav2's trees, read with the model beside them, get what the test
+    // with `--nodes-model` counts (no error; the model's optional ports and
+    // the application's entries; `lint_on_nav2_with_its_model_...`).
+    let all = v.as_array().unwrap();
+    let nav2: Vec<&serde_json::Value> = all
         .iter()
+        .filter(|f| f["file"].as_str().unwrap().contains("/nav2/"))
+        .collect();
+    let count = |c: &str| nav2.iter().filter(|f| f["code"] == c).count();
+    assert_eq!(
+        (
+            nav2.len(),
+            count("missing-required-port"),
+            count("key-never-read")
+        ),
+        (128, 82, 46)
+    );
+    let found: Vec<String> = all
+        .iter()
+        .filter(|f| !f["file"].as_str().unwrap().contains("/nav2/"))
         .map(|f| {
             format!(
                 "{} {} {}",
@@ -154,6 +170,7 @@ fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
     assert_eq!(
         found,
         [
+            "key-never-read subtree_with_remapping.xml BehaviorTree/0",
             "state-without-exit parallel-01.scxml end",
             "state-without-exit deep-initial.scxml uber/s2"
         ]
@@ -241,4 +258,34 @@ fn lint_resolves_subtrees_across_the_files_given_together() {
     let (code, _, err) = btfsm(&["lint", "tests/fixtures/btcpp-projects/pick/pick.xml"]);
     assert_eq!(code, 2);
     assert!(err.contains("unknown tree `Approach`"), "{err}");
+}
+
+#[test]
+fn lint_on_nav2_with_its_model_reports_what_docs_lint_md_lists() {
+    // docs/lint.md, "Findings on the bundled real files", Nav2 with its
+    // model: no error; the model's optional ports; the application's
+    // entries; three selectors whose output FollowPath does not take.
+    let (code, out, err) = btfsm(&[
+        "lint",
+        "tests/fixtures/corpus/bt-xml/nav2",
+        "--nodes-model",
+        "tests/fixtures/corpus/bt-xml/nav2/nav2_tree_nodes.xml",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let found = v.as_array().unwrap();
+    let count = |c: &str| found.iter().filter(|f| f["code"] == c).count();
+    assert_eq!(found.iter().filter(|f| f["level"] == "error").count(), 0);
+    assert_eq!(count("missing-required-port"), 82);
+    assert_eq!(count("key-never-read"), 46);
+    assert_eq!(count("read-before-write"), 0);
+    let selectors: Vec<&str> = found
+        .iter()
+        .filter(|f| f["code"] == "key-never-read")
+        .filter_map(|f| f["message"].as_str())
+        .filter(|m| m.contains("{selected_"))
+        .collect();
+    assert_eq!(selectors.len(), 3, "{selectors:?}");
 }

@@ -6,6 +6,7 @@
 use super::super::xml::shown;
 use super::derive_ids;
 use super::loader::Loader;
+use super::ports::{Key, KeyUse, SCRIPT_ATTRS, SubTreeFlow};
 use crate::diagnostic::suggest;
 use crate::model::{Bt, BtNode};
 use std::collections::{BTreeMap, HashMap};
@@ -32,8 +33,11 @@ impl Loader<'_> {
             id: tree_id.to_string(),
             parent: None,
             remap: BTreeMap::new(),
+            keys: BTreeMap::new(),
             autoremap: false,
         }];
+        // SubTree elements whose root node is the next node made.
+        let mut pending: Vec<usize> = Vec::new();
         // The expansions enclosing the element being read: recursion and
         // port remapping are looked up in O(1) per SubTree and port.
         let mut chain = Chain::default();
@@ -158,28 +162,71 @@ impl Loader<'_> {
                 // entry to an outer entry by its bare name: `target="goal"`
                 // is format 4's `target="{goal}"`.
                 let keys_by_name = tag == "SubTree" && self.format_3(it.d);
-                let remap = el
+                let mut remap = BTreeMap::new();
+                let mut keys = BTreeMap::new();
+                let mut flow_remap = Vec::new();
+                let me = frames.len();
+                for a in el
                     .attrs
                     .iter()
                     .filter(|a| a.ns.is_none() && !SUBTREE_ATTRS.contains(&a.name.as_str()))
-                    .map(|a| {
-                        let v = if a.value == "{=}" {
-                            format!("{{{}}}", a.name)
-                        } else if keys_by_name && port_key(&a.value).is_none() {
-                            format!("{{{}}}", a.value)
-                        } else {
-                            a.value.clone()
-                        };
-                        (a.name.clone(), chain.resolve(&frames, &v))
-                    })
-                    .collect();
+                {
+                    let v = if a.value == "{=}" {
+                        format!("{{{}}}", a.name)
+                    } else if keys_by_name && port_key(&a.value).is_none() {
+                        format!("{{{}}}", a.value)
+                    } else {
+                        a.value.clone()
+                    };
+                    // The entry the port designates: an outer one, or its
+                    // own, set to the literal.
+                    let key = port_key(&v).map(|k| chain.resolve_key(&frames, k));
+                    let inner = key.clone().unwrap_or_else(|| Key {
+                        scope: me,
+                        name: a.name.clone(),
+                    });
+                    if !a.name.starts_with('_') {
+                        if key.is_none() {
+                            self.flow.given.push(inner.clone());
+                        }
+                        flow_remap.push((a.name.clone(), a.value.clone(), key, a.span.clone()));
+                    }
+                    keys.insert(a.name.clone(), inner);
+                    remap.insert(a.name.clone(), chain.resolve(&frames, &v));
+                }
                 let autoremap = ["_autoremap", "__autoremap", "__shared_blackboard"]
                     .iter()
                     .any(|k| el.attr(k) == Some("true") || el.attr(k) == Some("1"));
+                pending.push(self.flow.subtrees.len());
+                let mut script_keys = Vec::new();
+                for a in el
+                    .attrs
+                    .iter()
+                    .filter(|a| a.ns.is_none() && SCRIPT_ATTRS.contains(&a.name.as_str()))
+                {
+                    for (name, access) in super::ports::script_keys(&a.value) {
+                        script_keys.push(KeyUse {
+                            key: chain.resolve_key(&frames, &name),
+                            access,
+                            port: a.name.clone(),
+                            ty: None,
+                            span: a.span.clone(),
+                        });
+                    }
+                }
+                self.flow.subtrees.push(SubTreeFlow {
+                    id: id.clone(),
+                    doc: it.d,
+                    span: el.span.clone(),
+                    node: usize::MAX,
+                    remap: flow_remap,
+                    keys: script_keys,
+                });
                 frames.push(Frame {
                     id,
                     parent: Some(it.frame),
                     remap,
+                    keys,
                     autoremap,
                 });
                 let child = self.docs[sd].elems[se].children[0];
@@ -210,6 +257,11 @@ impl Loader<'_> {
             };
             node.subtree = it.subtree;
             let idx = nodes.len();
+            for p in pending.drain(..) {
+                self.flow.subtrees[p].node = idx;
+            }
+            let flow = self.node_flow(it.d, &el, idx, |k| chain.resolve_key(&frames, k));
+            self.flow.nodes.push(flow);
             if let Some(p) = it.parent {
                 nodes[p].children.push(idx);
             }
@@ -239,6 +291,7 @@ impl Loader<'_> {
         for (n, id) in nodes.iter_mut().zip(ids) {
             n.id = id;
         }
+        self.flow.scopes = frames.iter().map(|f| f.id.clone()).collect();
         Some(Bt { nodes, root: 0 })
     }
 }
@@ -246,7 +299,7 @@ impl Loader<'_> {
 impl Loader<'_> {
     /// Does document `d` say `BTCPP_format="3"`? (Without the attribute,
     /// BehaviorTree.CPP 4 reads a file as format 4, with a warning.)
-    fn format_3(&self, d: usize) -> bool {
+    pub(super) fn format_3(&self, d: usize) -> bool {
         let doc = &self.docs[d];
         doc.elems[doc.root].attr("BTCPP_format") == Some("3")
     }
@@ -267,13 +320,15 @@ pub(super) struct Frame {
     pub(super) id: String,
     pub(super) parent: Option<usize>,
     pub(super) remap: BTreeMap<String, String>,
+    /// The blackboard entry each remapped port designates.
+    pub(super) keys: BTreeMap<String, Key>,
     /// Entries not remapped are shared with the enclosing tree by name
     /// (`_autoremap="true"`, format 3's `__shared_blackboard`).
     pub(super) autoremap: bool,
 }
 
 /// The entry a port value refers to: `key` of a whole `{key}`.
-fn port_key(value: &str) -> Option<&str> {
+pub(super) fn port_key(value: &str) -> Option<&str> {
     value
         .strip_prefix('{')
         .and_then(|v| v.strip_suffix('}'))
@@ -336,6 +391,27 @@ impl Chain {
         }
         if self.frames.last() != Some(&f) {
             self.push(frames, f);
+        }
+    }
+
+    /// The blackboard entry `key` (of a `{key}` in the innermost expansion)
+    /// is: the one the innermost expansion remapping it designates, else
+    /// the innermost expansion's own that does not share its blackboard by
+    /// name; `@key` is the tree's own (BehaviorTree.CPP 4's global entries).
+    pub(super) fn resolve_key(&self, frames: &[Frame], key: &str) -> Key {
+        if let Some(g) = key.strip_prefix('@') {
+            return Key {
+                scope: 0,
+                name: g.to_string(),
+            };
+        }
+        let barrier = self.barriers.last().copied().unwrap_or(0);
+        match self.by_key.get(key).and_then(|v| v.last()) {
+            Some(&at) if at >= barrier => frames[self.frames[at]].keys[key].clone(),
+            _ => Key {
+                scope: self.frames.get(barrier).copied().unwrap_or(0),
+                name: key.to_string(),
+            },
         }
     }
 

@@ -17,6 +17,8 @@ use std::sync::Arc;
 #[derive(Debug, Clone)]
 pub(super) struct ModelEntry {
     pub(super) cat: Category,
+    /// Its `<input_port>`, `<output_port>` and `<inout_port>`s.
+    pub(super) ports: Vec<super::ports::PortDecl>,
 }
 
 pub(super) struct Loader<'l> {
@@ -42,6 +44,10 @@ pub(super) struct Loader<'l> {
     pub(super) first_companion: usize,
     /// Tree IDs no file read defines and several companions do: the files.
     pub(super) ambiguous: BTreeMap<String, Vec<String>>,
+    /// `<SubTree ID>` entries of the models: the ports of each tree.
+    pub(super) tree_ports: super::ports::TreePorts,
+    /// The dataflow of the expanded tree (filled by `expand`).
+    pub(super) flow: super::ports::Dataflow,
 }
 
 pub(super) fn load(
@@ -69,10 +75,20 @@ pub(super) fn load(
         seen: HashSet::new(),
         first_companion: usize::MAX,
         ambiguous: BTreeMap::new(),
+        tree_ports: BTreeMap::new(),
+        flow: Default::default(),
     };
     l.diags.extend(repaired);
     let policy = l.run(identity);
-    crate::format::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")
+    let mut flow = std::mem::take(&mut l.flow);
+    flow.files = l.docs.iter().map(|d| d.file.clone()).collect();
+    let mut loaded =
+        crate::format::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")?;
+    if let crate::model::PolicyBody::Bt(_) = &loaded.policy.body {
+        flow.tree_ports = l.tree_ports.get(&loaded.policy.name).cloned();
+        loaded.dataflow = Some(Arc::new(flow));
+    }
+    Ok(loaded)
 }
 
 impl Loader<'_> {
@@ -324,7 +340,13 @@ impl Loader<'_> {
                 "Condition" => Category::Condition,
                 "Control" => Category::Control,
                 "Decorator" => Category::Decorator,
-                "SubTree" => continue,
+                "SubTree" => {
+                    if let Some(id) = el.attr("ID") {
+                        let ports = super::ports::model_ports(&self.docs[d], d, k);
+                        self.tree_ports.insert(id.to_string(), ports);
+                    }
+                    continue;
+                }
                 other => {
                     let h = suggest(
                         other,
@@ -384,7 +406,9 @@ impl Loader<'_> {
                 .hint = Some("keep one declaration per node type across the model files".into());
                 continue;
             }
-            self.models.insert(id.to_string(), ModelEntry { cat });
+            let ports = super::ports::model_ports(&self.docs[d], d, k);
+            self.models
+                .insert(id.to_string(), ModelEntry { cat, ports });
         }
     }
 

@@ -28,15 +28,18 @@
 
 mod companions;
 mod expand;
+mod flow;
 mod ids;
 mod loader;
 mod node;
+pub mod ports;
 #[cfg(test)]
 mod tests;
 
 pub use companions::Companions;
 pub use ids::derive_ids;
 use loader::load;
+pub use ports::{Dataflow, builtin_ports};
 
 use super::xml::XElem;
 use super::{AssumeLeaf, Limits, Loaded};
@@ -179,6 +182,34 @@ fn builtin_rule(
             "write num_attempts=\"3\" (-1: forever)",
             None,
         )),
+        // Ports these built-ins read when they are created: BehaviorTree.CPP
+        // 4 refuses the tree without them ("Missing port [code] in Script").
+        "Script" | "ScriptCondition" if el.attr("code").is_none() => Some((
+            format!("`{ty}` needs `code`"),
+            "write code=\"key := 1\" (the script to run)",
+            None,
+        )),
+        "Precondition" if el.attr("if").is_none() => Some((
+            "`Precondition` needs `if`".into(),
+            "write if=\"battery > 20\" (the condition script)",
+            None,
+        )),
+        "WasEntryUpdated" | "SkipUnlessUpdated" | "WaitValueUpdate"
+            if el.attr("entry").is_none() =>
+        {
+            Some((
+                format!("`{ty}` needs `entry`"),
+                "write entry=\"{key}\" (the blackboard entry to watch)",
+                None,
+            ))
+        }
+        "LoopInt" | "LoopDouble" | "LoopString" | "LoopBool" if el.attr("queue").is_none() => {
+            Some((
+                format!("`{ty}` needs `queue`"),
+                "write queue=\"{key}\" or queue=\"1;2;3\"",
+                None,
+            ))
+        }
         _ => None,
     }
 }

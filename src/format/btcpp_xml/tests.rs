@@ -521,6 +521,7 @@ fn generated_identities_stay_short_under_a_long_tree_id() {
 #[test]
 fn port_resolution_through_nested_expansions() {
     let frame = |parent, remap: &[(&str, &str)], autoremap| Frame {
+        keys: Default::default(),
         id: String::new(),
         parent,
         remap: remap
