@@ -244,26 +244,32 @@ pub fn render_table(r: &LogReport) -> String {
 
 /// The per-node figures as CSV (the coverage is in table and JSON).
 pub fn render_csv(r: &LogReport) -> String {
-    let cell = crate::report::csv_field;
     let mut out =
         String::from("uid,node,type,activations,RUNNING,SUCCESS,FAILURE,IDLE,SKIPPED,running_s\n");
     for n in &r.nodes {
-        let k = |s: &str| n.statuses.get(s).copied().unwrap_or(0);
-        out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{:.6}\n",
-            n.uid,
-            cell(&n.name),
-            cell(&n.tag),
-            n.activations,
-            k("RUNNING"),
-            k("SUCCESS"),
-            k("FAILURE"),
-            k("IDLE"),
-            k("SKIPPED"),
-            n.running_usec as f64 / 1e6
-        ));
+        out.push_str(&node_cells(n, crate::report::csv_field, 6).join(","));
+        out.push('\n');
     }
     out
+}
+
+/// One node's cells in the column order of the CSV and markdown tables:
+/// strings from the log through `esc`, the time RUNNING with `digits`
+/// decimals.
+fn node_cells(n: &NodeStats, esc: fn(&str) -> String, digits: usize) -> Vec<String> {
+    let k = |s: &str| n.statuses.get(s).copied().unwrap_or(0).to_string();
+    vec![
+        n.uid.to_string(),
+        esc(&n.name),
+        esc(&n.tag),
+        n.activations.to_string(),
+        k("RUNNING"),
+        k("SUCCESS"),
+        k("FAILURE"),
+        k("IDLE"),
+        k("SKIPPED"),
+        format!("{:.digits$}", n.running_usec as f64 / 1e6),
+    ]
 }
 
 /// For a `.db3`: `session 2 (sessions: 1 (2026-01-01 10:00:00), 2 (...))`.
@@ -310,20 +316,7 @@ pub fn render_markdown(r: &LogReport) -> String {
     }
     out.push_str("| uid | node | type | activations | RUNNING | SUCCESS | FAILURE | IDLE | SKIPPED | running s |\n|---:|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for n in &r.nodes {
-        let k = |s: &str| n.statuses.get(s).copied().unwrap_or(0);
-        out.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} |\n",
-            n.uid,
-            md(&n.name),
-            md(&n.tag),
-            n.activations,
-            k("RUNNING"),
-            k("SUCCESS"),
-            k("FAILURE"),
-            k("IDLE"),
-            k("SKIPPED"),
-            n.running_usec as f64 / 1e6
-        ));
+        out.push_str(&format!("| {} |\n", node_cells(n, md, 3).join(" | ")));
     }
     out
 }

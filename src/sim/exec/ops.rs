@@ -143,16 +143,7 @@ pub(super) fn op_of(n: &BtNode) -> Result<(Op, i64, i64), String> {
 
 /// BehaviorTree.CPP 4's pre- and post-condition ports (scripts run around
 /// a node's tick), which the executor does not model.
-const PRE_POST: &[&str] = &[
-    "_skipIf",
-    "_failureIf",
-    "_successIf",
-    "_while",
-    "_onSuccess",
-    "_onFailure",
-    "_onHalted",
-    "_post",
-];
+use crate::format::btcpp_xml::ports::SCRIPT_ATTRS as PRE_POST;
 
 /// Why the executor cannot tick node `n` as BehaviorTree.CPP 4 does (its
 /// type, as written, or a pre/post condition), if it cannot.
