@@ -116,12 +116,12 @@ DIFF_PAIRS := $(DP)/fig01-bt.toml $(DP)/fig03-bt.toml $(DP)/fig07a-bt.toml $(DP)
 
 # `btfsm view` pages driven in headless Chromium (Debian package `chromium`;
 # puppeteer-core pinned in tests/browser/package-lock.json; Node.js 18+):
-# every bundled scenario, the two BT.CPP logs and the hostile-names
+# every bundled scenario, the two BT.CPP logs, a .db3 and the hostile-names
 # scenario, each node's fill at each step reached checked against
 # `dot --trace` / `log dot` drawings of that step; the 10,000-step page's
 # size, load and jump times printed (docs/view.md). Pages and screenshots in
 # $(TARGET_DIR)/view-browser/.
-VIEW_LOGS := tests/fixtures/logs/fig01.btlog tests/fixtures/logs/subtree.btlog
+VIEW_LOGS := tests/fixtures/logs/fig01.btlog tests/fixtures/logs/subtree.btlog tests/fixtures/logs/sessions.db3
 browser-test: build
 	cd tests/browser && npm ci --silent --no-audit --no-fund
 	node tests/browser/view.mjs --btfsm $(BIN) --out $(TARGET_DIR)/view-browser \

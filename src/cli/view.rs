@@ -1,6 +1,6 @@
 //! `btfsm view INPUT... -o page.html`: one self-contained HTML page replaying
 //! runs (src/view/): a simulator scenario (run here as `btfsm sim` runs it),
-//! a trace written by `btfsm sim --trace`, or a BehaviorTree.CPP `.btlog`;
+//! a trace written by `btfsm sim --trace`, or a BehaviorTree.CPP `.btlog` (or `.db3`: its last session);
 //! several inputs share one slider.
 
 use super::commands::{emit_text, print_diagnostics};
@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 pub struct ViewArgs {
     /// Scenario (.toml, run with its seed), trace of `btfsm sim --trace`
     /// (.json; the policy files it names are read, relative to the current
-    /// directory and inside the root) or BehaviorTree.CPP log (.btlog)
+    /// directory and inside the root) or BehaviorTree.CPP log (.btlog, or .db3: its last session)
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// The HTML file to write (default: stdout)
@@ -35,6 +35,8 @@ enum Kind {
     Scenario,
     Trace,
     Log,
+    /// A SqliteLogger `.db3`: its last session, as the `log` commands read it.
+    Db3,
 }
 
 fn kind_of(path: &Path, head: &[u8]) -> Kind {
@@ -44,6 +46,8 @@ fn kind_of(path: &Path, head: &[u8]) -> Kind {
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("btlog") => Kind::Log,
+        Some("db3") => Kind::Db3,
+        _ if head.starts_with(b"SQLite format 3\0") => Kind::Db3,
         Some("json") => Kind::Trace,
         Some("toml") => Kind::Scenario,
         _ if head.starts_with(crate::log::btlog::MAGIC) => Kind::Log,
@@ -85,6 +89,17 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &crate::format::Limits) -> Optio
     };
     match kind_of(path, &bytes[..bytes.len().min(32)]) {
         Kind::Log => crate::view::log::from_log(&bytes[..], &shown, limits).map_or_else(fail, Some),
+        Kind::Db3 => match crate::log::open(path, None, limits.max_file_bytes) {
+            Ok(o) => crate::view::log::from_log(o.reader, &shown, limits).map_or_else(fail, Some),
+            Err(e) => {
+                eprintln!(
+                    "error: {}: {}",
+                    crate::sanitize::shown(&shown),
+                    crate::sanitize::shown(&e)
+                );
+                None
+            }
+        },
         Kind::Trace => {
             let text = text(bytes)?;
             let dir = path.parent().unwrap_or(Path::new(""));

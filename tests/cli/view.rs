@@ -199,6 +199,24 @@ fn a_btlog_replays_record_by_record() {
 }
 
 #[test]
+fn a_db3_replays_its_last_session_record_by_record() {
+    // tests/fixtures/logs/sessions.db3: session 2 holds 182 records
+    // (`log report` counts them; tests/fixtures/logs/README.md).
+    let (code, report, err) = btfsm(&[
+        "log",
+        "report",
+        "tests/fixtures/logs/sessions.db3",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&report).unwrap();
+    let records = r["records"].as_u64().unwrap() as usize;
+    let d = data(&page("db3", &["tests/fixtures/logs/sessions.db3"]));
+    assert_eq!(d["panels"][0]["times"].as_array().unwrap().len(), records);
+}
+
+#[test]
 fn view_pages_every_bundled_scenario() {
     let mut n = 0;
     for e in std::fs::read_dir("policies/scenarios").unwrap() {
