@@ -78,6 +78,7 @@ pub const RULES: &[Rule] = &[
     paper::UNGUARDED_FALLBACK_ACTION,
     paper::NOT_FAULT_TOLERANT,
     paper::FULLY_CONNECTED_STATE,
+    paper::SELECTOR_WITHOUT_RETURN,
     dataflow::OUTPUT_PORT_LITERAL,
     dataflow::UNDECLARED_PORT,
     dataflow::MISSING_REQUIRED_PORT,

@@ -5,7 +5,7 @@
 //! domain, `policies/domains/moma.toml` (README "Action domains").
 
 use super::{Level, Rule, Sink, Subject};
-use crate::model::{Bt, BtNodeKind, PolicyBody, StateBody, Trigger};
+use crate::model::{Bt, BtNodeKind, PolicyBody, StateBody, Target, Trigger};
 use crate::plan::Domain;
 use crate::plan::fact::Fact;
 use std::collections::{BTreeMap, HashMap};
@@ -316,5 +316,80 @@ fn fully_connected(p: &Subject, out: &mut Sink) {
             ),
             "in a BT the same behavior is one subtree at the root (the paper's Fig. 16a)".into(),
         );
+    }
+}
+
+pub const SELECTOR_WITHOUT_RETURN: Rule = Rule {
+    code: "selector-without-return",
+    level: Level::Note,
+    summary: "an action state that hands over to a decision state (the SELECTOR) which never resumes it",
+    check: selector_without_return,
+};
+
+/// The paper's fault-tolerant FSM (sec. IV-B, Fig. 4) sends an action
+/// state's FAILURE to the SELECTOR, whose guards resume the task at the
+/// state its conditions call for, that state included. An action state
+/// with a transition into a decision state that has no transition back to
+/// it is never retried from there: a failure there restarts the task
+/// somewhere else. Fully connected states are exempt (they go to the
+/// SELECTOR on SUCCESS by construction). Linear: each transition is read
+/// twice, the decision states' targets kept in a set per decision state.
+fn selector_without_return(p: &Subject, out: &mut Sink) {
+    let PolicyBody::Machine(m) = &p.body else {
+        return;
+    };
+    let decision: Vec<bool> = m
+        .states
+        .iter()
+        .map(|s| matches!(s.body, StateBody::Decision))
+        .collect();
+    // Targets of each decision state.
+    let mut resumes: std::collections::HashMap<usize, std::collections::HashSet<usize>> =
+        Default::default();
+    for (d, s) in m.states.iter().enumerate().filter(|(d, _)| decision[*d]) {
+        let set = resumes.entry(d).or_default();
+        for t in &s.transitions {
+            if let Target::State(x) = t.target {
+                set.insert(x);
+            }
+        }
+    }
+    if resumes.is_empty() {
+        return;
+    }
+    let connected = crate::metrics::counts::fully_connected_states(m);
+    for (i, s) in m.states.iter().enumerate() {
+        let StateBody::Task(Some(call)) = &s.body else {
+            continue;
+        };
+        if connected.contains(&i)
+            || crate::model::skill::skill_kind(&call.skill)
+                == Some(crate::model::SkillKind::Condition)
+        {
+            continue;
+        }
+        let mut seen = std::collections::HashSet::new();
+        for t in &s.transitions {
+            let Target::State(d) = t.target else { continue };
+            if !decision[d] || !seen.insert(d) || resumes[&d].contains(&i) {
+                continue;
+            }
+            out.push(
+                &m.path(i),
+                s.span.clone(),
+                format!(
+                    "action state `{}` goes to decision state `{}` on {}, which never comes back to it: the task is not resumed at `{}`",
+                    m.path(i),
+                    m.path(d),
+                    t.trigger.label(),
+                    m.path(i)
+                ),
+                format!(
+                    "give `{}` a guarded transition back to `{}` (the condition under which it should run again), as the paper's Fig. 4 does",
+                    m.path(d),
+                    m.path(i)
+                ),
+            );
+        }
     }
 }

@@ -90,3 +90,22 @@ fn every_summary_prints_whole_in_the_rule_list() {
         );
     }
 }
+
+#[test]
+fn the_selector_resumes_every_state_of_fig_4_but_not_safe_move_to() {
+    let m = paper("fig04-fsm");
+    let f = super::lint(&m, None, "fig04", &Default::default());
+    assert!(
+        f.iter().all(|f| f.code != "selector-without-return"),
+        "{f:?}"
+    );
+    for fig in ["fig08b-fsm", "fig08e-fsm"] {
+        let f = super::lint(&paper(fig), None, fig, &Default::default());
+        let at: Vec<&str> = f
+            .iter()
+            .filter(|f| f.code == "selector-without-return")
+            .map(|f| f.at.as_str())
+            .collect();
+        assert_eq!(at, ["Safe-Move-To cube2"], "{fig}");
+    }
+}
