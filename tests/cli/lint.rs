@@ -289,3 +289,28 @@ fn lint_on_nav2_with_its_model_reports_what_docs_lint_md_lists() {
         .collect();
     assert_eq!(selectors.len(), 3, "{selectors:?}");
 }
+
+#[cfg(unix)]
+#[test]
+fn a_symlinked_nodes_model_beside_a_tree_is_not_read() {
+    // Only regular files of the folder are read as models: a stranger's
+    // `*tree_nodes*.xml` symlink to a file outside is skipped, never echoed.
+    let dir = std::env::temp_dir().join(format!("btfsm-lint-symlink-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let outside = std::env::temp_dir().join(format!("btfsm-secret-{}.txt", std::process::id()));
+    std::fs::write(&outside, "SECRET-LINE not xml\n").unwrap();
+    std::os::unix::fs::symlink(&outside, dir.join("evil_tree_nodes.xml")).unwrap();
+    std::fs::write(
+        dir.join("tree.xml"),
+        r#"<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M"><Sequence><Approach/></Sequence></BehaviorTree></root>"#,
+    )
+    .unwrap();
+    let (code, out, err) = btfsm(&["lint", dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(
+        !out.contains("SECRET") && !err.contains("SECRET"),
+        "{out}{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_file(&outside).ok();
+}
