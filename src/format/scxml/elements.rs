@@ -57,6 +57,20 @@ pub(super) fn collect(doc: &XDoc, limits: &Limits, diags: &mut xml::Sink) -> Opt
             diags.push(d);
             return None;
         }
+        // Apache Commons SCXML 0.x wrote a final state as `<state
+        // final="true">`; W3C SCXML has no such attribute and reads an
+        // ordinary state (which, without transitions, the machine never
+        // leaves), as btfsm does.
+        if matches!(kind, Kind::State) && el.attr("final") == Some("true") {
+            diags.push(
+                Diagnostic::warning(format!(
+                    "`final=\"true\"` on `<state id=\"{}\">` is Apache Commons SCXML 0.x syntax; W3C SCXML reads an ordinary state",
+                    shown(el.attr("id").unwrap_or(""))
+                ))
+                .at(f, el.span.clone())
+                .hint("write a final state as `<final id=\"...\"/>`"),
+            );
+        }
         let depth = parent.map_or(0, |p| depth_of[p] + 1);
         if depth > limits.max_depth && !matches!(kind, Kind::Final) {
             err(

@@ -144,6 +144,25 @@ fn unreachable_state_is_a_warning() {
 }
 
 #[test]
+fn commons_scxml_final_attribute_is_a_warning_and_an_ordinary_state() {
+    // Apache Commons SCXML 0.x's `<state final="true">`: W3C SCXML reads an
+    // ordinary state, and so does btfsm, with a warning naming the syntax.
+    let l = parse_str(
+        "t.scxml",
+        "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" initial=\"a\">\n  <state id=\"a\"><transition event=\"e\" target=\"end\"/></state>\n  <state id=\"end\" final=\"true\"/>\n</scxml>",
+        &Limits::default(),
+    )
+    .unwrap();
+    assert_eq!(l.warnings.len(), 1, "{:?}", l.warnings);
+    assert!(l.warnings[0].message.contains("Apache Commons SCXML 0.x"));
+    assert_eq!(l.warnings[0].location().unwrap().1, 3);
+    let crate::model::PolicyBody::Machine(m) = &l.policy.body else {
+        panic!("a machine")
+    };
+    assert_eq!(m.states.len(), 2, "`end` is a state, not an outcome");
+}
+
+#[test]
 fn a_transition_into_a_nested_state_reaches_its_containers() {
     // `a` jumps straight into `c1` inside `outer/inner`: both containers
     // are entered with it, so neither is unreachable; `lone` is.
