@@ -171,15 +171,16 @@ pub enum Command {
     /// precondition conflict no order resolves is left)
     Plan(super::plan::PlanArgs),
     /// Checks policies against coded rules (structure, the paper's
-    /// smells); text, JSON or SARIF; exit 1 when an error-level finding
-    /// remains
+    /// smells, BehaviorTree.CPP ports and blackboard keys); text, JSON or
+    /// SARIF; exit 1 when an error-level finding remains
     Lint(super::lint::LintArgs),
-    /// Reads BehaviorTree.CPP execution logs (.btlog): `log report`
+    /// Reads BehaviorTree.CPP execution logs (.btlog, .db3): `log report`,
+    /// `log dot`, `log compare`, `log timeline`
     Log(super::log::LogArgs),
     /// Writes one self-contained HTML page replaying runs: each policy's
     /// diagram coloured by status at a step (RUNNING yellow, SUCCESS green,
     /// FAILURE red), a timeline of the actions, a slider and step buttons;
-    /// from a scenario (run here), a `sim --trace` file or a .btlog
+    /// from a scenario (run here), a `sim --trace` file, a .btlog or a .db3
     View(super::view::ViewArgs),
     /// Tree edit distances of trees in bracket notation, one pair per line
     /// (`{a{b}}<TAB>{a{c}}`): what tests/differential/ted.py and
