@@ -89,6 +89,17 @@ pub struct Transition {
     pub span: Option<Span>,
 }
 
+impl Transition {
+    /// The transition taken when the source state's skill returns `o`.
+    pub fn on_outcome(o: &str, target: Target) -> Self {
+        Transition {
+            trigger: Trigger::Outcome(o.to_string()),
+            target,
+            span: None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Trigger {
     /// Fires when the state's skill (or container) returns this outcome.

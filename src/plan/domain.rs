@@ -308,6 +308,15 @@ impl Domain {
 
     /// The condition a fact stands for: its predicate's skill with the
     /// fact's objects as arguments.
+    /// A fact as a guard term: its predicate's condition skill, negated or
+    /// not.
+    pub fn fact_term(&self, f: &Fact, negate: bool) -> crate::model::GuardTerm {
+        crate::model::GuardTerm {
+            condition: self.fact_condition(f),
+            negate,
+        }
+    }
+
     pub fn fact_condition(&self, f: &Fact) -> crate::model::skill::SkillCall {
         let pred = self.predicate(&f.pred).expect("a fact of the domain");
         let skill = pred

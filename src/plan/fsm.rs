@@ -23,7 +23,7 @@
 use super::backchain::{Planned, Step};
 use super::domain::Domain;
 use super::fact::Fact;
-use crate::model::skill::{Guard, GuardTerm};
+use crate::model::skill::Guard;
 use crate::model::{
     BtNodeKind, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
@@ -88,21 +88,6 @@ fn state_name(d: &Domain, s: &Step<'_>) -> String {
         .to_string()
 }
 
-fn term(d: &Domain, f: &Fact, negate: bool) -> Result<GuardTerm, FsmError> {
-    Ok(GuardTerm {
-        condition: d.fact_condition(f),
-        negate,
-    })
-}
-
-fn outcome(o: &str, target: Target) -> Transition {
-    Transition {
-        trigger: Trigger::Outcome(o.to_string()),
-        target,
-        span: None,
-    }
-}
-
 /// The fault-tolerant FSM of the planned tree (see the module docs).
 pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
     let all = steps(d, p);
@@ -148,7 +133,7 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             .into_iter()
             .find(|f| volatile.contains(&f))
             .expect("partitioned on it");
-        let t = term(d, &f, true)?;
+        let t = d.fact_term(&f, true);
         to_connected.push(Transition {
             trigger: Trigger::Guard(Guard {
                 label: t.to_string(),
@@ -178,9 +163,9 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         };
         let mut transitions = to_connected.clone();
         transitions.extend([
-            outcome("SUCCESS", next),
-            outcome("FAILURE", Target::State(sel)),
-            outcome("RUNNING", Target::State(i)),
+            Transition::on_outcome("SUCCESS", next),
+            Transition::on_outcome("FAILURE", Target::State(sel)),
+            Transition::on_outcome("RUNNING", Target::State(i)),
         ]);
         states.push(State {
             name: names[i].clone(),
@@ -206,10 +191,7 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             Target::State(k)
         };
         let (all, text) = if !ks[k].is_empty() {
-            let all = ks[k]
-                .iter()
-                .map(|f| term(d, f, false))
-                .collect::<Result<Vec<_>, _>>()?;
+            let all: Vec<_> = ks[k].iter().map(|f| d.fact_term(f, false)).collect();
             let text = if k == n {
                 format!("done: {}", label(&ks[k]))
             } else {
@@ -220,7 +202,7 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             // Nothing needed: every later kernel failed. Written as "not the
             // next kernel's first fact", which the SELECTOR knows here.
             match ks.get(k + 1).and_then(|next| next.first()) {
-                Some(f) => (vec![term(d, f, true)?], "restart the task".to_string()),
+                Some(f) => (vec![d.fact_term(f, true)], "restart the task".to_string()),
                 None => (vec![], "restart the task".to_string()),
             }
         };
@@ -233,7 +215,7 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             span: None,
         });
     }
-    guards.push(outcome("RUNNING", Target::State(sel)));
+    guards.push(Transition::on_outcome("RUNNING", Target::State(sel)));
     states.push(State {
         name: "SELECTOR".into(),
         label: "SELECTOR".into(),
@@ -251,8 +233,8 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             parent: None,
             body: task(s),
             transitions: vec![
-                outcome("SUCCESS", Target::State(sel)),
-                outcome("RUNNING", Target::State(i)),
+                Transition::on_outcome("SUCCESS", Target::State(sel)),
+                Transition::on_outcome("RUNNING", Target::State(i)),
             ],
             pseudo: None,
             span: None,

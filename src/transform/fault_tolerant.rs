@@ -108,22 +108,6 @@ pub enum FaultTolerantError {
     },
 }
 
-/// A fact as a guard term (its predicate's condition skill).
-fn fact_term(d: &Domain, f: &Fact, negate: bool) -> Result<GuardTerm, FaultTolerantError> {
-    Ok(GuardTerm {
-        condition: d.fact_condition(f),
-        negate,
-    })
-}
-
-fn outcome(o: &str, target: Target) -> Transition {
-    Transition {
-        trigger: Trigger::Outcome(o.to_string()),
-        target,
-        span: None,
-    }
-}
-
 fn has_outcome(s: &State, o: &str) -> bool {
     s.transitions
         .iter()
@@ -252,20 +236,24 @@ pub fn fault_tolerant(
         st.transitions
             .retain(|t| !matches!(t.target, Target::State(j) if det.sequential.contains(&j)));
         if !has_outcome(st, SUCCESS) {
-            st.transitions.push(outcome(SUCCESS, Target::State(sel)));
+            st.transitions
+                .push(Transition::on_outcome(SUCCESS, Target::State(sel)));
         }
         if !has_outcome(st, RUNNING) {
-            st.transitions.push(outcome(RUNNING, Target::State(c)));
+            st.transitions
+                .push(Transition::on_outcome(RUNNING, Target::State(c)));
         }
     }
     // Sequential states: RUNNING -> itself, FAILURE -> SELECTOR.
     for &s in &det.sequential {
         let st = &mut out.states[s];
         if !has_outcome(st, FAILURE) {
-            st.transitions.push(outcome(FAILURE, Target::State(sel)));
+            st.transitions
+                .push(Transition::on_outcome(FAILURE, Target::State(sel)));
         }
         if !has_outcome(st, RUNNING) {
-            st.transitions.push(outcome(RUNNING, Target::State(s)));
+            st.transitions
+                .push(Transition::on_outcome(RUNNING, Target::State(s)));
         }
     }
 
@@ -288,16 +276,13 @@ pub fn fault_tolerant(
         let guard = match used {
             Some(g) => g,
             None => match step(c).and_then(|st| st.adds().into_iter().next()) {
-                Some(f) => match fact_term(domain, &f, true) {
-                    Ok(term) => Guard {
+                Some(f) => {
+                    let term = domain.fact_term(&f, true);
+                    Guard {
                         label: format!("{term}"),
                         all: vec![term],
-                    },
-                    Err(e) => {
-                        errors.push(e);
-                        continue;
                     }
-                },
+                }
                 None => {
                     errors.push(no_action(c));
                     continue;
@@ -326,8 +311,8 @@ pub fn fault_tolerant(
     if !chain.is_empty() && steps.len() == chain.len() {
         let goal = steps.last().map(Step::adds).unwrap_or_default();
         let kernels = crate::plan::fsm::kernels(&steps, &goal);
-        let terms = |fs: &[Fact], negate: bool| -> Result<Vec<GuardTerm>, FaultTolerantError> {
-            fs.iter().map(|f| fact_term(domain, f, negate)).collect()
+        let terms = |fs: &[Fact], negate: bool| -> Vec<GuardTerm> {
+            fs.iter().map(|f| domain.fact_term(f, negate)).collect()
         };
         let text = |ts: &[GuardTerm]| {
             ts.iter()
@@ -338,10 +323,8 @@ pub fn fault_tolerant(
         if let Some(o) = &end {
             let target = Target::Outcome(o.clone());
             if !selector_has(&target) {
-                match terms(&goal, false) {
-                    Ok(ts) => back.push(resume(format!("done: {}", text(&ts)), ts, target)),
-                    Err(e) => errors.push(e),
-                }
+                let ts = terms(&goal, false);
+                back.push(resume(format!("done: {}", text(&ts)), ts, target));
             }
         }
         for k in (0..chain.len()).rev() {
@@ -356,21 +339,17 @@ pub fn fault_tolerant(
                 kernels
                     .get(k + 1)
                     .and_then(|next| next.first())
-                    .map(|f| terms(std::slice::from_ref(f), true).map(|ts| (true, ts)))
+                    .map(|f| (true, terms(std::slice::from_ref(f), true)))
             } else {
-                Some(terms(&kernels[k], false).map(|ts| (false, ts)))
+                Some((false, terms(&kernels[k], false)))
             };
-            match made {
-                Some(Ok((restart, ts))) => {
-                    let label = if restart {
-                        format!("restart: {}", text(&ts))
-                    } else {
-                        format!("resume at {}: {}", m.states[s].label, text(&ts))
-                    };
-                    back.push(resume(label, ts, target));
-                }
-                Some(Err(e)) => errors.push(e),
-                None => {}
+            if let Some((restart, ts)) = made {
+                let label = if restart {
+                    format!("restart: {}", text(&ts))
+                } else {
+                    format!("resume at {}: {}", m.states[s].label, text(&ts))
+                };
+                back.push(resume(label, ts, target));
             }
         }
     }
@@ -384,7 +363,8 @@ pub fn fault_tolerant(
     trs.extend(back);
     st.transitions = trs;
     if !has_outcome(st, RUNNING) {
-        st.transitions.push(outcome(RUNNING, Target::State(sel)));
+        st.transitions
+            .push(Transition::on_outcome(RUNNING, Target::State(sel)));
     }
     for &i in det.sequential.iter().chain(&det.connected).chain([&sel]) {
         guards_first(&mut out.states[i]);
