@@ -288,6 +288,19 @@ impl Reader<'_> {
                 );
                 continue;
             }
+            if outcomes.contains(&name) {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!(
+                        "state `{}` has the name of an outcome of this machine",
+                        shown(&name)
+                    ),
+                    "rename the state or the outcome (yasmin's add_state refuses a state named like an outcome)",
+                );
+                continue;
+            }
             if m.states.len() >= self.limits.max_nodes {
                 let span = e.span.clone();
                 self.err(
@@ -623,26 +636,6 @@ mod tests {
     }
 
     #[test]
-    fn an_outcome_of_the_machine_wins_over_a_state_of_the_same_name() {
-        // yasmin's StateMachine.execute checks the machine's outcomes first.
-        let m = machine(
-            r#"<StateMachine outcomes="done">
-  <State name="a"><Transition from="ok" to="done"/></State>
-  <State name="done"><Transition from="ok" to="a"/></State>
-</StateMachine>"#,
-        );
-        assert_eq!(
-            m.states[0].transitions[0].target,
-            Target::Outcome("done".into())
-        );
-        assert_eq!(
-            m.states[m.top.initial_state().unwrap()].name,
-            "a",
-            "the first state starts"
-        );
-    }
-
-    #[test]
     fn nested_machines_are_containers_with_their_outcome_map() {
         let m = machine(
             r#"<StateMachine outcomes="final_outcome">
@@ -763,6 +756,23 @@ mod tests {
             let text = format!("{}{ins}{}", &t[..a], &t[b..]);
             crate::fuzzing::yasmin(text.as_bytes());
         }
+    }
+
+    #[test]
+    fn a_state_named_like_an_outcome_is_an_error() {
+        // yasmin's StateMachine.add_state: "State name '...' is already
+        // registered as an outcome". Found by `mangled_files_never_panic`:
+        // an `outcomes` attribute cut into a sentence holding `Bar`.
+        let e = errors(
+            r#"<StateMachine outcomes="Bar done" start_state="Bar">
+  <State name="Bar" type="py" module="m" class="C"><Transition from="ok" to="done"/></State>
+</StateMachine>"#,
+        );
+        assert!(
+            e.iter()
+                .any(|m| m.contains("state `Bar` has the name of an outcome")),
+            "{e:?}"
+        );
     }
 
     #[test]
