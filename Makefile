@@ -94,7 +94,14 @@ differential: $(VENV)/.installed
 	@tail -1 $(TARGET_DIR)/btlog_compare.txt
 	$(VENV)/bin/python tests/differential/btlog_db3.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
-	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24
+	GED_DUMP=$(TARGET_DIR)/paper-graphs.jsonl GED_DUMP_FILES=$(GED_PAPER_FILES) \
+	  $(CARGO) test --quiet --locked --lib dump_policy_graphs -- --ignored > /dev/null
+	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24 \
+	  --paper $(TARGET_DIR)/paper-graphs.jsonl
+
+# The paper's dense FSMs (and Fig. 6's HFSM) whose pairs ged_highs.py also
+# checks against HiGHS: every pair of them, both modes.
+GED_PAPER_FILES := policies/paper/fig16b-fsm.toml,policies/paper/fig08e-fsm.toml,policies/paper/fig09b-fsm.toml,policies/paper/fig06-hfsm.toml,policies/paper/fig08d-fsm.toml,policies/paper/scal-fsm.toml,policies/paper/fig15-fsm.toml
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).

@@ -59,6 +59,18 @@ impl Adj {
         Adj { start, items }
     }
 
+    /// Flat index of `u`'s first entry: entry `i` of `self[u]` has flat
+    /// index `first(u) + i` (used as an arc id).
+    #[inline]
+    pub fn first(&self, u: usize) -> usize {
+        self.start[u]
+    }
+
+    /// Number of entries in all lists.
+    pub fn total(&self) -> usize {
+        self.items.len()
+    }
+
     /// The lists, vertex by vertex.
     pub fn iter(&self) -> impl Iterator<Item = &[(u32, u32)]> {
         self.start.windows(2).map(|w| &self.items[w[0]..w[1]])

@@ -1184,3 +1184,41 @@ fn search_with_a_spent_deadline_returns_the_count_bound() {
         }
     }
 }
+
+/// Writes the GED graphs of policy files as JSON lines `{"file", "n",
+/// "arcs": [[t, h], …] (one per arc), "labels"}` for an outside oracle:
+/// `GED_DUMP=out.jsonl cargo test dump_policy_graphs -- --ignored a.toml b.toml`
+/// reads the files named in `GED_DUMP_FILES` (comma-separated);
+/// `bench/ged_paper_highs.py` runs HiGHS on them (docs/performance.md).
+#[test]
+#[ignore]
+fn dump_policy_graphs() {
+    use std::io::Write;
+    let (Ok(out), Ok(files)) = (std::env::var("GED_DUMP"), std::env::var("GED_DUMP_FILES")) else {
+        return;
+    };
+    let mut w = std::fs::File::create(out).expect("writable");
+    for file in files.split(',') {
+        let loaded = crate::format::load(
+            std::path::Path::new(file),
+            &crate::format::Limits::default(),
+        )
+        .unwrap_or_else(|_| panic!("{file} loads"));
+        let g = GedGraph::from(&crate::graph::build::policy_graph(&loaded.policy));
+        let mut arcs = Vec::new();
+        for &(t, h, m) in g.arcs() {
+            for _ in 0..m {
+                arcs.push(format!("[{t},{h}]"));
+            }
+        }
+        let labels: Vec<String> = g.labels().iter().map(|l| format!("\"{l}\"")).collect();
+        writeln!(
+            w,
+            "{{\"file\":\"{file}\",\"n\":{},\"arcs\":[{}],\"labels\":[{}]}}",
+            g.n(),
+            arcs.join(","),
+            labels.join(",")
+        )
+        .expect("written");
+    }
+}

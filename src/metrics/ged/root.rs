@@ -1,0 +1,99 @@
+//! The schedule of the search's root bound with the ascent of `ascent.rs`:
+//! dual ascent until it stalls, then Polyak subgradient steps (each
+//! followed by a few ascent steps; Polyak, "Minimization of unsmooth
+//! functionals", USSR Comput. Math. 9, 1969), then back to the best shares
+//! seen. Used by `search.rs` at the root only.
+
+/// Ascent steps at the root (at most; it stops once `STALL` steps in a
+/// row have not raised the bound). Below the root the shares stay fixed,
+/// so that the local values can be updated pair by pair (`Ascent::apply`).
+const ROOT_STEPS: usize = 300;
+const STALL: usize = 12;
+/// Subgradient steps at the root, once the ascent stalls (each followed
+/// by up to `AFTER_SHAKE` ascent steps); the Polyak factor halves after
+/// `SHAKE_STALL` of them in a row without a better bound.
+const SUB_STEPS: usize = 50;
+const AFTER_SHAKE: usize = 3;
+const SHAKE_STALL: usize = 5;
+
+/// What the root does next with the shares of `ascent.rs`.
+pub(super) enum Next {
+    Done,
+    Ascend,
+    /// A subgradient step with this Polyak factor.
+    Shake(f64),
+    /// Back to the best shares seen (their assignment is then recomputed).
+    Restore,
+}
+
+/// The schedule of the root's bound: ascent until it stalls, then
+/// subgradient steps each followed by a few ascent steps, then the best
+/// shares seen. Elsewhere (or without the ascent) one evaluation.
+pub(super) struct RootPhase {
+    active: bool,
+    steps: usize,
+    best_total: i64,
+    stalled: usize,
+    shakes: usize,
+    pub(super) best_total_sub: i64,
+    shake_stall: usize,
+    lambda: f64,
+    pub(super) best_alpha: Vec<i64>,
+    restored: bool,
+}
+
+impl RootPhase {
+    pub(super) fn new(active: bool) -> RootPhase {
+        RootPhase {
+            active,
+            steps: ROOT_STEPS,
+            best_total: i64::MIN,
+            stalled: 0,
+            shakes: SUB_STEPS,
+            best_total_sub: i64::MIN,
+            shake_stall: 0,
+            lambda: 1.0,
+            best_alpha: Vec::new(),
+            restored: false,
+        }
+    }
+
+    /// Given the bound `total` just computed, and whether the root's budget
+    /// is `spent`.
+    pub(super) fn next(&mut self, total: i64, spent: bool) -> Next {
+        if !self.active || self.restored {
+            return Next::Done;
+        }
+        if total > self.best_total {
+            self.best_total = total;
+            self.stalled = 0;
+        } else {
+            self.stalled += 1;
+        }
+        if !spent && self.steps > 0 && self.stalled < STALL {
+            self.steps -= 1;
+            return Next::Ascend;
+        }
+        if !spent && self.shakes > 0 {
+            self.shakes -= 1;
+            if total > self.best_total_sub {
+                self.best_total_sub = total;
+                self.shake_stall = 0;
+            } else {
+                self.shake_stall += 1;
+                if self.shake_stall >= SHAKE_STALL {
+                    self.lambda /= 2.0;
+                    self.shake_stall = 0;
+                }
+            }
+            self.stalled = 0;
+            self.steps = AFTER_SHAKE;
+            return Next::Shake(self.lambda);
+        }
+        if !self.best_alpha.is_empty() && total < self.best_total_sub {
+            self.restored = true;
+            return Next::Restore;
+        }
+        Next::Done
+    }
+}
