@@ -100,29 +100,19 @@ def solve(g1, g2, labeled, time_limit=10.0, strong=False):
         idx = [xid[(u, v)] for u in range(n1) if (u, v) in xid]
         if idx:
             rows.append((idx, [1.0] * len(idx)))
-    by_tail, by_head = {}, {}
+    # Each row: a group of y columns <= one x column. A group is keyed by
+    # the x pair it is bounded by and what it sums over.
+    groups = {}
     for k, l, c in yid:
+        (u, w), _ = pa[k]
         (v, z), _ = pb[l]
-        by_tail.setdefault((k, v), []).append(c)
-        by_head.setdefault((k, z), []).append(c)
-    for (k, v), cols in by_tail.items():
-        u = pa[k][0][0]
-        rows.append((cols + [xid[(u, v)]], [1.0] * len(cols) + [-1.0]))
-    for (k, z), cols in by_head.items():
-        w = pa[k][0][1]
-        rows.append((cols + [xid[(w, z)]], [1.0] * len(cols) + [-1.0]))
-    if strong:
-        by_tail_l, by_head_l = {}, {}
-        for k, l, c in yid:
-            (u, w), _ = pa[k]
-            by_tail_l.setdefault((u, l), []).append(c)
-            by_head_l.setdefault((w, l), []).append(c)
-        for (u, l), cols in by_tail_l.items():
-            v = pb[l][0][0]
-            rows.append((cols + [xid[(u, v)]], [1.0] * len(cols) + [-1.0]))
-        for (w, l), cols in by_head_l.items():
-            z = pb[l][0][1]
-            rows.append((cols + [xid[(w, z)]], [1.0] * len(cols) + [-1.0]))
+        keys = [("F2 tail", k, (u, v)), ("F2 head", k, (w, z))]
+        if strong:
+            keys += [("tail", l, (u, v)), ("head", l, (w, z))]
+        for key in keys:
+            groups.setdefault(key, []).append(c)
+    for (_, _, pair), cols in groups.items():
+        rows.append((cols + [xid[pair]], [1.0] * len(cols) + [-1.0]))
     rows = [(i, v, 1.0 if all(x > 0 for x in v) else 0.0) for i, v in rows]
 
     h = highspy.Highs()

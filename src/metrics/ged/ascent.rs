@@ -316,6 +316,29 @@ impl Ascent {
         }
     }
 
+    /// The entry of G1 arc `k` and G2 arc `l` in a tail view (`tail`) or a
+    /// head view, if the arcs' other ends may map onto each other (same class).
+    #[inline]
+    fn entry(&self, tail: bool, k: u32, l: u32) -> Option<usize> {
+        let (k, l) = (k as usize, l as usize);
+        let (o1, o2) = if tail {
+            (self.a1.head[k], self.a2.head[l])
+        } else {
+            (self.a1.tail[k], self.a2.tail[l])
+        };
+        (self.class_of[o1 as usize] == self.class_of[o2 as usize]).then_some(k * self.a2.len() + l)
+    }
+
+    /// The share of entry `e` (arcs `k`, `l`) in a tail view or a head view.
+    #[inline]
+    fn share(&self, tail: bool, k: u32, l: u32, e: usize) -> i64 {
+        if tail {
+            self.alpha[e]
+        } else {
+            self.worth(k, l) - self.alpha[e]
+        }
+    }
+
     /// Rebuilds the view rows of G1 vertex `u` (its arcs to unmapped vertices).
     fn rows_of(&mut self, f: &[u32], u: usize) {
         let (tr, hr) = (&mut self.t_rows[u], &mut self.h_rows[u]);
@@ -465,27 +488,11 @@ impl Ascent {
         self.buf.resize(k * k, 0);
         let mut any = false;
         for (i, &ka) in rows.iter().enumerate() {
-            let other1 = if tail {
-                self.a1.head[ka as usize]
-            } else {
-                self.a1.tail[ka as usize]
-            };
             for (j, &lb) in cols.iter().enumerate() {
-                let other2 = if tail {
-                    self.a2.head[lb as usize]
-                } else {
-                    self.a2.tail[lb as usize]
-                };
-                if self.class_of[other1 as usize] != self.class_of[other2 as usize] {
+                let Some(e) = self.entry(tail, ka, lb) else {
                     continue;
-                }
-                let e = ka as usize * m2 + lb as usize;
-                let share = if tail {
-                    self.alpha[e]
-                } else {
-                    S * i64::from(self.a1.mult[ka as usize].min(self.a2.mult[lb as usize]))
-                        - self.alpha[e]
                 };
+                let share = self.share(tail, ka, lb, e);
                 if share > 0 {
                     self.buf[i * k + j] = -share;
                     any = true;
@@ -526,31 +533,21 @@ impl Ascent {
         // has a positive share: the zero dual is optimal).
         let epoch = self.epoch;
         for (i, &ka) in rows.iter().enumerate() {
-            let other1 = if tail {
-                self.a1.head[ka as usize]
-            } else {
-                self.a1.tail[ka as usize]
-            };
             for (j, &lb) in cols.iter().enumerate() {
-                let other2 = if tail {
-                    self.a2.head[lb as usize]
-                } else {
-                    self.a2.tail[lb as usize]
-                };
-                if self.class_of[other1 as usize] != self.class_of[other2 as usize] {
+                let Some(e) = self.entry(tail, ka, lb) else {
                     continue;
-                }
-                let e = ka as usize * m2 + lb as usize;
+                };
                 let dual = if any {
                     -self.hung.u[i + 1] - self.hung.v[j + 1]
                 } else {
                     0
                 };
+                let slack = dual - self.share(tail, ka, lb, e);
                 if tail {
-                    self.slack_t[e] = dual - self.alpha[e];
+                    self.slack_t[e] = slack;
                     self.stamp_t[e] = epoch;
                 } else {
-                    self.slack_h[e] = dual - (self.worth(ka, lb) - self.alpha[e]);
+                    self.slack_h[e] = slack;
                     self.stamp_h[e] = epoch;
                 }
             }
@@ -639,7 +636,7 @@ impl Ascent {
 
 #[cfg(test)]
 mod tests {
-    use super::super::graph::GedGraph;
+    use super::super::brute::random_pairs;
     use super::{Ascent, Hungarian, S};
     use crate::metrics::ged::problem::{NONE, Problem};
 
@@ -682,37 +679,12 @@ mod tests {
         (lb, rc)
     }
 
-    fn random_pairs(count: usize, mut seed: u64) -> Vec<(GedGraph, GedGraph, bool)> {
-        let mut next = move |m: u64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed % m.max(1)
-        };
-        (0..count)
-            .map(|i| {
-                let labels = if i % 2 == 0 { 1 } else { 3 };
-                let (n1, n2) = (next(6) as usize + 1, next(6) as usize + 1);
-                let mut graph = |n: usize| {
-                    let m = next(3 * n as u64 + 2) as usize;
-                    let l: Vec<u32> = (0..n).map(|_| next(labels) as u32).collect();
-                    let k: Vec<String> = (0..n).map(|i| format!("v{i}")).collect();
-                    let arcs: Vec<(usize, usize)> = (0..m)
-                        .map(|_| (next(n as u64) as usize, next(n as u64) as usize))
-                        .collect();
-                    GedGraph::new(l, k, arcs).expect("valid")
-                };
-                (graph(n1), graph(n2), labels > 1)
-            })
-            .collect()
-    }
-
     /// Any split of the arc pairs' worth, even an absurd one, bounds GED
     /// from below: the relaxation's claim.
     #[test]
     fn every_split_gives_a_valid_bound() {
         let mut x = 0x5EED_u64;
-        for (i, (a, b, labeled)) in random_pairs(200, 0x00A5_CE17).into_iter().enumerate() {
+        for (i, (a, b, labeled)) in random_pairs(200, 0x00A5_CE17, 6).into_iter().enumerate() {
             let p = Problem::new(&a, &b);
             let Some(mut asc) = Ascent::new(&p, 1) else {
                 continue;
@@ -734,7 +706,7 @@ mod tests {
     #[test]
     fn ascent_steps_never_lower_the_bound() {
         let mut raised = 0;
-        for (i, (a, b, labeled)) in random_pairs(200, 0xB0B).into_iter().enumerate() {
+        for (i, (a, b, labeled)) in random_pairs(200, 0xB0B, 6).into_iter().enumerate() {
             let p = Problem::new(&a, &b);
             let Some(mut asc) = Ascent::new(&p, 1) else {
                 continue;

@@ -84,3 +84,33 @@ pub(super) fn brute_ged(a: &GedGraph, b: &GedGraph, labeled: bool) -> u64 {
     o.step(0, 0);
     o.best
 }
+
+/// `count` seeded random multigraph pairs of 1 to `max_n` vertices each
+/// (self-loops and parallel arcs; even pairs unlabelled, odd ones with three
+/// labels), each with whether its labels are to be used.
+pub(super) fn random_pairs(count: usize, seed: u64, max_n: u64) -> Vec<(GedGraph, GedGraph, bool)> {
+    let mut x = seed;
+    let mut next = move |m: u64| {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x % m.max(1)
+    };
+    (0..count)
+        .map(|i| {
+            let n1 = next(max_n) as usize + 1;
+            let n2 = next(max_n) as usize + 1;
+            let labels = if i % 2 == 0 { 1 } else { 3 };
+            let mut graph = |n: usize| {
+                let m = next(3 * n as u64 + 2) as usize;
+                let l: Vec<u32> = (0..n).map(|_| next(labels) as u32).collect();
+                let k: Vec<String> = (0..n).map(|i| format!("v{i}")).collect();
+                let arcs: Vec<(usize, usize)> = (0..m)
+                    .map(|_| (next(n as u64) as usize, next(n as u64) as usize))
+                    .collect();
+                GedGraph::new(l, k, arcs).expect("valid")
+            };
+            (graph(n1), graph(n2), labels > 1)
+        })
+        .collect()
+}

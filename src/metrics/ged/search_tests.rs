@@ -57,28 +57,9 @@ fn bare_search_matches_brute_force() {
 
 /// 150 random pairs, the search with or without the ascent bound.
 fn bare_search_against_brute_force(ascent: bool) {
-    let mut x = 0xDEAD_BEEFu64;
-    let mut next = |m: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % m.max(1)
-    };
     let mut expanded = 0;
-    for i in 0..150 {
-        let n1 = next(7) as usize + 1;
-        let n2 = next(7) as usize + 1;
-        let labels = if i % 2 == 0 { 1 } else { 3 };
-        let mut graph = |n: usize| {
-            let m = next(3 * n as u64 + 2) as usize;
-            let l: Vec<u32> = (0..n).map(|_| next(labels) as u32).collect();
-            let k: Vec<String> = (0..n).map(|i| format!("v{i}")).collect();
-            let arcs: Vec<(usize, usize)> = (0..m)
-                .map(|_| (next(n as u64) as usize, next(n as u64) as usize))
-                .collect();
-            GedGraph::new(l, k, arcs).expect("valid")
-        };
-        let (a, b) = (graph(n1), graph(n2));
+    let pairs = super::super::brute::random_pairs(150, 0xDEAD_BEEF, 7);
+    for (i, (a, b, labeled)) in pairs.into_iter().enumerate() {
         let p = Problem::new(&a, &b);
         let lim = Limits {
             deadline: Instant::now() + Duration::from_secs(60),
@@ -89,7 +70,7 @@ fn bare_search_against_brute_force(ascent: bool) {
         bnb.want_ascent = ascent;
         let lower = bnb.search(0);
         assert_eq!(lower, bnb.ub);
-        let truth = super::super::brute::brute_ged(&a, &b, labels > 1);
+        let truth = super::super::brute::brute_ged(&a, &b, labeled);
         assert_eq!(bnb.ub, truth, "pair {i}, ascent {ascent}");
         assert_eq!(p.cost(&bnb.best), truth);
         expanded += bnb.expansions;
