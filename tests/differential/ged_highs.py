@@ -226,9 +226,24 @@ def main():
                     help="graphs of policy files (the ignored test dump_policy_graphs writes "
                          "them); every pair of them is also checked, by file")
     args = ap.parse_args()
-    bad = 0
-    exact = 0
-    checked = 0
+    tally = {"checked": 0, "exact": 0, "bad": 0}
+
+    def check(name, fa, fb, ga, gb, shown=""):
+        """Both modes of one pair: btfsm's result must hold HiGHS's optimum."""
+        for mode in ("structural", "labeled"):
+            r = run_btfsm(args.btfsm, fa, fb, mode)
+            truth, _ = solve(ga, gb, mode == "labeled", time_limit=60, strong=True)
+            if truth is None:
+                print(f"{name} {mode}: HiGHS did not finish, skipped")
+                continue
+            tally["checked"] += 1
+            tally["exact"] += r["exact"]
+            ok = r["lower_bound"] <= truth <= r["upper_bound"] and (not r["exact"] or r["ged"] == truth)
+            if not ok:
+                tally["bad"] += 1
+                print(f"DISAGREE {name} {mode}: HiGHS {truth}, btfsm {r['ged']} "
+                      f"[{r['lower_bound']}, {r['upper_bound']}] exact={r['exact']}{shown}")
+
     with tempfile.TemporaryDirectory() as d:
         for name, (ta, ga), (tb, gb) in pairs(args.seed, args.pairs):
             fa, fb = os.path.join(d, "a.toml"), os.path.join(d, "b.toml")
@@ -236,38 +251,15 @@ def main():
                 f.write(ta)
             with open(fb, "w") as f:
                 f.write(tb)
-            for mode in ("structural", "labeled"):
-                r = run_btfsm(args.btfsm, fa, fb, mode)
-                truth, _ = solve(ga, gb, mode == "labeled", time_limit=60, strong=True)
-                if truth is None:
-                    print(f"{name} {mode}: HiGHS did not finish, skipped")
-                    continue
-                checked += 1
-                exact += r["exact"]
-                ok = r["lower_bound"] <= truth <= r["upper_bound"] and (not r["exact"] or r["ged"] == truth)
-                if not ok:
-                    bad += 1
-                    print(f"DISAGREE {name} {mode}: HiGHS {truth}, btfsm {r['ged']} "
-                          f"[{r['lower_bound']}, {r['upper_bound']}] exact={r['exact']}\n{ta}\n{tb}")
+            check(name, fa, fb, ga, gb, f"\n{ta}\n{tb}")
     if args.paper:
         with open(args.paper) as f:
             graphs = [json.loads(line) for line in f if line.strip()]
         for i, ga in enumerate(graphs):
             for gb in graphs[i + 1:]:
-                for mode in ("structural", "labeled"):
-                    r = run_btfsm(args.btfsm, ga["file"], gb["file"], mode)
-                    truth, secs = solve(ga, gb, mode == "labeled", time_limit=60, strong=True)
-                    name = f"{os.path.basename(ga['file'])} -> {os.path.basename(gb['file'])}"
-                    if truth is None:
-                        print(f"{name} {mode}: HiGHS did not finish, skipped")
-                        continue
-                    checked += 1
-                    exact += r["exact"]
-                    ok = r["lower_bound"] <= truth <= r["upper_bound"] and (not r["exact"] or r["ged"] == truth)
-                    if not ok:
-                        bad += 1
-                        print(f"DISAGREE {name} {mode}: HiGHS {truth}, btfsm {r['ged']} "
-                              f"[{r['lower_bound']}, {r['upper_bound']}] exact={r['exact']}")
+                name = f"{os.path.basename(ga['file'])} -> {os.path.basename(gb['file'])}"
+                check(name, ga["file"], gb["file"], ga, gb)
+    checked, exact, bad = tally["checked"], tally["exact"], tally["bad"]
     print(f"GED vs HiGHS: {checked} pair-modes, {exact} exact in btfsm, {bad} disagreements")
     return 1 if bad else 0
 
