@@ -78,7 +78,7 @@ use super::embed::{self, Embedding};
 use super::local;
 use super::lsap::{Assignment, Lsap};
 use super::problem::{NONE, Problem};
-use super::root::{Next, RootPhase};
+use super::root::{self, Next, RootPhase};
 use super::treebound;
 use super::wl::Colours;
 
@@ -252,6 +252,9 @@ struct Bnb<'a> {
     rc: Vec<i64>,
     /// Whether the search uses the ascent bound (graphs that are not forests).
     want_ascent: bool,
+    /// Subgradient steps allowed at the root (`root::SUB_STEPS`; fewer in
+    /// tests, to make the search branch).
+    shakes: usize,
 }
 
 impl<'a> Bnb<'a> {
@@ -308,6 +311,7 @@ impl<'a> Bnb<'a> {
             deg1: (0..n).map(|u| p.s1.degree(u)).collect(),
             asc: None,
             want_ascent: false,
+            shakes: root::SUB_STEPS,
             unit: 2,
             rc: Vec::new(),
         }
@@ -741,7 +745,7 @@ impl<'a> Bnb<'a> {
     fn eval(&mut self, parent_lb: u64, warm: Option<&Warm>) -> Eval {
         let p = self.p;
         let root = self.expansions == 0;
-        let mut phase = RootPhase::new(root && self.asc.is_some());
+        let mut phase = RootPhase::new(root && self.asc.is_some(), self.shakes);
         let (classes, total, lb) = loop {
             let Some((classes, total)) = self.assign(warm) else {
                 return Eval::Timeout;

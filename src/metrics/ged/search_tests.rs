@@ -50,13 +50,17 @@ fn dives_recover_an_isomorphic_tree() {
 /// pruning, warm starts and symmetry breaking through deep trees.
 #[test]
 fn bare_search_matches_brute_force() {
-    for ascent in [false, true] {
-        bare_search_against_brute_force(ascent);
+    // Without the ascent bound; with it but no subgradient steps (a weaker
+    // root, so that the search branches and the pair-by-pair updates below
+    // the root are checked at every node); and as configured.
+    for (ascent, shakes, deep) in [(false, 0, 100), (true, 0, 10), (true, root::SUB_STEPS, 0)] {
+        bare_search_against_brute_force(ascent, shakes, deep);
     }
 }
 
-/// 150 random pairs, the search with or without the ascent bound.
-fn bare_search_against_brute_force(ascent: bool) {
+/// 150 random pairs, the search with or without the ascent bound; it must
+/// expand more than `deep` nodes in all.
+fn bare_search_against_brute_force(ascent: bool, shakes: usize, deep: u64) {
     let mut expanded = 0;
     let pairs = super::super::brute::random_pairs(150, 0xDEAD_BEEF, 7);
     for (i, (a, b, labeled)) in pairs.into_iter().enumerate() {
@@ -68,16 +72,14 @@ fn bare_search_against_brute_force(ascent: bool) {
         let greedy = p.greedy();
         let mut bnb = Bnb::new(&p, p.cost(&greedy) + 1, greedy, lim);
         bnb.want_ascent = ascent;
+        bnb.shakes = shakes;
         let lower = bnb.search(0);
         assert_eq!(lower, bnb.ub);
         let truth = super::super::brute::brute_ged(&a, &b, labeled);
-        assert_eq!(bnb.ub, truth, "pair {i}, ascent {ascent}");
+        assert_eq!(bnb.ub, truth, "pair {i}, ascent {ascent}, {shakes} steps");
         assert_eq!(p.cost(&bnb.best), truth);
         expanded += bnb.expansions;
     }
-    // The search must branch, not settle everything at the root (the
-    // ascent bound settles most of these small pairs there).
-    let deep = if ascent { 10 } else { 100 };
     assert!(expanded > deep, "the search went deep: {expanded}");
 }
 
