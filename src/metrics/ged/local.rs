@@ -106,7 +106,7 @@ pub(crate) fn iterated(
     };
     let start = p.cost(sigma);
     let mut best_cost = start;
-    let mut cand = sigma.clone();
+    let mut cand = sigma.to_vec();
     for r in 0..rounds {
         if Instant::now() > deadline {
             break;
