@@ -82,7 +82,7 @@ pub(crate) fn two_swap(p: &Problem, sigma: &mut [u32], deadline: Instant) -> u64
 /// Returns whether `sigma` got cheaper.
 pub(crate) fn iterated(
     p: &Problem,
-    sigma: &mut Vec<u32>,
+    sigma: &mut [u32],
     rounds: usize,
     seed: u64,
     deadline: Instant,
