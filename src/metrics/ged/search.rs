@@ -913,9 +913,11 @@ impl<'a> Bnb<'a> {
         if matches!(root, Eval::Branch(_)) && self.asc.is_some() {
             // A better mapping before branching: iterated local search, a
             // fixed number of rounds (ILS_WORK / n² of them, at most
-            // ILS_ROUNDS), charged to the work budget.
+            // ILS_ROUNDS, and within a quarter of the work left), charged
+            // to the work budget.
             let n2 = (self.n * self.n).max(1) as u64;
-            let rounds = (ILS_WORK / n2).min(ILS_ROUNDS);
+            let left = self.lim.work.saturating_sub(self.work) / 4;
+            let rounds = (ILS_WORK.min(left) / n2).min(ILS_ROUNDS);
             self.work += rounds * n2;
             let mut sigma = self.best.clone();
             if local::iterated(
