@@ -21,10 +21,12 @@
 //! mapping costing `upper`, the same on any machine.
 
 mod band;
+mod bounds;
 pub mod bt;
 mod greedy;
 mod mapping;
 mod script;
+mod sed;
 #[cfg(test)]
 mod tests;
 mod tree;
@@ -161,8 +163,36 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
     };
     let mut work = 0u64;
     let mut peak = 0u64;
+    // The label sequences' bounds (`bounds.rs`): a lower bound that often
+    // meets the upper one on a tree and its edited copy, and a mapping that
+    // is often better than the greedy one; skipped when they do not fit
+    // the budgets.
+    if bounds::work(n1, n2) <= opts.max_work && bounds::cells(n1, n2) <= opts.max_cells {
+        let sb = bounds::sequence_bounds(&f, &g);
+        work += sb.work;
+        peak = peak.max(sb.peak);
+        lower = lower.max(sb.lower);
+        if sb.upper < best.0 {
+            best = (sb.upper, to_arena(sb.mapping));
+        }
+        if lower >= best.0 {
+            let (upper, mapping) = best;
+            return TedResult {
+                lower: upper,
+                upper,
+                mapping,
+                work,
+                band: 0,
+                peak_cells: peak,
+            };
+        }
+    }
     let mut done_band = 0;
-    let mut u = n1.abs_diff(n2).max(2);
+    // A band narrower than the lower bound cannot prove the distance.
+    let mut u = n1
+        .abs_diff(n2)
+        .max(2)
+        .max(usize::try_from(lower).unwrap_or(usize::MAX));
     let full_cells = u128::from(f.keyroot_weight()) * u128::from(g.keyroot_weight());
     // The width and work of the last band run.
     let mut last: Option<(usize, u64)> = None;

@@ -321,3 +321,122 @@ fn a_distance_above_both_sizes_is_found() {
     assert_eq!((r.lower, r.upper), (26, 26));
     check_mapping(&a, &b, &r);
 }
+
+/// Zhang & Shasha's full tables: the band as wide as both trees together,
+/// which prunes nothing.
+fn zhang_shasha(a: &LabelledTree, b: &LabelledTree) -> u64 {
+    let f = OrderedTree::build(&a.children, &a.labels, a.root, false);
+    let g = OrderedTree::build(&b.children, &b.labels, b.root, false);
+    let mut band = Banded::new(&f, &g, f.len() + g.len());
+    band.run(u64::MAX).expect("no budget");
+    u64::from(band.distance())
+}
+
+/// The label sequences' bounds hold on thousands of random pairs: lower
+/// at most the distance, their mapping valid and costing `upper`.
+#[test]
+fn sequence_bounds_bracket_the_distance_with_a_valid_mapping() {
+    let mut rng = Rng(13);
+    for round in 0..3000 {
+        let (n1, n2) = if round % 10 == 0 {
+            (1 + rng.below(90), 1 + rng.below(90))
+        } else {
+            (1 + rng.below(14), 1 + rng.below(14))
+        };
+        let alphabet = 1 + rng.below(4) as u64;
+        let a = random_tree(&mut rng, n1, alphabet);
+        let b = if round % 3 == 0 {
+            // A copy with a few labels changed: the bounds often meet.
+            let mut b = a.clone();
+            for _ in 0..rng.below(3) {
+                let v = rng.below(n1 as u64);
+                b.labels[v] = 7;
+            }
+            b
+        } else {
+            random_tree(&mut rng, n2, alphabet)
+        };
+        let d = zhang_shasha(&a, &b);
+        let f = OrderedTree::build(&a.children, &a.labels, a.root, false);
+        let g = OrderedTree::build(&b.children, &b.labels, b.root, false);
+        let sb = bounds::sequence_bounds(&f, &g);
+        assert!(
+            sb.lower <= d && d <= sb.upper,
+            "{} {d} {}",
+            sb.lower,
+            sb.upper
+        );
+        let (m1, m2) = (f.len(), g.len());
+        assert!(sb.work <= bounds::work(m1, m2) && sb.peak <= bounds::cells(m1, m2));
+        let mut mapping: Vec<(usize, usize)> = sb
+            .mapping
+            .iter()
+            .map(|&(x, y)| (f.arena[x], g.arena[y]))
+            .collect();
+        mapping.sort_unstable();
+        let r = TedResult {
+            lower: sb.lower,
+            upper: sb.upper,
+            mapping,
+            work: sb.work,
+            band: 0,
+            peak_cells: sb.peak,
+        };
+        check_mapping(&a, &b, &r);
+        // And the whole computation agrees with Zhang–Shasha.
+        let t = ted(&a, &b, &TedOptions::default());
+        assert!(t.exact());
+        assert_eq!(t.upper, d);
+        check_mapping(&a, &b, &t);
+    }
+}
+
+/// A 2,000-node tree against a copy with a few renames, inserted and
+/// deleted leaves: the sequence bounds meet, so no band runs, and the work
+/// is the alignments' alone.
+#[test]
+fn bounds_that_meet_prove_the_distance_without_a_band() {
+    let mut rng = Rng(31);
+    let a = random_tree(&mut rng, 2000, 30);
+    let mut b = a.clone();
+    for v in [100, 900, 1500] {
+        b.labels[v] = 99;
+    }
+    b.children.push(Vec::new());
+    b.labels.push(98);
+    b.children[0].push(2000);
+    let leaf = (1..2000)
+        .rev()
+        .find(|&v| a.children[v].is_empty())
+        .unwrap_or(1);
+    for c in &mut b.children {
+        c.retain(|&x| x != leaf);
+    }
+    let r = ted(&a, &b, &TedOptions::default());
+    assert!(r.exact());
+    assert_eq!(r.upper, 5);
+    assert_eq!(r.band, 0);
+    assert!(r.work <= bounds::work(2000, 2000), "{}", r.work);
+    check_mapping(&a, &b, &r);
+}
+
+/// A budget too small for the bounds skips them: the band runs as before.
+#[test]
+fn bounds_past_the_budgets_are_skipped() {
+    let mut rng = Rng(37);
+    let a = random_tree(&mut rng, 500, 3);
+    let b = random_tree(&mut rng, 500, 3);
+    let small = TedOptions {
+        max_work: bounds::work(500, 500) - 1,
+        ..TedOptions::default()
+    };
+    let r = ted(&a, &b, &small);
+    assert!(r.work <= small.max_work + 500 * 500 * 4);
+    let tight = TedOptions {
+        max_cells: bounds::cells(500, 500) - 1,
+        ..TedOptions::default()
+    };
+    let r = ted(&a, &b, &tight);
+    assert!(r.peak_cells <= tight.max_cells);
+    check_mapping(&a, &b, &r);
+}
