@@ -170,7 +170,7 @@ pub fn alignment(a: &[u32], b: &[u32]) -> (u32, Vec<(usize, usize)>) {
         for k in 0..full {
             v += i64::from(pv[k].count_ones()) - i64::from(mv[k].count_ones());
         }
-        if i % 64 != 0 {
+        if !i.is_multiple_of(64) {
             let mask = (1u64 << (i % 64)) - 1;
             v += i64::from((pv[full] & mask).count_ones())
                 - i64::from((mv[full] & mask).count_ones());
