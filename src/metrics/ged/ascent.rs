@@ -31,7 +31,9 @@
 //! Each move stays within the receiving view's room and only lowers the
 //! other, so the old outer duals stay feasible: the bound never decreases.
 //!
-//! Any α gives a valid bound, so α is global, carried from node to node;
+//! Any α gives a valid bound, so α is global, carried from node to node
+//! (a node that re-optimises it for its subproblem puts it back on leaving:
+//! [`Ascent::snapshot`], [`Ascent::restore`]);
 //! integer arithmetic (shares in units of 1/`S`) keeps it exact.
 
 use super::problem::{NONE, Problem};
@@ -272,6 +274,16 @@ impl Ascent {
     }
 
     /// The shares (to keep the best seen and restore them).
+    /// The shares and the local values, to put back with [`Ascent::restore`].
+    pub fn snapshot(&self) -> (Vec<i64>, Vec<i64>) {
+        (self.alpha.clone(), self.msum.clone())
+    }
+
+    pub fn restore(&mut self, saved: &(Vec<i64>, Vec<i64>)) {
+        self.alpha.copy_from_slice(&saved.0);
+        self.msum.copy_from_slice(&saved.1);
+    }
+
     pub fn shares(&self) -> &[i64] {
         &self.alpha
     }

@@ -1,7 +1,8 @@
 //! The schedule of the search's root bound with the ascent of `ascent.rs`:
 //! dual ascent until it stalls, then Polyak subgradient steps (Polyak,
 //! "Minimization of unsmooth functionals", USSR Comput. Math. 9, 1969),
-//! then back to the best shares seen. Used by `search.rs` at the root only.
+//! then back to the best shares seen. Used by `search.rs` at the root, and
+//! shortened at the nodes below it that re-optimise the shares.
 //!
 //! Measured on the FSM-like pairs of `bench/ged_vs_highs.py` (root bound,
 //! default budget): the ascent alone stalls well below the relaxation's
@@ -14,7 +15,9 @@
 
 /// Ascent steps at the root (at most; it stops once `STALL` steps in a
 /// row have not raised the bound). Below the root the shares stay fixed,
-/// so that the local values can be updated pair by pair (`Ascent::apply`).
+/// so that the local values can be updated pair by pair (`Ascent::apply`),
+/// except at the nodes that re-optimise them (`reopt.rs`, with a shorter
+/// schedule: `RootPhase::with`).
 const ROOT_STEPS: usize = 300;
 const STALL: usize = 12;
 /// Subgradient steps at the root, once the ascent stalls; the Polyak
@@ -48,14 +51,22 @@ pub(super) struct RootPhase {
     lambda: f64,
     pub(super) best_alpha: Vec<i64>,
     restored: bool,
+    halvings: usize,
+    /// The subgradient steps end once the factor has been halved more often.
+    pub(super) max_halvings: usize,
 }
 
 impl RootPhase {
     /// With at most `shakes` subgradient steps (`SUB_STEPS` but in tests).
     pub(super) fn new(active: bool, shakes: usize) -> RootPhase {
+        RootPhase::with(active, ROOT_STEPS, shakes)
+    }
+
+    /// At most `steps` ascent steps, then at most `shakes` subgradient steps.
+    pub(super) fn with(active: bool, steps: usize, shakes: usize) -> RootPhase {
         RootPhase {
             active,
-            steps: ROOT_STEPS,
+            steps,
             best_total: i64::MIN,
             stalled: 0,
             shakes,
@@ -64,6 +75,8 @@ impl RootPhase {
             lambda: 1.0,
             best_alpha: Vec::new(),
             restored: false,
+            halvings: 0,
+            max_halvings: usize::MAX,
         }
     }
 
@@ -93,6 +106,10 @@ impl RootPhase {
                 if self.shake_stall >= SHAKE_STALL {
                     self.lambda /= 2.0;
                     self.shake_stall = 0;
+                    self.halvings += 1;
+                    if self.halvings > self.max_halvings {
+                        self.shakes = 0;
+                    }
                 }
             }
             self.stalled = 0;

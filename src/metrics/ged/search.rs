@@ -54,9 +54,13 @@
 //! `ascent::fits`), term (c) is replaced by the Lagrangian bound of
 //! `ascent.rs`, whose split of each arc pair's worth between its tail and
 //! head is optimised at the root (dual ascent, then subgradient steps, at
-//! most a quarter of the search's work) and then kept fixed, so that each
-//! step down the search recomputes only the pairs next to the vertices it
-//! maps. The search then gets three quarters of the budget instead of one.
+//! most a quarter of the search's work) and then kept, so that each step
+//! down the search recomputes only the pairs next to the vertices it maps.
+//! A node that would branch under those shares may re-optimise them for its
+//! own subproblem (a few ascent and subgradient steps, as at the root; the
+//! shares are put back when the search leaves it): where, `reopt.rs`
+//! decides from the work the subtrees at each depth have taken. The search
+//! then gets three quarters of the budget instead of one.
 //!
 //! **Forest bound.** The Lagrangian search of `treebound.rs` (over a forest
 //! side, such as a BT's, or a spanning branching) runs first with three
@@ -80,6 +84,7 @@ use super::embed::{self, Embedding};
 use super::local;
 use super::lsap::{Assignment, Lsap};
 use super::problem::{NONE, Problem};
+use super::reopt::{self, Reopt};
 use super::root::{self, Next, RootPhase};
 use super::treebound;
 use super::wl::Colours;
@@ -113,8 +118,8 @@ pub(crate) struct Limits {
 #[derive(Debug, Clone)]
 pub(crate) struct Outcome {
     pub lower: u64,
-    pub upper: u64,
-    /// Padded G1 → padded G2 bijection of cost `upper`.
+    /// Padded G1 → padded G2 bijection, the cheapest found (its cost is
+    /// the upper bound).
     pub sigma: Vec<u32>,
     /// The instance was too large for the exact search (`MAX_SEARCH_N`).
     pub too_large: bool,
@@ -179,6 +184,12 @@ struct Frame {
     warm: Warm,
     /// The mapping step that led here, to undo on leaving: (w, x, Δg).
     via: Option<(u32, u32, u64)>,
+    /// The ascent's shares and local values before this node re-optimised
+    /// them, to put back on leaving.
+    saved: Option<(Vec<i64>, Vec<i64>)>,
+    /// Depth of the node, and the work counter when it was entered.
+    depth: usize,
+    start: u64,
 }
 
 /// Column potentials (by G2 vertex) and assigned column (by G1 vertex) of a
@@ -266,6 +277,8 @@ struct Bnb<'a> {
     /// Subgradient steps allowed at the root (`root::SUB_STEPS`; fewer in
     /// tests, to make the search branch).
     shakes: usize,
+    /// Which nodes below the root re-optimise the ascent's shares (`reopt.rs`).
+    reopt: Reopt,
 }
 
 impl<'a> Bnb<'a> {
@@ -323,6 +336,7 @@ impl<'a> Bnb<'a> {
             asc: None,
             want_ascent: false,
             shakes: root::SUB_STEPS,
+            reopt: Reopt::new(reopt::RATIO),
             unit: 2,
             rc: Vec::new(),
         }
@@ -752,11 +766,48 @@ impl<'a> Bnb<'a> {
         }
     }
 
-    /// Bounds the current node and, unless it can be discarded, lists its children.
-    fn eval(&mut self, parent_lb: u64, warm: Option<&Warm>) -> Eval {
+    /// Bounds the current node at `depth` and, unless it can be discarded,
+    /// lists its children. Down to `reopt_depth` the ascent's shares are
+    /// re-optimised for the node's own subproblem (and put back on leaving).
+    fn eval(&mut self, parent_lb: u64, warm: Option<&Warm>, depth: usize) -> Eval {
+        if depth == 0 {
+            let phase = RootPhase::new(self.asc.is_some(), self.shakes);
+            return self.eval_with(parent_lb, warm, phase);
+        }
+        let plain = self.eval_with(parent_lb, warm, RootPhase::with(false, 0, 0));
+        if !matches!(plain, Eval::Branch(_)) || !self.reopt.wants(depth) {
+            return plain;
+        }
+        let Some(a) = self.asc.as_mut() else {
+            return plain;
+        };
+        let saved = a.snapshot();
+        a.frozen = false;
+        let w0 = self.work;
+        let mut phase = RootPhase::with(true, self.reopt.steps, self.reopt.shakes);
+        phase.max_halvings = reopt::MAX_HALVINGS;
+        let r = self.eval_with(parent_lb, warm, phase);
+        self.reopt
+            .reopt_done(self.work - w0, matches!(r, Eval::Branch(_)));
+        let Some(a) = self.asc.as_mut() else {
+            return r;
+        };
+        a.frozen = true;
+        match r {
+            Eval::Branch(mut fr) => {
+                fr.saved = Some(saved);
+                Eval::Branch(fr)
+            }
+            r => {
+                a.restore(&saved);
+                r
+            }
+        }
+    }
+
+    fn eval_with(&mut self, parent_lb: u64, warm: Option<&Warm>, mut phase: RootPhase) -> Eval {
         let p = self.p;
         let root = self.expansions == 0;
-        let mut phase = RootPhase::new(root && self.asc.is_some(), self.shakes);
         let (classes, total, lb) = loop {
             let Some((classes, total)) = self.assign(warm) else {
                 return Eval::Timeout;
@@ -769,7 +820,12 @@ impl<'a> Bnb<'a> {
                 return Eval::Prune;
             }
             // The root's ascent may use at most a quarter of the budget.
-            let spent = self.work > self.lim.work / 4 || Instant::now() > self.lim.deadline;
+            let share = if root {
+                self.lim.work / 4
+            } else {
+                self.lim.work
+            };
+            let spent = self.work > share || Instant::now() > self.lim.deadline;
             match phase.next(total, spent) {
                 Next::Done => break (classes, total, lb),
                 Next::Ascend => self.ascend(&classes),
@@ -887,6 +943,9 @@ impl<'a> Bnb<'a> {
             warm: w,
             cur: 0,
             via: None,
+            saved: None,
+            depth: 0,
+            start: 0,
         })
     }
 
@@ -906,7 +965,7 @@ impl<'a> Bnb<'a> {
                 self.unit = 2 * ascent::S;
             }
         }
-        let root = self.eval(root_lb, None);
+        let root = self.eval(root_lb, None, 0);
         if let Some(a) = self.asc.as_mut() {
             a.frozen = true;
         }
@@ -940,10 +999,16 @@ impl<'a> Bnb<'a> {
         while let Some(top) = stack.last() {
             let exhausted = top.cur >= top.children.len() || top.children[top.cur].0 >= self.ub;
             if exhausted {
-                if let Some(fr) = stack.pop()
-                    && let Some((w, x, dg)) = fr.via
-                {
-                    self.unmap(w, x, dg);
+                if let Some(fr) = stack.pop() {
+                    if fr.depth > 0 {
+                        self.reopt.subtree_done(fr.depth, self.work - fr.start);
+                    }
+                    if let (Some(s), Some(a)) = (&fr.saved, self.asc.as_mut()) {
+                        a.restore(s);
+                    }
+                    if let Some((w, x, dg)) = fr.via {
+                        self.unmap(w, x, dg);
+                    }
                 }
                 if let Some(parent) = stack.last_mut() {
                     parent.cur += 1;
@@ -952,6 +1017,7 @@ impl<'a> Bnb<'a> {
             }
             let (est, v) = top.children[top.cur];
             let u = top.u;
+            let start = self.work;
             self.expansions += 1;
             self.work += 1 + self.n as u64;
             if self.work > self.lim.work || Instant::now() > self.lim.deadline {
@@ -960,9 +1026,12 @@ impl<'a> Bnb<'a> {
             }
             let dg = self.map(u, v);
             let warm = stack.last().map(|fr| &fr.warm);
-            match self.eval(est, warm) {
+            let depth = stack.len();
+            match self.eval(est, warm, depth) {
                 Eval::Branch(mut fr) => {
                     fr.via = Some((u, v, dg));
+                    fr.depth = depth;
+                    fr.start = start;
                     stack.push(fr);
                 }
                 Eval::Prune => {
@@ -996,7 +1065,6 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     let count = p.count_bound();
     let mut best = p.greedy();
     let mut ub = p.cost(&best);
-    let hinted = hint.is_some();
     if let Some(h) = hint
         && h.len() == p.n()
     {
@@ -1010,32 +1078,25 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
         first_upper: ub,
         ..Stats::default()
     };
-    let done = |lower: u64, upper: u64, sigma: Vec<u32>, stats: Stats| Outcome {
+    let done = |lower: u64, sigma: Vec<u32>, stats: Stats| Outcome {
         lower,
-        upper,
         sigma,
         too_large: false,
         stats,
     };
     if ub == count {
-        return done(ub, ub, best, stats);
+        return done(ub, best, stats);
     }
     let now = Instant::now();
     if now >= lim.deadline {
-        return done(count, ub, best, stats);
+        return done(count, best, stats);
     }
     let mut lb = count;
-    // A hinted call is a second attempt: the embedding search, being
-    // deterministic, would only repeat itself.
-    let embedding = if hinted {
-        Embedding::Unknown
-    } else {
-        embed::find(p, lim.deadline, EMBED_BUDGET)
-    };
+    let embedding = embed::find(p, lim.deadline, EMBED_BUDGET);
     match embedding {
         Embedding::Found(sigma) => {
             stats.embedding = Some(true);
-            return done(count, count, sigma, stats);
+            return done(count, sigma, stats);
         }
         Embedding::Absent => {
             stats.embedding = Some(false);
@@ -1046,7 +1107,7 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     local::two_swap(p, &mut best, lim.deadline);
     ub = p.cost(&best);
     if lb >= ub {
-        return done(ub, ub, best, stats);
+        return done(ub, best, stats);
     }
     // The forest search (`treebound.rs`). On a forest (BTs) it runs first,
     // with three quarters of the work budget, and this search gets the rest.
@@ -1074,13 +1135,13 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
         }
         tree_lb = tb.lower;
         if lb.max(tree_lb) >= ub {
-            return done(ub, ub, best, stats);
+            return done(ub, best, stats);
         }
     }
     // Setting the search up costs O(n²) (its tables): not when the budget
     // is already spent.
     if p.n() > MAX_SEARCH_N || Instant::now() >= lim.deadline {
-        let mut out = done(lb.max(tree_lb).min(ub), ub, best, stats);
+        let mut out = done(lb.max(tree_lb).min(ub), best, stats);
         out.too_large = p.n() > MAX_SEARCH_N;
         return out;
     }
@@ -1118,7 +1179,7 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
         }
         lower = lower.max(tb.lower).min(ub);
     }
-    done(lower, ub, best, stats)
+    done(lower, best, stats)
 }
 
 #[cfg(test)]

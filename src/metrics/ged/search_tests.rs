@@ -52,17 +52,30 @@ fn dives_recover_an_isomorphic_tree() {
 fn bare_search_matches_brute_force() {
     // Without the ascent bound; with it but no subgradient steps (a weaker
     // root, so that the search branches and the pair-by-pair updates below
-    // the root are checked at every node); and as configured.
-    for (ascent, shakes, deep) in [(false, 0, 100), (true, 0, 10), (true, root::SUB_STEPS, 0)] {
-        bare_search_against_brute_force(ascent, shakes, deep);
+    // the root are checked at every node); the same with the shares
+    // re-optimised at every node that branches (and put back on leaving it:
+    // the debug build checks every node's local values against a full
+    // evaluation); and as configured.
+    for (ascent, shakes, everywhere, deep) in [
+        (false, 0, false, 100),
+        (true, 0, false, 10),
+        (true, 0, true, 10),
+        (true, root::SUB_STEPS, false, 0),
+    ] {
+        bare_search_against_brute_force(ascent, shakes, everywhere, deep);
     }
 }
 
-/// 150 random pairs, the search with or without the ascent bound; it must
-/// expand more than `deep` nodes in all.
-fn bare_search_against_brute_force(ascent: bool, shakes: usize, deep: u64) {
+/// 150 random pairs (1500 with re-optimisation everywhere), the search
+/// with or without the ascent bound; it must expand more than `deep` nodes
+/// in all.
+fn bare_search_against_brute_force(ascent: bool, shakes: usize, everywhere: bool, deep: u64) {
+    let (mut reopts, mut branched) = (0, 0);
     let mut expanded = 0;
-    let pairs = super::super::brute::random_pairs(150, 0xDEAD_BEEF, 7);
+    // Re-optimising only happens where the inherited shares do not prune,
+    // rarely on graphs this small: more pairs then.
+    let count = if everywhere { 1500 } else { 150 };
+    let pairs = super::super::brute::random_pairs(count, 0xDEAD_BEEF, 7);
     for (i, (a, b, labeled)) in pairs.into_iter().enumerate() {
         let p = Problem::new(&a, &b);
         let lim = Limits {
@@ -73,7 +86,13 @@ fn bare_search_against_brute_force(ascent: bool, shakes: usize, deep: u64) {
         let mut bnb = Bnb::new(&p, p.cost(&greedy) + 1, greedy, lim);
         bnb.want_ascent = ascent;
         bnb.shakes = shakes;
+        if everywhere {
+            bnb.reopt = Reopt::everywhere();
+        }
         let lower = bnb.search(0);
+        let (done, still) = bnb.reopt.count();
+        reopts += done;
+        branched += still;
         assert_eq!(lower, bnb.ub);
         let truth = super::super::brute::brute_ged(&a, &b, labeled);
         assert_eq!(bnb.ub, truth, "pair {i}, ascent {ascent}, {shakes} steps");
@@ -81,6 +100,10 @@ fn bare_search_against_brute_force(ascent: bool, shakes: usize, deep: u64) {
         expanded += bnb.expansions;
     }
     assert!(expanded > deep, "the search went deep: {expanded}");
+    assert!(
+        !everywhere || (reopts >= 50 && branched > 0),
+        "re-optimised {reopts} times, {branched} still branched"
+    );
 }
 
 #[test]
@@ -126,4 +149,50 @@ fn map_and_unmap_are_inverse() {
     bnb.unmap(1, 0, d2);
     bnb.unmap(0, 2, d1);
     assert!(before == snapshot(&bnb));
+}
+
+/// Re-optimising the shares at every node that branches (and putting them
+/// back on leaving it) changes no value: on graphs of up to 12 vertices,
+/// too large for the brute force, the search with it agrees with the search
+/// without it (itself checked against the brute force above), while many
+/// of its nodes still branch after re-optimising, so that the shares are
+/// put back under live subtrees (the debug build checks every node's local
+/// values against a full evaluation).
+#[test]
+fn re_optimised_shares_change_no_value() {
+    let (mut reopts, mut branched) = (0, 0);
+    for (i, (a, b, _)) in super::super::brute::random_pairs(60, 0x005E_ED12, 12)
+        .into_iter()
+        .enumerate()
+    {
+        let p = Problem::new(&a, &b);
+        let lim = Limits {
+            deadline: Instant::now() + Duration::from_secs(60),
+            work: u64::MAX,
+        };
+        let run = |everywhere: bool| {
+            let greedy = p.greedy();
+            let mut bnb = Bnb::new(&p, p.cost(&greedy) + 1, greedy, lim);
+            bnb.want_ascent = true;
+            bnb.shakes = 0;
+            if everywhere {
+                bnb.reopt = Reopt::everywhere();
+            } else {
+                bnb.reopt = Reopt::new(0);
+            }
+            let lower = bnb.search(0);
+            assert_eq!(lower, bnb.ub);
+            assert_eq!(p.cost(&bnb.best), bnb.ub);
+            (bnb.ub, bnb.reopt.count())
+        };
+        let (plain, _) = run(false);
+        let (value, (done, still)) = run(true);
+        assert_eq!(value, plain, "pair {i}");
+        reopts += done;
+        branched += still;
+    }
+    assert!(
+        reopts >= 100 && branched >= 20,
+        "re-optimised {reopts} times, {branched} still branched"
+    );
 }
