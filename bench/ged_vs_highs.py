@@ -15,7 +15,8 @@ pairs btfsm settled exactly and the median ratio on the pairs both settled
 (HiGHS within --highs-timeout).
 
 Usage: python3 bench/ged_vs_highs.py BTFSM [--seed S] [--highs-timeout S]
-       [--groups trees,big-trees,fsm] [--formulations f2,strong]
+       [--groups trees,big-trees,fsm,fsm-set] [--fsm-count N] [--fsm-sizes LO,HI]
+       [--formulations f2,strong]
        [--work UNITS] [--json OUT]
 """
 import argparse
@@ -32,7 +33,13 @@ sys.path.insert(0, os.path.join(ROOT, "tests", "differential"))
 from ged_highs import random_fsm, random_tree, run_btfsm, solve  # noqa: E402
 
 
-def groups(seed):
+def groups(seed, fsm_count=30, fsm_sizes=(10, 28)):
+    # "fsm-set": its own generator, so that a set of other seeds and sizes
+    # (docs/performance.md, "More pairs") does not depend on the groups above.
+    lo, hi = fsm_sizes
+    own = random.Random(seed)
+    yield "fsm-set", [(random_fsm(own, own.randint(lo, hi)), random_fsm(own, own.randint(lo, hi)))
+                      for _ in range(fsm_count)]
     rng = random.Random(seed)
     yield "trees", [(random_tree(rng, rng.randint(15, 27)), random_tree(rng, rng.randint(15, 27)))
                     for _ in range(10)]
@@ -47,7 +54,10 @@ def main():
     ap.add_argument("btfsm")
     ap.add_argument("--seed", type=int, default=2017)
     ap.add_argument("--highs-timeout", type=float, default=10.0)
-    ap.add_argument("--groups", default="trees,big-trees,fsm")
+    ap.add_argument("--groups", default="trees,big-trees,fsm",
+                    help="of trees, big-trees, fsm, fsm-set (--fsm-count pairs of --fsm-sizes states)")
+    ap.add_argument("--fsm-count", type=int, default=30)
+    ap.add_argument("--fsm-sizes", default="10,28", help="LO,HI states of fsm-set")
     ap.add_argument("--modes", default="structural,labeled")
     ap.add_argument("--formulations", default="f2,strong")
     ap.add_argument("--work", help="btfsm's --work (default: btfsm's default)")
@@ -63,7 +73,8 @@ def main():
     rows = []
     with tempfile.TemporaryDirectory() as d:
         fa, fb = os.path.join(d, "a.toml"), os.path.join(d, "b.toml")
-        for group, plist in groups(args.seed):
+        sizes = tuple(int(x) for x in args.fsm_sizes.split(","))
+        for group, plist in groups(args.seed, args.fsm_count, sizes):
             if group not in wanted:
                 continue
             for i, ((ta, ga), (tb, gb)) in enumerate(plist):

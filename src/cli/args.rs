@@ -97,7 +97,7 @@ pub enum Command {
         timeout_ms: u64,
         /// Work budget of the exact search per mode, in work units (one per
         /// assignment-matrix entry the search builds; 15-80 ns each: the
-        /// default is about 1.5 s on the hardest pairs measured, idle).
+        /// default is about 4-5 s on the hardest pairs measured, idle).
         /// The same pair gives the same result (GED, exact, interval) on any
         /// machine under any load; when the budget runs out the result is a
         /// certified interval with `exact: false` and `stopped_by: work`
