@@ -19,6 +19,8 @@ fn assert_exact(v: &serde_json::Value, mode: &str, want: u64, what: &str) {
     assert_eq!(m["exact"], true, "{what} {mode}");
     assert_eq!(m["lower_bound"].as_u64(), Some(want), "{what} {mode}");
     assert_eq!(m["upper_bound"].as_u64(), Some(want), "{what} {mode}");
+    let micros = m["micros"].as_u64().expect("micros");
+    assert_eq!(m["millis"].as_u64(), Some(micros / 1000), "{what} {mode}");
     let s = &m["edit_script"];
     let count = |k: &str| s[k].as_array().expect("list").len() as u64;
     let arcs = |k: &str| {

@@ -165,6 +165,9 @@ pub struct ModeReport {
     pub lower_bound: u64,
     pub upper_bound: u64,
     pub millis: u64,
+    /// The same time in microseconds (for timing pairs that take under a
+    /// millisecond; `millis` = `micros` / 1000, rounded down).
+    pub micros: u64,
     /// When `exact` is false: what ended the search, `work` (the work
     /// budget, reproducible on any machine), `timeout` (the wall-clock cap
     /// `--timeout-ms`) or `size` (too large for the exact search). Absent
@@ -298,6 +301,7 @@ impl<'a> Pair<'a> {
             }
         };
         debug_assert_eq!(edit_script.cost(), upper);
+        let micros = u64::try_from(start.elapsed().as_micros()).unwrap_or(u64::MAX);
         ModeReport {
             mode,
             ged: upper,
@@ -306,7 +310,8 @@ impl<'a> Pair<'a> {
             exact: lower >= upper,
             lower_bound: lower.min(upper),
             upper_bound: upper,
-            millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
+            millis: micros / 1000,
+            micros,
             stopped_by: if lower >= upper { None } else { stopped_by },
             edit_script,
         }
