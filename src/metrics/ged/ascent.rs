@@ -279,6 +279,11 @@ impl Ascent {
         (self.alpha.clone(), self.msum.clone())
     }
 
+    /// Bytes a [`Ascent::snapshot`] holds.
+    pub fn snapshot_bytes(&self) -> usize {
+        (self.alpha.len() + self.msum.len()) * std::mem::size_of::<i64>()
+    }
+
     pub fn restore(&mut self, saved: &(Vec<i64>, Vec<i64>)) {
         self.alpha.copy_from_slice(&saved.0);
         self.msum.copy_from_slice(&saved.1);

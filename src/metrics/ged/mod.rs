@@ -102,7 +102,9 @@ impl GedMode {
 ///
 /// Memory does not grow with either budget: with n the larger vertex count,
 /// the search holds two n × n tables (4 + 1 bytes per entry) and a stack of
-/// at most n frames of O(n) words; when one side is a forest, the forest
+/// at most n frames of O(n) words, those that re-optimised the ascent's
+/// shares each with a copy of them (64 MiB in all at most,
+/// `reopt::MAX_HELD_BYTES`); when one side is a forest, the forest
 /// bound adds one n × n table of 8 bytes per entry. Above 2048 vertices no search is made
 /// (the count bound and a local-search mapping are returned).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

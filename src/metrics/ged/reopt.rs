@@ -19,6 +19,11 @@
 
 /// Depths re-optimised before anything is known about their subtrees.
 const BLIND_DEPTH: usize = 2;
+/// Most bytes of saved shares and local values held at once by the nodes
+/// on the search's stack that re-optimised (each holds one copy, up to
+/// 8 bytes per arc pair and per vertex pair: 4.5 MB at `ascent`'s limits);
+/// past it a node does not re-optimise.
+pub(super) const MAX_HELD_BYTES: usize = 64 << 20;
 /// Re-optimise where a subtree costs at least this many re-optimisations.
 pub(super) const RATIO: u64 = 1;
 /// A re-optimisation: at most this many ascent steps, then at most this
@@ -37,6 +42,8 @@ pub(super) struct Reopt {
     cost: (u64, u64),
     branched: u64,
     always: bool,
+    /// Bytes of snapshots held by nodes on the stack.
+    held: usize,
     /// The schedule of one re-optimisation (`STEPS`, `SHAKES`).
     pub(super) steps: usize,
     pub(super) shakes: usize,
@@ -50,6 +57,7 @@ impl Reopt {
             cost: (0, 0),
             branched: 0,
             always: false,
+            held: 0,
             steps: STEPS,
             shakes: SHAKES,
         }
@@ -97,6 +105,21 @@ impl Reopt {
         }
     }
 
+    /// Whether a node may keep a snapshot of `bytes` more.
+    pub(super) fn may_hold(&self, bytes: usize) -> bool {
+        self.held.saturating_add(bytes) <= MAX_HELD_BYTES
+    }
+
+    /// A node on the stack keeps (`hold`) or gives back (`release`) a
+    /// snapshot of `bytes`.
+    pub(super) fn hold(&mut self, bytes: usize) {
+        self.held += bytes;
+    }
+
+    pub(super) fn release(&mut self, bytes: usize) {
+        self.held = self.held.saturating_sub(bytes);
+    }
+
     /// A subtree at `depth` (the node and everything below it) took `work`.
     pub(super) fn subtree_done(&mut self, depth: usize, work: u64) {
         if self.sub.len() <= depth {
@@ -134,5 +157,16 @@ mod tests {
         assert!(!r.wants(5), "subtrees of 100 cost one re-optimisation");
         assert!(!r.wants(6), "estimated from depth 5: 50");
         assert!(!Reopt::new(0).wants(1), "ratio 0 turns it off");
+    }
+
+    #[test]
+    fn snapshots_held_stay_within_their_cap() {
+        let mut r = Reopt::new(1);
+        assert!(r.may_hold(MAX_HELD_BYTES));
+        r.hold(MAX_HELD_BYTES - 10);
+        assert!(r.may_hold(10) && !r.may_hold(11));
+        r.release(MAX_HELD_BYTES - 10);
+        assert!(r.may_hold(MAX_HELD_BYTES));
+        assert!(!r.may_hold(usize::MAX), "no overflow");
     }
 }

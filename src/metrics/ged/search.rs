@@ -767,8 +767,10 @@ impl<'a> Bnb<'a> {
     }
 
     /// Bounds the current node at `depth` and, unless it can be discarded,
-    /// lists its children. Down to `reopt_depth` the ascent's shares are
-    /// re-optimised for the node's own subproblem (and put back on leaving).
+    /// lists its children. A node that would branch under the inherited
+    /// shares is, where `reopt.rs` says so, evaluated again with the shares
+    /// re-optimised for its own subproblem (put back on leaving); the first,
+    /// plain evaluation is what tells the nodes worth it from the rest.
     fn eval(&mut self, parent_lb: u64, warm: Option<&Warm>, depth: usize) -> Eval {
         if depth == 0 {
             let phase = RootPhase::new(self.asc.is_some(), self.shakes);
@@ -781,6 +783,10 @@ impl<'a> Bnb<'a> {
         let Some(a) = self.asc.as_mut() else {
             return plain;
         };
+        let bytes = a.snapshot_bytes();
+        if !self.reopt.may_hold(bytes) {
+            return plain;
+        }
         let saved = a.snapshot();
         a.frozen = false;
         let w0 = self.work;
@@ -795,6 +801,7 @@ impl<'a> Bnb<'a> {
         a.frozen = true;
         match r {
             Eval::Branch(mut fr) => {
+                self.reopt.hold(bytes);
                 fr.saved = Some(saved);
                 Eval::Branch(fr)
             }
@@ -1004,6 +1011,7 @@ impl<'a> Bnb<'a> {
                         self.reopt.subtree_done(fr.depth, self.work - fr.start);
                     }
                     if let (Some(s), Some(a)) = (&fr.saved, self.asc.as_mut()) {
+                        self.reopt.release(a.snapshot_bytes());
                         a.restore(s);
                     }
                     if let Some((w, x, dg)) = fr.via {
