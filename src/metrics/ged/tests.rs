@@ -1189,7 +1189,8 @@ fn search_with_a_spent_deadline_returns_the_count_bound() {
 /// "arcs": [[t, h], …] (one per arc), "labels"}` for an outside oracle:
 /// `GED_DUMP=out.jsonl cargo test dump_policy_graphs -- --ignored a.toml b.toml`
 /// reads the files named in `GED_DUMP_FILES` (comma-separated);
-/// `bench/ged_paper_highs.py` runs HiGHS on them (docs/performance.md).
+/// `tests/differential/ged_highs.py --paper` runs HiGHS on them (`make
+/// differential`, docs/performance.md).
 #[test]
 #[ignore]
 fn dump_policy_graphs() {

@@ -210,6 +210,19 @@ impl<'a> Dp<'a> {
         deadline: Instant,
         pairs: bool,
     ) -> (i64, Vec<(u32, u32)>) {
+        self.matching_free(x, y, deadline, pairs, None)
+    }
+
+    /// `matching`, with the images `taken` (if given) out of reach.
+    fn matching_free(
+        &mut self,
+        x: u32,
+        y: u32,
+        deadline: Instant,
+        pairs: bool,
+        taken: Option<&[bool]>,
+    ) -> (i64, Vec<(u32, u32)>) {
+        let free = |w: u32| taken.is_none_or(|t| !t[w as usize]);
         let kids = &self.children[x as usize];
         let extra = &self.extra[x as usize];
         let outs: Vec<(u32, u32)> = self.b.out[y as usize].to_vec();
@@ -223,6 +236,7 @@ impl<'a> Dp<'a> {
             let (z, ma) = kids[0];
             let best = outs
                 .iter()
+                .filter(|&&(w, _)| free(w))
                 .map(|&(w, mb)| (self.gain(z, w, ma, mb), w))
                 .max_by_key(|&(g, w)| (g, std::cmp::Reverse(w)));
             return match best {
@@ -233,7 +247,9 @@ impl<'a> Dp<'a> {
         let mut cost = vec![0i64; k * k];
         for (i, &(z, ma)) in kids.iter().enumerate() {
             for (j, &(w, mb)) in outs.iter().enumerate() {
-                cost[i * k + j] = -self.gain(z, w, ma, mb);
+                if free(w) {
+                    cost[i * k + j] = -self.gain(z, w, ma, mb);
+                }
             }
         }
         // An arc outside the branching is kept only if its head lands on
@@ -243,7 +259,9 @@ impl<'a> Dp<'a> {
             let fh = self.fixed[h as usize];
             for (j, &(w, mb)) in outs.iter().enumerate() {
                 let ok = if fh == NONE {
-                    !self.used[w as usize] && self.class_of[h as usize] == self.class_of[w as usize]
+                    !self.used[w as usize]
+                        && free(w)
+                        && self.class_of[h as usize] == self.class_of[w as usize]
                 } else {
                     fh == w
                 };
@@ -358,6 +376,56 @@ impl<'a> Dp<'a> {
         }
         img
     }
+
+    /// The relaxed optimum of the last `evaluate` decoded top-down into a
+    /// class-preserving injection (a primal heuristic): a root takes its
+    /// relaxed image, the children of a placed vertex are matched onto the
+    /// free out-neighbours of its image (reserved at once, so that no
+    /// other vertex takes them), and a child left out takes its relaxed
+    /// image if free, else its free image of highest Q. Vertices whose
+    /// class has no free image left stay `NONE` (for `repair`).
+    fn decode(&mut self, deadline: Instant) -> Vec<u32> {
+        let n = self.a.n;
+        let mut img = vec![NONE; n];
+        let mut taken = vec![false; n];
+        // (vertex, placed): a placed vertex already holds its image.
+        let mut stack: Vec<(u32, bool)> = self.roots.iter().rev().map(|&r| (r, false)).collect();
+        while let Some((x, placed)) = stack.pop() {
+            let xu = x as usize;
+            if !placed {
+                let relaxed = self.arg_r[xu];
+                let y = if relaxed != NONE && !taken[relaxed as usize] {
+                    relaxed
+                } else {
+                    let cls = self.class_of[xu] as usize;
+                    self.members[cls]
+                        .iter()
+                        .copied()
+                        .filter(|&y| !taken[y as usize] && self.q[xu * n + y as usize] != i64::MIN)
+                        .max_by_key(|&y| (self.q[xu * n + y as usize], std::cmp::Reverse(y)))
+                        .unwrap_or(NONE)
+                };
+                if y != NONE {
+                    img[xu] = y;
+                    taken[y as usize] = true;
+                }
+            }
+            let y = img[xu];
+            let mut matched = Vec::new();
+            if y != NONE {
+                let (_, m) = self.matching_free(x, y, deadline, true, Some(&taken));
+                for &(z, w) in &m {
+                    img[z as usize] = w;
+                    taken[w as usize] = true;
+                }
+                matched = m;
+            }
+            for &(z, _) in self.children[xu].iter().rev() {
+                stack.push((z, matched.iter().any(|&(c, _)| c == z)));
+            }
+        }
+        img
+    }
 }
 
 /// Whether either side of `p` is a forest (then the forest search alone is
@@ -396,6 +464,8 @@ struct Search<'a> {
     p: &'a Problem,
     dp: Dp<'a>,
     flip: bool,
+    /// The search's side is a forest (not a spanning branching).
+    forest: bool,
     total: u64,
     lambda: Vec<i64>,
     best: Vec<u32>,
@@ -404,9 +474,47 @@ struct Search<'a> {
     deadline: Instant,
     /// Out of work or time: the search stopped with subtrees open.
     stopped: bool,
+    /// While the root's multipliers are tuned: how often (weighted by the
+    /// step's index) each pair (x, y) was in the relaxed optimum, n × n.
+    votes: Option<Vec<u32>>,
 }
 
-impl Search<'_> {
+impl<'a> Search<'a> {
+    /// The search over a forest side of `p` if there is one (else over a
+    /// spanning branching of `s1`), from the mapping `best`, within `work`.
+    fn new(p: &'a Problem, best: &[u32], work: u64, deadline: Instant) -> Search<'a> {
+        let b1 = Branching::of(&p.s1);
+        let (flip, br, forest) = if b1.is_forest() {
+            (false, b1, true)
+        } else {
+            let b2 = Branching::of(&p.s2);
+            if b2.is_forest() {
+                (true, b2, true)
+            } else {
+                (false, b1, false)
+            }
+        };
+        let (a, b) = if flip { (&p.s2, &p.s1) } else { (&p.s1, &p.s2) };
+        let mut dp = Dp::new(a, b, p, br);
+        dp.limit = work;
+        let n = p.n();
+        Search {
+            p,
+            dp,
+            flip,
+            forest,
+            total: p.vertex_cost + p.s1.arcs + p.s2.arcs,
+            lambda: vec![0; n],
+            best: best.to_vec(),
+            best_cost: p.cost(best),
+            work_limit: work,
+            deadline,
+            stopped: false,
+            // Votes (n² of them) on the instances the forest search is made on.
+            votes: (n <= MAX_TREE_N).then(|| vec![0; n * n]),
+        }
+    }
+
     /// The best overlap known, scaled.
     fn target(&self) -> i64 {
         i64::try_from((self.total - self.best_cost) / 2).unwrap_or(0) * SCALE
@@ -414,17 +522,23 @@ impl Search<'_> {
 
     /// Offers the relaxed optimum of the last evaluation, repaired.
     fn offer(&mut self) {
-        let img = self.dp.argmax(self.deadline);
         let n = self.p.n();
-        let sigma = repair(
-            self.p,
-            &if self.flip {
-                invert_partial(&img, n)
-            } else {
-                img
-            },
-        );
-        let c = self.p.cost(&sigma);
+        let mut pick: Option<(u64, Vec<u32>)> = None;
+        for img in [self.dp.decode(self.deadline), self.dp.argmax(self.deadline)] {
+            let sigma = repair(
+                self.p,
+                &if self.flip {
+                    invert_partial(&img, n)
+                } else {
+                    img
+                },
+            );
+            let c = self.p.cost(&sigma);
+            if pick.as_ref().is_none_or(|(pc, _)| c < *pc) {
+                pick = Some((c, sigma));
+            }
+        }
+        let Some((c, sigma)) = pick else { return };
         if c < self.best_cost {
             let mut s = sigma;
             super::local::two_swap(self.p, &mut s, self.deadline);
@@ -433,15 +547,66 @@ impl Search<'_> {
         }
     }
 
+    /// Rounds the votes of the root's steps (an estimate of the linear
+    /// relaxation's optimum, as in primal recovery from subgradient
+    /// iterates: Anstreicher & Wolsey, "Two 'well-known' properties of
+    /// subgradient optimization", Math. Prog. 120, 2009) into the
+    /// class-preserving bijection with most votes, one assignment per
+    /// class, and offers it.
+    fn round_votes(&mut self) {
+        let Some(mut sigma) = self.vote_mapping() else {
+            return;
+        };
+        super::local::two_swap(self.p, &mut sigma, self.deadline);
+        let c = self.p.cost(&sigma);
+        if c < self.best_cost {
+            self.best_cost = c;
+            self.best = sigma;
+        }
+    }
+
+    /// The class-preserving bijection of the problem with most votes
+    /// (`None` without votes or past the deadline).
+    fn vote_mapping(&mut self) -> Option<Vec<u32>> {
+        let votes = self.votes.take()?;
+        let n = self.p.n();
+        let mut img = vec![NONE; n];
+        let mut cost = Vec::new();
+        let mut complete = true;
+        for &(s, e) in &self.p.classes {
+            let k = e - s;
+            let votes = &votes;
+            cost.clear();
+            cost.extend((s..e).flat_map(|x| (s..e).map(move |y| -i64::from(votes[x * n + y]))));
+            self.dp.work += (k * k * k) as u64;
+            let Some(sol) = self.dp.lsap.solve(k, &cost, self.deadline) else {
+                complete = false;
+                break;
+            };
+            for (i, &j) in sol.col_of_row.iter().enumerate() {
+                img[s + i] = (s + j) as u32;
+            }
+        }
+        self.votes = Some(votes);
+        complete.then(|| {
+            if self.flip {
+                invert_partial(&img, n)
+            } else {
+                img
+            }
+        })
+    }
+
     /// Up to `iters` subgradient steps from the current multipliers; the
     /// smallest L(λ) seen (scaled), `None` if the fixings are infeasible or
     /// the budget ran out. The multipliers are left at the best point.
-    fn lagrange(&mut self, iters: usize) -> Option<i64> {
+    fn lagrange(&mut self, iters: usize, patience: usize) -> Option<i64> {
         let n = self.p.n();
         let mut best_l = i64::MAX;
         let mut best_lambda = self.lambda.clone();
         let mut theta = 1.0f64;
         let mut stale = 0;
+        let mut step_no = 0u32;
         for _ in 0..iters {
             if self.dp.work > self.work_limit || Instant::now() > self.deadline {
                 self.stopped = true;
@@ -458,7 +623,7 @@ impl Search<'_> {
                 stale = 0;
             } else {
                 stale += 1;
-                if stale >= 3 {
+                if stale >= patience {
                     theta /= 2.0;
                     stale = 0;
                 }
@@ -468,9 +633,22 @@ impl Search<'_> {
                 break; // ⌊L⌋ meets the best mapping: nothing left to prove here
             }
             let mut count = vec![0i64; n];
-            for &v in &self.dp.arg_images() {
+            let img = self.dp.arg_images();
+            for &v in &img {
                 if v != NONE {
                     count[v as usize] += 1;
+                }
+            }
+            if let Some(votes) = self.votes.as_mut() {
+                step_no += 1;
+                for (x, &v) in img.iter().enumerate() {
+                    if v != NONE {
+                        let slot = &mut votes[x * n + v as usize];
+                        *slot = slot.saturating_add(step_no);
+                    }
+                }
+                if step_no.is_multiple_of(ROUND_EVERY) {
+                    self.round_votes();
                 }
             }
             let norm: i64 = count.iter().map(|&c| (1 - c) * (1 - c)).sum();
@@ -526,7 +704,7 @@ impl Search<'_> {
             self.dp.fixed[x as usize] = y;
             self.dp.used[y as usize] = true;
             self.lambda.clone_from(&saved);
-            if let Some(lc) = self.lagrange(NODE_STEPS) {
+            if let Some(lc) = self.lagrange(NODE_STEPS, NODE_PATIENCE) {
                 let child = lc.min(l);
                 open = open.max(self.branch(child, depth + 1));
             } else if self.stopped {
@@ -540,9 +718,21 @@ impl Search<'_> {
     }
 }
 
-/// Subgradient steps at the root and at each node of the forest search.
-const ROOT_STEPS: usize = 200;
+/// Subgradient steps at the root and at each node of the forest search (at
+/// most: the steps stop once the step size has shrunk below 1/1000).
+const ROOT_STEPS: usize = 2000;
 const NODE_STEPS: usize = 25;
+/// Steps without a better bound after which the step size is halved: at
+/// the root, and at each node. (At the root 3 left the bound short of the
+/// linear relaxation's on labeled trees, e.g. 50 where HiGHS's strong
+/// relaxation and the optimum are 52, and the search then spent 4·10^7
+/// work closing the gap; 10 closes it at the root. Measured on
+/// docs/performance.md's pairs; 6 and 15 did worse than 10 overall.)
+const ROOT_PATIENCE: usize = 10;
+const NODE_PATIENCE: usize = 3;
+/// The votes of the root's steps are rounded into a mapping every this
+/// many steps (and once at the end).
+const ROUND_EVERY: u32 = 16;
 /// The forest search is made on instances up to this padded size (its
 /// recursion is as deep as the forest has vertices with arcs).
 const MAX_TREE_N: usize = 256;
@@ -563,37 +753,12 @@ pub(crate) fn solve(
     deadline: Instant,
     search_any: bool,
 ) -> Option<TreeBound> {
-    let b1 = Branching::of(&p.s1);
-    let (flip, br, forest) = if b1.is_forest() {
-        (false, b1, true)
-    } else {
-        let b2 = Branching::of(&p.s2);
-        if b2.is_forest() {
-            (true, b2, true)
-        } else {
-            (false, b1, false)
-        }
-    };
-    let (a, b) = if flip { (&p.s2, &p.s1) } else { (&p.s1, &p.s2) };
-    let mut dp = Dp::new(a, b, p, br);
-    dp.limit = work;
-    let work_limit = work;
-    let n = p.n();
-    let total = p.vertex_cost + p.s1.arcs + p.s2.arcs;
-    let mut s = Search {
-        p,
-        dp,
-        flip,
-        total,
-        lambda: vec![0; n],
-        best: best.to_vec(),
-        best_cost: p.cost(best),
-        work_limit,
-        deadline,
-        stopped: false,
-    };
+    let mut s = Search::new(p, best, work, deadline);
+    let (forest, n, total) = (s.forest, p.n(), s.total);
     let start_cost = s.best_cost;
-    let root = s.lagrange(ROOT_STEPS)?;
+    let root = s.lagrange(ROOT_STEPS, ROOT_PATIENCE)?;
+    s.round_votes();
+    s.votes = None;
     let open = if (forest || search_any) && n <= MAX_TREE_N && !s.stopped {
         s.branch(root, 0)
     } else {
@@ -695,6 +860,103 @@ mod tests {
             }
         }
         assert_eq!(closed, 600);
+    }
+
+    /// The primal heuristics offer only what may be offered: `decode` a
+    /// class-preserving injection that keeps the branch's fixings, and
+    /// `vote_mapping` a class-preserving bijection, the voted one itself
+    /// when the votes name a bijection. Forests against multigraphs, both
+    /// orientations (so the forest is sometimes `s2`: flipped), 1 and 3
+    /// labels, at random multipliers and random fixings.
+    #[test]
+    fn primal_heuristics_give_valid_mappings() {
+        let mut x = 0xDEC0_DE5Au64;
+        let mut next = |m: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % m.max(1)
+        };
+        let keys = |n: usize| (0..n).map(|i| format!("v{i}")).collect::<Vec<_>>();
+        let far = Instant::now() + Duration::from_secs(60);
+        let (mut decoded, mut fixed_kept, mut voted) = (0, 0, 0);
+        for i in 0..200 {
+            let labels = if i % 2 == 0 { 1 } else { 3 };
+            let (n1, n2) = (next(12) as usize + 2, next(12) as usize + 2);
+            let arcs: Vec<(usize, usize)> = (1..n1).map(|v| (next(v as u64) as usize, v)).collect();
+            let la: Vec<u32> = (0..n1).map(|_| next(labels) as u32).collect();
+            let forest = GedGraph::new(la, keys(n1), arcs).expect("valid");
+            let arcs2: Vec<(usize, usize)> = (0..next(3 * n2 as u64 + 1))
+                .map(|_| (next(n2 as u64) as usize, next(n2 as u64) as usize))
+                .collect();
+            let lb: Vec<u32> = (0..n2).map(|_| next(labels) as u32).collect();
+            let other = GedGraph::new(lb, keys(n2), arcs2).expect("valid");
+            let (g1, g2) = if i % 4 < 2 {
+                (&forest, &other)
+            } else {
+                (&other, &forest)
+            };
+            let p = Problem::new(g1, g2);
+            let n = p.n();
+            let mut s = Search::new(&p, &p.greedy(), u64::MAX, far);
+            assert!(s.forest, "pair {i}");
+            // A random fixing of one vertex of the search's side.
+            let fx = next(n as u64) as usize;
+            let (cs, ce) = p.classes[p.class_of[fx] as usize];
+            let fy = (cs + next((ce - cs) as u64) as usize) as u32;
+            if i % 3 == 0 {
+                s.dp.fixed[fx] = fy;
+                s.dp.used[fy as usize] = true;
+            }
+            let lambda: Vec<i64> = (0..n)
+                .map(|_| next(4 * SCALE as u64) as i64 - 2 * SCALE)
+                .collect();
+            if s.dp.evaluate(&lambda, far).is_none() {
+                continue;
+            }
+            let img = s.dp.decode(far);
+            let mut seen = vec![false; n];
+            for (u, &v) in img.iter().enumerate() {
+                if v != NONE {
+                    assert!(!seen[v as usize], "pair {i}: image {v} twice");
+                    seen[v as usize] = true;
+                    assert_eq!(p.class_of[u], p.class_of[v as usize], "pair {i}");
+                }
+            }
+            if i % 3 == 0 {
+                assert_eq!(img[fx], fy, "pair {i}: the fixing is kept");
+                fixed_kept += 1;
+            }
+            decoded += 1;
+            // Votes naming a class-preserving bijection (a random one)
+            // round to it, in the problem's orientation.
+            let mut named = vec![NONE; n];
+            for &(cs, ce) in &p.classes {
+                let mut ys: Vec<u32> = (cs as u32..ce as u32).collect();
+                for k in (1..ys.len()).rev() {
+                    ys.swap(k, next(k as u64 + 1) as usize);
+                }
+                named[cs..ce].copy_from_slice(&ys);
+            }
+            let votes = s.votes.as_mut().expect("small instances vote");
+            votes.iter_mut().for_each(|v| *v = 0);
+            for (u, &v) in named.iter().enumerate() {
+                votes[u * n + v as usize] = 1 + next(5) as u32;
+            }
+            let m = s.vote_mapping().expect("no deadline");
+            assert!(p.is_valid(&m), "pair {i}");
+            let want = if s.flip {
+                invert_partial(&named, n)
+            } else {
+                named
+            };
+            assert_eq!(m, want, "pair {i}");
+            voted += 1;
+        }
+        assert!(
+            decoded > 150 && fixed_kept > 40 && voted == decoded,
+            "{decoded} {fixed_kept} {voted}"
+        );
     }
 
     /// Neither side a forest: the bound over a spanning branching (arcs
