@@ -97,7 +97,7 @@ differential: $(VENV)/.installed
 	GED_DUMP=$(TARGET_DIR)/paper-graphs.jsonl GED_DUMP_FILES=$(GED_PAPER_FILES) \
 	  $(CARGO) test --quiet --locked --lib dump_policy_graphs -- --ignored > /dev/null
 	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24 \
-	  --paper $(TARGET_DIR)/paper-graphs.jsonl
+	  --shapes tree-edit,fsm-edit3,fsm-edit8,scxml-1-2 --paper $(TARGET_DIR)/paper-graphs.jsonl
 
 # The paper's dense FSMs (and Fig. 6's HFSM) whose pairs ged_highs.py also
 # checks against HiGHS: every pair of them, both modes.

@@ -3,7 +3,9 @@
 
 Generates seeded random pairs (tests/differential/ged_highs.py): independent
 random trees of 15-27 nodes (as BehaviorTree TOML) and of 40-50 nodes, and
-FSM-like graphs of 10-28 states (as FSM TOML); times
+FSM-like graphs of 10-28 states (as FSM TOML), and with `--groups shapes`
+pairs of other shapes (`ged_highs.shapes`: trees of six shapes, edited
+copies of trees and FSMs, FSMs of very different sizes, SCXML charts); times
 `btfsm compare --mode structural|labeled --format json` at its default budget
 (the engine's own `micros`, no process start-up; at least 1 µs) and HiGHS (PyPI `highspy`, one thread) on the binary formulations
 documented in ged_highs.py: F2 (Lerouge et al. 2017, unit costs) and F2 with
@@ -14,7 +16,7 @@ pairs btfsm settled exactly and the median ratio on the pairs both settled
 (HiGHS within --highs-timeout).
 
 Usage: python3 bench/ged_vs_highs.py BTFSM [--seed S] [--highs-timeout S]
-       [--groups trees,big-trees,fsm,fsm-set] [--fsm-count N] [--fsm-sizes LO,HI]
+       [--groups trees,big-trees,fsm,fsm-set,shapes] [--fsm-count N] [--fsm-sizes LO,HI]
        [--formulations f2,strong]
        [--work UNITS] [--json OUT]
 """
@@ -29,7 +31,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "differential"))
 
-from ged_highs import random_fsm, random_tree, run_btfsm, solve  # noqa: E402
+from ged_highs import random_fsm, random_tree, run_btfsm, shapes, solve  # noqa: E402
 
 
 def groups(seed, fsm_count=30, fsm_sizes=(10, 28)):
@@ -46,6 +48,9 @@ def groups(seed, fsm_count=30, fsm_sizes=(10, 28)):
                         for _ in range(6)]
     yield "fsm", [(random_fsm(rng, rng.randint(10, 28)), random_fsm(rng, rng.randint(10, 28)))
                   for _ in range(10)]
+    # Other shapes, from their own generator (ged_highs.shapes): the
+    # groups above do not depend on it.
+    yield "shapes", shapes(seed)
 
 
 def main():
@@ -54,7 +59,8 @@ def main():
     ap.add_argument("--seed", type=int, default=2017)
     ap.add_argument("--highs-timeout", type=float, default=10.0)
     ap.add_argument("--groups", default="trees,big-trees,fsm",
-                    help="of trees, big-trees, fsm, fsm-set (--fsm-count pairs of --fsm-sizes states)")
+                    help="of trees, big-trees, fsm, fsm-set (--fsm-count pairs of --fsm-sizes states), "
+                         "shapes (tree shapes, edited copies, FSMs of very different sizes, SCXML)")
     ap.add_argument("--fsm-count", type=int, default=30)
     ap.add_argument("--fsm-sizes", default="10,28", help="LO,HI states of fsm-set")
     ap.add_argument("--modes", default="structural,labeled")
@@ -67,16 +73,18 @@ def main():
     wanted = args.groups.split(",")
     import highspy
     print(f"HiGHS {highspy.Highs().version()}, Python {sys.version.split()[0]}")
-    print(f"{'pair':22} {'mode':10} {'btfsm':>9} {'HiGHS':>6} {'btfsm ms':>9} "
+    print(f"{'pair':28} {'mode':10} {'btfsm':>9} {'HiGHS':>6} {'btfsm ms':>9} "
           + " ".join(f"{f + ' ms':>9} {'ratio':>7}" for f in forms) + "  note")
     rows = []
     with tempfile.TemporaryDirectory() as d:
-        fa, fb = os.path.join(d, "a.toml"), os.path.join(d, "b.toml")
         sizes = tuple(int(x) for x in args.fsm_sizes.split(","))
         for group, plist in groups(args.seed, args.fsm_count, sizes):
             if group not in wanted:
                 continue
-            for i, ((ta, ga), (tb, gb)) in enumerate(plist):
+            for i, pair in enumerate(plist):
+                kind, (ta, ga), (tb, gb) = pair if len(pair) == 3 else (group, *pair)
+                ext = ".scxml" if ta.startswith("<?xml") else ".toml"
+                fa, fb = os.path.join(d, "a" + ext), os.path.join(d, "b" + ext)
                 with open(fa, "w") as f:
                     f.write(ta)
                 with open(fb, "w") as f:
@@ -89,7 +97,7 @@ def main():
                     ms = r["micros"] / 1e3 if "micros" in r else max(r["millis"], 1)
                     ms = max(ms, 1e-3)
                     ours = str(r["ged"]) if r["exact"] else f"[{r['lower_bound']},{r['upper_bound']}]"
-                    row = {"group": group, "pair": i, "mode": mode, "n": [ga["n"], gb["n"]],
+                    row = {"group": group, "kind": kind, "pair": i, "mode": mode, "n": [ga["n"], gb["n"]],
                            "btfsm": r["ged"], "exact": r["exact"], "lower": r["lower_bound"],
                            "upper": r["upper_bound"], "btfsm_ms": ms}
                     note, cells, value = [], [], None
@@ -107,8 +115,8 @@ def main():
                     if not r["exact"]:
                         note.append(f"inexact ({r.get('stopped_by', '?')})")
                     rows.append(row)
-                    name = f"{group}-{i} ({ga['n']},{gb['n']})"
-                    print(f"{name:22} {mode:10} {ours:>9} {str(value):>6} {ms:>9.1f} "
+                    name = f"{group}-{i} ({ga['n']},{gb['n']})" if kind == group else f"{kind}-{i} ({ga['n']},{gb['n']})"
+                    print(f"{name:28} {mode:10} {ours:>9} {str(value):>6} {ms:>9.1f} "
                           + " ".join(cells) + f"  {', '.join(note)}", flush=True)
     print()
     for group in wanted:
@@ -131,6 +139,9 @@ def main():
                     # result is quick because it gave up, not a win.
                     line += (f", median ratio HiGHS/btfsm on those "
                              f"{statistics.median(r[f'ratio_{form}'] for r in both):.1f}x")
+            either = [r for r in g if any(r.get(f"highs_{f}") is not None for f in forms)]
+            line += (f"; HiGHS solved {len(either)} in some formulation, btfsm exact on "
+                     f"{sum(r['exact'] for r in either)} of those")
             print(line)
     if args.json:
         with open(args.json, "w") as f:

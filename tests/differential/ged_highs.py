@@ -45,7 +45,7 @@ with `btfsm compare --format json`: where btfsm says exact its value must be
 HiGHS's optimum, and HiGHS's optimum must lie in btfsm's certified interval
 whatever btfsm says.
 
-Usage: ged_highs.py BTFSM [--pairs N] [--seed S] [--budget ARGS]
+Usage: ged_highs.py BTFSM [--pairs N] [--seed S] [--shapes KINDS] [--paper JSONL]
 """
 
 import argparse
@@ -201,6 +201,209 @@ def random_fsm(rng, n):
     return "\n".join(lines), {"n": n + 2, "arcs": arcs, "labels": labels}
 
 
+# ---- more shapes (bench/ged_vs_highs.py --groups shapes) ----
+
+LEAVES = ("action", "condition")
+
+
+def tree_text(parent, kinds):
+    """A BT TOML text and its graph from a parent list (parent[0] is None)
+    and a kind per node: a node with children is a sequence or fallback
+    (kinds naming a leaf become sequences), a leaf an action or condition
+    (kinds naming a composite become actions)."""
+    n = len(parent)
+    kids = [[] for _ in range(n)]
+    for i in range(1, n):
+        kids[parent[i]].append(i)
+    lines = ['kind = "bt"', 'name = "random tree"', 'root = "n0"', "", "[nodes]"]
+    labels = []
+    for i in range(n):
+        if kids[i]:
+            t = kinds[i] if kinds[i] in ("sequence", "fallback") else "sequence"
+            names = ", ".join(f'"n{c}"' for c in kids[i])
+            lines.append(f"n{i} = {{ {t} = [{names}] }}")
+        elif kinds[i] == "condition":
+            t = "condition"
+            lines.append(f'n{i} = {{ condition = "c{i}", skill = "In-Hand", args = {{ object = "c" }} }}')
+        else:
+            t = "action"
+            lines.append(f'n{i} = {{ action = "a{i}", skill = "Pick", args = {{ object = "c" }} }}')
+        labels.append(t)
+    arcs = [(parent[i], i) for i in range(1, n)]
+    return "\n".join(lines) + "\n", {"n": n, "arcs": arcs, "labels": labels}
+
+
+def tree_parents(rng, n, shape):
+    """Parents of a random tree of n nodes: "recursive" (uniform earlier
+    parent), "preferential" (by degree + 1), "deep" (one of the 3 latest),
+    "wide" (one of the first 3), "binary" (heap order), "bt" (composites of
+    at most 5 children)."""
+    parent, deg = [None], [0] * n
+    for i in range(1, n):
+        if shape == "recursive":
+            j = rng.randrange(i)
+        elif shape == "preferential":
+            j = rng.choices(range(i), weights=[d + 1 for d in deg[:i]])[0]
+        elif shape == "deep":
+            j = rng.randrange(max(0, i - 3), i)
+        elif shape == "wide":
+            j = rng.randrange(min(i, 3))
+        elif shape == "binary":
+            j = (i - 1) // 2
+        else:
+            j = rng.choice([k for k in range(i) if deg[k] < 5])
+        parent.append(j)
+        deg[j] += 1
+    return parent
+
+
+def random_kinds(rng, n):
+    return [rng.choice(["sequence", "fallback", "action", "condition"]) for _ in range(n)]
+
+
+def edited_tree(rng, parent, kinds, k):
+    """k random edits of a tree: add a leaf, delete a leaf, move a subtree
+    under another parent, or change a node's kind."""
+    parent, kinds = list(parent), list(kinds)
+    for _ in range(k):
+        n = len(parent)
+        op = rng.choice(["add", "delete", "move", "kind"])
+        if op == "add":
+            parent.append(rng.randrange(n))
+            kinds.append(rng.choice(LEAVES))
+        elif op == "delete" and n > 3:
+            inner = set(parent[1:])
+            v = rng.choice([i for i in range(1, n) if i not in inner])
+            del parent[v], kinds[v]
+            parent = [None] + [p if p < v else p - 1 for p in parent[1:]]
+        elif op == "move" and n > 3:
+            v = rng.randrange(1, n)
+            below, grew = {v}, True
+            while grew:
+                grew = False
+                for i in range(1, n):
+                    if i not in below and parent[i] in below:
+                        below.add(i)
+                        grew = True
+            parent[v] = rng.choice([i for i in range(n) if i not in below])
+        else:
+            kinds[rng.randrange(n)] = rng.choice(["sequence", "fallback", "action", "condition"])
+    return parent, kinds
+
+
+def fsm_states(rng, n):
+    """n random FSM states as (is_condition, {outcome: target}), targets a
+    state index or "SUCCESS" / "FAILURE", as `random_fsm` draws them."""
+    out = []
+    for _ in range(n):
+        cond = rng.random() < 0.3
+        on = {}
+        for t in (("SUCCESS", "FAILURE") if cond else ("SUCCESS", "FAILURE", "RUNNING")):
+            if rng.random() < 0.8:
+                j = rng.randrange(n + 2)
+                on[t] = j if j < n else ("SUCCESS", "FAILURE")[j - n]
+        out.append((cond, on))
+    return out
+
+
+def fsm_text(states):
+    """An FSM TOML text and its graph (SPEC §2: states, then the outcomes)."""
+    n = len(states)
+    lines = ['kind = "fsm"', 'name = "random fsm"', 'initial = "s0"',
+             'outcomes = ["SUCCESS", "FAILURE"]', ""]
+    labels, arcs = [], []
+    for i, (cond, on) in enumerate(states):
+        labels.append("condition_state" if cond else "state")
+        lines += [f"[states.s{i}]", 'skill = "In-Hand"' if cond else 'skill = "Pick"',
+                  'args = { object = "c" }']
+        parts = []
+        for t, j in on.items():
+            parts.append(f'{t} = "{f"s{j}" if isinstance(j, int) else j}"')
+            arcs.append((i, j if isinstance(j, int) else n + ("SUCCESS", "FAILURE").index(j)))
+        if parts:
+            lines.append("on = { " + ", ".join(parts) + " }")
+        lines.append("")
+    return "\n".join(lines), {"n": n + 2, "arcs": arcs, "labels": labels + ["outcome", "outcome"]}
+
+
+def edited_fsm(rng, states, k):
+    """k random edits of an FSM: retarget, add or drop a transition, add a
+    state reached from an existing one, or turn an action state into a
+    condition state or back."""
+    states = [(c, dict(on)) for c, on in states]
+    for _ in range(k):
+        n = len(states)
+        i = rng.randrange(n)
+        cond, on = states[i]
+        outs = ("SUCCESS", "FAILURE") if cond else ("SUCCESS", "FAILURE", "RUNNING")
+        target = rng.randrange(n + 2)
+        target = target if target < n else ("SUCCESS", "FAILURE")[target - n]
+        op = rng.choice(["retarget", "add", "drop", "state", "flip"])
+        if op in ("retarget", "add"):
+            on[rng.choice(list(on) if op == "retarget" and on else outs)] = target
+        elif op == "drop" and on:
+            del on[rng.choice(list(on))]
+        elif op == "state":
+            states.append((rng.random() < 0.3, {"SUCCESS": rng.randrange(n)}))
+            on[rng.choice(outs)] = n
+        elif op == "flip":
+            on.pop("RUNNING", None)
+            states[i] = (not cond, on)
+    return states
+
+
+def random_scxml(rng, n, lo, hi):
+    """An SCXML chart of n flat states, each with lo..hi transitions (own
+    events) to random states or one of 1-3 final states, and its graph
+    (states, then finals, in document order)."""
+    finals = rng.randint(1, 3)
+    lines = ['<?xml version="1.0"?>',
+             '<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="s0">']
+    arcs = []
+    for i in range(n):
+        lines.append(f'  <state id="s{i}">')
+        for e in range(rng.randint(lo, hi)):
+            j = rng.randrange(n + finals)
+            lines.append(f'    <transition event="e{e}" target="{f"s{j}" if j < n else f"f{j - n}"}"/>')
+            arcs.append((i, j))
+        lines.append("  </state>")
+    lines += [f'  <final id="f{f}"/>' for f in range(finals)] + ["</scxml>"]
+    return "\n".join(lines) + "\n", {"n": n + finals, "arcs": arcs,
+                                       "labels": ["state"] * n + ["final"] * finals}
+
+
+def shapes(seed):
+    """Named pairs of other shapes than `random_tree`/`random_fsm`'s: trees
+    of six shapes (30-50 nodes), edited copies of trees (3-30 edits) and of
+    FSMs (3-25 edits), FSMs of very different sizes, and SCXML charts of
+    1-2, 2-4 and 3-6 transitions per state (10-28 states)."""
+    rng = random.Random(seed)
+    out = []
+    for shape in ("recursive", "preferential", "deep", "wide", "binary", "bt"):
+        for _ in range(3):
+            na, nb = rng.randint(30, 50), rng.randint(30, 50)
+            out.append((f"tree-{shape}", tree_text(tree_parents(rng, na, shape), random_kinds(rng, na)),
+                        tree_text(tree_parents(rng, nb, shape), random_kinds(rng, nb))))
+    for k in (3, 6, 10, 15, 20, 30):
+        for _ in range(2):
+            n = rng.randint(35, 50)
+            parent = tree_parents(rng, n, rng.choice(["recursive", "bt", "preferential"]))
+            kinds = random_kinds(rng, n)
+            out.append((f"tree-edit{k}", tree_text(parent, kinds), tree_text(*edited_tree(rng, parent, kinds, k))))
+    for k in (3, 8, 15, 25):
+        for _ in range(3):
+            st = fsm_states(rng, rng.randint(15, 26))
+            out.append((f"fsm-edit{k}", fsm_text(st), fsm_text(edited_fsm(rng, st, k))))
+    for _ in range(4):
+        out.append(("fsm-sizes", fsm_text(fsm_states(rng, rng.randint(5, 9))),
+                    fsm_text(fsm_states(rng, rng.randint(24, 28)))))
+    for lo, hi in ((1, 2), (2, 4), (3, 6)):
+        for _ in range(3):
+            out.append((f"scxml-{lo}-{hi}", random_scxml(rng, rng.randint(10, 28), lo, hi),
+                        random_scxml(rng, rng.randint(10, 28), lo, hi)))
+    return out
+
+
 def run_btfsm(btfsm, fa, fb, mode, extra=()):
     out = subprocess.run([btfsm, "compare", fa, fb, "--mode", mode, "--format", "json", *extra],
                          capture_output=True, text=True, check=True).stdout
@@ -225,6 +428,9 @@ def main():
     ap.add_argument("--paper", metavar="JSONL",
                     help="graphs of policy files (the ignored test dump_policy_graphs writes "
                          "them); every pair of them is also checked, by file")
+    ap.add_argument("--shapes", metavar="KINDS", default="",
+                    help="also check the pairs of shapes(--seed) whose kind starts with one of "
+                         "these comma-separated prefixes (e.g. tree-edit,fsm-edit3)")
     args = ap.parse_args()
     tally = {"checked": 0, "exact": 0, "bad": 0}
 
@@ -252,6 +458,17 @@ def main():
             with open(fb, "w") as f:
                 f.write(tb)
             check(name, fa, fb, ga, gb, f"\n{ta}\n{tb}")
+        kinds = [k for k in args.shapes.split(",") if k]
+        for i, (kind, (ta, ga), (tb, gb)) in enumerate(shapes(args.seed)):
+            if not any(kind.startswith(k) for k in kinds):
+                continue
+            ext = ".scxml" if ta.startswith("<?xml") else ".toml"
+            fa, fb = os.path.join(d, "a" + ext), os.path.join(d, "b" + ext)
+            with open(fa, "w") as f:
+                f.write(ta)
+            with open(fb, "w") as f:
+                f.write(tb)
+            check(f"{kind}-{i}", fa, fb, ga, gb, f"\n{ta}\n{tb}")
     if args.paper:
         with open(args.paper) as f:
             graphs = [json.loads(line) for line in f if line.strip()]
