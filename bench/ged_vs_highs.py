@@ -31,7 +31,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "differential"))
 
-from ged_highs import random_fsm, random_tree, run_btfsm, shapes, solve  # noqa: E402
+from ged_highs import random_fsm, random_tree, run_btfsm, shapes, solve, write_pair  # noqa: E402
 
 
 def groups(seed, fsm_count=30, fsm_sizes=(10, 28)):
@@ -83,12 +83,7 @@ def main():
                 continue
             for i, pair in enumerate(plist):
                 kind, (ta, ga), (tb, gb) = pair if len(pair) == 3 else (group, *pair)
-                ext = ".scxml" if ta.startswith("<?xml") else ".toml"
-                fa, fb = os.path.join(d, "a" + ext), os.path.join(d, "b" + ext)
-                with open(fa, "w") as f:
-                    f.write(ta)
-                with open(fb, "w") as f:
-                    f.write(tb)
+                fa, fb = write_pair(d, ta, tb)
                 for mode in args.modes.split(","):
                     r = run_btfsm(args.btfsm, fa, fb, mode, extra)
                     # The engine's own time in microseconds (`micros`), at

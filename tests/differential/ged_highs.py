@@ -147,24 +147,14 @@ def solve(g1, g2, labeled, time_limit=10.0, strong=False):
 def random_tree(rng, n):
     """A random recursive tree as a BT TOML text and its graph (parent -> child)."""
     parent = [None] + [rng.randrange(i) for i in range(1, n)]
-    kids = [[] for _ in range(n)]
-    for i in range(1, n):
-        kids[parent[i]].append(i)
-    lines = ['kind = "bt"', 'name = "random tree"', 'root = "n0"', "", "[nodes]"]
-    labels = []
+    inner = set(parent[1:])
+    kinds = []
     for i in range(n):
-        if kids[i]:
-            t = rng.choice(["sequence", "fallback"])
-            lines.append(f'n{i} = {{ {t} = [{", ".join(f"{chr(34)}n{c}{chr(34)}" for c in kids[i])}] }}')
-            labels.append(t)
-        elif rng.random() < 0.5:
-            lines.append(f'n{i} = {{ action = "a{i}", skill = "Pick", args = {{ object = "c" }} }}')
-            labels.append("action")
+        if i in inner:
+            kinds.append(rng.choice(["sequence", "fallback"]))
         else:
-            lines.append(f'n{i} = {{ condition = "c{i}", skill = "In-Hand", args = {{ object = "c" }} }}')
-            labels.append("condition")
-    arcs = [(parent[i], i) for i in range(1, n)]
-    return "\n".join(lines) + "\n", {"n": n, "arcs": arcs, "labels": labels}
+            kinds.append("action" if rng.random() < 0.5 else "condition")
+    return tree_text(parent, kinds)
 
 
 def random_fsm(rng, n):
@@ -404,6 +394,17 @@ def shapes(seed):
     return out
 
 
+def write_pair(d, ta, tb):
+    """Writes a pair's two texts into directory d (.scxml or .toml, by
+    content) and returns their paths."""
+    ext = ".scxml" if ta.startswith("<?xml") else ".toml"
+    paths = os.path.join(d, "a" + ext), os.path.join(d, "b" + ext)
+    for path, text in zip(paths, (ta, tb)):
+        with open(path, "w") as f:
+            f.write(text)
+    return paths
+
+
 def run_btfsm(btfsm, fa, fb, mode, extra=()):
     out = subprocess.run([btfsm, "compare", fa, fb, "--mode", mode, "--format", "json", *extra],
                          capture_output=True, text=True, check=True).stdout
@@ -452,22 +453,13 @@ def main():
 
     with tempfile.TemporaryDirectory() as d:
         for name, (ta, ga), (tb, gb) in pairs(args.seed, args.pairs):
-            fa, fb = os.path.join(d, "a.toml"), os.path.join(d, "b.toml")
-            with open(fa, "w") as f:
-                f.write(ta)
-            with open(fb, "w") as f:
-                f.write(tb)
+            fa, fb = write_pair(d, ta, tb)
             check(name, fa, fb, ga, gb, f"\n{ta}\n{tb}")
         kinds = [k for k in args.shapes.split(",") if k]
         for i, (kind, (ta, ga), (tb, gb)) in enumerate(shapes(args.seed)):
             if not any(kind.startswith(k) for k in kinds):
                 continue
-            ext = ".scxml" if ta.startswith("<?xml") else ".toml"
-            fa, fb = os.path.join(d, "a" + ext), os.path.join(d, "b" + ext)
-            with open(fa, "w") as f:
-                f.write(ta)
-            with open(fb, "w") as f:
-                f.write(tb)
+            fa, fb = write_pair(d, ta, tb)
             check(f"{kind}-{i}", fa, fb, ga, gb, f"\n{ta}\n{tb}")
     if args.paper:
         with open(args.paper) as f:

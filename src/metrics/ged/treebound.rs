@@ -799,18 +799,23 @@ mod tests {
     use super::*;
     use std::time::Duration;
 
+    /// A seeded xorshift draw below `m` (0 when `m` is 0).
+    fn xorshift(seed: u64) -> impl FnMut(u64) -> u64 {
+        let mut x = seed;
+        move |m| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % m.max(1)
+        }
+    }
+
     /// Random forests against random multigraphs (loops, parallel arcs),
     /// one and three labels: with an unbounded budget the forest search
     /// must return the brute-force optimum and a mapping of that cost.
     #[test]
     fn forest_search_matches_brute_force() {
-        let mut x = 0x5EED_F0E5u64;
-        let mut next = |m: u64| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x % m.max(1)
-        };
+        let mut next = xorshift(0x5EED_F0E5u64);
         let mut closed = 0;
         for i in 0..300 {
             let labels = if i % 2 == 0 { 1 } else { 3 };
@@ -870,13 +875,7 @@ mod tests {
     /// labels, at random multipliers and random fixings.
     #[test]
     fn primal_heuristics_give_valid_mappings() {
-        let mut x = 0xDEC0_DE5Au64;
-        let mut next = |m: u64| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x % m.max(1)
-        };
+        let mut next = xorshift(0xDEC0_DE5Au64);
         let keys = |n: usize| (0..n).map(|i| format!("v{i}")).collect::<Vec<_>>();
         let far = Instant::now() + Duration::from_secs(60);
         let (mut decoded, mut fixed_kept, mut voted) = (0, 0, 0);
@@ -965,13 +964,7 @@ mod tests {
     /// certified.
     #[test]
     fn branching_bound_is_certified_on_general_graphs() {
-        let mut x = 0xB0A7_1D06u64;
-        let mut next = |m: u64| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x % m.max(1)
-        };
+        let mut next = xorshift(0xB0A7_1D06u64);
         let keys = |n: usize| (0..n).map(|i| format!("v{i}")).collect::<Vec<_>>();
         let mut tight = 0;
         for i in 0..300 {
