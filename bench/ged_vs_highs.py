@@ -17,7 +17,7 @@ pairs btfsm settled exactly and the median ratio on the pairs both settled
 
 Usage: python3 bench/ged_vs_highs.py BTFSM [--seed S] [--highs-timeout S]
        [--groups trees,big-trees,fsm,fsm-set,shapes] [--fsm-count N] [--fsm-sizes LO,HI]
-       [--formulations f2,strong]
+       [--formulations f2,strong] [--kinds PREFIXES]
        [--work UNITS] [--json OUT]
 """
 import argparse
@@ -66,11 +66,15 @@ def main():
     ap.add_argument("--modes", default="structural,labeled")
     ap.add_argument("--formulations", default="f2,strong")
     ap.add_argument("--work", help="btfsm's --work (default: btfsm's default)")
+    ap.add_argument("--kinds", default="",
+                    help="only the shapes pairs whose kind starts with one of these "
+                         "comma-separated prefixes (e.g. fsm-edit)")
     ap.add_argument("--json")
     args = ap.parse_args()
     forms = args.formulations.split(",")
     extra = ["--work", args.work] if args.work else []
     wanted = args.groups.split(",")
+    kinds = [k for k in args.kinds.split(",") if k]
     import highspy
     print(f"HiGHS {highspy.Highs().version()}, Python {sys.version.split()[0]}")
     print(f"{'pair':28} {'mode':10} {'btfsm':>9} {'HiGHS':>6} {'btfsm ms':>9} "
@@ -83,6 +87,8 @@ def main():
                 continue
             for i, pair in enumerate(plist):
                 kind, (ta, ga), (tb, gb) = pair if len(pair) == 3 else (group, *pair)
+                if kinds and kind != group and not any(kind.startswith(k) for k in kinds):
+                    continue
                 fa, fb = write_pair(d, ta, tb)
                 for mode in args.modes.split(","):
                     r = run_btfsm(args.btfsm, fa, fb, mode, extra)
