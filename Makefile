@@ -38,10 +38,15 @@ run: build
 # failing case found so goes to proptest-regressions/ and is kept.
 PROPTEST_SEED ?= 20261123
 
+# The workspace's rules (ARCHITECTURE.md, "Rules"): formatting, clippy with
+# the `[workspace.lints]` table and `-D warnings`, the docs with warnings
+# denied, and the tests with and without the default features.
 test:
-	$(CARGO) fmt --check
-	$(CARGO) clippy --all-targets --locked -- -D warnings
-	PROPTEST_RNG_SEED=$(PROPTEST_SEED) $(CARGO) test --locked
+	$(CARGO) fmt --all --check
+	$(CARGO) clippy --workspace --all-targets --locked -- -D warnings
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps --locked
+	PROPTEST_RNG_SEED=$(PROPTEST_SEED) $(CARGO) test --workspace --locked
+	PROPTEST_RNG_SEED=$(PROPTEST_SEED) $(CARGO) test --locked -p btfsm -p btfsm-log --no-default-features
 	$(CARGO) test --locked --bench scale --bench ged --bench sim --bench ted --bench log -- --test
 	$(CARGO) run --quiet --locked -- paper --check
 	$(MAKE) --no-print-directory mermaid-oracle
@@ -94,8 +99,8 @@ differential: $(VENV)/.installed
 	@tail -1 $(TARGET_DIR)/btlog_compare.txt
 	$(VENV)/bin/python tests/differential/btlog_db3.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
-	GED_DUMP=$(TARGET_DIR)/paper-graphs.jsonl GED_DUMP_FILES=$(GED_PAPER_FILES) \
-	  $(CARGO) test --quiet --locked --lib dump_policy_graphs -- --ignored > /dev/null
+	GED_DUMP=$(abspath $(TARGET_DIR))/paper-graphs.jsonl GED_DUMP_FILES=$(GED_PAPER_FILES) \
+	  $(CARGO) test --quiet --locked -p btfsm-metrics --lib dump_policy_graphs -- --ignored > /dev/null
 	$(VENV)/bin/python tests/differential/ged_highs.py $(TARGET_DIR)/debug/btfsm --pairs 24 \
 	  --shapes tree-edit,fsm-edit3,fsm-edit8,scxml-1-2 --paper $(TARGET_DIR)/paper-graphs.jsonl
 

@@ -10,11 +10,17 @@
 //! Times are in-process medians over repeated runs (no process start-up),
 //! as NetworkX's are.
 
-use btfsm::format::{Limits, load};
-use btfsm::graph::{PolicyGraph, policy_graph};
-use btfsm::metrics::ged::{GedGraph, GedMode, GedOptions, ged_graphs};
-use btfsm::model::Policy;
-use btfsm::transform::bt_to_hfsm::bt_policy_to_hfsm;
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "benchmarks and tests report what they measured"
+)]
+
+use btfsm_format::{Limits, load};
+use btfsm_metrics::ged::{GedGraph, GedMode, GedOptions, ged_graphs};
+use btfsm_model::Policy;
+use btfsm_model::graph::{PolicyGraph, policy_graph};
+use btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm;
 use std::path::Path;
 use std::time::{Duration, Instant};
 

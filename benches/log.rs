@@ -6,7 +6,13 @@
 //! compared) and `log timeline` (two passes). `cargo bench --bench log`;
 //! `-- --test` (make test) runs 100,000 records.
 
-use btfsm::log::{compare, report, timeline};
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "benchmarks and tests report what they measured"
+)]
+
+use btfsm_log::{compare, report, timeline};
 use std::io::Write;
 use std::time::Instant;
 

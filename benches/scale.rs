@@ -8,10 +8,16 @@
 //! phase. Target: under 1 s per input, end to end, and
 //! under 1 s for `lint` (issue 17). Run with `cargo bench --bench scale`.
 
-use btfsm::format::{Limits, Loaded, toml::parse_str};
-use btfsm::graph::policy_graph;
-use btfsm::metrics::complexity::{cyclomatic, essential};
-use btfsm::report::analyze;
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "benchmarks and tests report what they measured"
+)]
+
+use btfsm_format::{Limits, Loaded, toml::parse_str};
+use btfsm_metrics::complexity::{cyclomatic, essential};
+use btfsm_model::graph::policy_graph;
+use btfsm_report::analyze;
 use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;
@@ -134,7 +140,7 @@ fn run(name: &str, text: &str) {
     let report = analyze(&loaded);
     let t_all = t3.elapsed();
     let t4 = Instant::now();
-    let findings = btfsm::lint::lint(&loaded.policy, None, name, &Default::default());
+    let findings = btfsm_lint::lint(&loaded.policy, None, name, &Default::default());
     let t_lint = t4.elapsed();
     let total = t_parse + t_all;
     println!(
@@ -188,16 +194,15 @@ pub fn btcpp_dataflow(nodes: usize) -> String {
 
 fn run_btcpp(name: &str, text: &str) {
     let t0 = Instant::now();
-    let loaded =
-        btfsm::format::btcpp_xml::parse_str(name, text, Path::new("."), &Limits::default())
-            .unwrap_or_else(|e| panic!("{name}: {}", e[0]));
+    let loaded = btfsm_format::btcpp_xml::parse_str(name, text, Path::new("."), &Limits::default())
+        .unwrap_or_else(|e| panic!("{name}: {}", e[0]));
     let t_parse = t0.elapsed();
     let t1 = Instant::now();
-    let subject = btfsm::lint::Subject {
+    let subject = btfsm_lint::Subject {
         policy: &loaded.policy,
         dataflow: loaded.dataflow.as_deref(),
     };
-    let findings = btfsm::lint::lint_subject(&subject, None, name, &Default::default());
+    let findings = btfsm_lint::lint_subject(&subject, None, name, &Default::default());
     let t_lint = t1.elapsed();
     println!(
         "{name:<22} parse {:>7.1} ms  lint {:>7.1} ms ({} findings)  {}",

@@ -7,14 +7,20 @@
 //! per episode) on all cores (the target: under 10 s on 2 cores). Run with `bench/sim_vs_py_trees.sh` to get the py_trees
 //! figure and the ratio in the same run, or `cargo bench --bench sim`.
 
-use btfsm::format::{Limits, load};
-use btfsm::model::PolicyBody;
-use btfsm::sim::exec::{BtExec, CompiledBt, Leaves};
-use btfsm::sim::monte_carlo::monte_carlo;
-use btfsm::sim::run::run_scenario;
-use btfsm::sim::scenario;
-use btfsm::sim::skills::{Call, Status, condition, resolve};
-use btfsm::sim::world::{Place, World};
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "benchmarks and tests report what they measured"
+)]
+
+use btfsm_format::{Limits, load};
+use btfsm_model::PolicyBody;
+use btfsm_sim::exec::{BtExec, CompiledBt, Leaves};
+use btfsm_sim::monte_carlo::monte_carlo;
+use btfsm_sim::run::run_scenario;
+use btfsm_sim::scenario;
+use btfsm_sim::skills::{Call, Status, condition, resolve};
+use btfsm_sim::world::{Place, World};
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;

@@ -10,9 +10,15 @@
 //! once, under a small work budget, as a smoke test. `bench/ted_vs_apted.py` times the `apted` package
 //! against btfsm on the same pairs in one run (docs/performance.md).
 
-use btfsm::metrics::ted::TedOptions;
-use btfsm::model::{Bt, BtNode, BtNodeKind, SkillCall};
-use btfsm::report::compare::tree::tree_report;
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "benchmarks and tests report what they measured"
+)]
+
+use btfsm_metrics::ted::TedOptions;
+use btfsm_model::{Bt, BtNode, BtNodeKind, SkillCall};
+use btfsm_report::compare::tree::tree_report;
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
@@ -64,7 +70,7 @@ fn leaf(rng: &mut Rng, id: String) -> BtNode {
     let mut args = BTreeMap::new();
     args.insert(
         "target".to_string(),
-        btfsm::model::ArgValue::Str(target.clone()),
+        btfsm_model::ArgValue::Str(target.clone()),
     );
     node(
         id,

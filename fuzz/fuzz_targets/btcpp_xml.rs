@@ -1,4 +1,4 @@
 //! Any bytes through the BehaviorTree.CPP XML importer, and every accepted
 //! tree through graph, metrics, DOT, write-back and transforms.
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm::fuzzing::btcpp_xml(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm_fuzzing::btcpp_xml(data));

@@ -2,4 +2,4 @@
 //! with a 20 ms budget; each result must be a certified interval whose edit
 //! script costs its upper bound.
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm::fuzzing::compare(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm_fuzzing::compare(data));

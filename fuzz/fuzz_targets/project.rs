@@ -2,4 +2,4 @@
 //! scenario and its policies), split at `\n%%\n`, read under the
 //! confinement rule.
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm::fuzzing::project(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm_fuzzing::project(data));

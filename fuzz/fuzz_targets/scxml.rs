@@ -1,4 +1,4 @@
 //! Any bytes through the SCXML importer, and every accepted machine through
 //! graph, metrics, DOT, write-back and transforms.
 #![no_main]
-libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm::fuzzing::scxml(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| btfsm_fuzzing::scxml(data));

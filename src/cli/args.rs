@@ -1,6 +1,6 @@
 //! Raw command-line flags (clap derive).
 
-use crate::report::OutputFormat;
+use btfsm_report::OutputFormat;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -11,13 +11,13 @@ use std::path::PathBuf;
     about = "Metrics for robot policy structures: Behavior Trees, FSMs and HFSMs",
     long_about = "Metrics for robot policy structures: Behavior Trees, FSMs and HFSMs.\n\nComputes the metrics of Iovino et al., \"Comparison between Behavior Trees and Finite State Machines\": element counts, cyclomatic and essential complexity, graph edit distance and effort.\n\nExit codes: 0 success, 1 a check failed, 2 bad usage or bad input."
 )]
-pub struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
     pub command: Command,
 }
 
 #[derive(Debug, Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Counts, complexity and Table I estimates of each policy
     Analyze {
         /// Policy files (TOML, BehaviorTree.CPP XML, SCXML, yasmin XML), `-`
@@ -31,7 +31,7 @@ pub enum Command {
         /// (repeatable; metrics: vertices, edges, graphical_elements,
         /// active_elements, cc, essential_cc)
         #[arg(long = "max", value_name = "METRIC=N")]
-        max: Vec<crate::report::gate::Limit>,
+        max: Vec<btfsm_report::gate::Limit>,
         /// A previous `analyze --format json` output: exit 1 when a policy's
         /// metric grew over it by more than --max-increase allows
         #[arg(long, value_name = "OLD.json")]
@@ -39,7 +39,7 @@ pub enum Command {
         /// How much METRIC may grow over the baseline (repeatable; default
         /// `cc=0` and `essential_cc=0`)
         #[arg(long = "max-increase", value_name = "METRIC=N", requires = "baseline")]
-        max_increase: Vec<crate::report::gate::Limit>,
+        max_increase: Vec<btfsm_report::gate::Limit>,
         #[command(flatten)]
         limits: LimitArgs,
     },
@@ -62,10 +62,10 @@ pub enum Command {
         /// Render with Graphviz's `dot` instead of printing DOT (default: the
         /// extension of -o when it is .svg, .png or .pdf, else DOT text)
         #[arg(long, value_enum)]
-        render: Option<crate::render::dot::RenderFormat>,
+        render: Option<btfsm_render::dot::RenderFormat>,
         /// With --render: Graphviz's time budget; past it `dot` is killed
         /// and the run exits 2
-        #[arg(long, default_value_t = crate::render::dot::DEFAULT_RENDER_TIMEOUT_MS, value_name = "MS")]
+        #[arg(long, default_value_t = btfsm_render::dot::DEFAULT_RENDER_TIMEOUT_MS, value_name = "MS")]
         timeout_ms: u64,
         /// Colour nodes by their status at --step in a `sim --trace` file
         #[command(flatten)]
@@ -93,7 +93,7 @@ pub enum Command {
         /// search, edit script; docs/robustness.md gives the floor on large
         /// graphs). The work budget (--work) decides the result; when this
         /// cap ends a search first the report says `stopped_by: timeout`
-        #[arg(long, default_value_t = crate::metrics::ged::DEFAULT_TIMEOUT_MS, value_name = "MS")]
+        #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_TIMEOUT_MS, value_name = "MS")]
         timeout_ms: u64,
         /// Work budget of the exact search per mode, in work units (one per
         /// assignment-matrix entry the search builds; 15-80 ns each: the
@@ -101,12 +101,12 @@ pub enum Command {
         /// The same pair gives the same result (GED, exact, interval) on any
         /// machine under any load; when the budget runs out the result is a
         /// certified interval with `exact: false` and `stopped_by: work`
-        #[arg(long, default_value_t = crate::metrics::ged::DEFAULT_WORK, value_name = "UNITS")]
+        #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_WORK, value_name = "UNITS")]
         work: u64,
         /// Work budget of --mode tree, in table cells (the default takes 1-3 s;
         /// memory is capped at 2^25 cells, 128 MiB): past it the result is an
         /// interval with `exact: false`, the same on any machine
-        #[arg(long, default_value_t = crate::metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
+        #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
         tree_max_work: u64,
         /// Output format
         #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
@@ -121,7 +121,7 @@ pub enum Command {
         /// the --timeout-ms budget of one mode: past it `dot` is killed);
         /// default: the extension of --dot when it is .svg, .png or .pdf
         #[arg(long, value_enum, requires = "dot")]
-        render: Option<crate::render::dot::RenderFormat>,
+        render: Option<btfsm_render::dot::RenderFormat>,
         #[command(flatten)]
         limits: LimitArgs,
     },
@@ -204,7 +204,7 @@ pub enum Command {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum CompareMode {
+pub(crate) enum CompareMode {
     Structural,
     Labeled,
     Named,
@@ -217,20 +217,20 @@ pub enum CompareMode {
 
 impl CompareMode {
     /// The GED modes selected, in report order (none for `tree`).
-    pub fn ged_modes(self) -> Vec<crate::metrics::ged::GedMode> {
-        use crate::metrics::ged::GedMode;
+    pub(crate) fn ged_modes(self) -> Vec<btfsm_metrics::ged::GedMode> {
+        use btfsm_metrics::ged::GedMode;
         match self {
             CompareMode::Structural => vec![GedMode::Structural],
             CompareMode::Labeled => vec![GedMode::Labeled],
             CompareMode::Named => vec![GedMode::Named],
             CompareMode::Tree => Vec::new(),
-            CompareMode::All => crate::report::compare::modes_of(None),
+            CompareMode::All => btfsm_report::compare::modes_of(None),
         }
     }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum CompareFormat {
+pub(crate) enum CompareFormat {
     Table,
     Json,
     /// GitHub-flavoured markdown, for a pull-request comment
@@ -238,7 +238,7 @@ pub enum CompareFormat {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ConvertTarget {
+pub(crate) enum ConvertTarget {
     /// The paper's BT -> HFSM construction (Fig. 5 -> Fig. 6)
     Hfsm,
     /// The paper's sequential FSM -> fault-tolerant FSM construction (Fig. 2 -> Fig. 4)
@@ -255,26 +255,26 @@ pub enum ConvertTarget {
 
 /// `--assume-leaf`: how to read BehaviorTree.CPP leaves of unknown type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum AssumeLeafArg {
+pub(crate) enum AssumeLeafArg {
     Action,
     Condition,
 }
 
 /// Input limits (documented defaults; see `format::Limits`).
 #[derive(Debug, Clone, Args)]
-pub struct LimitArgs {
+pub(crate) struct LimitArgs {
     /// Largest input file, in bytes (also the total read through subtree includes)
-    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_FILE_BYTES, hide_short_help = true)]
+    #[arg(long, default_value_t = btfsm_format::DEFAULT_MAX_FILE_BYTES, hide_short_help = true)]
     pub max_file_bytes: u64,
     /// Most BT nodes or FSM states per policy, subtrees expanded (and most
     /// nodes all policies of the command create by copying subtrees)
-    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_NODES, hide_short_help = true)]
+    #[arg(long, default_value_t = btfsm_format::DEFAULT_MAX_NODES, hide_short_help = true)]
     pub max_nodes: usize,
     /// Deepest BT or HFSM nesting (the root is at depth 0)
-    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_DEPTH, hide_short_help = true)]
+    #[arg(long, default_value_t = btfsm_format::DEFAULT_MAX_DEPTH, hide_short_help = true)]
     pub max_depth: usize,
     /// Longest node id, state name, display name or label, in bytes
-    #[arg(long, default_value_t = crate::format::DEFAULT_MAX_NAME_BYTES, hide_short_help = true)]
+    #[arg(long, default_value_t = btfsm_format::DEFAULT_MAX_NAME_BYTES, hide_short_help = true)]
     pub max_name_bytes: usize,
     /// BehaviorTree.CPP TreeNodesModel file declaring node types (repeatable),
     /// e.g. Nav2's nav2_tree_nodes.xml
@@ -292,7 +292,7 @@ pub struct LimitArgs {
     pub assume_leaf: Option<AssumeLeafArg>,
     /// Most bytes the command reads in all its files (includes, node models,
     /// baselines, traces and repeated arguments each count)
-    #[arg(long, default_value_t = crate::format::source::DEFAULT_MAX_TOTAL_BYTES, hide_short_help = true)]
+    #[arg(long, default_value_t = btfsm_format::source::DEFAULT_MAX_TOTAL_BYTES, hide_short_help = true)]
     pub max_total_bytes: u64,
     /// Directory that files named by a policy or scenario (subtrees,
     /// includes, scenario policies) must stay inside [default: the git work
@@ -307,7 +307,7 @@ pub struct LimitArgs {
 
 /// How `dot` draws a Behavior Tree: ports, folded subtrees, direction.
 #[derive(clap::Args, Debug, Clone)]
-pub struct DotLookArgs {
+pub(crate) struct DotLookArgs {
     /// Draw each BT node's ports under its label (by default they are in
     /// its tooltip only)
     #[arg(long)]
@@ -326,19 +326,19 @@ pub struct DotLookArgs {
     pub subtrees: SubtreesArg,
     /// Layout direction of a BT: auto is top-down unless that is wider than
     /// 2.5:1 and left-to-right is closer to square
-    #[arg(long, value_enum, default_value_t = crate::render::dot::RankDir::Auto)]
-    pub rankdir: crate::render::dot::RankDir,
+    #[arg(long, value_enum, default_value_t = btfsm_render::dot::RankDir::Auto)]
+    pub rankdir: btfsm_render::dot::RankDir,
 }
 
 #[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SubtreesArg {
+pub(crate) enum SubtreesArg {
     Expanded,
     Folded,
 }
 
 impl DotLookArgs {
     /// Sets the look on drawing options.
-    pub fn apply(&self, opts: &mut crate::render::dot::DotOptions) {
+    pub(crate) fn apply(&self, opts: &mut btfsm_render::dot::DotOptions) {
         opts.ports = self.ports;
         opts.collapse = self.collapse.iter().cloned().collect();
         opts.depth = self.depth;
@@ -348,24 +348,24 @@ impl DotLookArgs {
 }
 
 impl LimitArgs {
-    pub fn limits(&self) -> crate::format::Limits {
-        crate::format::Limits {
+    pub(crate) fn limits(&self) -> btfsm_format::Limits {
+        btfsm_format::Limits {
             max_file_bytes: self.max_file_bytes,
             max_nodes: self.max_nodes,
             max_depth: self.max_depth,
             max_name_bytes: self.max_name_bytes,
             nodes_models: self.nodes_model.clone(),
             assume_leaf: self.assume_leaf.map(|a| match a {
-                AssumeLeafArg::Action => crate::format::AssumeLeaf::Action,
-                AssumeLeafArg::Condition => crate::format::AssumeLeaf::Condition,
+                AssumeLeafArg::Action => btfsm_format::AssumeLeaf::Action,
+                AssumeLeafArg::Condition => btfsm_format::AssumeLeaf::Condition,
             }),
             confinement: match (&self.root, self.allow_outside_root) {
-                (_, true) => crate::format::source::Confinement::Off,
-                (Some(r), false) => crate::format::source::Confinement::Root(r.clone()),
-                (None, false) => crate::format::source::Confinement::Auto,
+                (_, true) => btfsm_format::source::Confinement::Off,
+                (Some(r), false) => btfsm_format::source::Confinement::Root(r.clone()),
+                (None, false) => btfsm_format::source::Confinement::Auto,
             },
-            read_budget: crate::format::source::Budget::new(self.max_total_bytes),
-            expansion_budget: crate::format::source::Budget::new(self.max_nodes as u64),
+            read_budget: btfsm_format::source::Budget::new(self.max_total_bytes),
+            expansion_budget: btfsm_format::source::Budget::new(self.max_nodes as u64),
             tree: self.tree.clone(),
             ..Default::default()
         }
@@ -374,10 +374,10 @@ impl LimitArgs {
 
 /// Flags of `btfsm paper`.
 #[derive(Debug, Clone, Args)]
-pub struct PaperArgs {
+pub(crate) struct PaperArgs {
     /// Output format
-    #[arg(long, value_enum, default_value_t = crate::report::paper::PaperFormat::Table)]
-    pub format: crate::report::paper::PaperFormat,
+    #[arg(long, value_enum, default_value_t = btfsm_report::paper::PaperFormat::Table)]
+    pub format: btfsm_report::paper::PaperFormat,
     /// Time budget of each exact GED; when it runs out the cell shows the
     /// certified interval
     #[arg(long, default_value_t = 2000, value_name = "MS")]
@@ -400,7 +400,7 @@ pub struct PaperArgs {
 
 /// Flags of `btfsm edit`.
 #[derive(Debug, Clone, Args)]
-pub struct EditArgs {
+pub(crate) struct EditArgs {
     /// Policy to edit (TOML)
     pub file: PathBuf,
     /// Output file (default: stdout); the summary goes to stderr
@@ -413,7 +413,7 @@ pub struct EditArgs {
 }
 
 #[derive(Debug, Clone, Subcommand)]
-pub enum EditOp {
+pub(crate) enum EditOp {
     /// Inserts a BT subtree (the root of another BT file) as a child of a node
     InsertSubtree {
         /// Id of the control node that receives the subtree
@@ -485,13 +485,13 @@ pub enum EditOp {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum WrapKind {
+pub(crate) enum WrapKind {
     Sequence,
     Fallback,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum AddKind {
+pub(crate) enum AddKind {
     /// Between the predecessor and its SUCCESS successor (Figs. 8a, 8c)
     Sequential,
     /// Takes the predecessor's FAILURE arc (Fig. 8b)

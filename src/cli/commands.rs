@@ -2,15 +2,16 @@
 
 use super::args::{Cli, Command, ConvertTarget};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
-use crate::diagnostic::Diagnostic;
-use crate::format::{self, Limits, Loaded};
-use crate::report::gate::{Baseline, Gate, Limit};
-use crate::report::{self, analyze, render_analysis};
-use crate::sanitize::shown;
+use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::sanitize::shown;
+use btfsm_format::{self as format, Limits, Loaded};
+use btfsm_report::gate::{Baseline, Gate, Limit};
+use btfsm_report::{self as report, analyze, render_analysis};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-pub fn execute(cli: Cli) -> u8 {
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub(super) fn execute(cli: Cli) -> u8 {
     match cli.command {
         Command::Analyze {
             files,
@@ -72,7 +73,7 @@ pub fn execute(cli: Cli) -> u8 {
                 let fmt = match input {
                     format::Input::Policy(fmt) => fmt,
                     format::Input::Domain => {
-                        match crate::plan::load(&file) {
+                        match btfsm_plan::load(&file) {
                             Ok(d) => {
                                 let _ = writeln!(
                                     err,
@@ -92,9 +93,9 @@ pub fn execute(cli: Cli) -> u8 {
                         }
                         continue;
                     }
-                    format::Input::Scenario if crate::sim::symbolic::looks_symbolic(&file.text) => {
+                    format::Input::Scenario if btfsm_sim::symbolic::looks_symbolic(&file.text) => {
                         let base = f.parent().unwrap_or(Path::new(""));
-                        match crate::sim::symbolic::scenario::parse(&file, base, &limits) {
+                        match btfsm_sim::symbolic::scenario::parse(&file, base, &limits) {
                             Ok(s) => {
                                 let _ = writeln!(
                                     err,
@@ -115,7 +116,7 @@ pub fn execute(cli: Cli) -> u8 {
                     }
                     format::Input::Scenario => {
                         let base = f.parent().unwrap_or(Path::new(""));
-                        match crate::sim::scenario::parse(&file, base, &limits) {
+                        match btfsm_sim::scenario::parse(&file, base, &limits) {
                             Ok(s) => {
                                 print_diagnostics(&mut err, &s.warnings);
                                 let _ = writeln!(
@@ -181,7 +182,7 @@ pub fn execute(cli: Cli) -> u8 {
                 return EXIT_BAD_INPUT;
             };
             look.apply(&mut opts);
-            if let Err(e) = crate::render::dot::check_fold(&policy, &opts) {
+            if let Err(e) = btfsm_render::dot::check_fold(&policy, &opts) {
                 eprintln!("error: {e}");
                 return EXIT_BAD_INPUT;
             }
@@ -240,14 +241,14 @@ pub fn execute(cli: Cli) -> u8 {
                 ConvertTarget::Mermaid => {
                     return emit_text(
                         output.as_deref(),
-                        crate::render::mermaid::policy_mermaid(&l.policy),
+                        btfsm_render::mermaid::policy_mermaid(&l.policy),
                     );
                 }
                 ConvertTarget::FaultTolerant => {
-                    use crate::transform::fault_tolerant as ft;
+                    use btfsm_transform::fault_tolerant as ft;
                     let d = domain
                         .as_ref()
-                        .unwrap_or_else(|| crate::plan::domain::builtin());
+                        .unwrap_or_else(|| btfsm_plan::domain::builtin());
                     match ft::fault_tolerant_policy_with(&l.policy, d) {
                         Ok(p) => p,
                         Err(errs) => {
@@ -255,7 +256,7 @@ pub fn execute(cli: Cli) -> u8 {
                                 eprintln!(
                                     "error: {}: {}\n  = hint: the construction needs a flat FSM whose action states run skills the domain has actions for (--domain; built in: policies/domains/moma.toml)",
                                     shown(&l.path),
-                                    crate::sanitize::shown_max(&e.to_string(), 1000)
+                                    btfsm_core::sanitize::shown_max(&e.to_string(), 1000)
                                 );
                             }
                             return EXIT_BAD_INPUT;
@@ -263,8 +264,8 @@ pub fn execute(cli: Cli) -> u8 {
                     }
                 }
                 ConvertTarget::Hfsm => {
-                    if let crate::model::PolicyBody::Bt(bt) = &l.policy.body {
-                        for n in crate::transform::bt_to_hfsm::memory_nodes(bt) {
+                    if let btfsm_model::PolicyBody::Bt(bt) = &l.policy.body {
+                        for n in btfsm_transform::bt_to_hfsm::memory_nodes(bt) {
                             let node = &bt.nodes[n];
                             eprintln!(
                                 "warning: {}: `{}` node `{}` becomes a container re-entered at its first state every tick: the HFSM counts as the paper's construction but does not keep the node's memory",
@@ -274,13 +275,13 @@ pub fn execute(cli: Cli) -> u8 {
                             );
                         }
                     }
-                    match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
+                    match btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&l.policy) {
                         Ok(p) => p,
                         Err(errs) => {
                             for e in errs {
                                 eprintln!(
                                     "error: {}\n  = hint: the construction covers sequence, fallback (with or without memory), inverter, force_success, force_failure and leaves",
-                                    crate::sanitize::shown_max(&e.to_string(), 1000)
+                                    btfsm_core::sanitize::shown_max(&e.to_string(), 1000)
                                 );
                             }
                             return EXIT_BAD_INPUT;
@@ -290,7 +291,7 @@ pub fn execute(cli: Cli) -> u8 {
             };
             // Only what reads back: a machine the TOML format can nest,
             // within the file size limit.
-            match crate::format::toml_write::write_policy_within(&policy, limits.max_file_bytes) {
+            match btfsm_format::toml_write::write_policy_within(&policy, limits.max_file_bytes) {
                 Ok(text) => emit_text(output.as_deref(), text),
                 Err(e) => {
                     eprintln!(
@@ -353,13 +354,13 @@ pub fn execute(cli: Cli) -> u8 {
 /// Draws a policy as DOT, or renders it through Graphviz (killed past
 /// `timeout`), to `output` or stdout.
 pub(super) fn draw(
-    policy: &crate::model::Policy,
-    opts: &crate::render::dot::DotOptions,
+    policy: &btfsm_model::Policy,
+    opts: &btfsm_render::dot::DotOptions,
     output: Option<&Path>,
-    render: Option<crate::render::dot::RenderFormat>,
+    render: Option<btfsm_render::dot::RenderFormat>,
     timeout: std::time::Duration,
 ) -> u8 {
-    use crate::render::dot::{self, RenderFormat};
+    use btfsm_render::dot::{self, RenderFormat};
     let text = dot::policy_dot(policy, opts);
     // `-o x.png` means PNG: the format follows the extension unless given.
     let render = render.or_else(|| output.and_then(RenderFormat::from_path));
@@ -375,7 +376,7 @@ pub(super) fn draw(
         Err(e) => {
             eprintln!(
                 "error: {}",
-                crate::sanitize::shown_max(&e.to_string(), 2000)
+                btfsm_core::sanitize::shown_max(&e.to_string(), 2000)
             );
             EXIT_BAD_INPUT
         }
@@ -444,7 +445,7 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
                 format::load_read(file, &input.path, format::FileFormat::Toml, limits)
             }
             Ok((file, Some(format::Input::Domain))) if !input.found => Err(vec![
-                crate::diagnostic::Diagnostic::error("an action domain, not a policy")
+                btfsm_core::diagnostic::Diagnostic::error("an action domain, not a policy")
                     .in_file(&file)
                     .hint("`btfsm plan DOMAIN` makes its policies; `btfsm validate` checks it"),
             ]),
@@ -508,10 +509,10 @@ pub(super) fn with_companions(
         .collect();
     if only.is_empty() {
         let trees = comp.tree_ids(&limits);
-        let hint = crate::diagnostic::suggest(&id, trees.iter().copied());
+        let hint = btfsm_core::diagnostic::suggest(&id, trees.iter().copied());
         return Err(Diagnostic::error(format!(
             "--tree `{}`: none of the {} BehaviorTree.CPP files given defines it",
-            crate::sanitize::shown(&id),
+            btfsm_core::sanitize::shown(&id),
             comp.len()
         ))
         .hint(hint));
@@ -576,7 +577,7 @@ pub(super) fn emit_text(path: Option<&Path>, text: impl AsRef<str>) -> u8 {
 /// symlinks, into devices and FIFOs) or to stdout (no path, `-`, or a path
 /// that is stdout).
 pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
-    use crate::report::output::Destination;
+    use btfsm_report::output::Destination;
     let dest = match path.map(Destination::resolve) {
         None => Destination::Stdout,
         Some(Ok(d)) => d,
@@ -606,7 +607,7 @@ fn cannot_write(path: Option<&Path>, e: std::io::Error) -> u8 {
     eprintln!(
         "error: cannot write `{}`: {}",
         shown(&path),
-        crate::sanitize::shown_max(&e.to_string(), 2000)
+        btfsm_core::sanitize::shown_max(&e.to_string(), 2000)
     );
     EXIT_BAD_INPUT
 }
@@ -619,12 +620,12 @@ pub(super) fn outputs_distinct(outputs: &[(&str, Option<&Path>)], report_on_stdo
         .iter()
         .filter_map(|&(flag, p)| Some((flag, p?)))
         .collect();
-    match crate::report::output::check_distinct(&given, report_on_stdout) {
+    match btfsm_report::output::check_distinct(&given, report_on_stdout) {
         Ok(()) => true,
         Err(e) => {
             eprintln!(
                 "error: {}",
-                crate::sanitize::shown_max(&e.to_string(), 2000)
+                btfsm_core::sanitize::shown_max(&e.to_string(), 2000)
             );
             false
         }
@@ -699,7 +700,7 @@ fn check_gate(gate: &Gate, reports: &[report::PolicyReport]) -> u8 {
     for v in &r.violations {
         eprintln!(
             "error: complexity gate: {}",
-            crate::sanitize::shown_max(&v.to_string(), 1000)
+            btfsm_core::sanitize::shown_max(&v.to_string(), 1000)
         );
     }
     eprintln!(

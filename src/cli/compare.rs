@@ -9,20 +9,20 @@
 use super::args::{CompareFormat, CompareMode};
 use super::commands::{draw, emit_text, load_all};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
-use crate::format::Limits;
-use crate::metrics::ged::{GedMode, GedOptions};
-use crate::metrics::ted::TedOptions;
-use crate::model::{PolicyBody, PolicyKind};
-use crate::render::dot::RenderFormat;
-use crate::report::compare::{self, Pair, Side};
-use crate::sanitize::shown;
+use btfsm_core::sanitize::shown;
+use btfsm_format::Limits;
+use btfsm_metrics::ged::{GedMode, GedOptions};
+use btfsm_metrics::ted::TedOptions;
+use btfsm_model::{PolicyBody, PolicyKind};
+use btfsm_render::dot::RenderFormat;
+use btfsm_report::compare::{self, Pair, Side};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 /// Validated arguments of `compare`.
-pub struct CompareArgs {
+pub(super) struct CompareArgs {
     pub a: PathBuf,
     pub b: PathBuf,
     pub mode: CompareMode,
@@ -36,7 +36,7 @@ pub struct CompareArgs {
     pub limits: Limits,
 }
 
-pub fn execute(args: CompareArgs) -> u8 {
+pub(super) fn execute(args: CompareArgs) -> u8 {
     if !super::commands::outputs_distinct(&[("--dot", args.dot.as_deref())], true) {
         return EXIT_BAD_INPUT;
     }

@@ -3,19 +3,19 @@
 
 use super::EXIT_BAD_INPUT;
 use super::args::ConvertTarget;
-use crate::model::Policy;
+use btfsm_model::Policy;
 use std::path::Path;
 
 /// Writes `p` as BehaviorTree.CPP XML or SCXML to `output` (or stdout).
-pub fn to_xml(p: &Policy, to: ConvertTarget, output: Option<&Path>) -> u8 {
+pub(super) fn to_xml(p: &Policy, to: ConvertTarget, output: Option<&Path>) -> u8 {
     let text = match to {
-        ConvertTarget::BtcppXml => crate::format::btcpp_xml_write::write_policy(p).map_err(|e| {
+        ConvertTarget::BtcppXml => btfsm_format::btcpp_xml_write::write_policy(p).map_err(|e| {
             (
                 e.to_string(),
                 "convert a machine with --to scxml (or --to toml)",
             )
         }),
-        _ => crate::format::scxml_write::write_policy(p)
+        _ => btfsm_format::scxml_write::write_policy(p)
             .map_err(|e| (e.to_string(), "convert a behavior tree with --to btcpp-xml")),
     };
     match text {
@@ -23,7 +23,7 @@ pub fn to_xml(p: &Policy, to: ConvertTarget, output: Option<&Path>) -> u8 {
         Err((msg, hint)) => {
             eprintln!(
                 "error: {}\n  = hint: {hint}",
-                crate::sanitize::shown_max(&msg.to_string(), 1000)
+                btfsm_core::sanitize::shown_max(&msg.to_string(), 1000)
             );
             EXIT_BAD_INPUT
         }

@@ -6,12 +6,13 @@
 use super::args::{AddKind, EditArgs, EditOp, WrapKind};
 use super::commands::{emit_text, load_one};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
-use crate::model::{BtNodeKind, PolicyBody, SkillCall};
-use crate::sanitize::{shown, shown_max};
-use crate::transform::edit::{self, AddState, EditError, Touched};
+use btfsm_core::sanitize::{shown, shown_max};
+use btfsm_model::{BtNodeKind, PolicyBody, SkillCall};
+use btfsm_transform::edit::{self, AddState, EditError, Touched};
 use std::collections::BTreeMap;
 
-pub fn edit(a: &EditArgs) -> u8 {
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub(super) fn edit(a: &EditArgs) -> u8 {
     let limits = a.limits.limits();
     let Some(loaded) = load_one(&a.file, &limits) else {
         return EXIT_BAD_INPUT;
@@ -132,8 +133,7 @@ pub fn edit(a: &EditArgs) -> u8 {
         (EditOp::AddState { .. }, _) => return wrong_kind("add-state", "FSMs and HFSMs"),
         (_, _) => return wrong_kind("insert-subtree and wrap-root", "BTs"),
     };
-    let text = match crate::format::toml_write::write_policy_within(&policy, limits.max_file_bytes)
-    {
+    let text = match btfsm_format::toml_write::write_policy_within(&policy, limits.max_file_bytes) {
         Ok(t) => t,
         Err(e) => {
             eprintln!("error: {e}");
@@ -142,7 +142,7 @@ pub fn edit(a: &EditArgs) -> u8 {
     };
     // The result must read back: an edit never writes an invalid file.
     let base = a.file.parent().unwrap_or(std::path::Path::new(""));
-    if let Err(diags) = crate::format::toml::parse_str("edited policy", &text, base, &limits) {
+    if let Err(diags) = btfsm_format::toml::parse_str("edited policy", &text, base, &limits) {
         eprintln!("error: the edited policy is not valid:");
         for d in diags {
             eprint!("{d}");

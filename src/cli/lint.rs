@@ -5,14 +5,14 @@
 
 use super::commands::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
-use crate::format;
-use crate::lint::{self, Level, config};
+use btfsm_format as format;
+use btfsm_lint::{self as lint, Level, config};
 use clap::{Args, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LintFormat {
+pub(crate) enum LintFormat {
     /// Positioned messages with snippet and help, as `validate` prints
     Text,
     Json,
@@ -21,7 +21,7 @@ pub enum LintFormat {
 }
 
 #[derive(Debug, Args)]
-pub struct LintArgs {
+pub(crate) struct LintArgs {
     /// Policy files (any format), `-` for stdin, or directories
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
@@ -48,9 +48,10 @@ pub struct LintArgs {
     pub limits: super::args::LimitArgs,
 }
 
-pub fn execute(a: LintArgs) -> u8 {
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub(super) fn execute(a: LintArgs) -> u8 {
     if a.list {
-        let mut t = crate::report::table::Table::new(&["code", "level", "what it finds"]);
+        let mut t = btfsm_core::table::Table::new(&["code", "level", "what it finds"]);
         for r in lint::RULES {
             t.row(vec![
                 r.code.to_string(),
@@ -149,7 +150,7 @@ pub fn execute(a: LintArgs) -> u8 {
     let text = match a.format {
         LintFormat::Sarif => lint::sarif::render(&findings),
         LintFormat::Json => {
-            let mut s = crate::sanitize::json(
+            let mut s = btfsm_core::sanitize::json(
                 serde_json::to_string_pretty(&findings).expect("serializable"),
             );
             s.push('\n');

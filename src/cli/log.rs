@@ -4,18 +4,18 @@
 
 use super::commands::emit_text;
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
-use crate::log::report;
+use btfsm_log::report;
 use clap::{Args, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
-pub struct LogArgs {
+pub(crate) struct LogArgs {
     #[command(subcommand)]
     pub command: LogCommand,
 }
 
 #[derive(Debug, Subcommand)]
-pub enum LogCommand {
+pub(crate) enum LogCommand {
     /// Per node: activations, status changes, time RUNNING; node and branch
     /// coverage (exit 1 below --min-coverage)
     Report(ReportArgs),
@@ -32,7 +32,7 @@ pub enum LogCommand {
 }
 
 #[derive(Debug, Args)]
-pub struct TimelineArgs {
+pub(crate) struct TimelineArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog; a file: it is read twice)
     pub log: PathBuf,
     /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
@@ -49,7 +49,7 @@ pub struct TimelineArgs {
 }
 
 #[derive(Debug, Args)]
-pub struct CompareArgs {
+pub(crate) struct CompareArgs {
     /// The first run: a BehaviorTree.CPP log (.btlog) or a simulator JSON
     pub a: PathBuf,
     /// The second run, as the first
@@ -78,14 +78,14 @@ pub struct CompareArgs {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum CompareFormat {
+pub(crate) enum CompareFormat {
     Table,
     Json,
     Markdown,
 }
 
 #[derive(Debug, Args)]
-pub struct DotArgs {
+pub(crate) struct DotArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog)
     pub log: PathBuf,
     /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
@@ -107,13 +107,13 @@ pub struct DotArgs {
     pub output: Option<PathBuf>,
     /// Render through Graphviz (svg, png, pdf) instead of writing DOT
     #[arg(long, value_enum)]
-    pub render: Option<crate::render::dot::RenderFormat>,
+    pub render: Option<btfsm_render::dot::RenderFormat>,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LogFormat {
+pub(crate) enum LogFormat {
     Table,
     Json,
     /// One row per node: uid, node, type, activations, status changes by
@@ -124,7 +124,7 @@ pub enum LogFormat {
 }
 
 #[derive(Debug, Args)]
-pub struct ReportArgs {
+pub(crate) struct ReportArgs {
     /// A BehaviorTree.CPP 4 FileLogger2 log (.btlog), or `-` for stdin
     pub log: PathBuf,
     /// For a .db3 (SqliteLogger) log: the session to read (default: the last)
@@ -140,7 +140,7 @@ pub struct ReportArgs {
     pub limits: super::args::LimitArgs,
 }
 
-pub fn execute(a: LogArgs) -> u8 {
+pub(super) fn execute(a: LogArgs) -> u8 {
     let a = match a.command {
         LogCommand::Report(a) => a,
         LogCommand::Dot(d) => return dot(d),
@@ -155,7 +155,7 @@ pub fn execute(a: LogArgs) -> u8 {
     }
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
-    let opened = match crate::log::open(&a.log, a.session, limits.max_file_bytes) {
+    let opened = match btfsm_log::open(&a.log, a.session, limits.max_file_bytes) {
         Ok(o) => o,
         Err(e) => return bad_log(&shown, &e),
     };
@@ -164,8 +164,8 @@ pub fn execute(a: LogArgs) -> u8 {
         Err(e) => {
             eprintln!(
                 "error: {}: {}\n  = hint: a BehaviorTree.CPP 4 FileLogger2 log (.btlog) is the header `BTCPP4-FileLogger2`, the tree XML, a timestamp and 9-byte records; a SqliteLogger log (.db3) an SQLite database",
-                crate::sanitize::shown(&shown),
-                crate::sanitize::shown(&e.to_string())
+                btfsm_core::sanitize::shown(&shown),
+                btfsm_core::sanitize::shown(&e.to_string())
             );
             return EXIT_BAD_INPUT;
         }
@@ -176,7 +176,7 @@ pub fn execute(a: LogArgs) -> u8 {
     let text = match a.format {
         LogFormat::Json => {
             let mut s =
-                crate::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
+                btfsm_core::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
             s.push('\n');
             s
         }
@@ -201,8 +201,8 @@ pub fn execute(a: LogArgs) -> u8 {
 }
 
 fn dot(a: DotArgs) -> u8 {
-    use crate::log::replay::{At, replay};
-    use crate::render::dot::{DotOptions, Highlight, Status as Drawn};
+    use btfsm_log::replay::{At, replay};
+    use btfsm_render::dot::{DotOptions, Highlight, Status as Drawn};
     let at = match (a.at, a.step) {
         (Some(t), _) if t.is_finite() && t >= 0.0 => At::Time((t * 1e6) as u64),
         (Some(t), _) => {
@@ -214,7 +214,7 @@ fn dot(a: DotArgs) -> u8 {
     };
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
-    let file = match crate::log::open(&a.log, a.session, limits.max_file_bytes) {
+    let file = match btfsm_log::open(&a.log, a.session, limits.max_file_bytes) {
         Ok(o) => o.reader,
         Err(e) => return bad_log(&shown, &e),
     };
@@ -223,8 +223,8 @@ fn dot(a: DotArgs) -> u8 {
         Err(e) => {
             eprintln!(
                 "error: {}: {}",
-                crate::sanitize::shown(&shown),
-                crate::sanitize::shown(&e.to_string())
+                btfsm_core::sanitize::shown(&shown),
+                btfsm_core::sanitize::shown(&e.to_string())
             );
             return EXIT_BAD_INPUT;
         }
@@ -232,9 +232,9 @@ fn dot(a: DotArgs) -> u8 {
     let mut opts = DotOptions::default();
     for (id, s) in &r.statuses {
         let st = match s {
-            crate::log::btlog::Status::Running => Drawn::Running,
-            crate::log::btlog::Status::Success => Drawn::Success,
-            crate::log::btlog::Status::Failure => Drawn::Failure,
+            btfsm_log::btlog::Status::Running => Drawn::Running,
+            btfsm_log::btlog::Status::Success => Drawn::Success,
+            btfsm_log::btlog::Status::Failure => Drawn::Failure,
             _ => continue,
         };
         opts.highlight.insert(id.clone(), Highlight::Status(st));
@@ -257,14 +257,14 @@ fn dot(a: DotArgs) -> u8 {
 fn bad_log(shown: &str, e: &str) -> u8 {
     eprintln!(
         "error: {}: {}",
-        crate::sanitize::shown(shown),
-        crate::sanitize::shown_max(e, 1000)
+        btfsm_core::sanitize::shown(shown),
+        btfsm_core::sanitize::shown_max(e, 1000)
     );
     EXIT_BAD_INPUT
 }
 
 fn compare(a: CompareArgs) -> u8 {
-    use crate::log::compare as c;
+    use btfsm_log::compare as c;
     if let Some(t) = a.tolerance
         && !(t.is_finite() && t >= 0.0)
     {
@@ -279,7 +279,7 @@ fn compare(a: CompareArgs) -> u8 {
     let mut sides = Vec::new();
     for (p, session) in [(&a.a, a.session_a), (&a.b, a.session_b)] {
         let shown = p.display().to_string();
-        let r = match crate::log::open(p, session, limits.max_file_bytes) {
+        let r = match btfsm_log::open(p, session, limits.max_file_bytes) {
             Ok(o) => o.reader,
             Err(e) => return bad_log(&shown, &e),
         };
@@ -297,7 +297,7 @@ fn compare(a: CompareArgs) -> u8 {
     let text = match a.format {
         CompareFormat::Json => {
             let mut s =
-                crate::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
+                btfsm_core::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
             s.push('\n');
             s
         }
@@ -311,16 +311,16 @@ fn compare(a: CompareArgs) -> u8 {
     if r.same { EXIT_OK } else { EXIT_CHECK_FAILED }
 }
 
-fn bad_run(e: &crate::log::compare::CompareError) -> u8 {
+fn bad_run(e: &btfsm_log::compare::CompareError) -> u8 {
     eprintln!(
         "error: {}\n  = hint: each run is a BehaviorTree.CPP 4 FileLogger2 log (.btlog) or what `btfsm sim --format json` or `--trace` writes",
-        crate::sanitize::shown_max(&e.to_string(), 4000)
+        btfsm_core::sanitize::shown_max(&e.to_string(), 4000)
     );
     EXIT_BAD_INPUT
 }
 
 fn timeline(a: TimelineArgs) -> u8 {
-    use crate::log::timeline::MAX_WIDTH;
+    use btfsm_log::timeline::MAX_WIDTH;
     if !(100..=MAX_WIDTH).contains(&a.width) {
         eprintln!(
             "error: --width must be from 100 to {MAX_WIDTH} pixels, found {}",
@@ -335,21 +335,21 @@ fn timeline(a: TimelineArgs) -> u8 {
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
     let open = || {
-        crate::log::open(&a.log, a.session, limits.max_file_bytes)
+        btfsm_log::open(&a.log, a.session, limits.max_file_bytes)
             .map(|o| o.reader)
             .map_err(std::io::Error::other)
     };
     if let Err(e) = open() {
         return bad_log(&shown, &e.to_string());
     }
-    let t = crate::log::timeline::timeline(&shown, open, limits.max_file_bytes, a.width);
+    let t = btfsm_log::timeline::timeline(&shown, open, limits.max_file_bytes, a.width);
     match t {
         Ok(t) => emit_text(a.output.as_deref(), t.svg),
         Err(e) => {
             eprintln!(
                 "error: {}: {}",
-                crate::sanitize::shown(&shown),
-                crate::sanitize::shown(&e.to_string())
+                btfsm_core::sanitize::shown(&shown),
+                btfsm_core::sanitize::shown(&e.to_string())
             );
             EXIT_BAD_INPUT
         }

@@ -22,17 +22,17 @@ macro_rules! eprint {
     };
 }
 
-pub mod args;
+pub(crate) mod args;
 mod commands;
 mod compare;
 mod convert;
 mod edit;
 mod lint;
 mod log;
-pub mod out;
+pub(crate) mod out;
 mod paper;
 mod plan;
-pub mod sim;
+pub(crate) mod sim;
 mod ted_pairs;
 mod tick;
 mod view;
@@ -42,12 +42,12 @@ use std::ffi::OsString;
 use std::process::ExitCode;
 
 /// Exit codes of the contract.
-pub const EXIT_OK: u8 = 0;
-pub const EXIT_CHECK_FAILED: u8 = 1;
-pub const EXIT_BAD_INPUT: u8 = 2;
+pub(crate) const EXIT_OK: u8 = 0;
+pub(crate) const EXIT_CHECK_FAILED: u8 = 1;
+pub(crate) const EXIT_BAD_INPUT: u8 = 2;
 
 /// Runs btfsm with the given arguments (the first is the program name).
-pub fn run<I, T>(args: I) -> ExitCode
+pub(crate) fn run<I, T>(args: I) -> ExitCode
 where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,

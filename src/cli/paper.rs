@@ -3,12 +3,12 @@
 use super::args::PaperArgs;
 use super::commands::emit_text;
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
-use crate::format::Limits;
-use crate::metrics::effort::effort as compute_effort;
-use crate::metrics::ged::GedOptions;
-use crate::report::OutputFormat;
-use crate::report::effort::{EffortRow, render_effort};
-use crate::report::paper::{self, EXPECTED_FILE};
+use btfsm_format::Limits;
+use btfsm_metrics::ged::GedOptions;
+use btfsm_report::OutputFormat;
+use btfsm_report::effort::effort as compute_effort;
+use btfsm_report::effort::{EffortRow, render_effort};
+use btfsm_report::paper::{self, EXPECTED_FILE};
 use std::path::PathBuf;
 
 /// The GED budget given with `--timeout-ms`.
@@ -20,7 +20,12 @@ fn ged_options(timeout_ms: u64) -> GedOptions {
 }
 
 /// `btfsm effort FILE...`.
-pub fn effort(files: &[PathBuf], format: OutputFormat, timeout_ms: u64, limits: &Limits) -> u8 {
+pub(super) fn effort(
+    files: &[PathBuf],
+    format: OutputFormat,
+    timeout_ms: u64,
+    limits: &Limits,
+) -> u8 {
     let Some((loaded, failed)) = super::commands::load_inputs(files, limits) else {
         return EXIT_BAD_INPUT;
     };
@@ -34,7 +39,7 @@ pub fn effort(files: &[PathBuf], format: OutputFormat, timeout_ms: u64, limits: 
 }
 
 /// `btfsm paper`.
-pub fn paper(a: &PaperArgs) -> u8 {
+pub(super) fn paper(a: &PaperArgs) -> u8 {
     let report = match paper::build(&a.policies, &a.limits.limits(), &ged_options(a.timeout_ms)) {
         Ok(r) => r,
         Err(diags) => {

@@ -6,15 +6,15 @@
 
 use super::commands::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
-use crate::format::{Limits, Loaded};
-use crate::model::{Policy, PolicyBody};
-use crate::plan::{self, Options};
-use crate::report::{self, OutputFormat};
+use btfsm_format::{Limits, Loaded};
+use btfsm_model::{Policy, PolicyBody};
+use btfsm_plan::{self as plan, Options};
+use btfsm_report::{self as report, OutputFormat};
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum PlanTarget {
+pub(crate) enum PlanTarget {
     /// The backchained Behavior Tree
     Bt,
     /// The fault-tolerant FSM of the same plan (SELECTOR with triangle-table kernels)
@@ -26,8 +26,8 @@ pub enum PlanTarget {
 }
 
 #[derive(Debug, Args)]
-pub struct PlanArgs {
-    /// Action domain (TOML; README "Action domains"), e.g. policies/domains/moma.toml
+pub(crate) struct PlanArgs {
+    /// Action domain (TOML; docs/guide/plan.md), e.g. policies/domains/moma.toml
     pub domain: PathBuf,
     /// A task of the domain (`[tasks.NAME]`) instead of its `[goal]`
     #[arg(long, value_name = "NAME")]
@@ -62,7 +62,7 @@ pub struct PlanArgs {
 pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> {
     let stderr = std::io::stderr();
     let shown = path.display().to_string();
-    let file = match crate::format::source::read(path, &shown, limits, true) {
+    let file = match btfsm_format::source::read(path, &shown, limits, true) {
         Ok(f) => f,
         Err(d) => {
             print_diagnostics(&mut stderr.lock(), &d);
@@ -78,7 +78,8 @@ pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> 
     }
 }
 
-pub fn execute(a: PlanArgs) -> u8 {
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub(super) fn execute(a: PlanArgs) -> u8 {
     let limits = a.limits.limits();
     let shown = a.domain.display().to_string();
     let Some(mut domain) = read_domain(&a.domain, &limits) else {
@@ -125,7 +126,7 @@ pub fn execute(a: PlanArgs) -> u8 {
             eprintln!("error: `-o -` writes one policy: choose it with --to bt, fsm or hfsm");
             return EXIT_BAD_INPUT;
         };
-        return emit_text(None, crate::format::toml_write::write_policy(p));
+        return emit_text(None, btfsm_format::toml_write::write_policy(p));
     }
     let mut written: Vec<(String, &Policy)> = Vec::new();
     for (tag, p) in &policies {
@@ -135,14 +136,14 @@ pub fn execute(a: PlanArgs) -> u8 {
         if let Err(e) = std::fs::create_dir_all(dir) {
             eprintln!(
                 "error: cannot create {}: {e}",
-                crate::sanitize::shown(&dir.display().to_string())
+                btfsm_core::sanitize::shown(&dir.display().to_string())
             );
             return EXIT_BAD_INPUT;
         }
         for (name, p) in &written {
             let code = emit_text(
                 Some(&dir.join(name)),
-                crate::format::toml_write::write_policy(p),
+                btfsm_format::toml_write::write_policy(p),
             );
             if code != EXIT_OK {
                 return code;
@@ -180,16 +181,17 @@ pub fn execute(a: PlanArgs) -> u8 {
                 conflicts: &planned.conflicts,
                 policies: &rows,
             };
-            let mut s =
-                crate::sanitize::json(serde_json::to_string_pretty(&out).expect("serializable"));
+            let mut s = btfsm_core::sanitize::json(
+                serde_json::to_string_pretty(&out).expect("serializable"),
+            );
             s.push('\n');
             s
         }
         _ => {
             let mut s = format!(
                 "domain `{}`, goal: {}\n",
-                crate::sanitize::shown(&domain.name),
-                crate::sanitize::shown(
+                btfsm_core::sanitize::shown(&domain.name),
+                btfsm_core::sanitize::shown(
                     &domain
                         .goal
                         .facts
@@ -271,7 +273,7 @@ fn policies(
         ));
     }
     if matches!(to, PlanTarget::Hfsm | PlanTarget::All) {
-        let h = crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&bt).map_err(|es| {
+        let h = btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&bt).map_err(|es| {
             es.iter()
                 .map(ToString::to_string)
                 .collect::<Vec<_>>()
@@ -280,7 +282,7 @@ fn policies(
         out.push(("hfsm", h));
     }
     for (_, p) in &out {
-        if let Some(d) = crate::format::check_shape(p, limits) {
+        if let Some(d) = btfsm_format::check_shape(p, limits) {
             return Err(d.message);
         }
     }

@@ -4,17 +4,17 @@
 
 use super::commands::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
-use crate::sim::report::{McReport, SimReport, TraceWriter};
-use crate::sim::{monte_carlo, plot, run, scenario};
+use btfsm_sim::report::{McReport, SimReport, TraceWriter};
+use btfsm_sim::{monte_carlo, plot, run, scenario};
 use clap::Args;
 use std::path::PathBuf;
 
 /// `--threads` above this many per core are lowered to it.
-pub const MAX_THREADS_PER_CORE: usize = 4;
+pub(crate) const MAX_THREADS_PER_CORE: usize = 4;
 
 /// What `sim` prints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum OutputFormat {
+pub(crate) enum OutputFormat {
     Table,
     Json,
     /// GitHub-flavoured markdown tables (with --runs)
@@ -24,7 +24,7 @@ pub enum OutputFormat {
 }
 
 #[derive(Debug, Args)]
-pub struct SimArgs {
+pub(crate) struct SimArgs {
     /// Scenario file (TOML)
     pub scenario: PathBuf,
     /// Output format (table, json or csv; markdown with --runs)
@@ -61,7 +61,8 @@ pub struct SimArgs {
     pub limits: super::args::LimitArgs,
 }
 
-pub fn execute(a: SimArgs) -> u8 {
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub(crate) fn execute(a: SimArgs) -> u8 {
     let outputs = [
         ("--trace", a.trace.as_deref()),
         ("--plot", a.plot.as_deref()),
@@ -71,7 +72,7 @@ pub fn execute(a: SimArgs) -> u8 {
     }
     let limits = a.limits.limits();
     let shown = a.scenario.display().to_string();
-    let file = match crate::format::toml::read_source(&a.scenario, &shown, &limits) {
+    let file = match btfsm_format::toml::read_source(&a.scenario, &shown, &limits) {
         Ok(f) => f,
         Err(d) => {
             print_diagnostics(&mut std::io::stderr().lock(), &d);
@@ -83,7 +84,7 @@ pub fn execute(a: SimArgs) -> u8 {
         .parent()
         .unwrap_or(std::path::Path::new(""))
         .to_path_buf();
-    if crate::sim::symbolic::looks_symbolic(&file.text) {
+    if btfsm_sim::symbolic::looks_symbolic(&file.text) {
         return symbolic(&a, &file, &base, &limits);
     }
     let mut s = match scenario::parse(&file, &base, &limits) {
@@ -172,12 +173,12 @@ pub fn execute(a: SimArgs) -> u8 {
     // The trace goes to its (temporary) file as the runs make it.
     let (runs, cut, trace_out) = match &a.trace {
         Some(p) => {
-            let f = match crate::report::output::OutputFile::create(p) {
+            let f = match btfsm_report::output::OutputFile::create(p) {
                 Ok(f) => f,
                 Err(e) => {
                     eprintln!(
                         "error: cannot write `{}`: {e}",
-                        crate::sanitize::shown(&p.display().to_string())
+                        btfsm_core::sanitize::shown(&p.display().to_string())
                     );
                     return EXIT_BAD_INPUT;
                 }
@@ -194,8 +195,8 @@ pub fn execute(a: SimArgs) -> u8 {
     // The verdicts' trajectory distances get what is left of the budget:
     // fewer points per trajectory when little is (300 at the least).
     let pairs = runs.len() * runs.len().saturating_sub(1) / 2;
-    let points = deadline.map_or(crate::sim::trace::FRECHET_POINTS, |d| {
-        crate::sim::trace::frechet_points(
+    let points = deadline.map_or(btfsm_sim::trace::FRECHET_POINTS, |d| {
+        btfsm_sim::trace::frechet_points(
             pairs,
             d.saturating_duration_since(std::time::Instant::now()),
         )
@@ -216,7 +217,7 @@ pub fn execute(a: SimArgs) -> u8 {
     {
         eprintln!(
             "error: cannot write `{}`: {e}",
-            crate::sanitize::shown(&p.display().to_string())
+            btfsm_core::sanitize::shown(&p.display().to_string())
         );
         return EXIT_BAD_INPUT;
     }
@@ -245,8 +246,8 @@ pub fn execute(a: SimArgs) -> u8 {
             rep.expectations_failed,
             rep.expectations.len(),
             (rep.expectations.iter())
-                .filter(|e| e.status != crate::sim::scenario::expect::Status::Pass)
-                .map(|e| crate::sanitize::shown(&e.name).into_owned())
+                .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
+                .map(|e| btfsm_core::sanitize::shown(&e.name).into_owned())
                 .take(10)
                 .collect::<Vec<_>>()
                 .join("; ")
@@ -317,7 +318,7 @@ fn with_budget<T: serde::Serialize>(report: &T, budget: &Budget) -> String {
         report: &'a T,
         budget: &'a Budget,
     }
-    let mut s = crate::sanitize::json(
+    let mut s = btfsm_core::sanitize::json(
         serde_json::to_string_pretty(&Out { report, budget }).expect("serializable"),
     );
     s.push('\n');
@@ -326,7 +327,7 @@ fn with_budget<T: serde::Serialize>(report: &T, budget: &Budget) -> String {
 
 /// `btfsm dot FILE --trace TRACE.json --step K [--policy NAME]`.
 #[derive(Debug, Clone, Args)]
-pub struct DotTraceArgs {
+pub(crate) struct DotTraceArgs {
     /// A trace written by `btfsm sim --trace`
     #[arg(long, value_name = "TRACE.json", requires = "step")]
     pub trace: Option<PathBuf>,
@@ -342,13 +343,13 @@ pub struct DotTraceArgs {
 /// ticked at step K coloured by its status (RUNNING yellow, SUCCESS green,
 /// FAILURE red); a trace of a converted HFSM converts FILE the same way.
 /// `None` after printing an error.
-pub fn dot_trace(
+pub(crate) fn dot_trace(
     a: &DotTraceArgs,
     file: &std::path::Path,
-    policy: crate::model::Policy,
-    limits: &crate::format::Limits,
-) -> Option<(crate::model::Policy, crate::render::dot::DotOptions)> {
-    use crate::render::dot::{Highlight, Status};
+    policy: btfsm_model::Policy,
+    limits: &btfsm_format::Limits,
+) -> Option<(btfsm_model::Policy, btfsm_render::dot::DotOptions)> {
+    use btfsm_render::dot::{Highlight, Status};
     let (Some(trace), Some(step)) = (&a.trace, a.step) else {
         return Some((policy, Default::default()));
     };
@@ -405,17 +406,17 @@ pub fn dot_trace(
         ));
     };
     let policy = if run["convert"] == "hfsm" {
-        match crate::transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
+        match btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
             Ok(p) => p,
             Err(e) => return fail(e[0].to_string()),
         }
     } else {
         policy
     };
-    let mut opts = crate::render::dot::DotOptions::default();
+    let mut opts = btfsm_render::dot::DotOptions::default();
     // A trace names an (H)FSM's states by their full path; the drawing by
     // their vertex key (the name, unless it repeats).
-    let (keys, paths) = crate::view::drawn_keys(&policy);
+    let (keys, paths) = btfsm_view::drawn_keys(&policy);
     let key_of: std::collections::HashMap<&str, &str> = paths
         .iter()
         .map(|(p, i)| (p.as_str(), keys[*i].as_str()))
@@ -436,21 +437,24 @@ pub fn dot_trace(
 /// command's `--max-total-bytes`, never blocking on a FIFO.
 fn read_trace(
     path: &std::path::Path,
-    limits: &crate::format::Limits,
-) -> Result<std::sync::Arc<crate::diagnostic::SourceFile>, Vec<crate::diagnostic::Diagnostic>> {
+    limits: &btfsm_format::Limits,
+) -> Result<
+    std::sync::Arc<btfsm_core::diagnostic::SourceFile>,
+    Vec<btfsm_core::diagnostic::Diagnostic>,
+> {
     let shown = path.display().to_string();
-    crate::format::source::read(path, &shown, limits, false)
+    btfsm_format::source::read(path, &shown, limits, false)
 }
 
 /// A symbolic scenario (a top-level `domain`): one run per policy, or
 /// `--runs` Monte Carlo episodes, in the domain's world of facts.
 fn symbolic(
     a: &SimArgs,
-    file: &std::sync::Arc<crate::diagnostic::SourceFile>,
+    file: &std::sync::Arc<btfsm_core::diagnostic::SourceFile>,
     base: &std::path::Path,
-    limits: &crate::format::Limits,
+    limits: &btfsm_format::Limits,
 ) -> u8 {
-    use crate::sim::symbolic::{report, run};
+    use btfsm_sim::symbolic::{report, run};
     if a.trace.is_some()
         || a.plot.is_some()
         || matches!(a.format, OutputFormat::Markdown | OutputFormat::Csv)
@@ -460,7 +464,7 @@ fn symbolic(
         );
         return EXIT_BAD_INPUT;
     }
-    let s = match crate::sim::symbolic::scenario::parse(file, base, limits) {
+    let s = match btfsm_sim::symbolic::scenario::parse(file, base, limits) {
         Ok(s) => s,
         Err(d) => {
             print_diagnostics(&mut std::io::stderr().lock(), &d);

@@ -8,15 +8,15 @@
 
 use super::EXIT_BAD_INPUT;
 use super::commands::{emit_text, print_diagnostics};
-use crate::format::source;
-use crate::metrics::ted::{self, TedOptions, TreeEdit, tree_text};
-use crate::sanitize::shown;
+use btfsm_core::sanitize::shown;
+use btfsm_format::source;
+use btfsm_metrics::ted::{self, TedOptions, TreeEdit, tree_text};
 use clap::Args;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
-pub struct TedPairsArgs {
+pub(crate) struct TedPairsArgs {
     /// File of pairs, one per line: `TREE<TAB>TREE` (or `-` for stdin)
     pub file: PathBuf,
     /// Work budget per pair, in table cells
@@ -26,7 +26,7 @@ pub struct TedPairsArgs {
     pub limits: super::args::LimitArgs,
 }
 
-pub fn execute(a: TedPairsArgs) -> u8 {
+pub(super) fn execute(a: TedPairsArgs) -> u8 {
     let limits = a.limits.limits();
     let name = a.file.display().to_string();
     let file = match source::read(&a.file, &name, &limits, false) {

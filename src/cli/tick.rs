@@ -5,17 +5,17 @@
 
 use super::EXIT_BAD_INPUT;
 use super::commands::{emit_text, print_diagnostics};
-use crate::diagnostic::Diagnostic;
-use crate::format;
-use crate::model::PolicyBody;
-use crate::report::OutputFormat;
-use crate::sanitize::shown;
-use crate::tick;
+use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::sanitize::shown;
+use btfsm_format as format;
+use btfsm_model::PolicyBody;
+use btfsm_report::OutputFormat;
+use btfsm_tick as tick;
 use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
-pub struct TickArgs {
+pub(crate) struct TickArgs {
     /// BT files (TOML or BehaviorTree.CPP XML), each with its --script
     #[arg(required = true)]
     pub trees: Vec<PathBuf>,
@@ -29,7 +29,7 @@ pub struct TickArgs {
     pub limits: super::args::LimitArgs,
 }
 
-pub fn execute(a: TickArgs) -> u8 {
+pub(super) fn execute(a: TickArgs) -> u8 {
     if a.format == OutputFormat::Csv {
         eprintln!("error: `tick` prints `table` or `json`, not `csv`");
         return EXIT_BAD_INPUT;
@@ -98,7 +98,7 @@ fn one(
                 .hint("`tick` runs Behavior Trees; `sim` runs FSMs and HFSMs in a world"),
         ]);
     };
-    if let Some((n, what)) = crate::sim::exec::unsupported(bt) {
+    if let Some((n, what)) = btfsm_sim::exec::unsupported(bt) {
         let node = &bt.nodes[n];
         let d = Diagnostic::error(format!(
             "node `{}`: {what} cannot be ticked as BehaviorTree.CPP 4 ticks it",
@@ -127,7 +127,7 @@ fn one(
 fn in_this_file(
     text: &str,
     f: format::FileFormat,
-    node: &crate::model::bt::BtNode,
+    node: &btfsm_model::bt::BtNode,
     sp: &std::ops::Range<usize>,
 ) -> bool {
     let Some(at) = text.get(sp.clone()) else {

@@ -5,12 +5,12 @@
 
 use super::commands::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
-use crate::view::{Replay, ViewError};
+use btfsm_view::{Replay, ViewError};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
-pub struct ViewArgs {
+pub(crate) struct ViewArgs {
     /// Scenario (.toml, run with its seed), trace of `btfsm sim --trace`
     /// (.json; the policy files it names are read, relative to the current
     /// directory and inside the root) or BehaviorTree.CPP log (.btlog, or .db3: its last session)
@@ -24,7 +24,7 @@ pub struct ViewArgs {
     pub seed: Option<u64>,
     /// Graphviz's time budget per diagram, ms; past it `dot` is killed and
     /// the run exits 2
-    #[arg(long, default_value_t = crate::render::dot::DEFAULT_RENDER_TIMEOUT_MS, value_name = "MS")]
+    #[arg(long, default_value_t = btfsm_render::dot::DEFAULT_RENDER_TIMEOUT_MS, value_name = "MS")]
     pub timeout_ms: u64,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
@@ -50,7 +50,7 @@ fn kind_of(path: &Path, head: &[u8]) -> Kind {
         _ if head.starts_with(b"SQLite format 3\0") => Kind::Db3,
         Some("json") => Kind::Trace,
         Some("toml") => Kind::Scenario,
-        _ if head.starts_with(crate::log::btlog::MAGIC) => Kind::Log,
+        _ if head.starts_with(btfsm_log::btlog::MAGIC) => Kind::Log,
         _ if head.trim_ascii_start().starts_with(b"{") => Kind::Trace,
         _ => Kind::Scenario,
     }
@@ -66,13 +66,13 @@ fn fail(e: ViewError) -> Option<Replay> {
 
 /// One input's replay; `None` after printing why not. Every input is read
 /// once through `format::source` (bounded, never blocking on a FIFO).
-fn replay_of(path: &Path, a: &ViewArgs, limits: &crate::format::Limits) -> Option<Replay> {
+fn replay_of(path: &Path, a: &ViewArgs, limits: &btfsm_format::Limits) -> Option<Replay> {
     let shown = path.display().to_string();
-    let diags = |d: Vec<crate::diagnostic::Diagnostic>| {
+    let diags = |d: Vec<btfsm_core::diagnostic::Diagnostic>| {
         print_diagnostics(&mut std::io::stderr().lock(), &d);
         None
     };
-    let bytes = match crate::format::source::read_bytes(path, &shown, limits, false) {
+    let bytes = match btfsm_format::source::read_bytes(path, &shown, limits, false) {
         Ok(b) => b,
         Err(d) => return diags(d),
     };
@@ -81,21 +81,21 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &crate::format::Limits) -> Optio
         Err(e) => {
             eprintln!(
                 "error: {}: byte {}: not UTF-8 text\n  = hint: a scenario (.toml) or a trace (.json) is UTF-8 text",
-                crate::sanitize::shown(&shown),
+                btfsm_core::sanitize::shown(&shown),
                 e.utf8_error().valid_up_to()
             );
             None
         }
     };
     match kind_of(path, &bytes[..bytes.len().min(32)]) {
-        Kind::Log => crate::view::log::from_log(&bytes[..], &shown, limits).map_or_else(fail, Some),
-        Kind::Db3 => match crate::log::open(path, None, limits.max_file_bytes) {
-            Ok(o) => crate::view::log::from_log(o.reader, &shown, limits).map_or_else(fail, Some),
+        Kind::Log => btfsm_view::log::from_log(&bytes[..], &shown, limits).map_or_else(fail, Some),
+        Kind::Db3 => match btfsm_log::open(path, None, limits.max_file_bytes) {
+            Ok(o) => btfsm_view::log::from_log(o.reader, &shown, limits).map_or_else(fail, Some),
             Err(e) => {
                 eprintln!(
                     "error: {}: {}",
-                    crate::sanitize::shown(&shown),
-                    crate::sanitize::shown(&e)
+                    btfsm_core::sanitize::shown(&shown),
+                    btfsm_core::sanitize::shown(&e)
                 );
                 None
             }
@@ -103,21 +103,21 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &crate::format::Limits) -> Optio
         Kind::Trace => {
             let text = text(bytes)?;
             let dir = path.parent().unwrap_or(Path::new(""));
-            let root = crate::format::source::root_for(limits, dir);
-            crate::view::sim::from_trace(&text, &shown, root.as_deref(), limits)
+            let root = btfsm_format::source::root_for(limits, dir);
+            btfsm_view::sim::from_trace(&text, &shown, root.as_deref(), limits)
                 .map_or_else(fail, Some)
         }
         Kind::Scenario => {
-            let file = crate::diagnostic::SourceFile::new(&shown, text(bytes)?);
-            if crate::sim::symbolic::looks_symbolic(&file.text) {
+            let file = btfsm_core::diagnostic::SourceFile::new(&shown, text(bytes)?);
+            if btfsm_sim::symbolic::looks_symbolic(&file.text) {
                 eprintln!(
                     "error: {}: a symbolic scenario (with `domain`) has no trace to replay\n  = hint: `btfsm view` replays the planar simulator's scenarios, `sim --trace` files and .btlog logs",
-                    crate::sanitize::shown(&shown)
+                    btfsm_core::sanitize::shown(&shown)
                 );
                 return None;
             }
             let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
-            let mut s = match crate::sim::scenario::parse(&file, &base, limits) {
+            let mut s = match btfsm_sim::scenario::parse(&file, &base, limits) {
                 Ok(s) => s,
                 Err(d) => return diags(d),
             };
@@ -125,17 +125,17 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &crate::format::Limits) -> Optio
                 print_diagnostics(&mut std::io::stderr().lock(), &s.warnings);
             }
             if let Some(seed) = a.seed {
-                let (ds, rates) = crate::sim::monte_carlo::episode(&s, seed);
+                let (ds, rates) = btfsm_sim::monte_carlo::episode(&s, seed);
                 s.seed = seed;
                 s.disturbances = ds;
                 s.rates = rates;
             }
-            crate::view::sim::from_scenario(&s, &shown).map_or_else(fail, Some)
+            btfsm_view::sim::from_scenario(&s, &shown).map_or_else(fail, Some)
         }
     }
 }
 
-pub fn execute(a: ViewArgs) -> u8 {
+pub(super) fn execute(a: ViewArgs) -> u8 {
     let limits = a.limits.limits();
     let mut all: Option<Replay> = None;
     for path in &a.inputs {
@@ -166,7 +166,7 @@ pub fn execute(a: ViewArgs) -> u8 {
         return EXIT_BAD_INPUT;
     };
     let timeout = std::time::Duration::from_millis(a.timeout_ms);
-    let page = match crate::view::html::page(&replay, timeout) {
+    let page = match btfsm_view::html::page(&replay, timeout) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("error: {e}");
@@ -183,7 +183,7 @@ pub fn execute(a: ViewArgs) -> u8 {
             .unwrap_or(0);
         eprintln!(
             "wrote {} ({} panel{}, {steps} steps)",
-            crate::sanitize::shown(&out.display().to_string()),
+            btfsm_core::sanitize::shown(&out.display().to_string()),
             replay.panels.len(),
             if replay.panels.len() == 1 { "" } else { "s" }
         );

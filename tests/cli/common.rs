@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 /// Runs the built `btfsm` in the crate root: (exit code, stdout, stderr).
-pub fn btfsm(args: &[&str]) -> (i32, String, String) {
+pub(crate) fn btfsm(args: &[&str]) -> (i32, String, String) {
     run(Command::new(env!("CARGO_BIN_EXE_btfsm")).args(args))
 }
 
@@ -22,7 +22,7 @@ fn run(cmd: &mut Command) -> (i32, String, String) {
 }
 
 /// A scratch directory of this test process.
-pub fn scratch(tag: &str) -> PathBuf {
+pub(crate) fn scratch(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("btfsm-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&d).expect("tmp");
     d
@@ -30,7 +30,7 @@ pub fn scratch(tag: &str) -> PathBuf {
 
 /// Runs the built `btfsm` in the crate root with its address space capped at
 /// `mib` MiB (`ulimit -v` of sh): (exit code, stdout, stderr, wall time).
-pub fn btfsm_capped(mib: u64, args: &[&str]) -> (i32, String, String, std::time::Duration) {
+pub(crate) fn btfsm_capped(mib: u64, args: &[&str]) -> (i32, String, String, std::time::Duration) {
     let start = std::time::Instant::now();
     let (code, out, err) = run(Command::new("sh")
         .arg("-c")

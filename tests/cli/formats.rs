@@ -316,21 +316,24 @@ fn convert(file: &Path, to: &str, out: &Path) {
     assert_eq!(code, 0, "convert {} --to {to}: {stderr}", file.display());
 }
 
-fn load(p: &Path) -> btfsm::model::Policy {
-    let limits = btfsm::format::Limits {
+fn load(p: &Path) -> btfsm_model::Policy {
+    let limits = btfsm_format::Limits {
         nodes_models: vec![PathBuf::from(nav2_model())],
         ..Default::default()
     };
-    match btfsm::format::load(p, &limits) {
+    match btfsm_format::load(p, &limits) {
         Ok(l) => l.policy,
         Err(d) => panic!("{}: {d:?}", p.display()),
     }
 }
 
 /// Named GED between two policies, with the edit script on failure.
-fn named_ged(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> (u64, String) {
-    use btfsm::metrics::ged::{GedMode, GedOptions, ged};
-    let (ga, gb) = (btfsm::graph::policy_graph(a), btfsm::graph::policy_graph(b));
+fn named_ged(a: &btfsm_model::Policy, b: &btfsm_model::Policy) -> (u64, String) {
+    use btfsm_metrics::ged::{GedMode, GedOptions, ged};
+    let (ga, gb) = (
+        btfsm_model::graph::policy_graph(a),
+        btfsm_model::graph::policy_graph(b),
+    );
     assert_eq!(ga.vertex_count(), gb.vertex_count());
     let r = ged(&ga, &gb, GedMode::Named, &GedOptions::default());
     (r.ged, format!("{:?}", r.edit_script))
@@ -357,11 +360,11 @@ fn round_trip(src: &Path, via: &str, back: &str, ext_via: &str, ext_back: &str, 
 /// The same policy up to source positions and arena order: BT nodes compared
 /// by id (label, kind, skill, type, ports, children), states by path (label,
 /// body, transitions in order).
-fn same_model(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> Result<(), String> {
-    use btfsm::model::{PolicyBody, StateBody, Target};
+fn same_model(a: &btfsm_model::Policy, b: &btfsm_model::Policy) -> Result<(), String> {
+    use btfsm_model::{PolicyBody, StateBody, Target};
     match (&a.body, &b.body) {
         (PolicyBody::Bt(x), PolicyBody::Bt(y)) => {
-            let kids = |t: &btfsm::model::Bt, i: usize| -> Vec<String> {
+            let kids = |t: &btfsm_model::Bt, i: usize| -> Vec<String> {
                 t.nodes[i]
                     .children
                     .iter()
@@ -402,13 +405,13 @@ fn same_model(a: &btfsm::model::Policy, b: &btfsm::model::Policy) -> Result<(), 
         }
         (PolicyBody::Machine(x), PolicyBody::Machine(y)) => {
             // Where a region starts: a state's path or an outcome.
-            let start = |m: &btfsm::model::StateMachine, t: &Target| match t {
+            let start = |m: &btfsm_model::StateMachine, t: &Target| match t {
                 Target::State(j) => m.path(*j),
                 Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
                     format!("outcome {o}")
                 }
             };
-            let desc = |m: &btfsm::model::StateMachine, i: usize| {
+            let desc = |m: &btfsm_model::StateMachine, i: usize| {
                 let s = &m.states[i];
                 let body = match &s.body {
                     StateBody::Container(r) => format!(
@@ -462,7 +465,7 @@ fn bundled_bts_round_trip_through_btcpp_xml_at_named_ged_0() {
     let dir = scratch("bt-rt");
     let mut n = 0;
     for f in fixtures_in("policies/paper") {
-        if load(&f).kind() == btfsm::model::PolicyKind::Bt {
+        if load(&f).kind() == btfsm_model::PolicyKind::Bt {
             round_trip(&f, "btcpp-xml", "toml", "xml", "toml", &dir);
             n += 1;
         }
@@ -485,7 +488,7 @@ fn machines_round_trip_through_scxml_at_named_ged_0() {
     let dir = scratch("scxml-rt");
     let mut n = 0;
     for f in fixtures_in("policies/paper") {
-        if load(&f).kind() != btfsm::model::PolicyKind::Bt {
+        if load(&f).kind() != btfsm_model::PolicyKind::Bt {
             round_trip(&f, "scxml", "toml", "scxml", "toml", &dir);
             n += 1;
         }

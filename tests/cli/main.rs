@@ -1,6 +1,12 @@
 //! Runs the built `btfsm` binary on fixture files and compares stdout, stderr
 //! and exit codes. Set `BLESS=1` to rewrite the expected `.stderr` files.
 
+#![allow(
+    clippy::print_stdout,
+    clippy::print_stderr,
+    reason = "benchmarks and tests report what they measured"
+)]
+
 use std::path::{Path, PathBuf};
 
 mod common;

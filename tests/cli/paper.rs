@@ -90,6 +90,7 @@ fn paper_check_names_the_cell_a_policy_edit_changes() {
 }
 
 #[test]
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 fn paper_json_holds_the_values_of_spec_section_5() {
     let j = paper_json();
     for r in j["rows"].as_array().expect("rows") {

@@ -198,6 +198,7 @@ fn a_btlog_replays_record_by_record() {
     assert_eq!(two["panels"].as_array().unwrap().len(), 2);
 }
 
+#[cfg(feature = "sqlite")]
 #[test]
 fn a_db3_replays_its_last_session_record_by_record() {
     // tests/fixtures/logs/sessions.db3: session 2 holds 182 records
@@ -324,4 +325,14 @@ fn dot_trace_colours_hfsm_states_named_by_their_path() {
         .find(|l| l.trim_start().starts_with("pick["))
         .unwrap_or("");
     assert!(pick.contains("fillcolor=gold"), "{dot}");
+}
+
+/// Without the `sqlite` feature a `.db3` is refused with a message that
+/// names the feature (exit 2), never read as something else.
+#[cfg(not(feature = "sqlite"))]
+#[test]
+fn a_db3_without_the_sqlite_feature_says_so() {
+    let (code, _, err) = btfsm(&["log", "report", "tests/fixtures/logs/sessions.db3"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`sqlite` feature"), "{err}");
 }

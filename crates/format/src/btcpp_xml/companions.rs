@@ -1,0 +1,164 @@
+//! BehaviorTree.CPP files given together: the trees each defines, so that a
+//! `<SubTree ID>` one file uses and another defines is found, as
+//! BehaviorTree.CPP's `BehaviorTreeFactory` registers every tree of every
+//! file it loads (`registerBehaviorTreeFromFile`) before `createTree(ID)`.
+//!
+//! The index is built on first use only (a command whose SubTrees are all
+//! defined where they are used reads nothing more), by one pass over each
+//! file: its document element's `<BehaviorTree ID>` children. A file that
+//! cannot be read or parsed is left out of the index (it reports its own
+//! errors when it is loaded as an input). Reading for the index counts
+//! against the command's `--max-total-bytes` like any read.
+
+use super::super::xml;
+use super::super::{Limits, source};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The BehaviorTree.CPP files of one command and, once asked, the trees
+/// each defines.
+#[derive(Debug, Default)]
+pub struct Companions {
+    files: Vec<PathBuf>,
+    index: OnceLock<BTreeMap<String, Vec<usize>>>,
+}
+
+impl Companions {
+    /// The files given together (regular files only: a pipe is read once,
+    /// as the input it is).
+    pub fn new(files: Vec<PathBuf>) -> Companions {
+        Companions {
+            files,
+            index: OnceLock::new(),
+        }
+    }
+
+    /// How many files there are.
+    pub fn len(&self) -> usize {
+        self.files.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.files.is_empty()
+    }
+
+    fn index(&self, limits: &Limits) -> &BTreeMap<String, Vec<usize>> {
+        self.index.get_or_init(|| {
+            let mut index: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+            for (i, path) in self.files.iter().enumerate() {
+                for id in trees_of(path, limits) {
+                    let at = index.entry(id).or_default();
+                    if at.last() != Some(&i) {
+                        at.push(i);
+                    }
+                }
+            }
+            index
+        })
+    }
+
+    /// The files that define tree `id`, in the order given.
+    pub fn defining(&self, id: &str, limits: &Limits) -> Vec<&Path> {
+        self.index(limits)
+            .get(id)
+            .map(|at| at.iter().map(|&i| self.files[i].as_path()).collect())
+            .unwrap_or_default()
+    }
+
+    /// Every tree ID defined by the files, sorted.
+    pub fn tree_ids(&self, limits: &Limits) -> Vec<&str> {
+        self.index(limits).keys().map(String::as_str).collect()
+    }
+}
+
+/// The `<BehaviorTree ID>`s directly under the `<root>` of `path` (none
+/// when it cannot be read or is not a BehaviorTree.CPP document).
+fn trees_of(path: &Path, limits: &Limits) -> Vec<String> {
+    let shown = path.display().to_string();
+    let Ok(file) = source::read(path, &shown, limits, false) else {
+        return Vec::new();
+    };
+    let Ok((doc, _)) = xml::parse_lenient(&file, limits.max_nodes, limits.max_nodes) else {
+        return Vec::new();
+    };
+    let root = &doc.elems[doc.root];
+    if root.name != "root" {
+        return Vec::new();
+    }
+    root.children
+        .iter()
+        .map(|&k| &doc.elems[k])
+        .filter(|el| el.name == "BehaviorTree")
+        .map(|el| el.attr("ID").unwrap_or("MainTree").to_string())
+        .collect()
+}
+
+impl super::loader::Loader<'_> {
+    /// Reads the companions that define the SubTree IDs no file read so far
+    /// defines, with their includes, until none is missing or no companion
+    /// defines what is: each document is scanned once, each file read once.
+    /// A tree the files read first define is theirs (a companion's tree of
+    /// the same ID is ignored); an ID several companions define is left
+    /// undefined and its use says which files define it.
+    pub(super) fn companion_trees(&mut self) {
+        let Some(comp) = self.limits.companions.clone() else {
+            return;
+        };
+        let mut scanned = 0;
+        while scanned < self.docs.len() {
+            let end = self.docs.len();
+            let mut missing: std::collections::BTreeSet<String> = Default::default();
+            for doc in &self.docs[scanned..end] {
+                for el in &doc.elems {
+                    if (el.name == "SubTree" || el.name == "SubTreePlus")
+                        && let Some(id) = el.attr("ID")
+                        && !self.trees.contains_key(id)
+                    {
+                        missing.insert(id.to_string());
+                    }
+                }
+            }
+            scanned = end;
+            for id in missing {
+                if self.trees.contains_key(&id) || self.ambiguous.contains_key(&id) {
+                    continue;
+                }
+                let files: Vec<PathBuf> = comp
+                    .defining(&id, self.limits)
+                    .into_iter()
+                    .filter(|p| !self.seen.contains(&crate::source::canonical(p)))
+                    .map(Path::to_path_buf)
+                    .collect();
+                match files.as_slice() {
+                    [] => {}
+                    [one] => self.read_companion(one),
+                    many => {
+                        let shown = many
+                            .iter()
+                            .map(|p| xml::shown(&p.display().to_string()).into_owned())
+                            .collect();
+                        self.ambiguous.insert(id, shown);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Reads one companion file and its includes, and collects their
+    /// definitions.
+    fn read_companion(&mut self, path: &Path) {
+        let Some(doc) = self.read_named(path) else {
+            return;
+        };
+        let first = self.docs.len();
+        self.first_companion = self.first_companion.min(first);
+        self.docs.push(doc);
+        self.dirs
+            .push(path.parent().unwrap_or(Path::new("")).to_path_buf());
+        self.includes(first, crate::source::canonical(path));
+        for d in first..self.docs.len() {
+            self.definitions(d);
+        }
+    }
+}

@@ -1,0 +1,609 @@
+//! The loader of a BehaviorTree.CPP file: the main document, its
+//! `<include>`s (depth-first, cycles rejected), `--nodes-model` files,
+//! `<BehaviorTree>` and `<TreeNodesModel>` definitions, and the choice of
+//! the tree to read (`--tree`, `main_tree_to_execute`, the only tree).
+
+use super::super::xml::{self, XDoc, XElem, shown};
+use super::super::{Limits, Loaded};
+use super::{Category, builtin};
+use btfsm_core::diagnostic::{Diagnostic, SourceFile, suggest};
+use btfsm_model::{Policy, PolicyBody};
+use std::collections::{BTreeMap, HashSet};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A type declared in a `<TreeNodesModel>`.
+#[derive(Debug, Clone)]
+pub(super) struct ModelEntry {
+    pub(super) cat: Category,
+    /// Its `<input_port>`, `<output_port>` and `<inout_port>`s.
+    pub(super) ports: Vec<super::ports::PortDecl>,
+}
+
+pub(super) struct Loader<'l> {
+    pub(super) limits: &'l Limits,
+    pub(super) diags: xml::Sink,
+    pub(super) docs: Vec<XDoc>,
+    pub(super) dirs: Vec<PathBuf>,
+    /// Tree ID -> (document, `<BehaviorTree>` element).
+    pub(super) trees: BTreeMap<String, (usize, usize)>,
+    pub(super) models: BTreeMap<String, ModelEntry>,
+    /// The directory every included file must be in (`None`: anywhere).
+    pub(super) root: Option<PathBuf>,
+    /// What remains of `--max-nodes` for the elements of the files still to
+    /// read: every element of every file counts, used or not.
+    pub(super) elems_left: usize,
+    /// Unknown node types already reported: each is an error once, at its
+    /// first use, however often it is used.
+    pub(super) unknown: std::collections::HashSet<String>,
+    /// Files read so far (canonical paths): each is read once.
+    pub(super) seen: HashSet<PathBuf>,
+    /// The first document read as a companion (a file given together with
+    /// this one that defines a missing SubTree); `usize::MAX` before any.
+    pub(super) first_companion: usize,
+    /// Tree IDs no file read defines and several companions do: the files.
+    pub(super) ambiguous: BTreeMap<String, Vec<String>>,
+    /// `<SubTree ID>` entries of the models: the ports of each tree.
+    pub(super) tree_ports: super::ports::TreePorts,
+    /// The dataflow of the expanded tree (filled by `expand`).
+    pub(super) flow: super::ports::Dataflow,
+}
+
+pub(super) fn load(
+    file: Arc<SourceFile>,
+    identity: PathBuf,
+    base: PathBuf,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    // BehaviorTree.CPP reads with tinyxml2, which is lenient: so is this
+    // reader, with a warning at each place (`xml_lenient`).
+    let (main, repaired) =
+        xml::parse_lenient(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    let elems_left = limits.max_nodes - main.elems.len();
+    let root = crate::source::root_for(limits, &base);
+    let mut l = Loader {
+        root,
+        elems_left,
+        limits,
+        diags: xml::Sink::default(),
+        docs: vec![main],
+        dirs: vec![base],
+        trees: BTreeMap::new(),
+        models: BTreeMap::new(),
+        unknown: Default::default(),
+        seen: HashSet::new(),
+        first_companion: usize::MAX,
+        ambiguous: BTreeMap::new(),
+        tree_ports: BTreeMap::new(),
+        flow: Default::default(),
+    };
+    l.diags.extend(repaired);
+    let policy = l.run(identity);
+    let mut flow = std::mem::take(&mut l.flow);
+    flow.files = l.docs.iter().map(|d| d.file.clone()).collect();
+    let mut loaded = crate::finish(&file, policy, l.diags.into_vec(&file), "behavior tree")?;
+    if let btfsm_model::PolicyBody::Bt(_) = &loaded.policy.body {
+        flow.tree_ports = l.tree_ports.get(&loaded.policy.name).cloned();
+        loaded.dataflow = Some(Arc::new(flow));
+    }
+    Ok(loaded)
+}
+
+impl Loader<'_> {
+    pub(super) fn err(
+        &mut self,
+        d: usize,
+        span: Range<usize>,
+        msg: impl Into<String>,
+    ) -> &mut Diagnostic {
+        let f = self.docs[d].file.clone();
+        self.diags.push(Diagnostic::error(msg).at(&f, span))
+    }
+
+    /// Parses a file read for this policy, charging its elements to the
+    /// shared element budget.
+    pub(super) fn parse_charged(&mut self, file: &Arc<SourceFile>) -> Result<XDoc, Diagnostic> {
+        let (doc, repaired) = xml::parse_lenient(file, self.elems_left, self.limits.max_nodes)?;
+        self.diags.extend(repaired);
+        self.elems_left -= doc.elems.len();
+        Ok(doc)
+    }
+
+    /// Are hints still worth computing? Past the messages shown
+    /// (`finish` keeps the first ones), no did-you-mean search is done.
+    pub(super) fn hinting(&self) -> bool {
+        self.diags.room_for_errors()
+    }
+
+    pub(super) fn warn(
+        &mut self,
+        d: usize,
+        span: Range<usize>,
+        msg: impl Into<String>,
+    ) -> &mut Diagnostic {
+        let f = self.docs[d].file.clone();
+        self.diags.push(Diagnostic::warning(msg).at(&f, span))
+    }
+
+    pub(super) fn run(&mut self, identity: PathBuf) -> Option<Policy> {
+        let root = self.docs[0].root;
+        if self.docs[0].elems[root].name != "root" {
+            let span = self.docs[0].elems[root].span.clone();
+            let found = self.docs[0].elems[root].name.clone();
+            self.err(
+                0,
+                span,
+                format!(
+                    "expected `<root>` as the document element, found `<{}>`",
+                    shown(&found)
+                ),
+            )
+            .hint = Some(
+                "a BehaviorTree.CPP file is `<root BTCPP_format=\"4\"><BehaviorTree ID=\"...\">...</BehaviorTree></root>`"
+                    .into(),
+            );
+            return None;
+        }
+        self.includes(0, identity);
+        let extra = self.limits.nodes_models.clone();
+        for m in &extra {
+            self.nodes_model_file(m);
+        }
+        for d in 0..self.docs.len() {
+            self.definitions(d);
+        }
+        if self.diags.has_errors() {
+            return None;
+        }
+        let (tree_id, (d, e)) = self.main_tree()?;
+        self.companion_trees();
+        if self.diags.has_errors() {
+            return None;
+        }
+        let bt = self.expand(&tree_id, d, e)?;
+        Some(Policy {
+            name: tree_id,
+            description: None,
+            body: PolicyBody::Bt(bt),
+        })
+    }
+
+    /// Loads `<include path>` files depth-first with an explicit stack; a file
+    /// including one of its includers is a cycle.
+    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    pub(super) fn includes(&mut self, start: usize, identity: PathBuf) {
+        self.seen.insert(identity.clone());
+        let mut chain: Vec<PathBuf> = vec![identity];
+        // The same chain as the user sees the paths (canonical ones differ by machine).
+        let mut shown_chain: Vec<String> = vec![self.docs[start].file.path.clone()];
+        let mut work: Vec<(usize, usize)> = vec![(start, 0)];
+        while let Some(&mut (d, ref mut pos)) = work.last_mut() {
+            let root = self.docs[d].root;
+            let kids = &self.docs[d].elems[root].children;
+            if *pos >= kids.len() {
+                work.pop();
+                chain.pop();
+                shown_chain.pop();
+                continue;
+            }
+            let e = kids[*pos];
+            *pos += 1;
+            let el = self.docs[d].elems[e].clone();
+            if el.name != "include" {
+                continue;
+            }
+            if el.attr("ros_pkg").is_some() {
+                self.err(
+                    d,
+                    el.span.clone(),
+                    "includes from ROS packages (`ros_pkg`) are not supported",
+                )
+                .hint = Some("give `path` relative to this file".into());
+                continue;
+            }
+            let Some(p) = el.attr_full("path") else {
+                self.err(d, el.span.clone(), "`<include>` needs a `path`")
+                    .hint = Some("write `<include path=\"subtrees/other.xml\"/>`".into());
+                continue;
+            };
+            let (pval, pspan) = (p.value.clone(), p.span.clone());
+            let full = match crate::source::resolve(self.root.as_deref(), &self.dirs[d], &pval) {
+                Ok(p) => p,
+                Err(r) => {
+                    self.err(d, pspan, format!("cannot include this file: {}", r.message))
+                        .hint = Some(r.hint);
+                    continue;
+                }
+            };
+            let canon = crate::toml::canonical(&full);
+            if let Some(at) = chain.iter().position(|c| *c == canon) {
+                let mut names: Vec<String> = shown_chain[at..]
+                    .iter()
+                    .map(|n| shown(n).into_owned())
+                    .collect();
+                names.push(shown(&full.display().to_string()).into_owned());
+                self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
+                    .set_code("include-cycle")
+                    .hint =
+                    Some("a file must not include itself, directly or through others".into());
+                continue;
+            }
+            if self.seen.contains(&canon) {
+                continue; // already read through another include
+            }
+            if chain.len() > self.limits.max_include_depth {
+                self.err(
+                    d,
+                    pspan,
+                    format!(
+                        "includes nested deeper than {}",
+                        self.limits.max_include_depth
+                    ),
+                );
+                continue;
+            }
+            let shown = full.display().to_string();
+            let file = match crate::toml::read_included(&full, &shown, self.limits) {
+                Ok(f) => f,
+                Err(mut ds) => {
+                    let msg = ds.remove(0).message;
+                    self.err(d, pspan, msg).hint =
+                        Some("`path` is relative to the including file".into());
+                    continue;
+                }
+            };
+            let doc = match self.parse_charged(&file) {
+                Ok(doc) => doc,
+                Err(diag) => {
+                    self.diags.push(diag);
+                    continue;
+                }
+            };
+            if doc.elems[doc.root].name != "root" {
+                let span = doc.elems[doc.root].span.clone();
+                self.docs.push(doc);
+                let nd = self.docs.len() - 1;
+                self.err(
+                    nd,
+                    span,
+                    "expected `<root>` as the document element of an included file",
+                );
+                self.docs.pop();
+                continue;
+            }
+            self.seen.insert(canon.clone());
+            self.docs.push(doc);
+            self.dirs
+                .push(full.parent().unwrap_or(Path::new("")).to_path_buf());
+            chain.push(canon);
+            shown_chain.push(shown);
+            work.push((self.docs.len() - 1, 0));
+        }
+    }
+
+    /// Reads and parses a file named on the command line (a `--nodes-model`
+    /// file, a companion), its elements charged to the element budget; its
+    /// problems go to the diagnostics.
+    pub(super) fn read_named(&mut self, path: &Path) -> Option<XDoc> {
+        let shown = path.display().to_string();
+        let file = match crate::source::read(path, &shown, self.limits, false) {
+            Ok(f) => f,
+            Err(ds) => {
+                self.diags.extend(ds);
+                return None;
+            }
+        };
+        match self.parse_charged(&file) {
+            Ok(doc) => Some(doc),
+            Err(d) => {
+                self.diags.push(d);
+                None
+            }
+        }
+    }
+
+    /// Reads a `--nodes-model` file: a `<root>` holding a `<TreeNodesModel>`, or a
+    /// bare `<TreeNodesModel>`.
+    pub(super) fn nodes_model_file(&mut self, path: &Path) {
+        let Some(doc) = self.read_named(path) else {
+            return;
+        };
+        let root = doc.root;
+        let models: Vec<usize> = if doc.elems[root].name == "TreeNodesModel" {
+            vec![root]
+        } else {
+            doc.children(root)
+                .filter(|(_, e)| e.name == "TreeNodesModel")
+                .map(|(i, _)| i)
+                .collect()
+        };
+        self.docs.push(doc);
+        let d = self.docs.len() - 1;
+        self.dirs.push(PathBuf::new());
+        if models.is_empty() {
+            self.err(d, self.docs[d].elems[root].span.clone(), "no `<TreeNodesModel>` in this file")
+                .hint = Some("a nodes model is `<root><TreeNodesModel><Action ID=\"...\"/>...</TreeNodesModel></root>`".into());
+        }
+        for m in models {
+            self.read_model(d, m);
+        }
+    }
+
+    pub(super) fn read_model(&mut self, d: usize, m: usize) {
+        let kids = self.docs[d].elems[m].children.clone();
+        for k in kids {
+            let el = self.docs[d].elems[k].clone();
+            let cat = match el.name.as_str() {
+                "Action" => Category::Action,
+                "Condition" => Category::Condition,
+                "Control" => Category::Control,
+                "Decorator" => Category::Decorator,
+                "SubTree" => {
+                    if let Some(id) = el.attr("ID") {
+                        let ports = super::ports::model_ports(&self.docs[d], d, k);
+                        self.tree_ports.insert(id.to_string(), ports);
+                    }
+                    continue;
+                }
+                other => {
+                    let h = suggest(
+                        other,
+                        ["Action", "Condition", "Control", "Decorator", "SubTree"],
+                    );
+                    self.err(
+                        d,
+                        el.span.clone(),
+                        format!("unknown entry `<{}>` in `<TreeNodesModel>`", shown(other)),
+                    )
+                    .hint = Some(h);
+                    continue;
+                }
+            };
+            let Some(id) = el.attr("ID") else {
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!(
+                        "`<{}>` in `<TreeNodesModel>` needs an `ID`",
+                        shown(&el.name)
+                    ),
+                );
+                continue;
+            };
+            if self.too_long(d, &el, "node type", id) {
+                continue;
+            }
+            if let Some(b) = builtin(id)
+                && b != cat
+            {
+                self.warn(
+                    d,
+                    el.span.clone(),
+                    format!(
+                        "`{}` is a built-in {} type; the model's `{}` is ignored",
+                        shown(id),
+                        b.tag().to_lowercase(),
+                        cat.tag()
+                    ),
+                );
+                continue;
+            }
+            if let Some(prev) = self.models.get(id)
+                && prev.cat != cat
+            {
+                let was = prev.cat.tag();
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!(
+                        "`{}` is declared both as `{was}` and as `{}`",
+                        shown(id),
+                        cat.tag()
+                    ),
+                )
+                .hint = Some("keep one declaration per node type across the model files".into());
+                continue;
+            }
+            let ports = super::ports::model_ports(&self.docs[d], d, k);
+            self.models
+                .insert(id.to_string(), ModelEntry { cat, ports });
+        }
+    }
+
+    /// Collects `<BehaviorTree>` definitions and `<TreeNodesModel>` entries.
+    pub(super) fn definitions(&mut self, d: usize) {
+        let root = self.docs[d].root;
+        if self.docs[d].elems[root].name != "root" {
+            return; // a bare nodes-model file
+        }
+        if let Some(v) = self.docs[d].elems[root].attr_full("BTCPP_format")
+            && v.value != "3"
+            && v.value != "4"
+        {
+            let span = v.span.clone();
+            let val = v.value.clone();
+            self.warn(
+                d,
+                span,
+                format!(
+                    "unknown `BTCPP_format` \"{}\"; read as format 4",
+                    shown(&val)
+                ),
+            )
+            .hint = Some("BehaviorTree.CPP writes `BTCPP_format=\"4\"` (or \"3\")".into());
+        }
+        let kids = self.docs[d].elems[root].children.clone();
+        for k in kids {
+            let el = self.docs[d].elems[k].clone();
+            match el.name.as_str() {
+                "BehaviorTree" => {
+                    let id = el.attr("ID").unwrap_or("MainTree").to_string();
+                    if self.too_long(d, &el, "tree ID", &id) {
+                        continue;
+                    }
+                    if d >= self.first_companion && self.trees.contains_key(&id) {
+                        continue; // the files read first define it (docs: companions)
+                    }
+                    if let Some(&(pd, pe)) = self.trees.get(&id) {
+                        let (l, c) = {
+                            let f = &self.docs[pd].file;
+                            f.line_col(self.docs[pd].elems[pe].span.start)
+                        };
+                        let first = format!("{}:{l}:{c}", self.docs[pd].file.path);
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            format!("tree `{}` is defined twice", shown(&id)),
+                        )
+                        .hint = Some(format!(
+                            "the first definition is at {first}; give each `<BehaviorTree>` its own `ID`"
+                        ));
+                        continue;
+                    }
+                    let n = el.children.len();
+                    if n != 1 {
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            format!(
+                                "tree `{}` must hold exactly one root node, found {n}",
+                                shown(&id)
+                            ),
+                        )
+                        .hint = Some("wrap several nodes in a `<Sequence>` or `<Fallback>`".into());
+                        continue;
+                    }
+                    self.trees.insert(id, (d, k));
+                }
+                "TreeNodesModel" => self.read_model(d, k),
+                "include" => {}
+                other => {
+                    let h = suggest(other, ["BehaviorTree", "TreeNodesModel", "include"]);
+                    self.warn(
+                        d,
+                        el.span.clone(),
+                        format!("`<{}>` under `<root>` is ignored", shown(other)),
+                    )
+                    .hint = Some(h);
+                }
+            }
+        }
+    }
+
+    /// The tree to run: `--tree ID`, else `main_tree_to_execute`, else the
+    /// only tree of the main file.
+    pub(super) fn main_tree(&mut self) -> Option<(String, (usize, usize))> {
+        let root = self.docs[0].root;
+        let all: Vec<String> = self.trees.keys().cloned().collect();
+        if let Some(id) = self.limits.tree.clone() {
+            return match self.trees.get(&id) {
+                Some(&t) => Some((id, t)),
+                None => {
+                    let span = self.docs[0].elems[root].span.clone();
+                    let h = suggest(&id, all.iter().map(String::as_str));
+                    self.err(
+                        0,
+                        span,
+                        format!(
+                            "--tree `{}`: no `<BehaviorTree ID>` of that name",
+                            shown(&id)
+                        ),
+                    )
+                    .hint = Some(h);
+                    None
+                }
+            };
+        }
+        if let Some(a) = self.docs[0].elems[root].attr_full("main_tree_to_execute") {
+            let (v, span) = (a.value.clone(), a.span.clone());
+            return match self.trees.get(&v) {
+                Some(&t) => Some((v, t)),
+                None => {
+                    let h = suggest(&v, all.iter().map(String::as_str));
+                    self.err(
+                        0,
+                        span,
+                        format!("`main_tree_to_execute` names unknown tree `{}`", shown(&v)),
+                    )
+                    .hint = Some(h);
+                    None
+                }
+            };
+        }
+        let local: Vec<(&String, &(usize, usize))> =
+            self.trees.iter().filter(|(_, (d, _))| *d == 0).collect();
+        match local.as_slice() {
+            [(id, t)] => Some(((*id).clone(), **t)),
+            [] if self.trees.len() == 1 => {
+                let (id, t) = self.trees.iter().next().expect("one tree");
+                Some((id.clone(), *t))
+            }
+            [] => {
+                let span = self.docs[0].elems[root].span.clone();
+                self.err(0, span, "no `<BehaviorTree>` in this file").hint = Some(
+                    "add `<BehaviorTree ID=\"Main\">...</BehaviorTree>` under `<root>`".into(),
+                );
+                None
+            }
+            many => {
+                let mut ids: Vec<String> = many
+                    .iter()
+                    .take(10)
+                    .map(|(id, _)| format!("`{}`", shown(id)))
+                    .collect();
+                if many.len() > 10 {
+                    ids.push(format!("... ({} more)", many.len() - 10));
+                }
+                let span = self.docs[0].elems[root].span.clone();
+                self.err(
+                    0,
+                    span,
+                    format!("{} trees and no `main_tree_to_execute`", many.len()),
+                )
+                .hint = Some(format!(
+                    "choose one with --tree ID, or add `main_tree_to_execute`: {}",
+                    ids.join(", ")
+                ));
+                None
+            }
+        }
+    }
+
+    /// Is `value` (a name, type, ID or attribute of element `el` of document
+    /// `d`) longer than `--max-name-bytes`? Then an error at the element.
+    pub(super) fn too_long(&mut self, d: usize, el: &XElem, what: &str, value: &str) -> bool {
+        if value.len() <= self.limits.max_name_bytes {
+            return false;
+        }
+        let max = self.limits.max_name_bytes;
+        self.err(
+            d,
+            el.span.clone(),
+            format!(
+                "{what} `{}` of `<{}>` is {} bytes long, more than the limit of {max} bytes",
+                shown(value),
+                shown(&el.name),
+                value.len()
+            ),
+        )
+        .hint = Some("shorten it, or raise the limit with --max-name-bytes".into());
+        true
+    }
+
+    /// Checks every name an element carries against `--max-name-bytes`: its
+    /// tag, and the name and value of each attribute (ports, IDs, names).
+    pub(super) fn names_too_long(&mut self, d: usize, el: &XElem) -> bool {
+        if self.too_long(d, el, "element name", &el.name) {
+            return true;
+        }
+        for a in &el.attrs {
+            if self.too_long(d, el, "attribute name", &a.name)
+                || self.too_long(d, el, &format!("value of `{}`", shown(&a.name)), &a.value)
+            {
+                return true;
+            }
+        }
+        false
+    }
+}

@@ -1,0 +1,255 @@
+//! One BehaviorTree.CPP element as a BT node: its type (built-in, from a
+//! `<TreeNodesModel>`, or `--assume-leaf`), label, ports, and the
+//! child-count rules BehaviorTree.CPP 4 enforces.
+
+use super::super::xml::{XElem, shown};
+use super::loader::Loader;
+use super::*;
+
+impl Loader<'_> {
+    /// One node: its kind, label, type name and ports; arity is checked here
+    /// on the element (a SubTree child counts as one).
+    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    pub(super) fn node(
+        &mut self,
+        d: usize,
+        el: &XElem,
+        resolve: impl Fn(&str) -> String,
+    ) -> Option<BtNode> {
+        let tag = el.name.as_str();
+        let n = el.children.len();
+        let (mut ty, explicit_cat): (String, Option<Category>) = match tag {
+            "Action" | "Condition" | "Control" | "Decorator" => {
+                let cat = match tag {
+                    "Action" => Category::Action,
+                    "Condition" => Category::Condition,
+                    "Control" => Category::Control,
+                    _ => Category::Decorator,
+                };
+                match el.attr("ID") {
+                    Some(id) => (id.to_string(), Some(cat)),
+                    None => {
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            format!("`<{tag}>` needs an `ID` naming its type"),
+                        )
+                        .hint = Some(format!(
+                            "write `<{tag} ID=\"MyNode\"/>`, or the compact `<MyNode/>`"
+                        ));
+                        return None;
+                    }
+                }
+            }
+            _ => (tag.to_string(), None),
+        };
+        let mut type_kept = true;
+        let mut consumed: &[&str] = &[];
+        let (kind, cat) = if let Some(cat) = builtin(&ty) {
+            let (k, c, keep) = builtin_kind(&ty, el, n);
+            consumed = c;
+            type_kept = keep;
+            (k, cat)
+        } else if let Some(cat) = explicit_cat {
+            (generic(cat), cat)
+        } else if let Some(m) = self.models.get(&ty) {
+            (generic(m.cat), m.cat)
+        } else if let Some((real, cat)) = BUILTINS.iter().find(|(b, _)| b.eq_ignore_ascii_case(&ty))
+        {
+            self.warn(
+                d,
+                el.span.clone(),
+                format!(
+                    "`{}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`",
+                    shown(&ty)
+                ),
+            )
+            .hint = Some(format!(
+                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{}>`)",
+                shown(&ty)
+            ));
+            let (k, c, keep) = builtin_kind(real, el, n);
+            consumed = c;
+            type_kept = keep;
+            ty = real.to_string();
+            (k, *cat)
+        } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
+            match a {
+                AssumeLeaf::Action => (BtNodeKind::Action, Category::Action),
+                AssumeLeaf::Condition => (BtNodeKind::Condition, Category::Condition),
+            }
+        } else if !self.unknown.insert(ty.clone()) {
+            // Reported at its first use already.
+            match n {
+                0 => return None,
+                1 => (BtNodeKind::Decorator, Category::Decorator),
+                _ => (BtNodeKind::Control, Category::Control),
+            }
+        } else {
+            // Hints only for messages that will be shown (the rest are
+            // counted): bounded work under a million unknown types.
+            let did = if self.hinting() {
+                let cands = BUILTINS
+                    .iter()
+                    .map(|(b, _)| *b)
+                    .chain(self.models.keys().map(String::as_str));
+                suggest(&ty, cands)
+            } else {
+                String::new()
+            };
+            let ty = shown(&ty);
+            let remedy = if n == 0 {
+                format!(
+                    "declare it as `<Action ID=\"{ty}\"/>` or `<Condition ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition"
+                )
+            } else {
+                format!(
+                    "declare it as `<Control ID=\"{ty}\"/>` or `<Decorator ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE)"
+                )
+            };
+            let hint = if did.starts_with("did you mean") {
+                format!("{did} or {remedy}")
+            } else {
+                remedy
+            };
+            self.err(
+                d,
+                el.span.clone(),
+                format!(
+                    "unknown node type `{ty}` ({n} child{})",
+                    if n == 1 { "" } else { "ren" }
+                ),
+            )
+            .hint = Some(hint);
+            // A node with children is read on as a placeholder of its
+            // shape, so that the unknown types below it are reported in the
+            // same run (the file fails with these errors anyway); a leaf has
+            // nothing below it and costs nothing more.
+            match n {
+                0 => return None,
+                1 => (BtNodeKind::Decorator, Category::Decorator),
+                _ => (BtNodeKind::Control, Category::Control),
+            }
+        };
+        // Arity of the element (a SubTree child is one node).
+        let bad = match cat {
+            Category::Action | Category::Condition => n != 0,
+            Category::Decorator => n != 1,
+            Category::Control => n == 0,
+        };
+        if bad {
+            let want = match cat {
+                Category::Action | Category::Condition => "no children",
+                Category::Decorator => "exactly one child",
+                Category::Control => "at least one child",
+            };
+            self.err(
+                d,
+                el.span.clone(),
+                format!(
+                    "`{}` is a {} and takes {want}, found {n}",
+                    shown(&ty),
+                    cat.tag().to_lowercase()
+                ),
+            )
+            .set_code(if cat == Category::Control {
+                "empty-composite"
+            } else {
+                "wrong-child-count"
+            })
+            .hint = Some(match cat {
+                Category::Decorator => "wrap several children in a `<Sequence>`".into(),
+                Category::Control => "give it children, or use a leaf".into(),
+                _ => "a leaf has no children; is the type right in the `<TreeNodesModel>`?".into(),
+            });
+            return None;
+        }
+        // BehaviorTree.CPP's own rules for built-ins it checks when the
+        // tree is built or first ticked (a program that loads the file fails
+        // there): child counts, thresholds, required ports.
+        if builtin(&ty).is_some()
+            && !self.models.contains_key(&ty)
+            && let Some((msg, hint, code)) = builtin_rule(&ty, el, n)
+        {
+            let e = self.err(d, el.span.clone(), msg);
+            e.hint = Some(hint.into());
+            e.code = code;
+            return None;
+        }
+        let mut ports: BTreeMap<String, String> = el
+            .attrs
+            .iter()
+            .filter(|a| {
+                a.ns.is_none()
+                    && a.name != "name"
+                    && a.name != "ID"
+                    && !consumed.contains(&a.name.as_str())
+            })
+            .map(|a| (a.name.clone(), resolve(&a.value)))
+            .collect();
+        // BehaviorTree.CPP 4's Parallel fails at its first failure unless
+        // told otherwise; the model's Parallel without `failure_count` is the
+        // paper's, which fails when it can no longer succeed
+        // (docs/bt-semantics.md).
+        if matches!(kind, BtNodeKind::Parallel { .. })
+            && ty == "Parallel"
+            && el.attr("success_threshold").is_none()
+            && el.attr("threshold").is_none()
+        {
+            ports
+                .entry("failure_count".into())
+                .or_insert_with(|| "1".into());
+        }
+        // A leaf whose type is a skill of the shared library, with arguments
+        // that fit the skill, is bound to it.
+        let mut skill_call = None;
+        if let (BtNodeKind::Action | BtNodeKind::Condition, Some(sk), Some(params)) =
+            (kind, skill::skill_kind(&ty), skill::skill_params(&ty))
+        {
+            let want = if kind == BtNodeKind::Action {
+                SkillKind::Action
+            } else {
+                SkillKind::Condition
+            };
+            let fits = sk == want
+                && ports.keys().all(|k| params.iter().any(|(p, _)| p == k))
+                && params.iter().all(|(p, req)| !req || ports.contains_key(*p));
+            if fits {
+                skill_call = Some(SkillCall {
+                    skill: ty.clone(),
+                    args: std::mem::take(&mut ports)
+                        .into_iter()
+                        .map(|(k, v)| (k, arg_value(&v)))
+                        .collect(),
+                });
+                type_kept = false;
+            }
+        }
+        let label = el
+            .attr("name")
+            .map(str::to_string)
+            .unwrap_or_else(|| ty.clone());
+        Some(BtNode {
+            id: String::new(),
+            label,
+            kind,
+            children: Vec::new(),
+            skill: skill_call,
+            // Format 3's names of built-ins are kept as format 4 names them
+            // (the same node; an export says BTCPP_format="4").
+            type_name: type_kept.then(|| v4_name(&ty).to_string()),
+            ports,
+            subtree: None,
+            span: Some(el.span.clone()),
+        })
+    }
+}
+
+fn generic(cat: Category) -> BtNodeKind {
+    match cat {
+        Category::Action => BtNodeKind::Action,
+        Category::Condition => BtNodeKind::Condition,
+        Category::Control => BtNodeKind::Control,
+        Category::Decorator => BtNodeKind::Decorator,
+    }
+}

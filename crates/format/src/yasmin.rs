@@ -1,0 +1,785 @@
+//! yasmin XML (the state machine files of yasmin_factory, the ROS 2
+//! state-machine library of uleroboticsgroup/yasmin) read into the FSM/HFSM
+//! model.
+//!
+//! - `<StateMachine name outcomes start_state>` is the machine; a nested
+//!   `<StateMachine>` is a container (so a file with one is an HFSM), and a
+//!   nested `<StateMachine file_path="other.xml">` takes its states and
+//!   outcomes from that file (relative to the including file, kept inside the
+//!   root like every named file: `format::source::resolve`).
+//! - A machine's outcomes are its `outcomes` attribute plus its
+//!   `<FinalOutcome name>` children. Its start state is `start_state`, else
+//!   its first state in document order (the first one added, as yasmin's
+//!   `StateMachine.add_state` makes it).
+//! - `<State name>` is a task state without a skill binding (its `class` /
+//!   `module` is code the model does not run); `<Transition from="OUTCOME" to="TARGET">` is an outcome
+//!   transition. `to` is resolved as yasmin's `StateMachine.execute` does:
+//!   first an outcome of the enclosing machine, then a state of it; anything
+//!   else is an error at the attribute, as yasmin's `validate` refuses it.
+//! - A container's own `<Transition>` children map its outcomes in the
+//!   enclosing machine.
+//! - `<OrthogonalState name default_outcome>` is a parallel state
+//!   (`Region::parallel`, as SCXML's `<parallel>`): its `<Region name
+//!   outcomes start_state>` children are its regions, read as nested
+//!   machines and all run at once; its outcomes are its `outcomes` attribute,
+//!   the `outcome` of each `<OutcomeMap>`, its `default_outcome` and its
+//!   `<FinalOutcome>`s (yasmin_factory's `_create_orthogonal_state`), and its
+//!   own `<Transition>`s map them. Which region outcomes give which outcome
+//!   (the `<Item>`s of an `<OutcomeMap>`) is not kept: the graph does not
+//!   count it. `<Param>`, `<Key>`, `<ParamRemap>`, `<Remap>` and other
+//!   elements (data flow, parameters, editor positions) are ignored.
+//!
+//! The document is walked region by region with a queue (no recursion on
+//! nesting depth), and every element and included byte is charged to the
+//! command's limits.
+
+use super::xml::{self, XDoc, XElem, shown};
+use super::{Limits, Loaded};
+use btfsm_core::diagnostic::{Diagnostic, SourceFile};
+use btfsm_model::{
+    Policy, PolicyBody, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
+};
+use std::collections::{HashMap, VecDeque};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Does the text look like a yasmin file (its document element is
+/// `<StateMachine`)?
+pub fn looks_like_yasmin(head: &str) -> bool {
+    let mut rest = head.trim_start_matches('\u{feff}');
+    // Skip the XML declaration, comments and processing instructions.
+    loop {
+        rest = rest.trim_start();
+        if let Some(r) = rest.strip_prefix("<?") {
+            match r.find("?>") {
+                Some(i) => rest = &r[i + 2..],
+                None => return false,
+            }
+        } else if let Some(r) = rest.strip_prefix("<!--") {
+            match r.find("-->") {
+                Some(i) => rest = &r[i + 3..],
+                None => return false,
+            }
+        } else {
+            break;
+        }
+    }
+    rest.strip_prefix("<StateMachine")
+        .is_some_and(|r| r.starts_with(|c: char| c.is_whitespace() || c == '>' || c == '/'))
+}
+
+/// Reads yasmin XML already read from `path`.
+pub fn load_read(
+    file: Arc<SourceFile>,
+    path: &Path,
+    limits: &Limits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let main = xml::parse(&file, limits.max_nodes, limits.max_nodes).map_err(|d| vec![d])?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut r = Reader {
+        root: super::source::root_for(limits, &base),
+        elems_left: limits.max_nodes - main.elems.len(),
+        limits,
+        diags: xml::Sink::default(),
+        docs: vec![(main, base)],
+        maps: Vec::new(),
+    };
+    let policy = r.read(path);
+    let diags = r.diags.into_vec(&file);
+    super::finish(&file, policy, diags, "state machine")
+}
+
+/// Reads yasmin XML from text (tests, fuzzing): includes are resolved
+/// against the current directory.
+pub fn parse_str(name: &str, text: &str, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    load_read(SourceFile::new(name, text), Path::new(name), limits)
+}
+
+/// A `<StateMachine>` element whose states are still to be read: in
+/// document `doc`, for container `state` (`None`: the top level).
+struct Pending {
+    doc: usize,
+    elem: usize,
+    state: Option<usize>,
+    depth: usize,
+    /// Canonical paths of the files included on the way here (cycles).
+    chain: Vec<PathBuf>,
+}
+
+struct Reader<'l> {
+    root: Option<PathBuf>,
+    elems_left: usize,
+    limits: &'l Limits,
+    diags: xml::Sink,
+    /// Documents read (the main file first) with their directories.
+    docs: Vec<(XDoc, PathBuf)>,
+    /// A container's transitions, checked against its outcomes once its
+    /// content is read: (state, document, `<Transition>` span, outcome).
+    maps: Vec<(usize, usize, std::ops::Range<usize>, String)>,
+}
+
+impl Reader<'_> {
+    fn err(&mut self, doc: usize, span: std::ops::Range<usize>, msg: String, hint: &str) {
+        let f = self.docs[doc].0.file.clone();
+        self.diags.push(Diagnostic::error(msg).at(&f, span)).hint = Some(hint.to_string());
+    }
+
+    fn read(&mut self, path: &Path) -> Option<Policy> {
+        let top = &self.docs[0].0.elems[self.docs[0].0.root];
+        if top.name != "StateMachine" {
+            let span = top.span.clone();
+            let msg = format!(
+                "expected `<StateMachine>` as the document element, found `<{}>`",
+                shown(&top.name)
+            );
+            self.err(
+                0,
+                span,
+                msg,
+                "a yasmin file is `<StateMachine outcomes=\"...\" start_state=\"...\">`",
+            );
+            return None;
+        }
+        let name = top.attr("name").map(str::to_string).unwrap_or_else(|| {
+            path.file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("machine")
+                .to_string()
+        });
+        let mut m = StateMachine::unset();
+        let mut queue = VecDeque::from([Pending {
+            doc: 0,
+            elem: self.docs[0].0.root,
+            state: None,
+            depth: 0,
+            chain: Vec::new(),
+        }]);
+        while let Some(p) = queue.pop_front() {
+            self.region(&mut m, p, &mut queue);
+            if !self.diags.room_for_errors() {
+                break;
+            }
+        }
+        // A container maps only the outcomes it has (its content is read).
+        for (s, doc, span, from) in std::mem::take(&mut self.maps) {
+            if let StateBody::Container(r) = &m.states[s].body
+                && !r.outcomes.contains(&from)
+            {
+                let msg = format!(
+                    "`{}` has no outcome `{}`",
+                    shown(&m.states[s].name),
+                    shown(&from)
+                );
+                self.err(
+                    doc,
+                    span,
+                    msg,
+                    "a nested machine's `<Transition from>` names one of its `outcomes`",
+                );
+            }
+        }
+        if self.diags.has_errors() {
+            return None;
+        }
+        m.hierarchical = m
+            .states
+            .iter()
+            .any(|s| matches!(s.body, StateBody::Container(_)));
+        Some(Policy {
+            name,
+            description: top_description(&self.docs[0].0),
+            body: PolicyBody::Machine(m),
+        })
+    }
+
+    /// Reads the states of one machine element into region of `p.state`,
+    /// queueing its nested machines.
+    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    fn region(&mut self, m: &mut StateMachine, p: Pending, queue: &mut VecDeque<Pending>) {
+        let (doc, elem) = (p.doc, p.elem);
+        let machine_span = self.docs[doc].0.elems[elem].span.clone();
+        let outer_span = machine_span.clone();
+        // Outcomes: the attribute, then `<FinalOutcome>`s not already named.
+        // (A set beside the list: nothing is quadratic in the outcome count.)
+        let mut outcome_set: std::collections::HashSet<String> = Default::default();
+        let mut outcomes: Vec<String> = Vec::new();
+        for o in self.docs[doc].0.elems[elem]
+            .attr("outcomes")
+            .unwrap_or_default()
+            .split_whitespace()
+        {
+            if outcome_set.insert(o.to_string()) {
+                outcomes.push(o.to_string());
+            }
+        }
+        let kids: Vec<usize> = self.docs[doc].0.elems[elem].children.clone();
+        // An `<OrthogonalState>`: its states are its `<Region>`s, all run at
+        // once; its outcomes also those its `<OutcomeMap>`s and
+        // `default_outcome` give (yasmin's OrthogonalState).
+        let orth = self.docs[doc].0.elems[elem].name == "OrthogonalState";
+        let mut mapped_outcomes: Vec<&str> = Vec::new();
+        if orth {
+            let e = &self.docs[doc].0.elems[elem];
+            mapped_outcomes.extend(e.attr("default_outcome").filter(|o| !o.is_empty()));
+            for &c in &kids {
+                let k = &self.docs[doc].0.elems[c];
+                if k.name == "OutcomeMap"
+                    && let Some(o) = k.attr("outcome")
+                {
+                    mapped_outcomes.push(o);
+                }
+            }
+        }
+        for &c in &kids {
+            let e = &self.docs[doc].0.elems[c];
+            if e.name == "FinalOutcome"
+                && let Some(n) = e.attr("name")
+            {
+                mapped_outcomes.push(n);
+            }
+        }
+        for n in mapped_outcomes {
+            if outcome_set.insert(n.to_string()) {
+                outcomes.push(n.to_string());
+            }
+        }
+        // States, in document order.
+        let mut names: HashMap<String, usize> = HashMap::new();
+        let mut made: Vec<(usize, usize)> = Vec::new(); // (element, state)
+        for &c in &kids {
+            let e = &self.docs[doc].0.elems[c];
+            let container = match (orth, e.name.as_str()) {
+                (false, "State") => false,
+                (false, "StateMachine" | "OrthogonalState") | (true, "Region") => true,
+                _ => continue,
+            };
+            let Some(name) = e.attr("name").map(str::to_string) else {
+                let span = e.span.clone();
+                let what = e.name.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!("`<{what}>` needs a `name`"),
+                    "write `<State name=\"Foo\" ...>`",
+                );
+                continue;
+            };
+            if name.len() > self.limits.max_name_bytes {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!(
+                        "state name `{}` is {} bytes long, more than the limit of {} bytes",
+                        shown(&name),
+                        name.len(),
+                        self.limits.max_name_bytes
+                    ),
+                    "shorten it, or raise the limit with --max-name-bytes",
+                );
+                continue;
+            }
+            if names.contains_key(&name) {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!("duplicate state `{}` in this machine", shown(&name)),
+                    "state names are unique within their machine (yasmin's add_state refuses a second one)",
+                );
+                continue;
+            }
+            if outcomes.contains(&name) {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!(
+                        "state `{}` has the name of an outcome of this machine",
+                        shown(&name)
+                    ),
+                    "rename the state or the outcome (yasmin's add_state refuses a state named like an outcome)",
+                );
+                continue;
+            }
+            if m.states.len() >= self.limits.max_nodes {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!("more than {} states", self.limits.max_nodes),
+                    "raise the limit with --max-nodes",
+                );
+                return;
+            }
+            let span = (doc == 0).then(|| e.span.clone());
+            let body = if container {
+                StateBody::Container(Region {
+                    parallel: e.name == "OrthogonalState",
+                    ..Region::unset(vec![])
+                })
+            } else {
+                StateBody::Task(None)
+            };
+            let idx = m.states.len();
+            m.states.push(State {
+                name: name.clone(),
+                label: name.clone(),
+                parent: p.state,
+                body,
+                transitions: Vec::new(),
+                pseudo: None,
+                span,
+            });
+            names.insert(name, idx);
+            made.push((c, idx));
+        }
+        // The start state.
+        let start = match self.docs[doc].0.elems[elem].attr_full("start_state") {
+            Some(a) => match names.get(a.value.as_str()) {
+                Some(&s) => Some(s),
+                None => {
+                    let (v, span) = (a.value.clone(), a.span.clone());
+                    self.err(
+                        doc,
+                        span,
+                        format!("start state `{}` is not a state of this machine", shown(&v)),
+                        "name one of the machine's own `<State>` or `<StateMachine>` children",
+                    );
+                    None
+                }
+            },
+            None => made.first().map(|&(_, s)| s),
+        };
+        let start = if orth {
+            made.first().map(|&(_, s)| s)
+        } else {
+            start
+        };
+        if made.is_empty() {
+            if !self.diags.has_errors() {
+                let (msg, hint) = if orth {
+                    (
+                        "this orthogonal state has no regions",
+                        "add `<Region name=\"...\" outcomes=\"...\">` children with their states",
+                    )
+                } else {
+                    (
+                        "this state machine has no states",
+                        "add a `<State name=\"...\">` with its `<Transition from=\"...\" to=\"...\"/>`s",
+                    )
+                };
+                self.err(doc, outer_span, msg.into(), hint);
+            }
+            return;
+        }
+        // Transitions of each state (a container's are its outcome map; a
+        // region of an orthogonal state has none: yasmin reads only its
+        // states).
+        for &(c, s) in made.iter().filter(|_| !orth) {
+            let tkids: Vec<usize> = self.docs[doc].0.elems[c].children.clone();
+            // An outcome maps to one target (yasmin keeps transitions in a
+            // dict): a second one is an error, not a silent overwrite.
+            let mut mapped: std::collections::HashSet<String> = Default::default();
+            for t in tkids {
+                let te = &self.docs[doc].0.elems[t];
+                if te.name != "Transition" {
+                    continue;
+                }
+                let tspan = te.span.clone();
+                let (Some(from), Some(to)) = (te.attr("from"), te.attr_full("to")) else {
+                    self.err(
+                        doc,
+                        tspan,
+                        "`<Transition>` needs `from` and `to`".into(),
+                        "write `<Transition from=\"OUTCOME\" to=\"STATE_OR_OUTCOME\"/>`",
+                    );
+                    continue;
+                };
+                let (from, to_v, to_span) = (from.to_string(), to.value.clone(), to.span.clone());
+                if !mapped.insert(from.clone()) {
+                    self.err(
+                        doc,
+                        tspan,
+                        format!("a second transition from outcome `{}`", shown(&from)),
+                        "each outcome of a state has one transition; remove one",
+                    );
+                    continue;
+                }
+                let target = if outcome_set.contains(&to_v) {
+                    Target::Outcome(to_v)
+                } else if let Some(&n) = names.get(to_v.as_str()) {
+                    Target::State(n)
+                } else {
+                    self.err(
+                        doc,
+                        to_span,
+                        format!(
+                            "`{}` is neither a state nor an outcome of this machine",
+                            shown(&to_v)
+                        ),
+                        "`to` names a sibling state or one of the machine's `outcomes`",
+                    );
+                    continue;
+                };
+                if container_state(&self.docs[doc].0.elems[c]) {
+                    self.maps.push((s, doc, tspan.clone(), from.clone()));
+                }
+                m.states[s].transitions.push(Transition {
+                    trigger: Trigger::Outcome(from),
+                    target,
+                    span: (doc == 0).then_some(tspan),
+                });
+            }
+        }
+        // Install the region.
+        let Some(start) = start else {
+            return;
+        };
+        let states: Vec<usize> = made.iter().map(|&(_, s)| s).collect();
+        let region = Region {
+            parallel: orth,
+            ..Region::at(start, outcomes, states)
+        };
+        match p.state {
+            None => m.top = region,
+            Some(c) => m.states[c].body = StateBody::Container(region),
+        }
+        // Nested machines: their content, inline or from their file.
+        for &(c, s) in &made {
+            if !matches!(
+                self.docs[doc].0.elems[c].name.as_str(),
+                "StateMachine" | "OrthogonalState" | "Region"
+            ) {
+                continue;
+            }
+            if p.depth + 1 > self.limits.max_depth {
+                let span = self.docs[doc].0.elems[c].span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!(
+                        "state machines nested deeper than the limit of {} levels",
+                        self.limits.max_depth
+                    ),
+                    "raise the limit with --max-depth",
+                );
+                continue;
+            }
+            match self.docs[doc].0.elems[c].attr_full("file_path").cloned() {
+                None => queue.push_back(Pending {
+                    doc,
+                    elem: c,
+                    state: Some(s),
+                    depth: p.depth + 1,
+                    chain: p.chain.clone(),
+                }),
+                Some(fp) => {
+                    if let Some((nd, chain)) = self.include(doc, &fp, &p.chain) {
+                        let root = self.docs[nd].0.root;
+                        queue.push_back(Pending {
+                            doc: nd,
+                            elem: root,
+                            state: Some(s),
+                            depth: p.depth + 1,
+                            chain,
+                        });
+                    }
+                }
+            }
+        }
+        // A container's outcome map may name outcomes its content lacks:
+        // checked once its content is read (it is later in the queue).
+    }
+
+    /// Reads the file a `file_path` names: its document index, and the
+    /// include chain through it.
+    fn include(
+        &mut self,
+        doc: usize,
+        fp: &xml::XAttr,
+        chain: &[PathBuf],
+    ) -> Option<(usize, Vec<PathBuf>)> {
+        let full = match super::source::resolve(self.root.as_deref(), &self.docs[doc].1, &fp.value)
+        {
+            Ok(p) => p,
+            Err(r) => {
+                self.err(
+                    doc,
+                    fp.span.clone(),
+                    format!("cannot include this file: {}", r.message),
+                    &r.hint,
+                );
+                return None;
+            }
+        };
+        let canon = super::toml::canonical(&full);
+        if chain.contains(&canon) {
+            self.err(
+                doc,
+                fp.span.clone(),
+                "cyclic include: a machine includes itself through `file_path`".into(),
+                "a file must not include itself, directly or through others",
+            );
+            return None;
+        }
+        if chain.len() >= self.limits.max_include_depth {
+            self.err(
+                doc,
+                fp.span.clone(),
+                format!(
+                    "includes nested deeper than {}",
+                    self.limits.max_include_depth
+                ),
+                "raise the limit with --max-include-depth",
+            );
+            return None;
+        }
+        let shown_path = full.display().to_string();
+        let file = match super::toml::read_included(&full, &shown_path, self.limits) {
+            Ok(f) => f,
+            Err(mut ds) => {
+                let msg = ds.remove(0).message;
+                self.err(
+                    doc,
+                    fp.span.clone(),
+                    msg,
+                    "`file_path` is relative to the including file",
+                );
+                return None;
+            }
+        };
+        let parsed = match xml::parse(&file, self.elems_left, self.limits.max_nodes) {
+            Ok(d) => d,
+            Err(d) => {
+                self.diags.push(d);
+                return None;
+            }
+        };
+        self.elems_left -= parsed.elems.len().min(self.elems_left);
+        if parsed.elems[parsed.root].name != "StateMachine" {
+            self.err(
+                doc,
+                fp.span.clone(),
+                "the included file is not a yasmin state machine (its document element is not `<StateMachine>`)".into(),
+                "`file_path` names another yasmin XML file",
+            );
+            return None;
+        }
+        let dir = full.parent().map(Path::to_path_buf).unwrap_or_default();
+        self.docs.push((parsed, dir));
+        let mut chain = chain.to_vec();
+        chain.push(canon);
+        Some((self.docs.len() - 1, chain))
+    }
+}
+
+/// Is the element a nested machine (a container)?
+fn container_state(e: &XElem) -> bool {
+    e.name == "StateMachine" || e.name == "OrthogonalState"
+}
+
+/// The machine's `description` attribute, if any.
+fn top_description(doc: &XDoc) -> Option<String> {
+    let e: &XElem = &doc.elems[doc.root];
+    e.attr("description").map(str::to_string)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use btfsm_model::StateBody;
+
+    fn machine(text: &str) -> StateMachine {
+        match parse_str("t.xml", text, &Limits::default())
+            .unwrap()
+            .policy
+            .body
+        {
+            PolicyBody::Machine(m) => m,
+            _ => unreachable!(),
+        }
+    }
+
+    fn errors(text: &str) -> Vec<String> {
+        parse_str("t.xml", text, &Limits::default())
+            .unwrap_err()
+            .into_iter()
+            .filter(|d| d.is_error())
+            .map(|d| d.to_string())
+            .collect()
+    }
+
+    #[test]
+    fn a_flat_machine_with_its_start_state_and_final_outcomes() {
+        let m = machine(
+            r#"<?xml version="1.0"?>
+<StateMachine name="Demo" outcomes="outcome4" start_state="Foo">
+  <Param name="p" default_type="int" default_value="2"/>
+  <State name="Bar" type="py" class="BarState"><Transition from="outcome3" to="Foo"/></State>
+  <State name="Foo" type="cpp" class="FooState">
+    <Transition from="outcome1" to="Bar"/>
+    <Transition from="outcome2" to="outcome4"/>
+  </State>
+  <FinalOutcome name="outcome4"/>
+</StateMachine>"#,
+        );
+        assert!(!m.hierarchical);
+        assert_eq!(m.states[m.top.initial_state().unwrap()].name, "Foo");
+        assert_eq!(m.top.outcomes, vec!["outcome4"]);
+        let foo = &m.states[m.top.initial_state().unwrap()];
+        assert_eq!(foo.transitions.len(), 2);
+        assert_eq!(foo.transitions[0].target, Target::State(0));
+        assert_eq!(
+            foo.transitions[1].target,
+            Target::Outcome("outcome4".into())
+        );
+    }
+
+    #[test]
+    fn nested_machines_are_containers_with_their_outcome_map() {
+        let m = machine(
+            r#"<StateMachine outcomes="final_outcome">
+    <StateMachine name="NestedSM" outcomes="outcome1 outcome2">
+        <State name="InnerState">
+            <Transition from="outcome1" to="outcome1"/>
+            <Transition from="outcome2" to="outcome2"/>
+        </State>
+        <Transition from="outcome1" to="NestedSM"/>
+        <Transition from="outcome2" to="final_outcome"/>
+    </StateMachine>
+</StateMachine>"#,
+        );
+        assert!(m.hierarchical);
+        let nested = &m.states[m.top.initial_state().unwrap()];
+        assert_eq!(nested.name, "NestedSM");
+        let StateBody::Container(r) = &nested.body else {
+            panic!("not a container")
+        };
+        assert_eq!(r.outcomes, vec!["outcome1", "outcome2"]);
+        assert_eq!(m.states[r.initial_state().unwrap()].name, "InnerState");
+        assert_eq!(
+            m.states[r.initial_state().unwrap()].parent,
+            m.top.initial_state()
+        );
+        assert_eq!(nested.transitions.len(), 2);
+        assert_eq!(nested.transitions[0].target, m.top.initial.clone());
+    }
+
+    #[test]
+    fn bad_targets_and_start_states_are_errors_at_once() {
+        let e = errors(
+            r#"<StateMachine outcomes="end" start_state="nope">
+  <State name="a"><Transition from="x" to="nowhere"/></State>
+  <State name="a"/>
+</StateMachine>"#,
+        );
+        assert_eq!(e.len(), 3, "{e:#?}");
+        assert!(e[0].contains("start state `nope`"), "{e:#?}");
+        assert!(
+            e.iter()
+                .any(|m| m.contains("`nowhere` is neither a state nor an outcome"))
+        );
+        assert!(e.iter().any(|m| m.contains("duplicate state `a`")));
+        // An orthogonal state needs regions.
+        let e = errors(
+            r#"<StateMachine outcomes="end">
+  <OrthogonalState name="o"/>
+</StateMachine>"#,
+        );
+        assert!(
+            e[0].contains("this orthogonal state has no regions"),
+            "{e:#?}"
+        );
+    }
+
+    /// `<OrthogonalState>`: a parallel state whose `<Region>`s are its
+    /// regions (nested machines, all run at once), whose outcomes are its
+    /// outcome map's, `default_outcome` and its `<FinalOutcome>`s, mapped by
+    /// its own `<Transition>`s.
+    #[test]
+    fn orthogonal_states_are_parallel_regions() {
+        let m = machine(
+            r#"<StateMachine outcomes="done fail" start_state="start">
+  <State name="start"><Transition from="ok" to="par"/></State>
+  <OrthogonalState name="par" default_outcome="timeout">
+    <Transition from="success" to="done"/>
+    <Transition from="timeout" to="fail"/>
+    <OutcomeMap outcome="success"><Item state="A" outcome="a_done"/><Item state="B" outcome="b_done"/></OutcomeMap>
+    <Region name="A" outcomes="a_done" start_state="w"><State name="w"><Transition from="ok" to="a_done"/></State></Region>
+    <Region name="B" outcomes="b_done"><State name="v"><Transition from="ok" to="b_done"/></State></Region>
+  </OrthogonalState>
+</StateMachine>"#,
+        );
+        assert!(m.hierarchical && m.has_parallel());
+        let par = m.states.iter().position(|s| s.name == "par").unwrap();
+        let StateBody::Container(r) = &m.states[par].body else {
+            panic!("a container")
+        };
+        assert!(r.parallel);
+        assert_eq!(r.outcomes, ["timeout", "success"]);
+        let regions: Vec<&str> = r
+            .entered(&m.states)
+            .into_iter()
+            .map(|i| m.states[i].name.as_str())
+            .collect();
+        assert_eq!(regions, ["A", "B"]);
+        assert_eq!(m.states[par].transitions.len(), 2);
+        let g = btfsm_model::graph::policy_graph(&Policy {
+            name: "t".into(),
+            description: None,
+            body: PolicyBody::Machine(m.clone()),
+        });
+        // start par A w B v + done fail; start->par, par's 2 outcomes, 2
+        // regions, A->w, B->v, w's and v's transitions.
+        assert_eq!((g.g.node_count(), g.g.edge_count()), (8, 9));
+    }
+
+    #[test]
+    fn a_state_named_like_an_outcome_is_an_error() {
+        // yasmin's StateMachine.add_state: "State name '...' is already
+        // registered as an outcome". Found by `mangled_files_never_panic`:
+        // an `outcomes` attribute cut into a sentence holding `Bar`.
+        let e = errors(
+            r#"<StateMachine outcomes="Bar done" start_state="Bar">
+  <State name="Bar" type="py" module="m" class="C"><Transition from="ok" to="done"/></State>
+</StateMachine>"#,
+        );
+        assert!(
+            e.iter()
+                .any(|m| m.contains("state `Bar` has the name of an outcome")),
+            "{e:?}"
+        );
+    }
+
+    #[test]
+    fn a_container_maps_only_its_outcomes_and_each_outcome_once() {
+        let e = errors(
+            r#"<StateMachine outcomes="end">
+  <StateMachine name="In" outcomes="done">
+    <State name="s"><Transition from="ok" to="done"/><Transition from="ok" to="s"/></State>
+    <Transition from="done" to="end"/>
+    <Transition from="nope" to="end"/>
+  </StateMachine>
+</StateMachine>"#,
+        );
+        assert!(
+            e.iter()
+                .any(|m| m.contains("a second transition from outcome `ok`")),
+            "{e:#?}"
+        );
+        assert!(
+            e.iter().any(|m| m.contains("`In` has no outcome `nope`")),
+            "{e:#?}"
+        );
+    }
+
+    #[test]
+    fn sniffing_sees_the_document_element() {
+        assert!(looks_like_yasmin(
+            "<?xml version='1.0'?>\n<!-- c --><StateMachine outcomes=\"a\">"
+        ));
+        assert!(!looks_like_yasmin("<root BTCPP_format=\"4\">"));
+        assert!(!looks_like_yasmin("<StateMachineX/>"));
+    }
+}

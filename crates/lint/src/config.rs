@@ -1,0 +1,113 @@
+//! Levels per rule: the defaults, a `[lint]` table of `btfsm.toml` (found
+//! in the current directory or above it, up to the repository root), then
+//! `--deny`/`--warn`/`--allow` (last word wins), as cargo-deny and ruff
+//! configure theirs.
+//!
+//! ```toml
+//! [lint]
+//! deny = ["unguarded-fallback-action"]   # error
+//! warn = ["chattering-precondition-order"]
+//! allow = ["fully-connected-state"]      # not reported
+//! ```
+
+use super::{Level, Rule, rule};
+use btfsm_core::diagnostic::{Diagnostic, SourceFile, suggest};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The levels in force.
+#[derive(Debug, Clone, Default)]
+pub struct Config {
+    levels: BTreeMap<&'static str, Level>,
+    /// The `btfsm.toml` read, if any.
+    pub file: Option<PathBuf>,
+}
+
+impl Config {
+    /// The level of `r`.
+    pub fn level(&self, r: &Rule) -> Level {
+        self.levels.get(r.code).copied().unwrap_or(r.level)
+    }
+
+    /// Sets `code` to `level`; an unknown code is an error naming the
+    /// closest.
+    pub fn set(&mut self, code: &str, level: Level) -> Result<(), String> {
+        match rule(code) {
+            Some(r) => {
+                self.levels.insert(r.code, level);
+                Ok(())
+            }
+            None => Err(format!(
+                "unknown lint `{}`; {}",
+                btfsm_core::sanitize::shown(code),
+                suggest(code, super::RULES.iter().map(|r| r.code))
+            )),
+        }
+    }
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    #[serde(default)]
+    lint: RawLint,
+}
+
+#[derive(serde::Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawLint {
+    #[serde(default)]
+    deny: Vec<toml::Spanned<String>>,
+    #[serde(default)]
+    warn: Vec<toml::Spanned<String>>,
+    #[serde(default)]
+    allow: Vec<toml::Spanned<String>>,
+}
+
+/// `btfsm.toml` in `dir` or the nearest folder above it, stopping at the
+/// repository root (a folder holding `.git`).
+pub fn find(dir: &Path) -> Option<PathBuf> {
+    let mut d = Some(dir);
+    while let Some(x) = d {
+        let f = x.join("btfsm.toml");
+        if f.is_file() {
+            return Some(f);
+        }
+        if x.join(".git").exists() {
+            return None;
+        }
+        d = x.parent();
+    }
+    None
+}
+
+/// Reads the `[lint]` table of a `btfsm.toml`; every unknown code is
+/// reported with its position.
+pub fn read(file: &Arc<SourceFile>) -> Result<Config, Vec<Diagnostic>> {
+    let raw: RawFile = toml::from_str(&file.text).map_err(|e| {
+        let d = Diagnostic::error(format!("invalid btfsm.toml: {}", e.message().trim()))
+            .hint("btfsm.toml holds `[lint]` with `deny`, `warn` and `allow` lists of rule codes");
+        vec![match e.span() {
+            Some(s) => d.at(file, s),
+            None => d,
+        }]
+    })?;
+    let mut cfg = Config {
+        file: Some(PathBuf::from(&file.path)),
+        ..Config::default()
+    };
+    let mut errs = Vec::new();
+    for (list, level) in [
+        (&raw.lint.allow, Level::Allow),
+        (&raw.lint.warn, Level::Warning),
+        (&raw.lint.deny, Level::Error),
+    ] {
+        for code in list {
+            if let Err(e) = cfg.set(code.get_ref(), level) {
+                errs.push(Diagnostic::error(e).at(file, code.span()));
+            }
+        }
+    }
+    if errs.is_empty() { Ok(cfg) } else { Err(errs) }
+}

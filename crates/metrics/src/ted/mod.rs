@@ -1,0 +1,279 @@
+//! Ordered labelled tree edit distance (Tai, J. ACM 1979): the fewest unit
+//! operations — delete a node (its children take its place), insert one,
+//! rename one — that turn tree a into tree b, children order mattering.
+//! `btfsm compare --mode tree` computes it between two Behavior Trees, where
+//! order is priority: swapping two children of a Sequence costs > 0 here,
+//! while the paper's GED (unordered, `metrics::ged`) sees no change.
+//!
+//! First, bounds from the label sequences (`bounds.rs`, with Myers'
+//! bit-parallel Levenshtein distance, `sed.rs`: `n·m/64` word steps, about
+//! 13 M for two 10,000-node trees): the preorder, postorder and half the
+//! Euler-string distances bound the distance from below, and the pairs of
+//! an optimal sequence alignment that keep both orders are a mapping. When
+//! the lower bound meets the best mapping (this one or the top-down one of
+//! `greedy.rs`), that is the distance (so on the benchmark's copies with 1
+//! and 5 edits).
+//! Otherwise Zhang & Shasha's algorithm (SIAM J. Comput. 1989; `zs.rs`) runs
+//! in a diagonal band of width `u` (Touzet, CPM 2005), starting at the lower
+//! bound, with `u` grown by half (or set to the best mapping's cost once
+//! close to it) until the band's result is at most `u`, which proves it
+//! exact. Similar trees cost about O(n·k·u²) cells (`k` the keyroots on a
+//! root-leaf path; measured: docs/performance.md) and O(n·u) memory. Of the
+//! trees' two orientations (as drawn and mirrored, same distance) the one
+//! with fewer cells is used.
+//!
+//! Not built: Pawlik & Augsten's optimal path strategies (RTED, PVLDB 2011;
+//! APTED, TODS 2015, Inf. Syst. 2016). Counted with their cost formula on
+//! the 10,000-node benchmark trees (deep: 172 levels), the optimal strategy
+//! needs 1.6·10¹¹ subproblems for two unrelated trees and 5.4·10¹¹ for a
+//! tree and its edited copy (Zhang–Shasha: 2.6·10¹¹ and 8.4·10¹¹), and its
+//! n·m subtree-distance table alone (10⁸ entries) exceeds the memory bound:
+//! far past the work budget either way, so unrelated large trees end with
+//! the interval of the bounds above.
+//!
+//! Work and memory are bounded by counts, not time ([`TedOptions`]): past
+//! either, the result is an interval `[lower, upper]` with the script of a
+//! mapping costing `upper`, the same on any machine.
+
+mod band;
+mod bounds;
+pub mod bt;
+mod greedy;
+mod mapping;
+mod script;
+mod sed;
+#[cfg(test)]
+mod tests;
+mod tree;
+pub mod tree_text;
+
+pub use script::{TreeEdit, edit_script};
+pub use tree::OrderedTree;
+
+use zs::Banded;
+mod zs;
+
+/// A tree to compare: an arena of children lists with a label id per node
+/// (ids shared by both trees: equal ids, equal labels).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LabelledTree {
+    pub children: Vec<Vec<usize>>,
+    pub labels: Vec<u32>,
+    pub root: usize,
+}
+
+impl LabelledTree {
+    /// Nodes reachable from the root, parents before children, children
+    /// in order (each node once).
+    pub fn preorder(&self) -> Vec<usize> {
+        let mut seen = vec![false; self.children.len()];
+        let mut out = Vec::new();
+        let mut stack = vec![self.root];
+        while let Some(n) = stack.pop() {
+            if n >= seen.len() || seen[n] {
+                continue;
+            }
+            seen[n] = true;
+            out.push(n);
+            stack.extend(self.children[n].iter().rev().copied());
+        }
+        out
+    }
+}
+
+/// Bounds of one computation, counted so that a result never depends on
+/// the machine's load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TedOptions {
+    /// Most table cells computed, over all bands tried (checked after each
+    /// forest table).
+    pub max_work: u64,
+    /// Most table cells held at once (4 bytes each).
+    pub max_cells: u64,
+}
+
+/// Default [`TedOptions::max_work`]: 3·10⁸ cells, about 1–3 s.
+pub const DEFAULT_MAX_WORK: u64 = 300_000_000;
+/// Default [`TedOptions::max_cells`]: 2²⁵ cells, 128 MiB.
+pub const DEFAULT_MAX_CELLS: u64 = 1 << 25;
+
+impl Default for TedOptions {
+    fn default() -> Self {
+        TedOptions {
+            max_work: DEFAULT_MAX_WORK,
+            max_cells: DEFAULT_MAX_CELLS,
+        }
+    }
+}
+
+/// The distance, or the interval it lies in, with a mapping of cost `upper`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TedResult {
+    pub lower: u64,
+    pub upper: u64,
+    /// Mapped pairs `(node of a, node of b)` in arena indices, sorted.
+    pub mapping: Vec<(usize, usize)>,
+    /// Table cells computed (the work budget's unit).
+    pub work: u64,
+    /// Width `u` of the last band that ran to completion (0 when none).
+    pub band: usize,
+    /// Most table cells held at once (4 bytes each), never above
+    /// [`TedOptions::max_cells`].
+    pub peak_cells: u64,
+}
+
+impl TedResult {
+    pub fn exact(&self) -> bool {
+        self.lower >= self.upper
+    }
+}
+
+/// The ordered tree edit distance of `a` and `b` with unit costs.
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
+    // The orientation with fewer cells: same distance, mirrored mapping.
+    let (fa, fb) = (
+        OrderedTree::build(&a.children, &a.labels, a.root, false),
+        OrderedTree::build(&b.children, &b.labels, b.root, false),
+    );
+    let (ma, mb) = (
+        OrderedTree::build(&a.children, &a.labels, a.root, true),
+        OrderedTree::build(&b.children, &b.labels, b.root, true),
+    );
+    let weight = |x: &OrderedTree, y: &OrderedTree| {
+        u128::from(x.keyroot_weight()) * u128::from(y.keyroot_weight())
+    };
+    let mirrored = weight(&ma, &mb) < weight(&fa, &fb);
+    let (f, g) = if mirrored { (ma, mb) } else { (fa, fb) };
+    let to_arena = |pairs: Vec<(usize, usize)>| -> Vec<(usize, usize)> {
+        let mut m: Vec<(usize, usize)> = pairs
+            .into_iter()
+            .map(|(x, y)| (f.arena[x], g.arena[y]))
+            .collect();
+        m.sort_unstable();
+        m
+    };
+    let (n1, n2) = (f.len(), g.len());
+    if n1 == 0 || n2 == 0 {
+        let d = (n1 + n2) as u64;
+        return TedResult {
+            lower: d,
+            upper: d,
+            mapping: Vec::new(),
+            work: 0,
+            band: 0,
+            peak_cells: 0,
+        };
+    }
+    // No mapping costs more than n1 + n2: a band this wide prunes nothing.
+    let full = n1 + n2;
+    let mut lower = n1.abs_diff(n2) as u64;
+    // A mapping always available: the roots to each other; usually a far
+    // better one: the top-down alignment of `greedy.rs` (arena pairs).
+    let root_cost = (n1 + n2 - 2) as u64 + u64::from(f.label[n1 - 1] != g.label[n2 - 1]);
+    let (gm, gcost) = greedy::greedy_mapping(a, b);
+    let mut best: (u64, Vec<(usize, usize)>) = if gcost < root_cost {
+        (gcost, gm)
+    } else {
+        (root_cost, vec![(f.arena[n1 - 1], g.arena[n2 - 1])])
+    };
+    let mut work = 0u64;
+    let mut peak = 0u64;
+    // The label sequences' bounds (`bounds.rs`): a lower bound that often
+    // meets the upper one on a tree and its edited copy, and a mapping that
+    // is often better than the greedy one; skipped when they do not fit
+    // the budgets.
+    if bounds::work(n1, n2) <= opts.max_work && bounds::cells(n1, n2) <= opts.max_cells {
+        let sb = bounds::sequence_bounds(&f, &g);
+        work += sb.work;
+        peak = peak.max(sb.peak);
+        lower = lower.max(sb.lower);
+        if sb.upper < best.0 {
+            best = (sb.upper, to_arena(sb.mapping));
+        }
+        if lower >= best.0 {
+            let (upper, mapping) = best;
+            return TedResult {
+                lower: upper,
+                upper,
+                mapping,
+                work,
+                band: 0,
+                peak_cells: peak,
+            };
+        }
+    }
+    let mut done_band = 0;
+    // A band narrower than the lower bound cannot prove the distance.
+    let mut u = n1
+        .abs_diff(n2)
+        .max(2)
+        .max(usize::try_from(lower).unwrap_or(usize::MAX));
+    let full_cells = u128::from(f.keyroot_weight()) * u128::from(g.keyroot_weight());
+    // The width and work of the last band run.
+    let mut last: Option<(usize, u64)> = None;
+    loop {
+        // A band as wide as a known mapping's cost holds that mapping, so
+        // its result is exact: jump there once the growth comes close.
+        let ub = usize::try_from(best.0).unwrap_or(usize::MAX);
+        if u.saturating_mul(3) >= ub.saturating_mul(2) {
+            u = ub;
+        }
+        // Once a band would cost about as much as Zhang–Shasha's whole
+        // tables (the product of the keyroot weights), run those instead.
+        if let Some((pu, pw)) = last {
+            let grow = (u as f64 / pu as f64).powi(3);
+            if pw as f64 * grow >= full_cells as f64 {
+                u = full;
+            }
+        }
+        u = u.min(full);
+        if Banded::memory_cells(&f, &g, u) > opts.max_cells {
+            break;
+        }
+        let mut band = Banded::new(&f, &g, u);
+        let ran = band.run(opts.max_work.saturating_sub(work));
+        work += band.work;
+        peak = peak.max(band.peak);
+        last = Some((u.max(1), band.work.max(1)));
+        if ran.is_err() {
+            break;
+        }
+        done_band = u;
+        let r = u64::from(band.distance());
+        if r <= u as u64 || u == full {
+            band.work = 0;
+            let m = mapping::mapping(&mut band);
+            work += band.work;
+            return TedResult {
+                lower: r,
+                upper: r,
+                mapping: to_arena(m),
+                work,
+                band: u,
+                peak_cells: peak.max(band.peak),
+            };
+        }
+        // The distance is above u; r, if finite, is a mapping's cost.
+        lower = lower.max(u as u64 + 1);
+        if r < best.0 {
+            band.work = 0;
+            let m = mapping::mapping(&mut band);
+            work += band.work;
+            peak = peak.max(band.peak);
+            best = (r, to_arena(m));
+        }
+        // Grow by half: the work grows as about u³, so overshooting the
+        // distance by up to 1.5× costs less than doubling's 2×.
+        u = u.saturating_add(u.div_ceil(2));
+    }
+    let (upper, m) = best;
+    TedResult {
+        lower: lower.min(upper),
+        upper,
+        mapping: m,
+        work,
+        band: done_band,
+        peak_cells: peak,
+    }
+}

@@ -1,0 +1,341 @@
+//! `btfsm compare`: graph edit distance between two policies (paper sec. IV-A 2,
+//! Eq. 2; SPEC §3) in the `structural`, `labeled` and `named` modes, each with
+//! the edit script of its mapping told in the policies' own terms (vertex
+//! names and types, transition labels) with the relabels and reorders the
+//! distance does not count (`changes.rs`), and the diff drawing of the
+//! paper's Figs. 7 and 8 (the new policy with added elements magenta, the
+//! old one's removed elements dashed grey, changed ones orange; DOT in
+//! `diff_dot.rs`, Mermaid in `diff_mermaid.rs`).
+//!
+//! The GED engine (`metrics::ged`) works on unlabeled arcs, so a mapping says
+//! only how many arcs between two vertices are kept. Which of several
+//! parallel transitions those are is decided here, label by label: arcs whose
+//! labels agree are kept first, so a re-routed `FAILURE` arc shows up as one
+//! `FAILURE` arc removed and one added, not as an arbitrary pair.
+
+mod changes;
+#[cfg(test)]
+mod changes_tests;
+mod changes_text;
+mod diff_dot;
+mod diff_mermaid;
+mod render;
+mod script;
+#[cfg(test)]
+mod tests;
+mod text;
+pub mod tree;
+
+pub use changes::{Relabel, Reorder};
+pub use render::{render_json, render_markdown, render_table};
+use script::{ScriptIndex, key_ids};
+pub use text::Text;
+
+use btfsm_metrics::ged::{
+    GedMode, GedOptions, Shape, StopReason, keep_same_labels, mapping_cost, named_mapping_of_ids,
+    search_mapping,
+};
+use btfsm_model::graph::{PolicyGraph, VertexType, policy_graph};
+use btfsm_model::{Policy, PolicyBody, PolicyKind};
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+/// One policy being compared.
+#[derive(Debug, Clone, Copy)]
+pub struct Side<'a> {
+    /// The file it came from, as given.
+    pub file: &'a str,
+    pub policy: &'a Policy,
+}
+
+/// The modes `compare` computes, in report order.
+pub fn modes_of(selection: Option<GedMode>) -> Vec<GedMode> {
+    match selection {
+        Some(m) => vec![m],
+        None => vec![GedMode::Structural, GedMode::Labeled, GedMode::Named],
+    }
+}
+
+/// A vertex named in an edit script.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct VertexRef {
+    /// Identity (BT node id, state path, outcome name).
+    pub key: Text,
+    /// Display name.
+    pub name: Text,
+    #[serde(rename = "type")]
+    pub vtype: VertexType,
+}
+
+/// A vertex of a kept (substituted at cost 0) as the vertex of b it maps to.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct KeptVertex {
+    pub a: Text,
+    pub b: Text,
+}
+
+/// Arcs between two vertices with one label.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+pub struct ArcRef {
+    /// Tail key (of b for added and kept arcs, of a for removed ones).
+    pub from: Text,
+    /// Head key, likewise.
+    pub to: Text,
+    /// Outcome or guard label; `initial` for an HFSM container's arc to its
+    /// initial state; empty for a BT edge.
+    pub label: Text,
+    /// How many such parallel arcs.
+    pub count: u32,
+    /// For a kept arc whose label differs in a: a's label (unit-cost GED does
+    /// not charge for it, a reviewer wants to see it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub label_in_a: Option<Text>,
+}
+
+/// The edit script of one mode's mapping, a → b.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Script {
+    pub vertices_added: Vec<VertexRef>,
+    pub vertices_removed: Vec<VertexRef>,
+    pub vertices_kept: Vec<KeptVertex>,
+    pub arcs_added: Vec<ArcRef>,
+    pub arcs_removed: Vec<ArcRef>,
+    pub arcs_kept: Vec<ArcRef>,
+    /// Kept elements whose type, skill, arguments, name, initial state or
+    /// guard terms changed (not charged by the GED; `changes.rs`).
+    pub relabelled: Vec<Relabel>,
+    /// Kept composites whose kept children (states whose kept guards) come
+    /// in another order (not charged by the GED; `changes.rs`).
+    pub reordered: Vec<Reorder>,
+}
+
+impl Script {
+    /// Unit edit operations: vertices and arcs added and removed.
+    pub fn cost(&self) -> u64 {
+        let arcs = |l: &[ArcRef]| l.iter().map(|a| u64::from(a.count)).sum::<u64>();
+        (self.vertices_added.len() + self.vertices_removed.len()) as u64
+            + arcs(&self.arcs_added)
+            + arcs(&self.arcs_removed)
+    }
+
+    /// Kept vertices whose key changes (only `structural` and `labeled`
+    /// mappings have them).
+    pub fn rematched(&self) -> impl Iterator<Item = &KeptVertex> {
+        self.vertices_kept.iter().filter(|k| k.a != k.b)
+    }
+
+    /// Relabels: the entries of `relabelled` and the kept arcs whose label
+    /// changed (each parallel arc once).
+    pub fn relabels(&self) -> u64 {
+        let arcs: u64 = self
+            .arcs_kept
+            .iter()
+            .filter(|a| a.label_in_a.is_some())
+            .map(|a| u64::from(a.count))
+            .sum();
+        self.relabelled.len() as u64 + arcs
+    }
+
+    /// Reorders: the entries of `reordered`.
+    pub fn reorders(&self) -> u64 {
+        self.reordered.len() as u64
+    }
+
+    /// Whether the mapping keeps everything as it was: no edit, no
+    /// rematch, no relabel, no reorder.
+    pub fn is_unchanged(&self) -> bool {
+        self.cost() == 0
+            && self.rematched().next().is_none()
+            && self.relabels() == 0
+            && self.reorders() == 0
+    }
+}
+
+/// One mode's result (SPEC §7: `ged`, `exact`, `lower_bound`, `upper_bound`,
+/// `millis`, `edit_script`), with the counts of the script's relabels and
+/// reorders beside the distance, which does not count them.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ModeReport {
+    #[serde(skip)]
+    pub mode: GedMode,
+    pub ged: u64,
+    pub relabels: u64,
+    pub reorders: u64,
+    pub exact: bool,
+    pub lower_bound: u64,
+    pub upper_bound: u64,
+    pub millis: u64,
+    /// The same time in microseconds (for timing pairs that take under a
+    /// millisecond; `millis` = `micros` / 1000, rounded down).
+    pub micros: u64,
+    /// When `exact` is false: what ended the search, `work` (the work
+    /// budget, reproducible on any machine), `timeout` (the wall-clock cap
+    /// `--timeout-ms`) or `size` (too large for the exact search). Absent
+    /// when exact.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped_by: Option<StopReason>,
+    pub edit_script: Script,
+}
+
+/// Size and kind of one side, for the table header.
+#[derive(Debug, Clone)]
+pub struct SideSummary {
+    pub file: String,
+    pub name: String,
+    pub kind: PolicyKind,
+    pub vertices: usize,
+    pub arcs: usize,
+}
+
+/// `btfsm compare A B`.
+#[derive(Debug, Clone)]
+pub struct CompareReport {
+    pub a: SideSummary,
+    pub b: SideSummary,
+    pub modes: Vec<ModeReport>,
+    /// The primary mode's diff as a Mermaid flowchart (`diff_mermaid.rs`),
+    /// `Err` with the numbers of nodes and links when it is too large.
+    pub diagram: Option<Result<String, (usize, usize)>>,
+    /// The ordered tree edit distance (`--mode tree`; BT pairs only).
+    pub tree: Option<tree::TreeReport>,
+}
+
+impl CompareReport {
+    /// The result of one mode, if computed.
+    pub fn mode(&self, mode: GedMode) -> Option<&ModeReport> {
+        self.modes.iter().find(|m| m.mode == mode)
+    }
+
+    /// The mode whose edit script the table prints and `--dot` draws: the
+    /// only one computed, or `named` (the engineer's own edits) when all are.
+    pub fn primary(&self) -> Option<&ModeReport> {
+        self.mode(GedMode::Named).or(self.modes.first())
+    }
+}
+
+/// The two graphs of a comparison, built once and reused by every mode.
+pub struct Pair<'a> {
+    a: Side<'a>,
+    b: Side<'a>,
+    ga: PolicyGraph,
+    gb: PolicyGraph,
+    ia: ScriptIndex,
+    ib: ScriptIndex,
+    /// Each vertex's key as an id shared by both graphs (equal keys, equal
+    /// ids), so that the mapping by name costs no string work per mode.
+    ids_a: Vec<u32>,
+    ids_b: Vec<u32>,
+    /// HFSM containment in a: state key -> its container's key.
+    parent_a: BTreeMap<String, String>,
+    /// What relabels and reorders read of two BTs (`changes.rs`).
+    bt_facts: Option<(changes::BtFacts, changes::BtFacts)>,
+}
+
+/// State key -> container key, for every nested state of an HFSM.
+fn containers(p: &Policy) -> BTreeMap<String, String> {
+    let PolicyBody::Machine(m) = &p.body else {
+        return BTreeMap::new();
+    };
+    let keys = m.keys();
+    m.states
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| s.parent.map(|q| (keys[i].clone(), keys[q].clone())))
+        .collect()
+}
+
+impl<'a> Pair<'a> {
+    pub fn new(a: Side<'a>, b: Side<'a>) -> Self {
+        let (ga, gb) = (policy_graph(a.policy), policy_graph(b.policy));
+        let (ia, ib) = (ScriptIndex::new(&ga), ScriptIndex::new(&gb));
+        let (ids_a, ids_b) = key_ids(&ia, &ib);
+        Pair {
+            ia,
+            ib,
+            ids_a,
+            ids_b,
+            ga,
+            gb,
+            parent_a: containers(a.policy),
+            bt_facts: changes::bt_facts(a.policy, b.policy),
+            a,
+            b,
+        }
+    }
+
+    /// GED in one mode, with its labelled edit script, within
+    /// `opts.timeout` for the whole of it: the clock starts before the
+    /// compact graphs are built, the mapping by name and its script come
+    /// next, and the search gets what remains minus twice the time that
+    /// script took (the script of the search's mapping, if better, costs
+    /// about as much, and the unused one must be freed: 1.3 to 1.6 times
+    /// the first on 100k-vertex BTs). `millis` is the time of all of it.
+    pub fn run(&self, mode: GedMode, opts: &GedOptions) -> ModeReport {
+        let start = Instant::now();
+        let (sa, sb) = (Shape::from(&self.ga), Shape::from(&self.gb));
+        let mut by_name = named_mapping_of_ids(&self.ids_a, &self.ids_b);
+        if mode == GedMode::Labeled {
+            keep_same_labels(&sa, &sb, &mut by_name);
+        }
+        let named_cost = mapping_cost(&sa, &sb, &by_name);
+        let before_script = Instant::now();
+        let named = self.script(&by_name);
+        let (lower, upper, edit_script, stopped_by) = if mode == GedMode::Named {
+            (named_cost, named_cost, named, None)
+        } else {
+            let reserve = before_script.elapsed() * 2;
+            // Checked: a budget past the clock's range means no deadline.
+            let deadline = start
+                .checked_add(opts.timeout)
+                .unwrap_or_else(|| start + Duration::from_secs(1 << 32))
+                .checked_sub(reserve)
+                .map_or(start, |d| d.max(start));
+            let found = search_mapping(&sa, &sb, mode == GedMode::Labeled, deadline, opts.work);
+            // Among mappings of equal cost, prefer the one by name: its
+            // script reads as the engineer's own edits.
+            if named_cost <= found.upper_bound {
+                (found.lower_bound, named_cost, named, found.stopped_by)
+            } else {
+                let s = self.script(&found.map);
+                (found.lower_bound, found.upper_bound, s, found.stopped_by)
+            }
+        };
+        debug_assert_eq!(edit_script.cost(), upper);
+        let micros = u64::try_from(start.elapsed().as_micros()).unwrap_or(u64::MAX);
+        ModeReport {
+            mode,
+            ged: upper,
+            relabels: edit_script.relabels(),
+            reorders: edit_script.reorders(),
+            exact: lower >= upper,
+            lower_bound: lower.min(upper),
+            upper_bound: upper,
+            millis: micros / 1000,
+            micros,
+            stopped_by: if lower >= upper { None } else { stopped_by },
+            edit_script,
+        }
+    }
+
+    pub fn report(&self, modes: Vec<ModeReport>) -> CompareReport {
+        let summary = |s: &Side, g: &PolicyGraph| SideSummary {
+            file: s.file.to_string(),
+            name: s.policy.name.clone(),
+            kind: s.policy.kind(),
+            vertices: g.vertex_count(),
+            arcs: g.arc_count(),
+        };
+        let diagram = modes
+            .iter()
+            .find(|m| m.mode == GedMode::Named)
+            .or(modes.first())
+            .map(|p| self.diagram(&p.edit_script));
+        CompareReport {
+            a: summary(&self.a, &self.ga),
+            b: summary(&self.b, &self.gb),
+            modes,
+            diagram,
+            tree: None,
+        }
+    }
+}

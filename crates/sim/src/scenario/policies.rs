@@ -1,0 +1,331 @@
+//! Reading a whole scenario: its top-level keys and `[[policies]]` (each
+//! policy file read, converted and checked against the world).
+
+use super::*;
+
+impl Reader {
+    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    pub(super) fn scenario(
+        &mut self,
+        t: &DeTable<'_>,
+        base: &Path,
+        limits: &Limits,
+    ) -> Option<Scenario> {
+        self.keys(t, TOP_KEYS, "top-level key");
+        let name = match t.get("name") {
+            Some(n) => self.string(n, "`name`")?,
+            None => Path::new(&self.file.path)
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        };
+        let description = match t.get("description") {
+            Some(d) => self.string(d, "`description`"),
+            None => None,
+        };
+        let seed = t
+            .get("seed")
+            .and_then(|v| self.integer(v, "`seed`", 0, i64::MAX as u64))
+            .unwrap_or(1);
+        let dt = t
+            .get("dt")
+            .and_then(|v| self.number(v, "`dt`", 0.001, 10.0))
+            .unwrap_or(0.1);
+        let max_steps = t
+            .get("max_steps")
+            .and_then(|v| self.integer(v, "`max_steps`", 1, MAX_STEPS))
+            .unwrap_or(20_000);
+        if let Some(v) = t.get("chatter_switches")
+            && self
+                .integer(v, "`chatter_switches`", 2, 1_000_000)
+                .is_some()
+        {
+            self.diags.push(
+                Diagnostic::warning("`chatter_switches` is no longer used: a livelock is a recurring abstract state without progress toward the goal")
+                    .at(&self.file, v.span())
+                    .hint("remove it; `livelock_repeats` (default 3) sets how often a state may recur"),
+            );
+        }
+        let livelock_repeats = t
+            .get("livelock_repeats")
+            .and_then(|v| self.integer(v, "`livelock_repeats`", 2, 1_000_000))
+            .unwrap_or(3) as u32;
+        let max_failures = t
+            .get("max_failures")
+            .and_then(|v| self.integer(v, "`max_failures`", 1, 1_000_000))
+            .unwrap_or(50) as u32;
+        let world = self.world(t.get("world"))?;
+        let rates = match t.get("rates") {
+            Some(r) => self.rates(r)?,
+            None => BTreeMap::new(),
+        };
+        let goal = match t.get("goal") {
+            Some(g) => Some(self.terms(g, &world)?),
+            None => None,
+        };
+        let mut disturbances = Vec::new();
+        if let Some(d) = t.get("disturbances") {
+            let a = self.array(d, "`disturbances`")?;
+            if !self.at_most(d.span(), a.len(), MAX_DISTURBANCES, "disturbances") {
+                return None;
+            }
+            // Every `block` adds an obstacle.
+            let blocks = (a.iter())
+                .filter(|x| {
+                    x.get_ref()
+                        .as_table()
+                        .is_some_and(|t| t.contains_key("block"))
+                })
+                .count();
+            let obstacles = world.layout.obstacles.len() + blocks;
+            if !self.at_most(
+                d.span(),
+                obstacles,
+                MAX_OBSTACLES,
+                "obstacles (`block` disturbances included)",
+            ) {
+                return None;
+            }
+            for x in a {
+                if let Some(d) = self.disturbance(x, &world) {
+                    disturbances.push(d);
+                }
+            }
+        }
+        let monte_carlo = match t.get("monte_carlo") {
+            Some(m) => self.monte_carlo(m, &world)?,
+            None => MonteCarlo::default(),
+        };
+        let mut policies = Vec::new();
+        match t.get("policies") {
+            None => self.err(
+                0..0,
+                "a scenario needs at least one policy",
+                "add `[[policies]]` with `file = \"../paper/fig01-bt.toml\"`",
+            ),
+            Some(p) => {
+                let a = self.array(p, "`policies`")?;
+                if !self.at_most(p.span(), a.len(), MAX_POLICIES, "policies") {
+                    return None;
+                }
+                for e in a {
+                    if let Some(pe) = self.policy(e, base, limits, &world) {
+                        policies.push(pe);
+                    }
+                }
+            }
+        }
+        let expect = match t.get("expect") {
+            Some(e) => {
+                let names: Vec<String> = policies.iter().map(|p| p.policy.name.clone()).collect();
+                self.expect(e, &names, goal.is_some())
+            }
+            None => Vec::new(),
+        };
+        Some(Scenario {
+            expect,
+            warnings: Vec::new(),
+            name,
+            description,
+            seed,
+            dt,
+            max_steps,
+            livelock_repeats,
+            max_failures,
+            world,
+            policies,
+            rates,
+            disturbances,
+            goal,
+            monte_carlo,
+        })
+    }
+
+    /// `after_success` / `after_failure`: `"stop"` or `"keep-ticking"`.
+    pub(super) fn afterwards(
+        &mut self,
+        v: Option<&Val<'_>>,
+        key: &str,
+        keep: bool,
+    ) -> Option<Afterwards> {
+        let Some(a) = v else {
+            return Some(if keep {
+                Afterwards::KeepTicking
+            } else {
+                Afterwards::Stop
+            });
+        };
+        match a.get_ref().as_str() {
+            Some("stop") => Some(Afterwards::Stop),
+            Some("keep-ticking") => Some(Afterwards::KeepTicking),
+            _ => {
+                self.err(
+                    a.span(),
+                    format!("`{key}` must be \"stop\" or \"keep-ticking\""),
+                    format!("write `{key} = \"keep-ticking\"` to tick the policy again (a BT's default), `\"stop\"` to end it (an FSM's and an HFSM's)"),
+                );
+                None
+            }
+        }
+    }
+
+    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    pub(super) fn policy(
+        &mut self,
+        v: &Val<'_>,
+        base: &Path,
+        limits: &Limits,
+        world: &World,
+    ) -> Option<PolicyEntry> {
+        let t = self.table(v, "a policy entry")?;
+        self.keys(
+            t,
+            &["file", "convert", "name", "after_success", "after_failure"],
+            "field of a policy entry",
+        );
+        let Some(f) = t.get("file") else {
+            self.err(
+                v.span(),
+                "a policy entry needs `file`",
+                "write `file = \"../paper/fig01-bt.toml\"` (relative to the scenario)",
+            );
+            return None;
+        };
+        let rel = self.string(f, "`file`")?;
+        let root = format::source::root_for(limits, base);
+        let path = match format::source::resolve(root.as_deref(), base, &rel) {
+            Ok(p) => p,
+            Err(r) if r.message == "no such file" => {
+                self.err(
+                    f.span(),
+                    format!("policy file `{rel}` not found"),
+                    format!(
+                        "paths are relative to the scenario's folder (`{}`)",
+                        base.display()
+                    ),
+                );
+                return None;
+            }
+            Err(r) => {
+                self.err(
+                    f.span(),
+                    format!("policy file `{rel}`: {}", r.message),
+                    r.hint,
+                );
+                return None;
+            }
+        };
+        let convert = match t.get("convert") {
+            None => None,
+            Some(c) => match c.get_ref().as_str() {
+                Some("hfsm") => Some("hfsm".to_string()),
+                _ => {
+                    self.err(c.span(), "`convert` must be \"hfsm\"", "write `convert = \"hfsm\"` to run the BT converted to an HFSM (Fig. 5 -> Fig. 6)");
+                    return None;
+                }
+            },
+        };
+        let loaded = match format::load(&path, limits) {
+            Ok(l) => l,
+            Err(d) => {
+                self.diags.extend(d);
+                return None;
+            }
+        };
+        let mut policy = loaded.policy;
+        if convert.is_some() {
+            if !matches!(policy.body, PolicyBody::Bt(_)) {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` is not a BT and cannot be converted"),
+                    "remove `convert`",
+                );
+                return None;
+            }
+            if let PolicyBody::Bt(bt) = &policy.body
+                && let Some(&n) = btfsm_transform::bt_to_hfsm::memory_nodes(bt).first()
+            {
+                let node = &bt.nodes[n];
+                self.err(
+                    f.span(),
+                    format!(
+                        "the HFSM of `{rel}` would not behave as the BT: its `{}` node `{}` keeps memory, and the construction re-enters containers at their first state every tick",
+                        node.kind.keyword(),
+                        node.id
+                    ),
+                    "run the BT itself, or make the node reactive (sequence / fallback); `btfsm convert --to hfsm` still gives the HFSM to count",
+                );
+                return None;
+            }
+            match btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
+                Ok(p) => policy = p,
+                Err(e) => {
+                    self.err(
+                        f.span(),
+                        e[0].to_string(),
+                        "only sequence, fallback and simple decorators convert",
+                    );
+                    return None;
+                }
+            }
+        }
+        check_bindings(&policy, &loaded.path, limits, world, &mut self.diags);
+        // The executor runs one state per region, from a state.
+        if let PolicyBody::Machine(m) = &policy.body {
+            if m.has_parallel() {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` has parallel regions (SCXML `<parallel>`): the simulator runs one state at a time"),
+                    "simulate each region as its own machine; `analyze`, `dot` and `compare` take the whole machine",
+                );
+                return None;
+            }
+            if m.top.initial_state().is_none() {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` starts in an outcome: it has no state to run"),
+                    "give the machine a state to start in",
+                );
+                return None;
+            }
+        }
+        if convert.is_none()
+            && let PolicyBody::Machine(m) = &policy.body
+            && m.top.outcomes.iter().any(|o| o == "RUNNING")
+            && let Some(st) = (m.states.iter()).find(|st| {
+                matches!(st.body, StateBody::Container(_))
+                    && (st.label == "Sequence*" || st.label == "Fallback*")
+            })
+        {
+            self.diags.push(
+                Diagnostic::warning(format!(
+                    "`{rel}` looks converted from a BT with memory: its container `{}` ({}) is re-entered at its first state every tick, so it forgets the running child and does not behave as the BT",
+                    st.name, st.label
+                ))
+                .at(&self.file, f.span())
+                .hint("run the BT itself, or convert a BT whose composites are reactive (sequence / fallback)"),
+            );
+        }
+        if let Some(n) = t.get("name") {
+            policy.name = self.string(n, "`name`")?;
+        }
+        // Defaults: a BT keeps ticking after both (its root is ticked every
+        // step); a machine stops, unless its top-level outcomes include
+        // RUNNING (the Fig. 6 construction says it is ticked), which keeps
+        // ticking after FAILURE.
+        let (bt, tick_driven) = match &policy.body {
+            PolicyBody::Bt(_) => (true, true),
+            PolicyBody::Machine(m) => (false, m.top.outcomes.iter().any(|o| o == "RUNNING")),
+        };
+        let after_success = self.afterwards(t.get("after_success"), "after_success", bt)?;
+        let after_failure =
+            self.afterwards(t.get("after_failure"), "after_failure", tick_driven)?;
+        Some(PolicyEntry {
+            file: path,
+            convert,
+            policy,
+            after_success,
+            after_failure,
+        })
+    }
+}

@@ -1,0 +1,410 @@
+//! Symbolic scenarios: a scenario file with a top-level `domain` runs its
+//! policies in the abstract world of that action domain's facts instead of
+//! the planar room (docs/guide/sim.md, "Symbolic simulation"). Read with serde from TOML;
+//! every problem is reported at once with its position.
+
+use btfsm_core::diagnostic::{Diagnostic, SourceFile, suggest};
+use btfsm_format::{self as format, Limits};
+use btfsm_model::{Policy, PolicyBody};
+use btfsm_plan::Domain;
+use btfsm_plan::fact::Fact;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::Spanned;
+
+/// Most policies and disturbances of a symbolic scenario (each).
+pub const MAX_ENTRIES: usize = 64;
+/// Most steps a run may take.
+pub const MAX_STEPS: u64 = 1_000_000;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Raw {
+    name: String,
+    #[serde(default)]
+    description: Option<String>,
+    domain: Spanned<String>,
+    #[serde(default)]
+    task: Option<Spanned<String>>,
+    #[serde(default)]
+    seed: u64,
+    #[serde(default = "default_steps")]
+    max_steps: u64,
+    #[serde(default = "default_repeats")]
+    livelock_repeats: u32,
+    #[serde(default = "default_failures")]
+    max_failures: u32,
+    #[serde(default)]
+    facts: Vec<Spanned<String>>,
+    #[serde(default)]
+    durations: BTreeMap<String, Spanned<u32>>,
+    #[serde(default)]
+    rates: BTreeMap<String, Spanned<f64>>,
+    policies: Vec<RawPolicy>,
+    #[serde(default)]
+    disturbances: Vec<RawDisturbance>,
+    #[serde(default)]
+    monte_carlo: Option<RawMc>,
+}
+
+fn default_steps() -> u64 {
+    1000
+}
+fn default_repeats() -> u32 {
+    3
+}
+fn default_failures() -> u32 {
+    10
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPolicy {
+    file: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDisturbance {
+    at: u64,
+    #[serde(default)]
+    set: Vec<Spanned<String>>,
+    #[serde(default)]
+    unset: Vec<Spanned<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMc {
+    #[serde(default)]
+    rates: BTreeMap<String, Spanned<f64>>,
+    #[serde(default)]
+    unset: Option<RawFlip>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFlip {
+    probability: Spanned<f64>,
+    facts: Vec<Spanned<String>>,
+    window: [u64; 2],
+}
+
+/// A disturbance: facts made true and false at a step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Disturbance {
+    pub at: u64,
+    pub set: Vec<Fact>,
+    pub unset: Vec<Fact>,
+}
+
+/// Monte Carlo sampling: action failure rates, and one fact made false at a
+/// random step of `window` with `probability` per episode.
+#[derive(Debug, Clone, Default)]
+pub struct Mc {
+    pub rates: BTreeMap<String, f64>,
+    pub unset: Option<(f64, Vec<Fact>, [u64; 2])>,
+}
+
+/// A validated symbolic scenario.
+#[derive(Debug, Clone)]
+pub struct SymScenario {
+    pub name: String,
+    pub description: Option<String>,
+    pub domain: Arc<Domain>,
+    pub goal: Vec<Fact>,
+    pub seed: u64,
+    pub max_steps: u64,
+    pub livelock_repeats: u32,
+    pub max_failures: u32,
+    pub facts: Vec<Fact>,
+    /// Steps per action, by action name (default 1).
+    pub durations: BTreeMap<String, u32>,
+    /// Failure probability per action name (single runs too).
+    pub rates: BTreeMap<String, f64>,
+    pub policies: Vec<(PathBuf, Policy)>,
+    pub disturbances: Vec<Disturbance>,
+    pub mc: Mc,
+}
+
+/// Does a TOML text set `domain` before its first table (a symbolic
+/// scenario)?
+pub fn looks_symbolic(text: &str) -> bool {
+    for line in text.lines() {
+        let l = line.trim();
+        if l.starts_with('[') {
+            return false;
+        }
+        let key = l.split('=').next().unwrap_or("").trim().trim_matches('"');
+        if key == "domain" && l.contains('=') {
+            return true;
+        }
+    }
+    false
+}
+
+/// Parses a symbolic scenario from its text (its domain and policies too:
+/// paths relative to `base`, confined as every file a file names).
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub fn parse(
+    file: &Arc<SourceFile>,
+    base: &Path,
+    limits: &Limits,
+) -> Result<SymScenario, Vec<Diagnostic>> {
+    let raw: Raw = toml::from_str(&file.text).map_err(|e| {
+        let d = Diagnostic::error(format!("invalid symbolic scenario: {}", e.message().trim()))
+            .hint("see docs/guide/sim.md (\"Symbolic simulation\") for the format");
+        vec![match e.span() {
+            Some(s) => d.at(file, s),
+            None => d,
+        }]
+    })?;
+    let mut diags: Vec<Diagnostic> = Vec::new();
+    let mut err = |span: std::ops::Range<usize>, msg: String, hint: String| {
+        diags.push(Diagnostic::error(msg).at(file, span).hint(hint));
+    };
+    let root = format::source::root_for(limits, base);
+    let resolve = |rel: &str| format::source::resolve(root.as_deref(), base, rel);
+    // The domain.
+    let domain = match resolve(raw.domain.get_ref()) {
+        Ok(p) => {
+            let shown = p.display().to_string();
+            match format::source::read(&p, &shown, limits, true) {
+                Ok(f) => match btfsm_plan::load(&f) {
+                    Ok(d) => Some(d),
+                    Err(ds) => return Err(ds),
+                },
+                Err(ds) => return Err(ds),
+            }
+        }
+        Err(r) => {
+            err(
+                raw.domain.span(),
+                format!(
+                    "domain `{}`: {}",
+                    btfsm_core::sanitize::shown(raw.domain.get_ref()),
+                    r.message
+                ),
+                r.hint,
+            );
+            None
+        }
+    };
+    let Some(mut domain) = domain else {
+        return Err(diags);
+    };
+    if let Some(t) = &raw.task
+        && let Err(e) = domain.select_task(t.get_ref())
+    {
+        err(t.span(), e, "name a `[tasks.NAME]` of the domain".into());
+    }
+    let facts = |list: &[Spanned<String>],
+                 diags_err: &mut dyn FnMut(std::ops::Range<usize>, String, String)|
+     -> Vec<Fact> {
+        let mut out = Vec::new();
+        for f in list {
+            match domain.ground_fact(f.get_ref()) {
+                Ok(g) => out.push(g),
+                Err((m, h)) => diags_err(f.span(), m, h),
+            }
+        }
+        out
+    };
+    let initial = facts(&raw.facts, &mut err);
+    let mut disturbances = Vec::new();
+    if raw.disturbances.len() > MAX_ENTRIES || raw.policies.len() > MAX_ENTRIES {
+        err(
+            0..0,
+            format!("more than {MAX_ENTRIES} policies or disturbances"),
+            "split the scenario".into(),
+        );
+    }
+    for d in raw.disturbances.iter().take(MAX_ENTRIES) {
+        let set = facts(&d.set, &mut err);
+        let unset = facts(&d.unset, &mut err);
+        disturbances.push(Disturbance {
+            at: d.at,
+            set,
+            unset,
+        });
+    }
+    let mut rates = BTreeMap::new();
+    let mut mc = Mc::default();
+    let check_rates =
+        |table: &BTreeMap<String, Spanned<f64>>,
+         out: &mut BTreeMap<String, f64>,
+         err: &mut dyn FnMut(std::ops::Range<usize>, String, String)| {
+            for (name, p) in table {
+                if !domain.actions.iter().any(|a| &a.name == name) {
+                    let h = suggest(name, domain.actions.iter().map(|a| a.name.as_str()));
+                    err(
+                        p.span(),
+                        format!(
+                            "no action `{}` in the domain",
+                            btfsm_core::sanitize::shown(name)
+                        ),
+                        h,
+                    );
+                } else if !(0.0..=1.0).contains(p.get_ref()) {
+                    err(
+                        p.span(),
+                        format!("a failure rate is a probability, found {}", p.get_ref()),
+                        "write a number from 0 to 1".into(),
+                    );
+                } else {
+                    out.insert(name.clone(), *p.get_ref());
+                }
+            }
+        };
+    check_rates(&raw.rates, &mut rates, &mut err);
+    if let Some(m) = &raw.monte_carlo {
+        check_rates(&m.rates, &mut mc.rates, &mut err);
+        if let Some(u) = &m.unset {
+            let p = *u.probability.get_ref();
+            if !(0.0..=1.0).contains(&p) {
+                err(
+                    u.probability.span(),
+                    format!("`probability` must be from 0 to 1, found {p}"),
+                    "write e.g. `probability = 0.3`".into(),
+                );
+            }
+            let fs = facts(&u.facts, &mut err);
+            if u.window[0] > u.window[1] {
+                err(
+                    u.probability.span(),
+                    "`window` must be [first, last] with first <= last".into(),
+                    "write e.g. `window = [2, 20]`".into(),
+                );
+            }
+            mc.unset = Some((p, fs, u.window));
+        }
+    }
+    let mut durations = BTreeMap::new();
+    for (name, v) in &raw.durations {
+        if !domain.actions.iter().any(|a| &a.name == name) {
+            let h = suggest(name, domain.actions.iter().map(|a| a.name.as_str()));
+            err(
+                v.span(),
+                format!(
+                    "no action `{}` in the domain",
+                    btfsm_core::sanitize::shown(name)
+                ),
+                h,
+            );
+        } else if *v.get_ref() == 0 || *v.get_ref() > 10_000 {
+            err(
+                v.span(),
+                format!("a duration is 1 to 10000 steps, found {}", v.get_ref()),
+                "write e.g. `Move-To = 3`".into(),
+            );
+        } else {
+            durations.insert(name.clone(), *v.get_ref());
+        }
+    }
+    if raw.max_steps == 0 || raw.max_steps > MAX_STEPS {
+        err(
+            0..0,
+            format!(
+                "`max_steps` must be 1 to {MAX_STEPS}, found {}",
+                raw.max_steps
+            ),
+            "write e.g. `max_steps = 1000`".into(),
+        );
+    }
+    if raw.livelock_repeats < 2 {
+        err(
+            0..0,
+            "`livelock_repeats` must be at least 2".into(),
+            "the default is 3".into(),
+        );
+    }
+    let mut policies = Vec::new();
+    let mut loaded_errors = Vec::new();
+    for p in raw.policies.iter().take(MAX_ENTRIES) {
+        let rel = p.file.get_ref();
+        let path = match resolve(rel) {
+            Ok(x) => x,
+            Err(r) => {
+                err(
+                    p.file.span(),
+                    format!(
+                        "policy file `{}`: {}",
+                        btfsm_core::sanitize::shown(rel),
+                        r.message
+                    ),
+                    r.hint,
+                );
+                continue;
+            }
+        };
+        match format::load(&path, limits) {
+            Ok(l) => match unbound(&domain, &l.policy) {
+                None => policies.push((path, l.policy)),
+                Some(why) => err(
+                    p.file.span(),
+                    format!("policy `{}`: {why}", btfsm_core::sanitize::shown(rel)),
+                    format!(
+                        "bind every leaf to a skill that domain `{}` has a predicate or action for",
+                        btfsm_core::sanitize::shown(&domain.name)
+                    ),
+                ),
+            },
+            Err(ds) => loaded_errors.extend(ds),
+        }
+    }
+    diags.extend(loaded_errors);
+    if !diags.is_empty() {
+        return Err(diags);
+    }
+    Ok(SymScenario {
+        name: raw.name,
+        description: raw.description,
+        goal: domain.goal.facts.clone(),
+        domain: Arc::new(domain),
+        seed: raw.seed,
+        max_steps: raw.max_steps,
+        livelock_repeats: raw.livelock_repeats,
+        max_failures: raw.max_failures,
+        facts: initial,
+        durations,
+        rates,
+        policies,
+        disturbances,
+        mc,
+    })
+}
+
+/// Why a policy cannot run in the domain's world (a leaf or guard bound to
+/// a skill the domain has no predicate or action for), if it cannot.
+fn unbound(d: &Domain, p: &Policy) -> Option<String> {
+    let ok = |c: &btfsm_model::SkillCall| super::world::binding(d, c).is_some();
+    match &p.body {
+        PolicyBody::Bt(bt) => bt
+            .nodes
+            .iter()
+            .find_map(|n| match (&n.skill, n.kind.arity()) {
+                (Some(c), _) if !ok(c) => Some(format!("node `{}` runs `{c}`", n.id)),
+                (None, btfsm_model::bt::Arity::Leaf) => {
+                    Some(format!("leaf `{}` has no skill", n.id))
+                }
+                _ => None,
+            }),
+        PolicyBody::Machine(m) => m.states.iter().find_map(|s| {
+            if let btfsm_model::StateBody::Task(Some(c)) = &s.body
+                && !ok(c)
+            {
+                return Some(format!("state `{}` runs `{c}`", s.name));
+            }
+            s.transitions.iter().find_map(|t| match &t.trigger {
+                btfsm_model::Trigger::Guard(g) => g
+                    .all
+                    .iter()
+                    .find(|term| !ok(&term.condition))
+                    .map(|term| format!("a guard of `{}` checks `{}`", s.name, term.condition)),
+                _ => None,
+            })
+        }),
+    }
+}

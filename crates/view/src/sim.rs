@@ -1,0 +1,338 @@
+//! Replays of the simulator's runs: a scenario run here with its seed, as
+//! `btfsm sim` runs it (its policies side by side, their first divergences
+//! from the behavior-match verdicts of `sim::trace`), or a trace file that
+//! `btfsm sim --trace` wrote (its policies read from the files it names,
+//! inside the root, its verdicts as recorded).
+
+use super::{Divergence, Mark, Panel, Recorder, Replay, Row, Span, ViewError, code, drawn_keys};
+use btfsm_format::Limits;
+use btfsm_render::dot::Status;
+use btfsm_sim::scenario::Scenario;
+use btfsm_sim::trace::{Run, SkillRecord, Step};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// `Move-To(to=table)`: a timeline row's label.
+fn skill_label(skill: &str, args: &[(String, String)]) -> String {
+    let a: Vec<String> = args.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    format!("{skill}({})", a.join(", "))
+}
+
+/// Timeline rows of executed skills, in order of first start; a span's
+/// index is its place in the list.
+fn rows_of(skills: impl Iterator<Item = (String, Span)>) -> Vec<Row> {
+    let mut rows: Vec<Row> = Vec::new();
+    let mut at: HashMap<String, usize> = HashMap::new();
+    for (label, span) in skills {
+        let r = *at.entry(label.clone()).or_insert_with(|| {
+            rows.push(Row {
+                label,
+                spans: Vec::new(),
+            });
+            rows.len() - 1
+        });
+        rows[r].spans.push(span);
+    }
+    rows
+}
+
+fn record_rows(skills: &[SkillRecord]) -> Vec<Row> {
+    rows_of(skills.iter().enumerate().map(|(i, k)| {
+        let args: Vec<(String, String)> =
+            k.args.iter().map(|(a, b)| (a.clone(), b.clone())).collect();
+        (
+            skill_label(&k.skill, &args),
+            Span {
+                start: k.start,
+                end: k.end,
+                outcome: k.outcome.clone(),
+                index: i,
+            },
+        )
+    }))
+}
+
+fn status_code(s: &str) -> u8 {
+    code(Status::from_outcome(s))
+}
+
+/// A policy's vertex keys, their other names, and the policy's name.
+type Drawn = (Vec<String>, Vec<(String, usize)>, String);
+
+/// Collects each run's statuses as the runs are made (`TraceOut`).
+struct Collect {
+    recorders: Vec<Recorder>,
+    keys: Vec<Drawn>,
+    err: Option<ViewError>,
+}
+
+impl btfsm_sim::run::TraceOut for Collect {
+    fn begin(&mut self) {
+        let (keys, alias, _) = &self.keys[self.recorders.len()];
+        self.recorders.push(Recorder::new(keys.clone(), alias));
+    }
+
+    fn step(&mut self, st: &Step) {
+        if self.err.is_some() {
+            return;
+        }
+        let i = self.recorders.len() - 1;
+        let name = &self.keys[i].2;
+        let statuses = st
+            .statuses
+            .iter()
+            .map(|(k, s)| (k.as_str(), status_code(s)));
+        if let Err(e) = self.recorders[i].snapshot(name, st.t, statuses) {
+            self.err = Some(e);
+        }
+    }
+
+    fn end(&mut self, _run: &Run) {}
+}
+
+fn subtitle(file: &str, outcome: &str, reason: &str, steps: u64) -> String {
+    format!("{file} · {outcome} after {steps} steps ({reason})")
+}
+
+/// Marks the first divergence of every pair of runs in both panels.
+fn mark(panels: &mut [Panel], divs: &[Divergence], index: &[(usize, usize)]) {
+    for (d, &(ia, ib)) in divs.iter().zip(index) {
+        let (na, nb) = (panels[d.a].title.clone(), panels[d.b].title.clone());
+        panels[d.a].marks.push(Mark {
+            t: d.t,
+            index: ia,
+            text: format!("first divergence from `{nb}`: {}", d.text),
+        });
+        panels[d.b].marks.push(Mark {
+            t: d.t,
+            index: ib,
+            text: format!("first divergence from `{na}`: {}", d.text),
+        });
+    }
+}
+
+/// Runs a scenario's policies (seed: `seed`, else the scenario's) and
+/// makes their replay.
+pub fn from_scenario(s: &Scenario, file: &str) -> Result<Replay, ViewError> {
+    let mut collect = Collect {
+        recorders: Vec::new(),
+        keys: s
+            .policies
+            .iter()
+            .map(|e| {
+                let (k, a) = drawn_keys(&e.policy);
+                (k, a, e.policy.name.clone())
+            })
+            .collect(),
+        err: None,
+    };
+    let (runs, _cut) = btfsm_sim::run::run_scenario_traced(s, None, &mut collect);
+    if let Some(e) = collect.err {
+        return Err(e);
+    }
+    // The page shows the first divergences, which the path distance does
+    // not change: trajectories thinned to two points keep the 2,016 pairs
+    // of 64 policies cheap.
+    let verdicts = btfsm_sim::trace::verdicts(&runs, 2);
+    let mut panels: Vec<Panel> = Vec::new();
+    for ((e, run), rec) in s.policies.iter().zip(&runs).zip(collect.recorders) {
+        panels.push(Panel {
+            title: run.policy.clone(),
+            subtitle: subtitle(&run.file, run.outcome.as_str(), &run.reason, run.steps),
+            policy: e.policy.clone(),
+            rec,
+            rows: record_rows(&run.skills),
+            marks: Vec::new(),
+        });
+    }
+    let pos = |name: &str| runs.iter().position(|r| r.policy == name);
+    let mut divs = Vec::new();
+    let mut index = Vec::new();
+    for v in &verdicts {
+        if let (Some(d), Some(a), Some(b)) = (&v.first_divergence, pos(&v.a), pos(&v.b)) {
+            divs.push(Divergence {
+                a,
+                b,
+                t: d.t,
+                text: d.summary(),
+            });
+            index.push((d.index, d.index));
+        }
+    }
+    mark(&mut panels, &divs, &index);
+    Ok(Replay {
+        title: format!("{} (seed {})", s.name, s.seed),
+        subtitle: s
+            .description
+            .clone()
+            .unwrap_or_else(|| format!("scenario {file}")),
+        step_name: format!("step of {} s", s.dt),
+        panels,
+        divergences: divs,
+    })
+}
+
+fn str_of<'a>(v: &'a serde_json::Value, what: &str) -> Result<&'a str, ViewError> {
+    v.as_str()
+        .ok_or_else(|| ViewError::Input(format!("`{what}` is not a string")))
+}
+
+/// A trace of `btfsm sim --trace`: the policies it names read from their
+/// files (paths as `sim` wrote them: relative to the current directory,
+/// and inside `root` unless it is `None`).
+#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+pub fn from_trace(
+    text: &str,
+    shown: &str,
+    root: Option<&Path>,
+    limits: &Limits,
+) -> Result<Replay, ViewError> {
+    let bad = |m: String| {
+        ViewError::Input(format!(
+            "`{shown}` is not a trace written by `btfsm sim --trace`: {m}"
+        ))
+    };
+    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+    let runs = v["policies"]
+        .as_array()
+        .ok_or_else(|| bad("no `policies` array".into()))?;
+    let mut panels = Vec::new();
+    for (i, run) in runs.iter().enumerate() {
+        let name = str_of(&run["policy"], "policy").map_err(|e| bad(e.to_string()))?;
+        let file = str_of(&run["file"], "file").map_err(|e| bad(e.to_string()))?;
+        let path = btfsm_format::source::resolve(root, Path::new("."), file).map_err(|r| {
+            ViewError::Input(format!(
+                "{shown}: policy {} names the file `{}`: {}\n  = hint: {}",
+                i + 1,
+                btfsm_core::sanitize::shown(file),
+                r.message,
+                r.hint
+            ))
+        })?;
+        let loaded = btfsm_format::load(&path, limits).map_err(ViewError::Diagnostics)?;
+        let mut policy = if run["convert"] == "hfsm" {
+            btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&loaded.policy)
+                .map_err(|e| ViewError::Input(format!("{file}: {}", e[0])))?
+        } else {
+            loaded.policy
+        };
+        // Named as it ran (a scenario may rename it).
+        policy.name = name.to_string();
+        let (keys, alias) = drawn_keys(&policy);
+        let mut rec = Recorder::new(keys, &alias);
+        let empty = Vec::new();
+        for st in run["trace"].as_array().unwrap_or(&empty) {
+            let t = st["t"].as_f64().unwrap_or(f64::NAN);
+            let pairs = st["statuses"].as_array().unwrap_or(&empty);
+            let statuses = pairs
+                .iter()
+                .filter_map(|p| Some((p[0].as_str()?, status_code(p[1].as_str().unwrap_or("")))));
+            rec.snapshot(name, t, statuses)?;
+        }
+        let skills = run["skills"].as_array().unwrap_or(&empty);
+        let rows = rows_of(skills.iter().enumerate().map(|(i, k)| {
+            let args: Vec<(String, String)> = k["args"]
+                .as_object()
+                .map(|o| {
+                    o.iter()
+                        .map(|(a, b)| (a.clone(), b.as_str().unwrap_or("").to_string()))
+                        .collect()
+                })
+                .unwrap_or_default();
+            (
+                skill_label(k["skill"].as_str().unwrap_or("?"), &args),
+                Span {
+                    start: k["start"].as_f64().unwrap_or(0.0),
+                    end: k["end"].as_f64(),
+                    outcome: k["outcome"].as_str().unwrap_or("").to_string(),
+                    index: i,
+                },
+            )
+        }));
+        panels.push(Panel {
+            title: name.to_string(),
+            subtitle: subtitle(
+                file,
+                run["outcome"].as_str().unwrap_or("?"),
+                run["reason"].as_str().unwrap_or(""),
+                run["steps"].as_u64().unwrap_or(rec.times.len() as u64),
+            ),
+            policy,
+            rec,
+            rows,
+            marks: Vec::new(),
+        });
+    }
+    let pos = |n: &serde_json::Value| panels.iter().position(|p| n == p.title.as_str());
+    let mut divs = Vec::new();
+    let mut index = Vec::new();
+    let empty = Vec::new();
+    for verdict in v["verdicts"].as_array().unwrap_or(&empty) {
+        let d = &verdict["first_divergence"];
+        if let (Some(a), Some(b), Some(t), Some(k)) = (
+            pos(&verdict["a"]),
+            pos(&verdict["b"]),
+            d["t"].as_f64(),
+            d["index"].as_u64(),
+        ) {
+            let side = |x: &str| d[x].as_str().unwrap_or("(none)").to_string();
+            divs.push(Divergence {
+                a,
+                b,
+                t,
+                text: format!(
+                    "at {t} s, skill {}: {} | {}",
+                    k.saturating_add(1),
+                    side("a"),
+                    side("b")
+                ),
+            });
+            index.push((k as usize, k as usize));
+        }
+    }
+    mark(&mut panels, &divs, &index);
+    let scenario = v["scenario"].as_str().unwrap_or("trace");
+    Ok(Replay {
+        title: format!("{scenario} (seed {})", v["seed"].as_u64().unwrap_or(0)),
+        subtitle: format!("trace {shown}"),
+        step_name: format!("step of {} s", v["dt"].as_f64().unwrap_or(0.0)),
+        panels,
+        divergences: divs,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A trace from a stranger: wrong types, missing fields, hostile
+    /// values give an error or a replay, never a panic.
+    #[test]
+    fn malformed_traces_never_panic() {
+        let fig = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../policies/paper/fig01-bt.toml"
+        );
+        let cases = [
+            "{}".to_string(),
+            "[]".into(),
+            r#"{"policies": 3}"#.into(),
+            r#"{"policies": [{}]}"#.into(),
+            format!(r#"{{"policies": [{{"policy": 1, "file": "{fig}"}}]}}"#),
+            format!(
+                r#"{{"policies": [{{"policy": "p", "file": "{fig}", "trace": [{{"t": "x", "statuses": [[1, 2], ["moma"], ["moma", "RUNNING", 3], "s"]}}, 7, {{"t": 1e308}}], "skills": [{{"skill": 3, "args": [1], "start": null, "end": "x"}}, 5]}}], "verdicts": [{{"a": "p", "b": "p", "first_divergence": {{"t": -1e308, "index": 18446744073709551615}}}}, 3]}}"#
+            ),
+            format!(
+                r#"{{"policies": [{{"policy": "p", "file": "{fig}", "convert": "hfsm", "trace": [{{"t": 0, "statuses": [["moma/deliver", "SUCCESS"]]}}]}}]}}"#
+            ),
+        ];
+        for c in &cases {
+            let _ = from_trace(c, "t.json", None, &Limits::default());
+        }
+        let ok = from_trace(&cases[5], "t.json", None, &Limits::default()).unwrap();
+        assert_eq!(ok.panels[0].rec.times.len(), 3);
+        assert_eq!(ok.divergences.len(), 1);
+        let html = super::super::html::page(&ok, std::time::Duration::from_secs(60)).unwrap();
+        assert!(html.contains("btfsm-data"));
+    }
+}

@@ -1,8 +1,0 @@
-//! The paper's metrics (sec. IV), one per file, all computed from the graphs of
-//! `crate::graph`.
-
-pub mod complexity;
-pub mod counts;
-pub mod effort;
-pub mod ged;
-pub mod ted;
