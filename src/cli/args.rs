@@ -1,6 +1,5 @@
 //! Raw command-line flags (clap derive).
 
-use btfsm_report::OutputFormat;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -19,145 +18,18 @@ pub(crate) struct Cli {
 #[derive(Debug, Subcommand)]
 pub(crate) enum Command {
     /// Counts, complexity and Table I estimates of each policy
-    Analyze {
-        /// Policy files (TOML, BehaviorTree.CPP XML, SCXML, yasmin XML), `-`
-        /// for stdin, or directories (every policy file below, sorted)
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Output format
-        #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
-        format: OutputFormat,
-        /// Exit 1 when a policy's METRIC is above N, e.g. `--max cc=30`
-        /// (repeatable; metrics: vertices, edges, graphical_elements,
-        /// active_elements, cc, essential_cc)
-        #[arg(long = "max", value_name = "METRIC=N")]
-        max: Vec<btfsm_report::gate::Limit>,
-        /// A previous `analyze --format json` output: exit 1 when a policy's
-        /// metric grew over it by more than --max-increase allows
-        #[arg(long, value_name = "OLD.json")]
-        baseline: Option<PathBuf>,
-        /// How much METRIC may grow over the baseline (repeatable; default
-        /// `cc=0` and `essential_cc=0`)
-        #[arg(long = "max-increase", value_name = "METRIC=N", requires = "baseline")]
-        max_increase: Vec<btfsm_report::gate::Limit>,
-        #[command(flatten)]
-        limits: LimitArgs,
-    },
+    Analyze(super::analyze::AnalyzeArgs),
     /// Checks policy files and reports every problem with its position
-    Validate {
-        /// Policy or scenario files, `-` for stdin, or directories (every
-        /// policy and scenario file below, sorted)
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        #[command(flatten)]
-        limits: LimitArgs,
-    },
+    Validate(super::validate::ValidateArgs),
     /// Draws a policy as Graphviz DOT (or SVG/PNG with --render)
-    Dot {
-        /// Policy file (any format), or `-` for stdin
-        file: PathBuf,
-        /// Output file (default: stdout)
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Render with Graphviz's `dot` instead of printing DOT (default: the
-        /// extension of -o when it is .svg, .png or .pdf, else DOT text)
-        #[arg(long, value_enum)]
-        render: Option<btfsm_render::dot::RenderFormat>,
-        /// With --render: Graphviz's time budget; past it `dot` is killed
-        /// and the run exits 2
-        #[arg(long, default_value_t = btfsm_render::dot::DEFAULT_RENDER_TIMEOUT_MS, value_name = "MS")]
-        timeout_ms: u64,
-        /// Colour nodes by their status at --step in a `sim --trace` file
-        #[command(flatten)]
-        trace: super::sim::DotTraceArgs,
-        #[command(flatten)]
-        look: DotLookArgs,
-        #[command(flatten)]
-        limits: LimitArgs,
-    },
+    Dot(super::dot::DotArgs),
     /// Graph edit distance between two policies (and, for two BTs, the
     /// ordered tree edit distance), with the edit script
-    Compare {
-        /// The old policy
-        a: PathBuf,
-        /// The new policy
-        b: PathBuf,
-        /// Which distance: a GED — structural (any vertex to any vertex),
-        /// labeled (same vertex type only), named (by node id / state name) —
-        /// or tree, the ordered tree edit distance of two BTs (children
-        /// order and node labels count); all: the three GEDs, and tree when
-        /// both policies are BTs
-        #[arg(long, value_enum, default_value_t = CompareMode::All)]
-        mode: CompareMode,
-        /// Wall-clock safety cap per mode, its whole computation (graphs,
-        /// search, edit script; docs/robustness.md gives the floor on large
-        /// graphs). The work budget (--work) decides the result; when this
-        /// cap ends a search first the report says `stopped_by: timeout`
-        #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_TIMEOUT_MS, value_name = "MS")]
-        timeout_ms: u64,
-        /// Work budget of the exact search per mode, in work units (one per
-        /// assignment-matrix entry the search builds; 15-80 ns each: the
-        /// default is about 4-5 s on the hardest pairs measured, idle).
-        /// The same pair gives the same result (GED, exact, interval) on any
-        /// machine under any load; when the budget runs out the result is a
-        /// certified interval with `exact: false` and `stopped_by: work`
-        #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_WORK, value_name = "UNITS")]
-        work: u64,
-        /// Work budget of --mode tree, in table cells (the default takes 1-3 s;
-        /// memory is capped at 2^25 cells, 128 MiB): past it the result is an
-        /// interval with `exact: false`, the same on any machine
-        #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
-        tree_max_work: u64,
-        /// Output format
-        #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
-        format: CompareFormat,
-        /// Also draw B with added elements magenta, A's removed ones dashed
-        /// grey and changed ones (relabels, reorders) orange with their old
-        /// value, a title and a legend (the edit script of --mode; named when
-        /// all modes run)
-        #[arg(long, value_name = "OUT")]
-        dot: Option<PathBuf>,
-        /// With --dot: render through Graphviz instead of writing DOT (under
-        /// the --timeout-ms budget of one mode: past it `dot` is killed);
-        /// default: the extension of --dot when it is .svg, .png or .pdf
-        #[arg(long, value_enum, requires = "dot")]
-        render: Option<btfsm_render::dot::RenderFormat>,
-        #[command(flatten)]
-        limits: LimitArgs,
-    },
+    Compare(super::compare::CompareArgs),
     /// Converts a policy into another representation
-    Convert {
-        /// Policy file (any format), or `-` for stdin
-        file: PathBuf,
-        /// Target representation
-        #[arg(long, value_enum)]
-        to: ConvertTarget,
-        /// Output file (default: stdout)
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// With --to fault-tolerant: the action domain giving the skills'
-        /// preconditions and effects (default: the built-in
-        /// policies/domains/moma.toml)
-        #[arg(long, value_name = "DOMAIN.toml")]
-        domain: Option<PathBuf>,
-        #[command(flatten)]
-        limits: LimitArgs,
-    },
+    Convert(super::convert::ConvertArgs),
     /// Effort (Eq. 4/5) to make an FSM reactive: formula and measured named GED
-    Effort {
-        /// FSM files (any policy format), `-` for stdin, or directories
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Output format
-        #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
-        format: OutputFormat,
-        /// Time budget of the structural GED per policy; when it runs out the
-        /// result is a certified interval (the named GED has no budget)
-        #[arg(long, default_value_t = 2000, value_name = "MS")]
-        timeout_ms: u64,
-        #[command(flatten)]
-        limits: LimitArgs,
-    },
+    Effort(super::effort::EffortArgs),
     /// Reproduces the paper's Tables I-III and effort examples from policies/paper
     Paper(PaperArgs),
     /// The paper's edit operations: insert a BT subtree, add an (H)FSM state
@@ -190,17 +62,10 @@ pub(crate) enum Command {
     TedPairs(super::ted_pairs::TedPairsArgs),
     /// Prints a shell completion script (e.g. `btfsm completions bash >
     /// ~/.local/share/bash-completion/completions/btfsm`)
-    Completions {
-        /// The shell to complete in
-        #[arg(value_enum)]
-        shell: clap_complete::Shell,
-    },
+    Completions(super::completions::CompletionsArgs),
     /// Prints the man page (roff; `make man` writes target/man/btfsm*.1)
     #[command(hide = true)]
-    Man {
-        /// A subcommand's page instead of the main one (`btfsm-sim.1`)
-        subcommand: Option<String>,
-    },
+    Man(super::man::ManArgs),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -6,47 +6,83 @@
 //! default, for two BTs) adds the ordered tree edit distance
 //! (`metrics::ted`), bounded by a count of table cells.
 
-use super::args::{CompareFormat, CompareMode};
-use super::commands::{draw, emit_text, load_all};
+use super::args::{CompareFormat, CompareMode, LimitArgs};
+use super::dot::draw;
+use super::io::{emit_text, fail, load_all, outputs_distinct};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_core::sanitize::shown;
-use btfsm_format::Limits;
 use btfsm_metrics::ged::{GedMode, GedOptions};
 use btfsm_metrics::ted::TedOptions;
 use btfsm_model::{PolicyBody, PolicyKind};
-use btfsm_render::dot::RenderFormat;
 use btfsm_report::compare::{self, Pair, Side};
+use clap::Args;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-/// Validated arguments of `compare`.
-pub(super) struct CompareArgs {
-    pub a: PathBuf,
-    pub b: PathBuf,
-    pub mode: CompareMode,
-    pub timeout_ms: u64,
-    /// Work budget (`GedOptions::work`).
-    pub work: u64,
-    pub tree_max_work: u64,
-    pub format: CompareFormat,
-    pub dot: Option<PathBuf>,
-    pub render: Option<RenderFormat>,
-    pub limits: Limits,
+#[derive(Debug, Args)]
+pub(crate) struct CompareArgs {
+    /// The old policy
+    pub(super) a: PathBuf,
+    /// The new policy
+    pub(super) b: PathBuf,
+    /// Which distance: a GED — structural (any vertex to any vertex),
+    /// labeled (same vertex type only), named (by node id / state name) —
+    /// or tree, the ordered tree edit distance of two BTs (children
+    /// order and node labels count); all: the three GEDs, and tree when
+    /// both policies are BTs
+    #[arg(long, value_enum, default_value_t = CompareMode::All)]
+    pub(super) mode: CompareMode,
+    /// Wall-clock safety cap per mode, its whole computation (graphs,
+    /// search, edit script; docs/robustness.md gives the floor on large
+    /// graphs). The work budget (--work) decides the result; when this
+    /// cap ends a search first the report says `stopped_by: timeout`
+    #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_TIMEOUT_MS, value_name = "MS")]
+    pub(super) timeout_ms: u64,
+    /// Work budget of the exact search per mode, in work units (one per
+    /// assignment-matrix entry the search builds; 15-80 ns each: the
+    /// default is about 4-5 s on the hardest pairs measured, idle).
+    /// The same pair gives the same result (GED, exact, interval) on any
+    /// machine under any load; when the budget runs out the result is a
+    /// certified interval with `exact: false` and `stopped_by: work`
+    #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_WORK, value_name = "UNITS")]
+    pub(super) work: u64,
+    /// Work budget of --mode tree, in table cells (the default takes 1-3 s;
+    /// memory is capped at 2^25 cells, 128 MiB): past it the result is an
+    /// interval with `exact: false`, the same on any machine
+    #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
+    pub(super) tree_max_work: u64,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
+    pub(super) format: CompareFormat,
+    /// Also draw B with added elements magenta, A's removed ones dashed
+    /// grey and changed ones (relabels, reorders) orange with their old
+    /// value, a title and a legend (the edit script of --mode; named when
+    /// all modes run)
+    #[arg(long, value_name = "OUT")]
+    pub(super) dot: Option<PathBuf>,
+    /// With --dot: render through Graphviz instead of writing DOT (under
+    /// the --timeout-ms budget of one mode: past it `dot` is killed);
+    /// default: the extension of --dot when it is .svg, .png or .pdf
+    #[arg(long, value_enum, requires = "dot")]
+    pub(super) render: Option<btfsm_render::dot::RenderFormat>,
+    #[command(flatten)]
+    pub(super) limits: LimitArgs,
 }
 
-pub(super) fn execute(args: CompareArgs) -> u8 {
-    if !super::commands::outputs_distinct(&[("--dot", args.dot.as_deref())], true) {
+pub(super) fn run(args: CompareArgs) -> u8 {
+    if !outputs_distinct(&[("--dot", args.dot.as_deref())], true) {
         return EXIT_BAD_INPUT;
     }
     if args.mode == CompareMode::Tree && args.dot.is_some() {
-        eprintln!(
-            "error: --dot draws a GED edit script, and --mode tree computes none\n  = hint: use --dot with --mode named (or structural, labeled, all)"
+        return fail(
+            Diagnostic::error("--dot draws a GED edit script, and --mode tree computes none")
+                .hint("use --dot with --mode named (or structural, labeled, all)"),
         );
-        return EXIT_BAD_INPUT;
     }
-    let Some(loaded) = load_all(&[args.a.clone(), args.b.clone()], &args.limits) else {
+    let Some(loaded) = load_all(&[args.a.clone(), args.b.clone()], &args.limits.limits()) else {
         return EXIT_BAD_INPUT;
     };
     let [la, lb] = loaded.as_slice() else {
@@ -62,12 +98,14 @@ pub(super) fn execute(args: CompareArgs) -> u8 {
         } else {
             la
         };
-        eprintln!(
-            "error: --mode tree compares two Behavior Trees, and {} is an {}\n  = hint: FSMs and HFSMs are graphs, not ordered trees: use --mode structural, labeled or named (or leave --mode out)",
-            shown(&other.path),
-            other.policy.kind().as_str().to_uppercase(),
+        return fail(
+            Diagnostic::error(format!(
+                "--mode tree compares two Behavior Trees, and {} is an {}",
+                shown(&other.path),
+                other.policy.kind().as_str().to_uppercase(),
+            ))
+            .hint("FSMs and HFSMs are graphs, not ordered trees: use --mode structural, labeled or named (or leave --mode out)"),
         );
-        return EXIT_BAD_INPUT;
     }
     let opts = GedOptions {
         timeout: Duration::from_millis(args.timeout_ms),

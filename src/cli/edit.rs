@@ -4,9 +4,10 @@
 //! to stderr.
 
 use super::args::{AddKind, EditArgs, EditOp, WrapKind};
-use super::commands::{emit_text, load_one};
+use super::io::{emit_text, fail, load_one};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
-use btfsm_core::sanitize::{shown, shown_max};
+use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::sanitize::shown;
 use btfsm_model::{BtNodeKind, PolicyBody, SkillCall};
 use btfsm_transform::edit::{self, AddState, EditError, Touched};
 use std::collections::BTreeMap;
@@ -19,18 +20,20 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
     };
     let mut policy = loaded.policy;
     let kind = policy.kind();
-    let fail = |e: EditError| {
-        eprintln!(
-            "error: {}: {}",
-            shown(&loaded.path),
-            shown_max(&e.to_string(), 1000)
-        );
-        EXIT_BAD_INPUT
+    let edit_failed = |e: EditError| {
+        let d = Diagnostic::error(format!("{}: {}", shown(&loaded.path), e.message));
+        super::io::fail(match e.hint {
+            Some(h) => d.hint(h),
+            None => d,
+        })
     };
     let wrong_kind = |op: &str, want: &str| {
-        eprintln!(
-            "error: {}: {op} edits {want}, and this policy is a {kind}",
-            shown(&loaded.path)
+        eprint!(
+            "{}",
+            Diagnostic::error(format!(
+                "{}: {op} edits {want}, and this policy is a {kind}",
+                shown(&loaded.path)
+            ))
         );
         EXIT_BAD_INPUT
     };
@@ -48,16 +51,15 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
                 return EXIT_BAD_INPUT;
             };
             let PolicyBody::Bt(sub_bt) = &sub.policy.body else {
-                eprintln!(
-                    "error: {}: the subtree must be a BT, and this is a {}",
+                return fail(Diagnostic::error(format!(
+                    "{}: the subtree must be a BT, and this is a {}",
                     shown(&sub.path),
                     sub.policy.kind()
-                );
-                return EXIT_BAD_INPUT;
+                )));
             };
             match edit::insert_subtree(bt, parent, *index, sub_bt, prefix.as_deref()) {
                 Ok(t) => t,
-                Err(e) => return fail(e),
+                Err(e) => return edit_failed(e),
             }
         }
         (EditOp::WrapRoot { kind, id, name }, PolicyBody::Bt(bt)) => {
@@ -67,7 +69,7 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
             };
             match edit::wrap_root(bt, k, id, name.as_deref()) {
                 Ok(t) => t,
-                Err(e) => return fail(e),
+                Err(e) => return edit_failed(e),
             }
         }
         (
@@ -92,10 +94,10 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
             };
             for kv in args {
                 let Some((k, v)) = kv.split_once('=') else {
-                    eprintln!(
-                        "error: invalid --arg `{kv}`\n  = hint: write key=value, e.g. --arg target=cube2"
+                    return fail(
+                        Diagnostic::error(format!("invalid --arg `{kv}`"))
+                            .hint("write key=value, e.g. --arg target=cube2"),
                     );
-                    return EXIT_BAD_INPUT;
                 };
                 call.args
                     .insert(k.trim().to_string(), edit::parse_value(v.trim()));
@@ -109,7 +111,7 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
                 parse(selector_guard, selector_guard_label),
             ) {
                 (Ok(g), Ok(s)) => (g, s),
-                (Err(e), _) | (_, Err(e)) => return fail(e),
+                (Err(e), _) | (_, Err(e)) => return edit_failed(e),
             };
             let spec = AddState {
                 kind: match kind {
@@ -127,7 +129,7 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
             };
             match edit::add_state(m, &spec) {
                 Ok(t) => t,
-                Err(e) => return fail(e),
+                Err(e) => return edit_failed(e),
             }
         }
         (EditOp::AddState { .. }, _) => return wrong_kind("add-state", "FSMs and HFSMs"),
@@ -136,14 +138,13 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
     let text = match btfsm_format::toml_write::write_policy_within(&policy, limits.max_file_bytes) {
         Ok(t) => t,
         Err(e) => {
-            eprintln!("error: {e}");
-            return EXIT_BAD_INPUT;
+            return fail(Diagnostic::error(format!("{e}")));
         }
     };
     // The result must read back: an edit never writes an invalid file.
     let base = a.file.parent().unwrap_or(std::path::Path::new(""));
     if let Err(diags) = btfsm_format::toml::parse_str("edited policy", &text, base, &limits) {
-        eprintln!("error: the edited policy is not valid:");
+        eprint!("{}", Diagnostic::error("the edited policy is not valid:"));
         for d in diags {
             eprint!("{d}");
         }

@@ -3,8 +3,9 @@
 //! JSON or SARIF 2.1.0; exit 1 when an error-level finding remains, 2 when
 //! an input does not load (its errors printed, the others still linted).
 
-use super::commands::{emit_text, print_diagnostics};
+use super::io::{emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_format as format;
 use btfsm_lint::{self as lint, Level, config};
 use clap::{Args, ValueEnum};
@@ -85,7 +86,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
     ] {
         for c in codes {
             if let Err(e) = cfg.set(c, level) {
-                let _ = writeln!(err, "error: {e}");
+                let _ = write!(err, "{}", Diagnostic::error(e.to_string()));
                 return EXIT_BAD_INPUT;
             }
         }
@@ -100,7 +101,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
     };
     // BehaviorTree.CPP files given together resolve each other's SubTrees
     // (and models), as `analyze` reads them.
-    let (limits, only) = match super::commands::with_companions(&inputs, &limits) {
+    let (limits, only) = match super::io::with_companions(&inputs, &limits) {
         Ok(x) => x,
         Err(d) => {
             print_diagnostics(&mut err, &[d]);
@@ -112,7 +113,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
     let mut models = SiblingModels::default();
     for input in &inputs {
         if let Some(only) = &only
-            && super::commands::is_btcpp_candidate(&input.path)
+            && super::io::is_btcpp_candidate(&input.path)
             && !only.contains(&input.path)
         {
             continue;

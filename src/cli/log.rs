@@ -2,8 +2,9 @@
 //! BehaviorTree.CPP `FileLogger2` log (src/log/); `--min-coverage` makes it
 //! a CI gate (exit 1 below it).
 
-use super::commands::emit_text;
+use super::io::{emit_text, fail};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_log::report;
 use clap::{Args, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -150,8 +151,9 @@ pub(super) fn execute(a: LogArgs) -> u8 {
     if let Some(x) = a.min_coverage
         && !(0.0..=1.0).contains(&x)
     {
-        eprintln!("error: --min-coverage must be a ratio from 0 to 1, found {x}");
-        return EXIT_BAD_INPUT;
+        return fail(Diagnostic::error(format!(
+            "--min-coverage must be a ratio from 0 to 1, found {x}"
+        )));
     }
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
@@ -162,12 +164,7 @@ pub(super) fn execute(a: LogArgs) -> u8 {
     let mut r = match report::report(&shown, opened.reader, limits.max_file_bytes) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!(
-                "error: {}: {}\n  = hint: a BehaviorTree.CPP 4 FileLogger2 log (.btlog) is the header `BTCPP4-FileLogger2`, the tree XML, a timestamp and 9-byte records; a SqliteLogger log (.db3) an SQLite database",
-                btfsm_core::sanitize::shown(&shown),
-                btfsm_core::sanitize::shown(&e.to_string())
-            );
-            return EXIT_BAD_INPUT;
+            return fail(Diagnostic::error(format!("{}: {}", btfsm_core::sanitize::shown(&shown), btfsm_core::sanitize::shown(&e.to_string()))).hint("a BehaviorTree.CPP 4 FileLogger2 log (.btlog) is the header `BTCPP4-FileLogger2`, the tree XML, a timestamp and 9-byte records; a SqliteLogger log (.db3) an SQLite database"));
         }
     };
     r.session = opened.session;
@@ -190,9 +187,12 @@ pub(super) fn execute(a: LogArgs) -> u8 {
     }
     match a.min_coverage {
         Some(x) if r.node_coverage.ratio < x || r.branch_coverage.ratio < x => {
-            eprintln!(
-                "error: coverage below {x}: node {:.3}, branch {:.3}",
-                r.node_coverage.ratio, r.branch_coverage.ratio
+            eprint!(
+                "{}",
+                Diagnostic::error(format!(
+                    "coverage below {x}: node {:.3}, branch {:.3}",
+                    r.node_coverage.ratio, r.branch_coverage.ratio
+                ))
             );
             EXIT_CHECK_FAILED
         }
@@ -206,8 +206,9 @@ fn dot(a: DotArgs) -> u8 {
     let at = match (a.at, a.step) {
         (Some(t), _) if t.is_finite() && t >= 0.0 => At::Time((t * 1e6) as u64),
         (Some(t), _) => {
-            eprintln!("error: --at must be a time in seconds from 0, found {t}");
-            return EXIT_BAD_INPUT;
+            return fail(Diagnostic::error(format!(
+                "--at must be a time in seconds from 0, found {t}"
+            )));
         }
         (None, Some(k)) => At::Step(k),
         (None, None) => unreachable!("clap requires one"),
@@ -221,12 +222,11 @@ fn dot(a: DotArgs) -> u8 {
     let r = match replay(file, at, &limits) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!(
-                "error: {}: {}",
+            return fail(Diagnostic::error(format!(
+                "{}: {}",
                 btfsm_core::sanitize::shown(&shown),
                 btfsm_core::sanitize::shown(&e.to_string())
-            );
-            return EXIT_BAD_INPUT;
+            )));
         }
     };
     let mut opts = DotOptions::default();
@@ -245,7 +245,7 @@ fn dot(a: DotArgs) -> u8 {
         r.t_usec as f64 / 1e6,
         r.applied
     ));
-    super::commands::draw(
+    super::dot::draw(
         &r.policy,
         &opts,
         a.output.as_deref(),
@@ -255,10 +255,13 @@ fn dot(a: DotArgs) -> u8 {
 }
 
 fn bad_log(shown: &str, e: &str) -> u8 {
-    eprintln!(
-        "error: {}: {}",
-        btfsm_core::sanitize::shown(shown),
-        btfsm_core::sanitize::shown_max(e, 1000)
+    eprint!(
+        "{}",
+        Diagnostic::error(format!(
+            "{}: {}",
+            btfsm_core::sanitize::shown(shown),
+            btfsm_core::sanitize::shown_max(e, 1000)
+        ))
     );
     EXIT_BAD_INPUT
 }
@@ -268,12 +271,14 @@ fn compare(a: CompareArgs) -> u8 {
     if let Some(t) = a.tolerance
         && !(t.is_finite() && t >= 0.0)
     {
-        eprintln!("error: --tolerance must be a number of seconds from 0, found {t}");
-        return EXIT_BAD_INPUT;
+        return fail(Diagnostic::error(format!(
+            "--tolerance must be a number of seconds from 0, found {t}"
+        )));
     }
     if a.a.as_os_str() == "-" && a.b.as_os_str() == "-" {
-        eprintln!("error: only one of the two runs can be `-` (stdin)");
-        return EXIT_BAD_INPUT;
+        return fail(Diagnostic::error(
+            "only one of the two runs can be `-` (stdin)",
+        ));
     }
     let limits = a.limits.limits();
     let mut sides = Vec::new();
@@ -312,25 +317,22 @@ fn compare(a: CompareArgs) -> u8 {
 }
 
 fn bad_run(e: &btfsm_log::compare::CompareError) -> u8 {
-    eprintln!(
-        "error: {}\n  = hint: each run is a BehaviorTree.CPP 4 FileLogger2 log (.btlog) or what `btfsm sim --format json` or `--trace` writes",
-        btfsm_core::sanitize::shown_max(&e.to_string(), 4000)
-    );
+    eprint!("{}", Diagnostic::error(format!("{}", btfsm_core::sanitize::shown_max(&e.to_string(), 4000))).hint("each run is a BehaviorTree.CPP 4 FileLogger2 log (.btlog) or what `btfsm sim --format json` or `--trace` writes"));
     EXIT_BAD_INPUT
 }
 
 fn timeline(a: TimelineArgs) -> u8 {
     use btfsm_log::timeline::MAX_WIDTH;
     if !(100..=MAX_WIDTH).contains(&a.width) {
-        eprintln!(
-            "error: --width must be from 100 to {MAX_WIDTH} pixels, found {}",
+        return fail(Diagnostic::error(format!(
+            "--width must be from 100 to {MAX_WIDTH} pixels, found {}",
             a.width
-        );
-        return EXIT_BAD_INPUT;
+        )));
     }
     if a.log.as_os_str() == "-" {
-        eprintln!("error: log timeline reads its log twice: give a file, not `-`");
-        return EXIT_BAD_INPUT;
+        return fail(Diagnostic::error(
+            "log timeline reads its log twice: give a file, not `-`",
+        ));
     }
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
@@ -346,10 +348,13 @@ fn timeline(a: TimelineArgs) -> u8 {
     match t {
         Ok(t) => emit_text(a.output.as_deref(), t.svg),
         Err(e) => {
-            eprintln!(
-                "error: {}: {}",
-                btfsm_core::sanitize::shown(&shown),
-                btfsm_core::sanitize::shown(&e.to_string())
+            eprint!(
+                "{}",
+                Diagnostic::error(format!(
+                    "{}: {}",
+                    btfsm_core::sanitize::shown(&shown),
+                    btfsm_core::sanitize::shown(&e.to_string())
+                ))
             );
             EXIT_BAD_INPUT
         }

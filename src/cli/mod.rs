@@ -23,18 +23,27 @@ macro_rules! eprint {
 }
 
 pub(crate) mod args;
-mod commands;
+pub(crate) mod out;
+
+mod io;
+
+// One file per command, each with its flags and one `run`.
+mod analyze;
 mod compare;
+mod completions;
 mod convert;
+mod dot;
 mod edit;
+mod effort;
 mod lint;
 mod log;
-pub(crate) mod out;
+mod man;
 mod paper;
 mod plan;
-pub(crate) mod sim;
+mod sim;
 mod ted_pairs;
 mod tick;
+mod validate;
 mod view;
 
 use clap::Parser;
@@ -64,5 +73,29 @@ where
             return ExitCode::from(code);
         }
     };
-    ExitCode::from(commands::execute(cli))
+    ExitCode::from(execute(cli.command))
+}
+
+/// Runs one command: each is one function in its own file.
+fn execute(command: args::Command) -> u8 {
+    use args::Command;
+    match command {
+        Command::Analyze(a) => analyze::run(a),
+        Command::Validate(a) => validate::run(a),
+        Command::Dot(a) => dot::run(a),
+        Command::Compare(a) => compare::run(a),
+        Command::Convert(a) => convert::run(a),
+        Command::Effort(a) => effort::run(a),
+        Command::Paper(a) => paper::paper(&a),
+        Command::Edit(a) => edit::edit(&a),
+        Command::Sim(a) => sim::execute(a),
+        Command::Tick(a) => tick::execute(a),
+        Command::Plan(a) => plan::execute(a),
+        Command::Lint(a) => lint::execute(a),
+        Command::Log(a) => log::execute(a),
+        Command::View(a) => view::execute(a),
+        Command::TedPairs(a) => ted_pairs::execute(a),
+        Command::Completions(a) => completions::run(a),
+        Command::Man(a) => man::run(a),
+    }
 }

@@ -1,7 +1,7 @@
 //! Writing to the terminal without panicking and without raw control
 //! characters: everything `cli` prints on stderr goes through [`stderr`]
 //! (the `eprintln!` of this module tree), and every text output through
-//! [`text`] before [`super::commands::emit`].
+//! [`text`] before [`super::io::emit`].
 
 use std::io::Write;
 

@@ -1,15 +1,11 @@
 //! `btfsm paper` and `btfsm effort`: load, compute through the library, print.
 
 use super::args::PaperArgs;
-use super::commands::emit_text;
+use super::io::emit_text;
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
-use btfsm_format::Limits;
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_metrics::ged::GedOptions;
-use btfsm_report::OutputFormat;
-use btfsm_report::effort::effort as compute_effort;
-use btfsm_report::effort::{EffortRow, render_effort};
 use btfsm_report::paper::{self, EXPECTED_FILE};
-use std::path::PathBuf;
 
 /// The GED budget given with `--timeout-ms`.
 fn ged_options(timeout_ms: u64) -> GedOptions {
@@ -17,25 +13,6 @@ fn ged_options(timeout_ms: u64) -> GedOptions {
         timeout: std::time::Duration::from_millis(timeout_ms),
         ..GedOptions::default()
     }
-}
-
-/// `btfsm effort FILE...`.
-pub(super) fn effort(
-    files: &[PathBuf],
-    format: OutputFormat,
-    timeout_ms: u64,
-    limits: &Limits,
-) -> u8 {
-    let Some((loaded, failed)) = super::commands::load_inputs(files, limits) else {
-        return EXIT_BAD_INPUT;
-    };
-    let opts = ged_options(timeout_ms);
-    let rows: Vec<EffortRow> = loaded
-        .iter()
-        .map(|l| EffortRow::new(&l.path, &l.policy.name, &compute_effort(&l.policy, &opts).0))
-        .collect();
-    let code = emit_text(None, render_effort(&rows, format));
-    if failed { EXIT_BAD_INPUT } else { code }
 }
 
 /// `btfsm paper`.
@@ -81,15 +58,9 @@ pub(super) fn paper(a: &PaperArgs) -> u8 {
             return EXIT_OK;
         }
         for d in &departures {
-            eprintln!("error: paper check: {d}");
+            eprint!("{}", Diagnostic::error(format!("paper check: {d}")));
         }
-        eprintln!(
-            "error: paper check: {} cell{} departed from `{}`\n  = hint: if the change is deliberate, review it and run `btfsm paper --record --policies {}`",
-            departures.len(),
-            if departures.len() == 1 { "" } else { "s" },
-            expected_path.display(),
-            a.policies.display()
-        );
+        eprint!("{}", Diagnostic::error(format!("paper check: {} cell{} departed from `{}`", departures.len(), if departures.len() == 1 { "" } else { "s" }, expected_path.display())).hint(format!("if the change is deliberate, review it and run `btfsm paper --record --policies {}`", a.policies.display())));
         return EXIT_CHECK_FAILED;
     }
     emit_text(a.output.as_deref(), paper::render(&report, a.format))

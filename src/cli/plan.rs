@@ -4,8 +4,9 @@
 //! left and the metrics of the three side by side, and writes the policies
 //! with `-o DIR` (or one of them to stdout with `-o -`).
 
-use super::commands::{emit_text, print_diagnostics};
+use super::io::{emit_text, fail, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_format::{Limits, Loaded};
 use btfsm_model::{Policy, PolicyBody};
 use btfsm_plan::{self as plan, Options};
@@ -88,14 +89,13 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
     if let Some(t) = &a.task
         && let Err(e) = domain.select_task(t)
     {
-        eprintln!("error: {e}");
-        return EXIT_BAD_INPUT;
+        return fail(Diagnostic::error(e.to_string()));
     }
     if !a.goals.is_empty()
         && let Err(es) = domain.set_goal(&a.goals)
     {
         for e in es {
-            eprintln!("error: {e}");
+            eprint!("{}", Diagnostic::error(e.to_string()));
         }
         return EXIT_BAD_INPUT;
     }
@@ -108,23 +108,23 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
     let planned = match plan::plan_bt(&domain, &opts) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!(
-                "error: {shown}: {e}\n  = hint: raise --max-nodes, or lower --max-plan-depth"
+            return fail(
+                Diagnostic::error(format!("{shown}: {e}"))
+                    .hint("raise --max-nodes, or lower --max-plan-depth"),
             );
-            return EXIT_BAD_INPUT;
         }
     };
     let policies = match policies(&domain, &planned, a.to, &limits) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {shown}: {e}");
-            return EXIT_BAD_INPUT;
+            return fail(Diagnostic::error(format!("{shown}: {e}")));
         }
     };
     if a.output.as_deref() == Some(Path::new("-")) {
         let [(_, p)] = policies.as_slice() else {
-            eprintln!("error: `-o -` writes one policy: choose it with --to bt, fsm or hfsm");
-            return EXIT_BAD_INPUT;
+            return fail(Diagnostic::error(
+                "`-o -` writes one policy: choose it with --to bt, fsm or hfsm",
+            ));
         };
         return emit_text(None, btfsm_format::toml_write::write_policy(p));
     }
@@ -134,11 +134,10 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
     }
     if let Some(dir) = &a.output {
         if let Err(e) = std::fs::create_dir_all(dir) {
-            eprintln!(
-                "error: cannot create {}: {e}",
+            return fail(Diagnostic::error(format!(
+                "cannot create {}: {e}",
                 btfsm_core::sanitize::shown(&dir.display().to_string())
-            );
-            return EXIT_BAD_INPUT;
+            )));
         }
         for (name, p) in &written {
             let code = emit_text(

@@ -2,8 +2,9 @@
 //! prints outcomes, executed skills, final worlds and behavior-match verdicts
 //! (SPEC §6, §7); `--runs N` runs seeded Monte Carlo episodes instead.
 
-use super::commands::{emit_text, print_diagnostics};
+use super::io::{emit_text, fail, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_sim::report::{McReport, SimReport, TraceWriter};
 use btfsm_sim::{monte_carlo, plot, run, scenario};
 use clap::Args;
@@ -67,7 +68,7 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
         ("--trace", a.trace.as_deref()),
         ("--plot", a.plot.as_deref()),
     ];
-    if !super::commands::outputs_distinct(&outputs, true) {
+    if !super::io::outputs_distinct(&outputs, true) {
         return EXIT_BAD_INPUT;
     }
     let limits = a.limits.limits();
@@ -106,15 +107,15 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
         .and_then(|ms| t0.checked_add(std::time::Duration::from_millis(ms)));
     if let Some(n) = a.runs {
         if a.trace.is_some() || a.plot.is_some() {
-            eprintln!("error: --trace and --plot record one run; leave them out with --runs");
-            return EXIT_BAD_INPUT;
+            return fail(Diagnostic::error(
+                "--trace and --plot record one run; leave them out with --runs",
+            ));
         }
         let seed = a.seed.unwrap_or(s.seed);
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let threads = match a.threads {
             Some(0) => {
-                eprintln!("error: --threads must be at least 1");
-                return EXIT_BAD_INPUT;
+                return fail(Diagnostic::error("--threads must be at least 1"));
             }
             // More threads than cores only wait; a few per core at most.
             Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
@@ -156,8 +157,9 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
         return emit_text(None, text);
     }
     if a.format == OutputFormat::Markdown {
-        eprintln!("error: `sim` prints markdown with --runs; use `table` or `json` for one run");
-        return EXIT_BAD_INPUT;
+        return fail(Diagnostic::error(
+            "`sim` prints markdown with --runs; use `table` or `json` for one run",
+        ));
     }
     if let Some(seed) = a.seed {
         // The episode with this seed, as `--runs` draws it.
@@ -176,11 +178,10 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
             let f = match btfsm_report::output::OutputFile::create(p) {
                 Ok(f) => f,
                 Err(e) => {
-                    eprintln!(
-                        "error: cannot write `{}`: {e}",
+                    return fail(Diagnostic::error(format!(
+                        "cannot write `{}`: {e}",
                         btfsm_core::sanitize::shown(&p.display().to_string())
-                    );
-                    return EXIT_BAD_INPUT;
+                    )));
                 }
             };
             let mut w = TraceWriter::new(f, &s.name, &file, s.seed, s.dt);
@@ -215,11 +216,10 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
     if let Some((p, w)) = trace_out
         && let Err(e) = w.finish(&rep).and_then(|f| f.commit())
     {
-        eprintln!(
-            "error: cannot write `{}`: {e}",
+        return fail(Diagnostic::error(format!(
+            "cannot write `{}`: {e}",
             btfsm_core::sanitize::shown(&p.display().to_string())
-        );
-        return EXIT_BAD_INPUT;
+        )));
     }
     if let Some(p) = &a.plot
         && emit_text(Some(p), plot::svg(&s, &rep.policies)) != EXIT_OK
@@ -241,16 +241,19 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
         return code;
     }
     if rep.expectations_failed > 0 {
-        eprintln!(
-            "error: {} of {} expectations of the scenario failed: {}",
-            rep.expectations_failed,
-            rep.expectations.len(),
-            (rep.expectations.iter())
-                .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
-                .map(|e| btfsm_core::sanitize::shown(&e.name).into_owned())
-                .take(10)
-                .collect::<Vec<_>>()
-                .join("; ")
+        eprint!(
+            "{}",
+            Diagnostic::error(format!(
+                "{} of {} expectations of the scenario failed: {}",
+                rep.expectations_failed,
+                rep.expectations.len(),
+                (rep.expectations.iter())
+                    .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
+                    .map(|e| btfsm_core::sanitize::shown(&e.name).into_owned())
+                    .take(10)
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ))
         );
         return EXIT_CHECK_FAILED;
     }
@@ -353,24 +356,24 @@ pub(crate) fn dot_trace(
     let (Some(trace), Some(step)) = (&a.trace, a.step) else {
         return Some((policy, Default::default()));
     };
-    let fail = |m: String| {
-        eprintln!("error: {m}");
+    let fail = |d: Diagnostic| {
+        eprint!("{d}");
         None
     };
     let text = match read_trace(trace, limits) {
         Ok(t) => t,
         Err(diags) => {
-            super::commands::print_diagnostics(&mut std::io::stderr().lock(), &diags);
+            super::io::print_diagnostics(&mut std::io::stderr().lock(), &diags);
             return None;
         }
     };
     let v: serde_json::Value = match serde_json::from_str(&text.text) {
         Ok(v) => v,
         Err(e) => {
-            return fail(format!(
+            return fail(Diagnostic::error(format!(
                 "`{}` is not a trace written by `btfsm sim --trace`: {e}",
                 trace.display()
-            ));
+            )));
         }
     };
     let empty = Vec::new();
@@ -389,26 +392,28 @@ pub(crate) fn dot_trace(
     };
     let Some(run) = run else {
         let names: Vec<&str> = runs.iter().filter_map(|r| r["policy"].as_str()).collect();
-        return fail(format!(
-            "no policy of `{}` in the trace `{}`\n  = hint: choose one with --policy: {}",
-            file.display(),
-            trace.display(),
-            names.join(", ")
-        ));
+        return fail(
+            Diagnostic::error(format!(
+                "no policy of `{}` in the trace `{}`",
+                file.display(),
+                trace.display(),
+            ))
+            .hint(format!("choose one with --policy: {}", names.join(", "))),
+        );
     };
     let steps = run["trace"].as_array().unwrap_or(&empty);
     let Some(st) = steps.get(step) else {
-        return fail(format!(
+        return fail(Diagnostic::error(format!(
             "step {step} is past the end of the trace of `{}` ({} steps, 0 to {})",
             run["policy"].as_str().unwrap_or(""),
             steps.len(),
             steps.len().saturating_sub(1)
-        ));
+        )));
     };
     let policy = if run["convert"] == "hfsm" {
         match btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
             Ok(p) => p,
-            Err(e) => return fail(e[0].to_string()),
+            Err(e) => return fail(Diagnostic::error(e[0].to_string())),
         }
     } else {
         policy
@@ -459,10 +464,10 @@ fn symbolic(
         || a.plot.is_some()
         || matches!(a.format, OutputFormat::Markdown | OutputFormat::Csv)
     {
-        eprintln!(
-            "error: a symbolic scenario has no trace, plot, markdown or csv report\n  = hint: print `table` or `json`"
+        return fail(
+            Diagnostic::error("a symbolic scenario has no trace, plot, markdown or csv report")
+                .hint("print `table` or `json`"),
         );
-        return EXIT_BAD_INPUT;
     }
     let s = match btfsm_sim::symbolic::scenario::parse(file, base, limits) {
         Ok(s) => s,

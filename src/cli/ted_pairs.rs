@@ -7,7 +7,8 @@
 //! and `zss` packages, and bench/ted_vs_apted.py time them, in one process.
 
 use super::EXIT_BAD_INPUT;
-use super::commands::{emit_text, print_diagnostics};
+use super::io::{emit_text, fail, print_diagnostics};
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_core::sanitize::shown;
 use btfsm_format::source;
 use btfsm_metrics::ted::{self, TedOptions, TreeEdit, tree_text};
@@ -53,17 +54,19 @@ pub(super) fn execute(a: TedPairsArgs) -> u8 {
         let trees = match parsed {
             Ok(t) if t.len() == 2 => t,
             Ok(t) => {
-                eprintln!(
-                    "error: {}:{}: {} trees on the line, expected 2 separated by a tab",
+                return fail(Diagnostic::error(format!(
+                    "{}:{}: {} trees on the line, expected 2 separated by a tab",
                     shown(&name),
                     i + 1,
                     t.len()
-                );
-                return EXIT_BAD_INPUT;
+                )));
             }
             Err(e) => {
-                eprintln!("error: {}:{}: {e}", shown(&name), i + 1);
-                return EXIT_BAD_INPUT;
+                return fail(Diagnostic::error(format!(
+                    "{}:{}: {e}",
+                    shown(&name),
+                    i + 1
+                )));
             }
         };
         let start = std::time::Instant::now();

@@ -4,7 +4,7 @@
 //! line), which is how tests/differential/ drives it.
 
 use super::EXIT_BAD_INPUT;
-use super::commands::{emit_text, print_diagnostics};
+use super::io::{emit_text, fail, print_diagnostics};
 use btfsm_core::diagnostic::Diagnostic;
 use btfsm_core::sanitize::shown;
 use btfsm_format as format;
@@ -31,18 +31,21 @@ pub(crate) struct TickArgs {
 
 pub(super) fn execute(a: TickArgs) -> u8 {
     if a.format == OutputFormat::Csv {
-        eprintln!("error: `tick` prints `table` or `json`, not `csv`");
-        return EXIT_BAD_INPUT;
+        return fail(Diagnostic::error(
+            "`tick` prints `table` or `json`, not `csv`",
+        ));
     }
     if a.trees.len() != a.scripts.len() {
-        eprintln!(
-            "error: {} tree{} and {} script{}\n  = hint: give one --script per tree, in the same order",
-            a.trees.len(),
-            if a.trees.len() == 1 { "" } else { "s" },
-            a.scripts.len(),
-            if a.scripts.len() == 1 { "" } else { "s" },
+        return fail(
+            Diagnostic::error(format!(
+                "{} tree{} and {} script{}",
+                a.trees.len(),
+                if a.trees.len() == 1 { "" } else { "s" },
+                a.scripts.len(),
+                if a.scripts.len() == 1 { "" } else { "s" }
+            ))
+            .hint("give one --script per tree, in the same order"),
         );
-        return EXIT_BAD_INPUT;
     }
     let limits = a.limits.limits();
     let mut out = String::new();

@@ -3,8 +3,9 @@
 //! a trace written by `btfsm sim --trace`, or a BehaviorTree.CPP `.btlog` (or `.db3`: its last session);
 //! several inputs share one slider.
 
-use super::commands::{emit_text, print_diagnostics};
+use super::io::{emit_text, fail, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
+use btfsm_core::diagnostic::Diagnostic;
 use btfsm_view::{Replay, ViewError};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -56,10 +57,10 @@ fn kind_of(path: &Path, head: &[u8]) -> Kind {
     }
 }
 
-fn fail(e: ViewError) -> Option<Replay> {
+fn view_failed(e: ViewError) -> Option<Replay> {
     match e {
         ViewError::Diagnostics(d) => print_diagnostics(&mut std::io::stderr().lock(), &d),
-        e => eprintln!("error: {e}"),
+        e => eprint!("{}", Diagnostic::error(e.to_string())),
     }
     None
 }
@@ -79,23 +80,34 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &btfsm_format::Limits) -> Option
     let text = |bytes: Vec<u8>| match String::from_utf8(bytes) {
         Ok(t) => Some(t),
         Err(e) => {
-            eprintln!(
-                "error: {}: byte {}: not UTF-8 text\n  = hint: a scenario (.toml) or a trace (.json) is UTF-8 text",
-                btfsm_core::sanitize::shown(&shown),
-                e.utf8_error().valid_up_to()
+            eprint!(
+                "{}",
+                Diagnostic::error(format!(
+                    "{}: byte {}: not UTF-8 text",
+                    btfsm_core::sanitize::shown(&shown),
+                    e.utf8_error().valid_up_to()
+                ))
+                .hint("a scenario (.toml) or a trace (.json) is UTF-8 text")
             );
             None
         }
     };
     match kind_of(path, &bytes[..bytes.len().min(32)]) {
-        Kind::Log => btfsm_view::log::from_log(&bytes[..], &shown, limits).map_or_else(fail, Some),
+        Kind::Log => {
+            btfsm_view::log::from_log(&bytes[..], &shown, limits).map_or_else(view_failed, Some)
+        }
         Kind::Db3 => match btfsm_log::open(path, None, limits.max_file_bytes) {
-            Ok(o) => btfsm_view::log::from_log(o.reader, &shown, limits).map_or_else(fail, Some),
+            Ok(o) => {
+                btfsm_view::log::from_log(o.reader, &shown, limits).map_or_else(view_failed, Some)
+            }
             Err(e) => {
-                eprintln!(
-                    "error: {}: {}",
-                    btfsm_core::sanitize::shown(&shown),
-                    btfsm_core::sanitize::shown(&e)
+                eprint!(
+                    "{}",
+                    Diagnostic::error(format!(
+                        "{}: {}",
+                        btfsm_core::sanitize::shown(&shown),
+                        btfsm_core::sanitize::shown(&e)
+                    ))
                 );
                 None
             }
@@ -105,15 +117,12 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &btfsm_format::Limits) -> Option
             let dir = path.parent().unwrap_or(Path::new(""));
             let root = btfsm_format::source::root_for(limits, dir);
             btfsm_view::sim::from_trace(&text, &shown, root.as_deref(), limits)
-                .map_or_else(fail, Some)
+                .map_or_else(view_failed, Some)
         }
         Kind::Scenario => {
             let file = btfsm_core::diagnostic::SourceFile::new(&shown, text(bytes)?);
             if btfsm_sim::symbolic::looks_symbolic(&file.text) {
-                eprintln!(
-                    "error: {}: a symbolic scenario (with `domain`) has no trace to replay\n  = hint: `btfsm view` replays the planar simulator's scenarios, `sim --trace` files and .btlog logs",
-                    btfsm_core::sanitize::shown(&shown)
-                );
+                eprint!("{}", Diagnostic::error(format!("{}: a symbolic scenario (with `domain`) has no trace to replay", btfsm_core::sanitize::shown(&shown))).hint("`btfsm view` replays the planar simulator's scenarios, `sim --trace` files and .btlog logs"));
                 return None;
             }
             let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -130,7 +139,7 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &btfsm_format::Limits) -> Option
                 s.disturbances = ds;
                 s.rates = rates;
             }
-            btfsm_view::sim::from_scenario(&s, &shown).map_or_else(fail, Some)
+            btfsm_view::sim::from_scenario(&s, &shown).map_or_else(view_failed, Some)
         }
     }
 }
@@ -169,8 +178,7 @@ pub(super) fn execute(a: ViewArgs) -> u8 {
     let page = match btfsm_view::html::page(&replay, timeout) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {e}");
-            return EXIT_BAD_INPUT;
+            return fail(Diagnostic::error(format!("{e}")));
         }
     };
     let code = emit_text(a.output.as_deref(), page);

@@ -421,3 +421,33 @@ fn edit_commands_rebuild_fig07c_and_fig08a() {
     assert!(!bad.exists());
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
+
+/// An edit the policy refuses is one diagnostic: the message, then its hint
+/// on a line of its own (it once printed a literal `\n` before the hint).
+#[test]
+fn edit_errors_print_their_hint_on_its_own_line() {
+    let (code, out, err) = btfsm(&[
+        "edit",
+        "policies/paper/fig01-bt.toml",
+        "insert-subtree",
+        "--parent",
+        "nosuch",
+        "--subtree",
+        "policies/paper/lib/tuck-arm.toml",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(out.is_empty());
+    assert!(!err.contains("\\n"), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(
+        lines.first().copied(),
+        Some("error: policies/paper/fig01-bt.toml: unknown node `nosuch`"),
+        "{err}"
+    );
+    assert!(
+        lines
+            .get(1)
+            .is_some_and(|l| l.starts_with("  = hint: control nodes of the tree:")),
+        "{err}"
+    );
+}

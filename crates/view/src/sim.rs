@@ -201,13 +201,15 @@ pub fn from_trace(
         let name = str_of(&run["policy"], "policy").map_err(|e| bad(e.to_string()))?;
         let file = str_of(&run["file"], "file").map_err(|e| bad(e.to_string()))?;
         let path = btfsm_format::source::resolve(root, Path::new("."), file).map_err(|r| {
-            ViewError::Input(format!(
-                "{shown}: policy {} names the file `{}`: {}\n  = hint: {}",
-                i + 1,
-                btfsm_core::sanitize::shown(file),
-                r.message,
-                r.hint
-            ))
+            ViewError::Diagnostics(vec![
+                btfsm_core::diagnostic::Diagnostic::error(format!(
+                    "{shown}: policy {} names the file `{}`: {}",
+                    i + 1,
+                    btfsm_core::sanitize::shown(file),
+                    r.message,
+                ))
+                .hint(r.hint),
+            ])
         })?;
         let loaded = btfsm_format::load(&path, limits).map_err(ViewError::Diagnostics)?;
         let mut policy = if run["convert"] == "hfsm" {

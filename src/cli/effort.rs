@@ -1,0 +1,44 @@
+//! `btfsm effort FILE|DIR...`: Eq. 4/5 at the M_s and M_fc detected in each
+//! FSM beside the measured effort, the named GED to the fault-tolerant FSM
+//! generated from it (paper sec. IV-B).
+
+use super::EXIT_BAD_INPUT;
+use super::args::LimitArgs;
+use super::io::{emit_text, load_inputs};
+use btfsm_metrics::ged::GedOptions;
+use btfsm_report::OutputFormat;
+use btfsm_report::effort::{EffortRow, effort, render_effort};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub(crate) struct EffortArgs {
+    /// FSM files (any policy format), `-` for stdin, or directories
+    #[arg(required = true)]
+    pub(super) files: Vec<PathBuf>,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+    pub(super) format: OutputFormat,
+    /// Time budget of the structural GED per policy; when it runs out the
+    /// result is a certified interval (the named GED has no budget)
+    #[arg(long, default_value_t = 2000, value_name = "MS")]
+    pub(super) timeout_ms: u64,
+    #[command(flatten)]
+    pub(super) limits: LimitArgs,
+}
+
+pub(super) fn run(a: EffortArgs) -> u8 {
+    let Some((loaded, failed)) = load_inputs(&a.files, &a.limits.limits()) else {
+        return EXIT_BAD_INPUT;
+    };
+    let opts = GedOptions {
+        timeout: std::time::Duration::from_millis(a.timeout_ms),
+        ..GedOptions::default()
+    };
+    let rows: Vec<EffortRow> = loaded
+        .iter()
+        .map(|l| EffortRow::new(&l.path, &l.policy.name, &effort(&l.policy, &opts).0))
+        .collect();
+    let code = emit_text(None, render_effort(&rows, a.format));
+    if failed { EXIT_BAD_INPUT } else { code }
+}
