@@ -7,7 +7,7 @@ VENV := .venv
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
-.PHONY: build run test bench bench-ged bench-ted clean paper-docs fuzz mermaid-oracle man differential browser-test view-screenshots
+.PHONY: prerequisites build run test bench bench-ged bench-ted clean paper-docs fuzz mermaid-oracle man differential browser-test view-screenshots
 
 build:
 	$(CARGO) build --release --locked
@@ -38,10 +38,22 @@ run: build
 # failing case found so goes to proptest-regressions/ and is kept.
 PROPTEST_SEED ?= 20261123
 
+# What `make test` needs besides Rust, checked before anything runs, with
+# one message naming each missing program: Graphviz's dot (SVG rendering and
+# `btfsm view`), Python 3 with venv (the differential oracles), Node.js and
+# npm (Mermaid, the browser test) and Chromium (the browser test).
+prerequisites:
+	@missing=""; \
+	command -v dot >/dev/null 2>&1 || missing="$$missing  Graphviz's dot (apt-get install graphviz)\n"; \
+	python3 -c 'import venv, ensurepip' >/dev/null 2>&1 || missing="$$missing  Python 3 with venv (apt-get install python3-venv)\n"; \
+	command -v npm >/dev/null 2>&1 || missing="$$missing  Node.js 18+ and npm (apt-get install nodejs npm)\n"; \
+	command -v chromium >/dev/null 2>&1 || missing="$$missing  Chromium (apt-get install chromium)\n"; \
+	if [ -n "$$missing" ]; then printf "make test needs programs that are not installed:\n$$missing(.ci/run installs them with apt-get)\n" >&2; exit 2; fi
+
 # The workspace's rules (ARCHITECTURE.md, "Rules"): formatting, clippy with
 # the `[workspace.lints]` table and `-D warnings`, the docs with warnings
 # denied, and the tests with and without the default features.
-test:
+test: prerequisites
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets --locked -- -D warnings
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps --locked

@@ -137,21 +137,24 @@ pub(super) fn run(args: CompareArgs) -> u8 {
         };
         report.tree = Some(compare::tree::tree_report(a, b, &topts));
     }
+    // The drawing first (its file is written or its error said), then the
+    // comparison, which is printed whatever became of the drawing: a
+    // missing Graphviz costs the picture, not the report (exit 2 still says
+    // that an output asked for was not made).
+    let mut drawn = EXIT_OK;
     if let (Some(path), Some(primary)) = (&args.dot, report.primary()) {
         let opts = pair.dot_options(&primary.edit_script);
         // Graphviz gets the budget of one mode (--timeout-ms).
         let timeout = Duration::from_millis(args.timeout_ms);
-        let code = draw(&lb.policy, &opts, Some(path), args.render, timeout);
-        if code != EXIT_OK {
-            return code;
-        }
+        drawn = draw(&lb.policy, &opts, Some(path), args.render, timeout);
     }
     let text = match args.format {
         CompareFormat::Json => compare::render_json(&report),
         CompareFormat::Table => compare::render_table(&report),
         CompareFormat::Markdown => compare::render_markdown(&report),
     };
-    emit_text(None, text)
+    let printed = emit_text(None, text);
+    if drawn != EXIT_OK { drawn } else { printed }
 }
 
 /// A progress line on stderr, shown after a short delay while a search runs

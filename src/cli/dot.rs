@@ -74,6 +74,9 @@ pub(super) fn draw(
     }
     match dot::render(&text, fmt, timeout) {
         Ok(bytes) => emit(output, &bytes),
+        Err(e @ dot::RenderError::NotInstalled { .. }) => fail(Diagnostic::error(format!("no {fmt} made: {e}")).hint(
+            "install Graphviz, or write DOT (an output path ending in .dot) and render it where Graphviz is installed",
+        )),
         Err(e) => fail(Diagnostic::error(e.to_string())),
     }
 }

@@ -177,9 +177,12 @@ pub(super) fn execute(a: ViewArgs) -> u8 {
     let timeout = std::time::Duration::from_millis(a.timeout_ms);
     let page = match btfsm_view::html::page(&replay, timeout) {
         Ok(p) => p,
-        Err(e) => {
-            return fail(Diagnostic::error(format!("{e}")));
+        Err(e @ ViewError::Render(btfsm_render::dot::RenderError::NotInstalled { .. })) => {
+            return fail(Diagnostic::error(format!("no page made: {e}")).hint(
+                "`btfsm view` draws each policy with Graphviz: install it; `btfsm sim --plot` and `btfsm dot` (DOT text) work without it",
+            ));
         }
+        Err(e) => return fail(Diagnostic::error(e.to_string())),
     };
     let code = emit_text(a.output.as_deref(), page);
     if code == EXIT_OK

@@ -289,3 +289,53 @@ fn svg_node_ids_are_the_vertex_keys() {
     let svg = decode(&svg);
     assert!(svg.contains("<g id=\"Move-To cube2\" class=\"node\">"));
 }
+
+/// Without Graphviz, `compare --dot diff.svg` still prints the whole
+/// comparison, then says why no SVG was made and how to get a drawing
+/// (exit 2: an output asked for is missing); `dot --render` says the same.
+#[test]
+fn without_graphviz_compare_still_reports_and_says_why_no_svg() {
+    let svg = crate::common::scratch("no-graphviz").join("diff.svg");
+    let (code, out, err) = crate::common::btfsm_without_graphviz(&[
+        "compare",
+        "policies/paper/fig01-bt.toml",
+        "policies/paper/fig03-bt.toml",
+        "--mode",
+        "named",
+        "--dot",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(out.contains("named edit script"), "{out}");
+    assert!(
+        err.contains("error: no svg made: graphviz `dot` is not installed"),
+        "{err}"
+    );
+    assert!(
+        err.contains("= hint: install Graphviz, or write DOT"),
+        "{err}"
+    );
+    assert!(!svg.exists());
+    let (code, out, err) = crate::common::btfsm_without_graphviz(&[
+        "dot",
+        "policies/paper/fig01-bt.toml",
+        "--render",
+        "svg",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(out.is_empty());
+    assert!(err.contains("no svg made"), "{err}");
+    let page = crate::common::scratch("no-graphviz").join("view.html");
+    let (code, _, err) = crate::common::btfsm_without_graphviz(&[
+        "view",
+        "policies/scenarios/exp1-pick-fails.toml",
+        "-o",
+        page.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("= hint: `btfsm view` draws each policy with Graphviz"),
+        "{err}"
+    );
+    assert!(!page.exists());
+}

@@ -668,6 +668,9 @@ fn a_yasmin_file_path_outside_the_root_is_refused() {
 
 #[test]
 fn the_render_format_follows_the_output_extension() {
+    if !crate::common::graphviz("the_render_format_follows_the_output_extension") {
+        return;
+    }
     let dir = scratch("render-ext");
     let fig = concat!(env!("CARGO_MANIFEST_DIR"), "/policies/paper/fig01-bt.toml");
     let out = |name: &str| dir.join(name).display().to_string();

@@ -28,6 +28,9 @@ fn data(html: &str) -> serde_json::Value {
 
 #[test]
 fn view_writes_one_self_contained_page() {
+    if !crate::common::graphviz("view_writes_one_self_contained_page") {
+        return;
+    }
     let html = page("nominal", &["policies/scenarios/exp1-nominal.toml"]);
     let d = data(&html);
     let panels = d["panels"].as_array().unwrap();
@@ -76,6 +79,9 @@ fn view_writes_one_self_contained_page() {
 
 #[test]
 fn view_marks_the_first_divergence() {
+    if !crate::common::graphviz("view_marks_the_first_divergence") {
+        return;
+    }
     let html = page("pick-fails", &["policies/scenarios/exp1-pick-fails.toml"]);
     let d = data(&html);
     let divs = d["divergences"].as_array().unwrap();
@@ -94,6 +100,9 @@ fn view_marks_the_first_divergence() {
 
 #[test]
 fn view_escapes_hostile_names() {
+    if !crate::common::graphviz("view_escapes_hostile_names") {
+        return;
+    }
     let html = page("hostile", &["tests/fixtures/view/hostile.toml"]);
     // Only the page's own two scripts; no tag any name tried to open.
     assert_eq!(html.matches("<script").count(), 2);
@@ -122,6 +131,9 @@ fn view_escapes_hostile_names() {
 /// 355 KB for the two runs of 10,860 steps (docs/view.md).
 #[test]
 fn view_of_a_10000_step_run_stays_small() {
+    if !crate::common::graphviz("view_of_a_10000_step_run_stays_small") {
+        return;
+    }
     let html = page("long", &["tests/fixtures/view/five-cubes-10k.toml"]);
     let d = data(&html);
     let steps = d["panels"][0]["times"].as_array().unwrap().len();
@@ -131,6 +143,9 @@ fn view_of_a_10000_step_run_stays_small() {
 
 #[test]
 fn a_sim_trace_replays_as_its_scenario() {
+    if !crate::common::graphviz("a_sim_trace_replays_as_its_scenario") {
+        return;
+    }
     let dir = scratch("view-trace");
     let trace = dir.join("t.json");
     let (code, _, stderr) = btfsm(&[
@@ -156,6 +171,9 @@ fn a_sim_trace_replays_as_its_scenario() {
 /// `--seed S` replays the episode `sim --seed S` runs.
 #[test]
 fn view_seed_runs_the_episode_of_sim_seed() {
+    if !crate::common::graphviz("view_seed_runs_the_episode_of_sim_seed") {
+        return;
+    }
     let scenario = "policies/scenarios/exp1-pick-fails.toml";
     let html = page("seed", &[scenario, "--seed", "17"]);
     assert!(html.contains("<h1>exp1-pick-fails (seed 17)</h1>"));
@@ -178,6 +196,9 @@ fn view_seed_runs_the_episode_of_sim_seed() {
 
 #[test]
 fn a_btlog_replays_record_by_record() {
+    if !crate::common::graphviz("a_btlog_replays_record_by_record") {
+        return;
+    }
     let html = page("log", &["tests/fixtures/logs/fig01.btlog"]);
     let d = data(&html);
     let p = &d["panels"][0];
@@ -201,6 +222,9 @@ fn a_btlog_replays_record_by_record() {
 #[cfg(feature = "sqlite")]
 #[test]
 fn a_db3_replays_its_last_session_record_by_record() {
+    if !crate::common::graphviz("a_db3_replays_its_last_session_record_by_record") {
+        return;
+    }
     // tests/fixtures/logs/sessions.db3: session 2 holds 182 records
     // (`log report` counts them; tests/fixtures/logs/README.md).
     let (code, report, err) = btfsm(&[
@@ -219,6 +243,9 @@ fn a_db3_replays_its_last_session_record_by_record() {
 
 #[test]
 fn view_pages_every_bundled_scenario() {
+    if !crate::common::graphviz("view_pages_every_bundled_scenario") {
+        return;
+    }
     let mut n = 0;
     for e in std::fs::read_dir("policies/scenarios").unwrap() {
         let p = e.unwrap().path();

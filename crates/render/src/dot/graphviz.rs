@@ -95,6 +95,16 @@ impl Budget {
     }
 }
 
+/// Whether Graphviz's `dot` runs on this machine (`dot -V` succeeds).
+pub fn installed() -> bool {
+    std::process::Command::new("dot")
+        .arg("-V")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
 /// Renders DOT to svg/png/pdf by running Graphviz's `dot` as a child killed
 /// after `timeout` or [`MAX_RENDER_BYTES`] of output; a clear error when
 /// `dot` is not installed.
