@@ -307,46 +307,49 @@ pub(crate) enum EditOp {
         name: Option<String>,
     },
     /// Adds an FSM state as the paper's sec. IV-A 1b does (Algorithm 1 for connected states)
-    AddState {
-        /// How the new state is connected
-        #[arg(long, value_enum)]
-        kind: AddKind,
-        /// Name of the new state
-        #[arg(long, value_name = "N")]
-        name: String,
-        /// Preceding state (sequential, alternative); connected: file position only.
-        /// A name unique in the machine, or a path `Container/State` (HFSM)
-        #[arg(long, value_name = "P")]
-        after: Option<String>,
-        /// HFSM: the container to add the state to when there is no --after
-        /// (default: the top level)
-        #[arg(long = "in", value_name = "CONTAINER")]
-        within: Option<String>,
-        /// Skill the state runs, e.g. Tuck-Arm
-        #[arg(long)]
-        skill: String,
-        /// Skill argument, `key=value` (repeatable)
-        #[arg(long = "arg", value_name = "KEY=VALUE")]
-        args: Vec<String>,
-        /// Connected: the guard every other state gets to the new one,
-        /// e.g. `not Battery-Level(min=20)`
-        #[arg(long, value_name = "COND")]
-        guard: Option<String>,
-        /// Label of --guard (default: the condition)
-        #[arg(long, value_name = "TEXT")]
-        guard_label: Option<String>,
-        /// The SELECTOR's guard to the new state (sequential; connected: default --guard),
-        /// e.g. `In-Hand(object=cube2) & not Arm-Tucked`
-        #[arg(long, value_name = "COND")]
-        selector_guard: Option<String>,
-        /// Label of --selector-guard (default: the condition)
-        #[arg(long, value_name = "TEXT")]
-        selector_guard_label: Option<String>,
-        /// Position of the SELECTOR's new guard among its guards (default:
-        /// sequential: right before the predecessor's; connected: first)
-        #[arg(long, value_name = "K")]
-        selector_guard_index: Option<usize>,
-    },
+    AddState(AddStateArgs),
+}
+
+#[derive(Debug, Clone, Args)]
+pub(crate) struct AddStateArgs {
+    /// How the new state is connected
+    #[arg(long, value_enum)]
+    pub kind: AddKind,
+    /// Name of the new state
+    #[arg(long, value_name = "N")]
+    pub name: String,
+    /// Preceding state (sequential, alternative); connected: file position only.
+    /// A name unique in the machine, or a path `Container/State` (HFSM)
+    #[arg(long, value_name = "P")]
+    pub after: Option<String>,
+    /// HFSM: the container to add the state to when there is no --after
+    /// (default: the top level)
+    #[arg(long = "in", value_name = "CONTAINER")]
+    pub within: Option<String>,
+    /// Skill the state runs, e.g. Tuck-Arm
+    #[arg(long)]
+    pub skill: String,
+    /// Skill argument, `key=value` (repeatable)
+    #[arg(long = "arg", value_name = "KEY=VALUE")]
+    pub args: Vec<String>,
+    /// Connected: the guard every other state gets to the new one,
+    /// e.g. `not Battery-Level(min=20)`
+    #[arg(long, value_name = "COND")]
+    pub guard: Option<String>,
+    /// Label of --guard (default: the condition)
+    #[arg(long, value_name = "TEXT")]
+    pub guard_label: Option<String>,
+    /// The SELECTOR's guard to the new state (sequential; connected: default --guard),
+    /// e.g. `In-Hand(object=cube2) & not Arm-Tucked`
+    #[arg(long, value_name = "COND")]
+    pub selector_guard: Option<String>,
+    /// Label of --selector-guard (default: the condition)
+    #[arg(long, value_name = "TEXT")]
+    pub selector_guard_label: Option<String>,
+    /// Position of the SELECTOR's new guard among its guards (default:
+    /// sequential: right before the predecessor's; connected: first)
+    #[arg(long, value_name = "K")]
+    pub selector_guard_index: Option<usize>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -3,7 +3,7 @@
 //! checking that it reads back as a valid policy; what the edit touched goes
 //! to stderr.
 
-use super::args::{AddKind, EditArgs, EditOp, WrapKind};
+use super::args::{AddKind, AddStateArgs, EditArgs, EditOp, WrapKind};
 use super::io::{emit_text, fail, load_one};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
@@ -12,7 +12,6 @@ use btfsm_model::{BtNodeKind, PolicyBody, SkillCall};
 use btfsm_transform::edit::{self, AddState, EditError, Touched};
 use std::collections::BTreeMap;
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub(super) fn edit(a: &EditArgs) -> u8 {
     let limits = a.limits.limits();
     let Some(loaded) = load_one(&a.file, &limits) else {
@@ -72,67 +71,18 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
                 Err(e) => return edit_failed(e),
             }
         }
-        (
-            EditOp::AddState {
-                kind,
-                name,
-                after,
-                within,
-                skill,
-                args,
-                guard,
-                guard_label,
-                selector_guard,
-                selector_guard_label,
-                selector_guard_index,
-            },
-            PolicyBody::Machine(m),
-        ) => {
-            let mut call = SkillCall {
-                skill: skill.clone(),
-                args: BTreeMap::new(),
-            };
-            for kv in args {
-                let Some((k, v)) = kv.split_once('=') else {
-                    return fail(
-                        Diagnostic::error(format!("invalid --arg `{kv}`"))
-                            .hint("write key=value, e.g. --arg target=cube2"),
-                    );
-                };
-                call.args
-                    .insert(k.trim().to_string(), edit::parse_value(v.trim()));
-            }
-            let parse = |g: &Option<String>, l: &Option<String>| match g {
-                Some(text) => edit::parse_guard(text, l.as_deref()).map(Some),
-                None => Ok(None),
-            };
-            let (guard, selector_guard) = match (
-                parse(guard, guard_label),
-                parse(selector_guard, selector_guard_label),
-            ) {
-                (Ok(g), Ok(s)) => (g, s),
-                (Err(e), _) | (_, Err(e)) => return edit_failed(e),
-            };
-            let spec = AddState {
-                kind: match kind {
-                    AddKind::Sequential => edit::AddKind::Sequential,
-                    AddKind::Alternative => edit::AddKind::Alternative,
-                    AddKind::Connected => edit::AddKind::Connected,
-                },
-                name: name.clone(),
-                after: after.clone(),
-                within: within.clone(),
-                skill: call,
-                guard,
-                selector_guard,
-                selector_guard_index: *selector_guard_index,
+        (EditOp::AddState(s), PolicyBody::Machine(m)) => {
+            let spec = match add_state_spec(s) {
+                Ok(spec) => spec,
+                Err(Ok(d)) => return fail(d),
+                Err(Err(e)) => return edit_failed(e),
             };
             match edit::add_state(m, &spec) {
                 Ok(t) => t,
                 Err(e) => return edit_failed(e),
             }
         }
-        (EditOp::AddState { .. }, _) => return wrong_kind("add-state", "FSMs and HFSMs"),
+        (EditOp::AddState(_), _) => return wrong_kind("add-state", "FSMs and HFSMs"),
         (_, _) => return wrong_kind("insert-subtree and wrap-root", "BTs"),
     };
     let text = match btfsm_format::toml_write::write_policy_within(&policy, limits.max_file_bytes) {
@@ -162,4 +112,42 @@ pub(super) fn edit(a: &EditArgs) -> u8 {
         );
     }
     code
+}
+
+/// The `add-state` operation from its flags: its skill call with the
+/// `--arg`s, its guards parsed. A bad `--arg` is a usage error (`Ok`), a
+/// bad guard an edit error (`Err`).
+fn add_state_spec(s: &AddStateArgs) -> Result<AddState, Result<Diagnostic, EditError>> {
+    let mut call = SkillCall {
+        skill: s.skill.clone(),
+        args: BTreeMap::new(),
+    };
+    for kv in &s.args {
+        let Some((k, v)) = kv.split_once('=') else {
+            return Err(Ok(Diagnostic::error(format!("invalid --arg `{kv}`"))
+                .hint("write key=value, e.g. --arg target=cube2")));
+        };
+        call.args
+            .insert(k.trim().to_string(), edit::parse_value(v.trim()));
+    }
+    let parse = |g: &Option<String>, l: &Option<String>| match g {
+        Some(text) => edit::parse_guard(text, l.as_deref()).map(Some),
+        None => Ok(None),
+    };
+    let guard = parse(&s.guard, &s.guard_label).map_err(Err)?;
+    let selector_guard = parse(&s.selector_guard, &s.selector_guard_label).map_err(Err)?;
+    Ok(AddState {
+        kind: match s.kind {
+            AddKind::Sequential => edit::AddKind::Sequential,
+            AddKind::Alternative => edit::AddKind::Alternative,
+            AddKind::Connected => edit::AddKind::Connected,
+        },
+        name: s.name.clone(),
+        after: s.after.clone(),
+        within: s.within.clone(),
+        skill: call,
+        guard,
+        selector_guard,
+        selector_guard_index: s.selector_guard_index,
+    })
 }

@@ -49,48 +49,15 @@ pub(crate) struct LintArgs {
     pub limits: super::args::LimitArgs,
 }
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub(super) fn execute(a: LintArgs) -> u8 {
     if a.list {
-        let mut t = btfsm_core::table::Table::new(&["code", "level", "what it finds"]);
-        for r in lint::RULES {
-            t.row(vec![
-                r.code.to_string(),
-                r.level.as_str().to_string(),
-                r.summary.to_string(),
-            ]);
-        }
-        return emit_text(None, t.render());
+        return emit_text(None, rule_table());
     }
     let stderr = std::io::stderr();
     let mut err = stderr.lock();
-    let mut cfg = config::Config::default();
-    if !a.no_config
-        && let Ok(cwd) = std::env::current_dir()
-        && let Some(path) = config::find(&cwd)
-    {
-        let limits = a.limits.limits();
-        let shown = path.display().to_string();
-        match format::source::read(&path, &shown, &limits, true).map(|f| config::read(&f)) {
-            Ok(Ok(c)) => cfg = c,
-            Ok(Err(d)) | Err(d) => {
-                print_diagnostics(&mut err, &d);
-                return EXIT_BAD_INPUT;
-            }
-        }
-    }
-    for (codes, level) in [
-        (&a.allow, Level::Allow),
-        (&a.warn, Level::Warning),
-        (&a.deny, Level::Error),
-    ] {
-        for c in codes {
-            if let Err(e) = cfg.set(c, level) {
-                let _ = write!(err, "{}", Diagnostic::error(e.to_string()));
-                return EXIT_BAD_INPUT;
-            }
-        }
-    }
+    let Some(cfg) = levels(&a, &mut err) else {
+        return EXIT_BAD_INPUT;
+    };
     let limits = a.limits.limits();
     let inputs = match format::discover::expand(&a.files) {
         Ok(i) => i,
@@ -108,51 +75,124 @@ pub(super) fn execute(a: LintArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    let (findings, failed) = lint_inputs(&inputs, only.as_deref(), &limits, &cfg, &mut err);
+    let code = emit_text(None, rendered(&findings, a.format, inputs.len()));
+    if code != EXIT_OK || failed {
+        return EXIT_BAD_INPUT;
+    }
+    if findings.iter().any(|f| f.level == Level::Error) {
+        EXIT_CHECK_FAILED
+    } else {
+        EXIT_OK
+    }
+}
+
+/// `lint --list`: every rule's code, default level and summary.
+fn rule_table() -> String {
+    let mut t = btfsm_core::table::Table::new(&["code", "level", "what it finds"]);
+    for r in lint::RULES {
+        t.row(vec![
+            r.code.to_string(),
+            r.level.as_str().to_string(),
+            r.summary.to_string(),
+        ]);
+    }
+    t.render()
+}
+
+/// The rules' levels: `btfsm.toml`'s `[lint]` table (unless `--no-config`),
+/// then the flags; `None` after printing why they are invalid.
+fn levels(a: &LintArgs, err: &mut impl Write) -> Option<config::Config> {
+    let mut cfg = config::Config::default();
+    if !a.no_config
+        && let Ok(cwd) = std::env::current_dir()
+        && let Some(path) = config::find(&cwd)
+    {
+        let limits = a.limits.limits();
+        let shown = path.display().to_string();
+        match format::source::read(&path, &shown, &limits, true).map(|f| config::read(&f)) {
+            Ok(Ok(c)) => cfg = c,
+            Ok(Err(d)) | Err(d) => {
+                print_diagnostics(err, &d);
+                return None;
+            }
+        }
+    }
+    for (codes, level) in [
+        (&a.allow, Level::Allow),
+        (&a.warn, Level::Warning),
+        (&a.deny, Level::Error),
+    ] {
+        for c in codes {
+            if let Err(e) = cfg.set(c, level) {
+                let _ = write!(err, "{}", Diagnostic::error(e.to_string()));
+                return None;
+            }
+        }
+    }
+    Some(cfg)
+}
+
+/// Lints every input (only those of `only` among BehaviorTree.CPP files,
+/// when `--tree` chose some): the findings, and whether an input did not
+/// load.
+fn lint_inputs(
+    inputs: &[format::discover::Input],
+    only: Option<&[PathBuf]>,
+    limits: &btfsm_format::Limits,
+    cfg: &config::Config,
+    err: &mut impl Write,
+) -> (Vec<lint::Finding>, bool) {
     let mut findings = Vec::new();
     let mut failed = false;
     let mut models = SiblingModels::default();
-    for input in &inputs {
-        if let Some(only) = &only
+    for input in inputs {
+        if let Some(only) = only
             && super::io::is_btcpp_candidate(&input.path)
             && !only.contains(&input.path)
         {
             continue;
         }
-        let (file, fmt) = match format::discover::read(input, &limits) {
+        let (file, fmt) = match format::discover::read(input, limits) {
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
             Ok(_) => continue,
             Err(d) => {
                 failed = true;
-                print_diagnostics(&mut err, &d);
+                print_diagnostics(err, &d);
                 continue;
             }
         };
-        let limits = models.limits_for(&input.path, fmt, &limits);
+        let limits = models.limits_for(&input.path, fmt, limits);
         match format::load_read(file.clone(), &input.path, fmt, &limits) {
             Ok(l) => {
                 let subject = lint::Subject {
                     policy: &l.policy,
                     dataflow: l.dataflow.as_deref(),
                 };
-                findings.extend(lint::lint_subject(&subject, Some(&file), &l.path, &cfg))
+                findings.extend(lint::lint_subject(&subject, Some(&file), &l.path, cfg))
             }
             Err(d) => {
                 // Coded load errors are findings (lint::load); the others
                 // mean the input does not load.
-                let (coded, rest) = lint::load::findings(&d, &file.path, &cfg);
+                let (coded, rest) = lint::load::findings(&d, &file.path, cfg);
                 findings.extend(coded);
                 if rest.iter().any(|d| d.is_error()) {
                     failed = true;
-                    print_diagnostics(&mut err, &rest);
+                    print_diagnostics(err, &rest);
                 }
             }
         }
     }
-    let text = match a.format {
-        LintFormat::Sarif => lint::sarif::render(&findings),
+    (findings, failed)
+}
+
+/// The findings in `format`; the text ends with the counts.
+fn rendered(findings: &[lint::Finding], format: LintFormat, files: usize) -> String {
+    match format {
+        LintFormat::Sarif => lint::sarif::render(findings),
         LintFormat::Json => {
             let mut s = btfsm_core::sanitize::json(
-                serde_json::to_string_pretty(&findings).expect("serializable"),
+                serde_json::to_string_pretty(findings).expect("serializable"),
             );
             s.push('\n');
             s
@@ -168,20 +208,11 @@ pub(super) fn execute(a: LintArgs) -> u8 {
                 if count(Level::Warning) == 1 { "" } else { "s" },
                 count(Level::Note),
                 if count(Level::Note) == 1 { "" } else { "s" },
-                inputs.len(),
-                if inputs.len() == 1 { "" } else { "s" },
+                files,
+                if files == 1 { "" } else { "s" },
             ));
             s
         }
-    };
-    let code = emit_text(None, text);
-    if code != EXIT_OK || failed {
-        return EXIT_BAD_INPUT;
-    }
-    if findings.iter().any(|f| f.level == Level::Error) {
-        EXIT_CHECK_FAILED
-    } else {
-        EXIT_OK
     }
 }
 

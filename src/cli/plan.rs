@@ -79,7 +79,6 @@ pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> 
     }
 }
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub(super) fn execute(a: PlanArgs) -> u8 {
     let limits = a.limits.limits();
     let shown = a.domain.display().to_string();
@@ -164,8 +163,31 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
             })
         })
         .collect();
-    let text = match a.format {
-        OutputFormat::Csv => report::render_analysis(&rows, OutputFormat::Csv),
+    let text = plan_report(&domain, &planned, &rows, a.format);
+    let code = emit_text(None, text);
+    let left = planned.conflicts.iter().any(|c| {
+        matches!(
+            c.outcome,
+            plan::conflicts::Outcome::Left | plan::conflicts::Outcome::Cycle
+        )
+    });
+    if code == EXIT_OK && left && !a.no_reorder {
+        // A cycle no order resolves: the tree chatters; say so in the status.
+        return super::EXIT_CHECK_FAILED;
+    }
+    code
+}
+
+/// What `plan` prints: the goal, the conflicts and the planned policies'
+/// figures (the `analyze` rows), as a table, JSON or CSV.
+fn plan_report(
+    domain: &plan::Domain,
+    planned: &plan::Planned,
+    rows: &[report::PolicyReport],
+    format: OutputFormat,
+) -> String {
+    match format {
+        OutputFormat::Csv => report::render_analysis(rows, OutputFormat::Csv),
         OutputFormat::Json => {
             #[derive(serde::Serialize)]
             struct Out<'a> {
@@ -178,7 +200,7 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
                 domain: &domain.name,
                 goal: domain.goal.facts.iter().map(ToString::to_string).collect(),
                 conflicts: &planned.conflicts,
-                policies: &rows,
+                policies: rows,
             };
             let mut s = btfsm_core::sanitize::json(
                 serde_json::to_string_pretty(&out).expect("serializable"),
@@ -214,22 +236,10 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
                 }
             }
             s.push('\n');
-            s.push_str(&report::render_analysis(&rows, OutputFormat::Table));
+            s.push_str(&report::render_analysis(rows, OutputFormat::Table));
             s
         }
-    };
-    let code = emit_text(None, text);
-    let left = planned.conflicts.iter().any(|c| {
-        matches!(
-            c.outcome,
-            plan::conflicts::Outcome::Left | plan::conflicts::Outcome::Cycle
-        )
-    });
-    if code == EXIT_OK && left && !a.no_reorder {
-        // A cycle no order resolves: the tree chatters; say so in the status.
-        return super::EXIT_CHECK_FAILED;
     }
-    code
 }
 
 /// The policies `to` asks for, named after the domain.

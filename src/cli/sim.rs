@@ -62,7 +62,6 @@ pub(crate) struct SimArgs {
     pub limits: super::args::LimitArgs,
 }
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub(crate) fn execute(a: SimArgs) -> u8 {
     let outputs = [
         ("--trace", a.trace.as_deref()),
@@ -88,7 +87,7 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
     if btfsm_sim::symbolic::looks_symbolic(&file.text) {
         return symbolic(&a, &file, &base, &limits);
     }
-    let mut s = match scenario::parse(&file, &base, &limits) {
+    let s = match scenario::parse(&file, &base, &limits) {
         Ok(s) => s,
         Err(d) => {
             print_diagnostics(&mut std::io::stderr().lock(), &d);
@@ -98,64 +97,86 @@ pub(crate) fn execute(a: SimArgs) -> u8 {
     if !s.warnings.is_empty() {
         print_diagnostics(&mut std::io::stderr().lock(), &s.warnings);
     }
-    let file = a.scenario.display().to_string();
     // The budget's clock starts once the scenario is read.
     let t0 = std::time::Instant::now();
     // Checked: a budget past what the clock can hold is no deadline.
     let deadline = a
         .timeout_ms
         .and_then(|ms| t0.checked_add(std::time::Duration::from_millis(ms)));
-    if let Some(n) = a.runs {
-        if a.trace.is_some() || a.plot.is_some() {
-            return fail(Diagnostic::error(
-                "--trace and --plot record one run; leave them out with --runs",
-            ));
-        }
-        let seed = a.seed.unwrap_or(s.seed);
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let threads = match a.threads {
-            Some(0) => {
-                return fail(Diagnostic::error("--threads must be at least 1"));
-            }
-            // More threads than cores only wait; a few per core at most.
-            Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
-            None => cores,
-        };
-        let mc = monte_carlo::monte_carlo_within(&s, n, seed, threads, deadline);
-        let done = mc.runs;
-        let rep = McReport {
-            scenario: s.name.clone(),
-            seed,
-            // What the figures cover.
-            runs: done,
-            threads: threads.max(1).min(n.max(1) as usize),
-            millis: t0.elapsed().as_millis(),
-            policies: mc.policies,
-            pairs: mc.pairs,
-        };
-        let budget = a.timeout_ms.map(|ms| Budget {
-            timeout_ms: ms,
-            exhausted: done < n,
-            requested_runs: Some(n),
-            millis: None,
-        });
-        let note =
-            format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
-        let text = render(
-            &rep,
-            a.format,
-            McReport::json,
-            McReport::csv,
-            if a.format == OutputFormat::Markdown {
-                McReport::markdown
-            } else {
-                McReport::table
-            },
-            &budget,
-            &note,
-        );
-        return emit_text(None, text);
+    match a.runs {
+        Some(n) => monte_carlo_runs(&a, &s, n, t0, deadline),
+        None => one_run(&a, s, t0, deadline),
     }
+}
+
+/// `sim --runs N`: seeded episodes over the cores, within the deadline.
+fn monte_carlo_runs(
+    a: &SimArgs,
+    s: &scenario::Scenario,
+    n: u32,
+    t0: std::time::Instant,
+    deadline: Option<std::time::Instant>,
+) -> u8 {
+    if a.trace.is_some() || a.plot.is_some() {
+        return fail(Diagnostic::error(
+            "--trace and --plot record one run; leave them out with --runs",
+        ));
+    }
+    let seed = a.seed.unwrap_or(s.seed);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = match a.threads {
+        Some(0) => {
+            return fail(Diagnostic::error("--threads must be at least 1"));
+        }
+        // More threads than cores only wait; a few per core at most.
+        Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
+        None => cores,
+    };
+    let mc = monte_carlo::monte_carlo_within(s, n, seed, threads, deadline);
+    let done = mc.runs;
+    let rep = McReport {
+        scenario: s.name.clone(),
+        seed,
+        // What the figures cover.
+        runs: done,
+        threads: threads.max(1).min(n.max(1) as usize),
+        millis: t0.elapsed().as_millis(),
+        policies: mc.policies,
+        pairs: mc.pairs,
+    };
+    let budget = a.timeout_ms.map(|ms| Budget {
+        timeout_ms: ms,
+        exhausted: done < n,
+        requested_runs: Some(n),
+        millis: None,
+    });
+    let note =
+        format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
+    let text = render(
+        &rep,
+        a.format,
+        McReport::json,
+        McReport::csv,
+        if a.format == OutputFormat::Markdown {
+            McReport::markdown
+        } else {
+            McReport::table
+        },
+        &budget,
+        &note,
+    );
+    emit_text(None, text)
+}
+
+/// `sim` without `--runs`: each policy once (or the episode of `--seed`),
+/// the verdicts, the expectations, the trace and the plot.
+fn one_run(
+    a: &SimArgs,
+    mut s: scenario::Scenario,
+    t0: std::time::Instant,
+    deadline: Option<std::time::Instant>,
+) -> u8 {
+    let file = a.scenario.display().to_string();
     if a.format == OutputFormat::Markdown {
         return fail(Diagnostic::error(
             "`sim` prints markdown with --runs; use `table` or `json` for one run",
