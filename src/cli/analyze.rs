@@ -3,14 +3,14 @@
 //! `--baseline`, `--max-increase`) that exits 1 naming every limit passed.
 
 use super::args::LimitArgs;
-use super::io::{emit_text, load_inputs};
+use super::io::{emit_report, load_inputs};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::output::{Format, Report};
 use btfsm_core::sanitize::shown;
 use btfsm_format::Limits;
-use btfsm_report::OutputFormat;
 use btfsm_report::gate::{Baseline, Gate, Limit};
-use btfsm_report::{analyze, render_analysis};
+use btfsm_report::{Analysis, analyze};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -21,8 +21,8 @@ pub(crate) struct AnalyzeArgs {
     #[arg(required = true)]
     pub(super) files: Vec<PathBuf>,
     /// Output format
-    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
-    pub(super) format: OutputFormat,
+    #[arg(long, value_parser = super::format::parser(Analysis::FORMATS, &[]), default_value = "table")]
+    pub(super) format: Format,
     /// Exit 1 when a policy's METRIC is above N, e.g. `--max cc=30`
     /// (repeatable; metrics: vertices, edges, graphical_elements,
     /// active_elements, cc, essential_cc)
@@ -51,7 +51,7 @@ pub(super) fn run(a: AnalyzeArgs) -> u8 {
         return EXIT_BAD_INPUT;
     };
     let reports: Vec<_> = loaded.iter().map(analyze).collect();
-    let code = emit_text(None, render_analysis(&reports, a.format));
+    let code = emit_report(None, &Analysis(&reports), a.format);
     if failed {
         return EXIT_BAD_INPUT;
     }

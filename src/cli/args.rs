@@ -95,14 +95,6 @@ impl CompareMode {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub(crate) enum CompareFormat {
-    Table,
-    Json,
-    /// GitHub-flavoured markdown, for a pull-request comment
-    Markdown,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub(crate) enum ConvertTarget {
     /// The paper's BT -> HFSM construction (Fig. 5 -> Fig. 6)
     Hfsm,
@@ -241,8 +233,8 @@ impl LimitArgs {
 #[derive(Debug, Clone, Args)]
 pub(crate) struct PaperArgs {
     /// Output format
-    #[arg(long, value_enum, default_value_t = btfsm_report::paper::PaperFormat::Table)]
-    pub format: btfsm_report::paper::PaperFormat,
+    #[arg(long, value_parser = super::format::parser(<btfsm_report::paper::PaperReport as btfsm_core::output::Report>::FORMATS, &[]), default_value = "table")]
+    pub format: btfsm_core::output::Format,
     /// Time budget of each exact GED; when it runs out the cell shows the
     /// certified interval
     #[arg(long, default_value_t = 2000, value_name = "MS")]

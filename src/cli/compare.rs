@@ -6,11 +6,12 @@
 //! default, for two BTs) adds the ordered tree edit distance
 //! (`metrics::ted`), bounded by a count of table cells.
 
-use super::args::{CompareFormat, CompareMode, LimitArgs};
+use super::args::{CompareMode, LimitArgs};
 use super::dot::draw;
-use super::io::{emit_text, fail, load_all, outputs_distinct};
+use super::io::{emit_report, fail, load_all, outputs_distinct};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::output::{Format, Report};
 use btfsm_core::sanitize::shown;
 use btfsm_metrics::ged::{GedMode, GedOptions};
 use btfsm_metrics::ted::TedOptions;
@@ -55,8 +56,8 @@ pub(crate) struct CompareArgs {
     #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
     pub(super) tree_max_work: u64,
     /// Output format
-    #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
-    pub(super) format: CompareFormat,
+    #[arg(long, value_parser = super::format::parser(Comparison::FORMATS, super::format::COMPARISON_HELP), default_value = "table")]
+    pub(super) format: Format,
     /// Also draw B with added elements magenta, A's removed ones dashed
     /// grey and changed ones (relabels, reorders) orange with their old
     /// value, a title and a legend (the edit script of --mode; named when
@@ -148,12 +149,7 @@ pub(super) fn run(args: CompareArgs) -> u8 {
         let timeout = Duration::from_millis(args.timeout_ms);
         drawn = draw(&lb.policy, &opts, Some(path), args.render, timeout);
     }
-    let text = match args.format {
-        CompareFormat::Json => compare::render_json(&report),
-        CompareFormat::Table => compare::render_table(&report),
-        CompareFormat::Markdown => compare::render_markdown(&report),
-    };
-    let printed = emit_text(None, text);
+    let printed = emit_report(None, &Comparison(&report), args.format);
     if drawn != EXIT_OK { drawn } else { printed }
 }
 
@@ -211,6 +207,21 @@ impl Drop for Progress {
         }
         if let Some(t) = self.thread.take() {
             let _ = t.join();
+        }
+    }
+}
+
+/// `compare`'s report in its formats.
+struct Comparison<'a>(&'a compare::CompareReport);
+
+impl Report for Comparison<'_> {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json, Format::Markdown];
+
+    fn write(&self, format: Format) -> String {
+        match Self::supported(format) {
+            Format::Json => compare::render_json(self.0),
+            Format::Markdown => compare::render_markdown(self.0),
+            _ => compare::render_table(self.0),
         }
     }
 }

@@ -4,10 +4,10 @@
 
 use super::EXIT_BAD_INPUT;
 use super::args::LimitArgs;
-use super::io::{emit_text, load_inputs};
+use super::io::{emit_report, load_inputs};
+use btfsm_core::output::{Format, Report};
 use btfsm_metrics::ged::GedOptions;
-use btfsm_report::OutputFormat;
-use btfsm_report::effort::{EffortRow, effort, render_effort};
+use btfsm_report::effort::{EffortRow, EffortTable, effort};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -17,8 +17,8 @@ pub(crate) struct EffortArgs {
     #[arg(required = true)]
     pub(super) files: Vec<PathBuf>,
     /// Output format
-    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
-    pub(super) format: OutputFormat,
+    #[arg(long, value_parser = super::format::parser(EffortTable::FORMATS, &[]), default_value = "table")]
+    pub(super) format: Format,
     /// Time budget of the structural GED per policy; when it runs out the
     /// result is a certified interval (the named GED has no budget)
     #[arg(long, default_value_t = 2000, value_name = "MS")]
@@ -39,6 +39,6 @@ pub(super) fn run(a: EffortArgs) -> u8 {
         .iter()
         .map(|l| EffortRow::new(&l.path, &l.policy.name, &effort(&l.policy, &opts).0))
         .collect();
-    let code = emit_text(None, render_effort(&rows, a.format));
+    let code = emit_report(None, &EffortTable(&rows), a.format);
     if failed { EXIT_BAD_INPUT } else { code }
 }

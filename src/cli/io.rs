@@ -212,6 +212,16 @@ pub(super) fn print_diagnostics(w: &mut impl Write, diags: &[Diagnostic]) {
     }
 }
 
+/// Writes a report in `format` (one its command's `--format` admits) to a
+/// file or stdout: the one way a command prints what it computed.
+pub(super) fn emit_report<R: btfsm_core::output::Report>(
+    path: Option<&Path>,
+    report: &R,
+    format: btfsm_core::output::Format,
+) -> u8 {
+    emit_text(path, report.write(format))
+}
+
 /// Writes a text output (report, DOT, SVG, policy) through
 /// [`super::out::text`] to a file (atomically) or stdout.
 pub(super) fn emit_text(path: Option<&Path>, text: impl AsRef<str>) -> u8 {

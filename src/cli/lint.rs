@@ -3,23 +3,24 @@
 //! JSON or SARIF 2.1.0; exit 1 when an error-level finding remains, 2 when
 //! an input does not load (its errors printed, the others still linted).
 
-use super::io::{emit_text, print_diagnostics};
+use super::io::{emit_report, emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::output::{Format, Report};
 use btfsm_format as format;
 use btfsm_lint::{self as lint, Level, config};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub(crate) enum LintFormat {
-    /// Positioned messages with snippet and help, as `validate` prints
-    Text,
-    Json,
-    /// SARIF 2.1.0, for GitHub code scanning
-    Sarif,
-}
+/// The help of `lint`'s formats.
+const LINT_HELP: super::format::Help = &[
+    (
+        Format::Text,
+        "Positioned messages with snippet and help, as `validate` prints",
+    ),
+    (Format::Sarif, "SARIF 2.1.0, for GitHub code scanning"),
+];
 
 #[derive(Debug, Args)]
 pub(crate) struct LintArgs {
@@ -27,8 +28,8 @@ pub(crate) struct LintArgs {
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Output format
-    #[arg(long, value_enum, default_value_t = LintFormat::Text)]
-    pub format: LintFormat,
+    #[arg(long, value_parser = super::format::parser(Findings::FORMATS, LINT_HELP), default_value = "text")]
+    pub format: Format,
     /// Report rule CODE as an error (repeatable)
     #[arg(long, value_name = "CODE")]
     pub deny: Vec<String>,
@@ -76,7 +77,11 @@ pub(super) fn execute(a: LintArgs) -> u8 {
         }
     };
     let (findings, failed) = lint_inputs(&inputs, only.as_deref(), &limits, &cfg, &mut err);
-    let code = emit_text(None, rendered(&findings, a.format, inputs.len()));
+    let report = Findings {
+        findings: &findings,
+        files: inputs.len(),
+    };
+    let code = emit_report(None, &report, a.format);
     if code != EXIT_OK || failed {
         return EXIT_BAD_INPUT;
     }
@@ -186,32 +191,43 @@ fn lint_inputs(
     (findings, failed)
 }
 
-/// The findings in `format`; the text ends with the counts.
-fn rendered(findings: &[lint::Finding], format: LintFormat, files: usize) -> String {
-    match format {
-        LintFormat::Sarif => lint::sarif::render(findings),
-        LintFormat::Json => {
-            let mut s = btfsm_core::sanitize::json(
-                serde_json::to_string_pretty(findings).expect("serializable"),
-            );
-            s.push('\n');
-            s
-        }
-        LintFormat::Text => {
-            let mut s: String = findings.iter().map(lint::render_text).collect();
-            let count = |l: Level| findings.iter().filter(|f| f.level == l).count();
-            s.push_str(&format!(
-                "{} error{}, {} warning{}, {} note{} in {} file{}\n",
-                count(Level::Error),
-                if count(Level::Error) == 1 { "" } else { "s" },
-                count(Level::Warning),
-                if count(Level::Warning) == 1 { "" } else { "s" },
-                count(Level::Note),
-                if count(Level::Note) == 1 { "" } else { "s" },
-                files,
-                if files == 1 { "" } else { "s" },
-            ));
-            s
+/// `lint`'s report: the findings of every file linted.
+struct Findings<'a> {
+    findings: &'a [lint::Finding],
+    files: usize,
+}
+
+impl Report for Findings<'_> {
+    const FORMATS: &'static [Format] = &[Format::Text, Format::Json, Format::Sarif];
+
+    /// The findings in `format`; the text ends with the counts.
+    fn write(&self, format: Format) -> String {
+        let (findings, files) = (self.findings, self.files);
+        match Self::supported(format) {
+            Format::Sarif => lint::sarif::render(findings),
+            Format::Json => {
+                let mut s = btfsm_core::sanitize::json(
+                    serde_json::to_string_pretty(findings).expect("serializable"),
+                );
+                s.push('\n');
+                s
+            }
+            _ => {
+                let mut s: String = findings.iter().map(lint::render_text).collect();
+                let count = |l: Level| findings.iter().filter(|f| f.level == l).count();
+                s.push_str(&format!(
+                    "{} error{}, {} warning{}, {} note{} in {} file{}\n",
+                    count(Level::Error),
+                    if count(Level::Error) == 1 { "" } else { "s" },
+                    count(Level::Warning),
+                    if count(Level::Warning) == 1 { "" } else { "s" },
+                    count(Level::Note),
+                    if count(Level::Note) == 1 { "" } else { "s" },
+                    files,
+                    if files == 1 { "" } else { "s" },
+                ));
+                s
+            }
         }
     }
 }

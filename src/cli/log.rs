@@ -5,8 +5,9 @@
 use super::io::{emit_text, fail};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::output::Format;
 use btfsm_log::report;
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -72,17 +73,10 @@ pub(crate) struct CompareArgs {
     #[arg(long)]
     pub ignore_args: bool,
     /// Output format
-    #[arg(long, value_enum, default_value_t = CompareFormat::Table)]
-    pub format: CompareFormat,
+    #[arg(long, value_parser = super::format::parser(super::format::COMPARISON, super::format::COMPARISON_HELP), default_value = "table")]
+    pub format: Format,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub(crate) enum CompareFormat {
-    Table,
-    Json,
-    Markdown,
 }
 
 #[derive(Debug, Args)]
@@ -113,16 +107,20 @@ pub(crate) struct DotArgs {
     pub limits: super::args::LimitArgs,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub(crate) enum LogFormat {
-    Table,
-    Json,
-    /// One row per node: uid, node, type, activations, status changes by
-    /// status, seconds RUNNING
-    Csv,
-    /// GitHub-flavoured markdown: coverage, branches not covered, the nodes
-    Markdown,
-}
+/// `log report`'s formats.
+const LOG_REPORT_FORMATS: &[Format] = &[Format::Table, Format::Json, Format::Csv, Format::Markdown];
+
+/// The help of `log report`'s formats.
+const LOG_REPORT_HELP: super::format::Help = &[
+    (
+        Format::Csv,
+        "One row per node: uid, node, type, activations, status changes by status, seconds RUNNING",
+    ),
+    (
+        Format::Markdown,
+        "GitHub-flavoured markdown: coverage, branches not covered, the nodes",
+    ),
+];
 
 #[derive(Debug, Args)]
 pub(crate) struct ReportArgs {
@@ -132,8 +130,8 @@ pub(crate) struct ReportArgs {
     #[arg(long, value_name = "N")]
     pub session: Option<i64>,
     /// Output format
-    #[arg(long, value_enum, default_value_t = LogFormat::Table)]
-    pub format: LogFormat,
+    #[arg(long, value_parser = super::format::parser(LOG_REPORT_FORMATS, LOG_REPORT_HELP), default_value = "table")]
+    pub format: Format,
     /// Exit 1 when node or branch coverage is below this ratio (0 to 1)
     #[arg(long, value_name = "X")]
     pub min_coverage: Option<f64>,
@@ -171,15 +169,15 @@ pub(super) fn execute(a: LogArgs) -> u8 {
     r.sessions = opened.sessions;
     r.more_sessions = opened.more_sessions;
     let text = match a.format {
-        LogFormat::Json => {
+        Format::Json => {
             let mut s =
                 btfsm_core::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
             s.push('\n');
             s
         }
-        LogFormat::Table => report::render_table(&r),
-        LogFormat::Csv => report::render_csv(&r),
-        LogFormat::Markdown => report::render_markdown(&r),
+        Format::Csv => report::render_csv(&r),
+        Format::Markdown => report::render_markdown(&r),
+        _ => report::render_table(&r),
     };
     let code = emit_text(None, text);
     if code != EXIT_OK {
@@ -300,14 +298,14 @@ fn compare(a: CompareArgs) -> u8 {
         Err(e) => return bad_run(&e),
     };
     let text = match a.format {
-        CompareFormat::Json => {
+        Format::Json => {
             let mut s =
                 btfsm_core::sanitize::json(serde_json::to_string_pretty(&r).expect("serializable"));
             s.push('\n');
             s
         }
-        CompareFormat::Table => c::render_table(&r),
-        CompareFormat::Markdown => c::render_markdown(&r),
+        Format::Markdown => c::render_markdown(&r),
+        _ => c::render_table(&r),
     };
     let code = emit_text(None, text);
     if code != EXIT_OK {

@@ -25,6 +25,7 @@ macro_rules! eprint {
 pub(crate) mod args;
 pub(crate) mod out;
 
+mod format;
 mod io;
 
 // One file per command, each with its flags and one `run`.

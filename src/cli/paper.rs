@@ -63,5 +63,5 @@ pub(super) fn paper(a: &PaperArgs) -> u8 {
         eprint!("{}", Diagnostic::error(format!("paper check: {} cell{} departed from `{}`", departures.len(), if departures.len() == 1 { "" } else { "s" }, expected_path.display())).hint(format!("if the change is deliberate, review it and run `btfsm paper --record --policies {}`", a.policies.display())));
         return EXIT_CHECK_FAILED;
     }
-    emit_text(a.output.as_deref(), paper::render(&report, a.format))
+    super::io::emit_report(a.output.as_deref(), &report, a.format)
 }

@@ -7,10 +7,11 @@
 use super::io::{emit_text, fail, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::output::Format;
 use btfsm_format::{Limits, Loaded};
 use btfsm_model::{Policy, PolicyBody};
 use btfsm_plan::{self as plan, Options};
-use btfsm_report::{self as report, OutputFormat};
+use btfsm_report::{self as report};
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 
@@ -53,8 +54,8 @@ pub(crate) struct PlanArgs {
     pub max_plan_depth: u16,
     /// Output format of the report: table, json, or csv (the metrics rows,
     /// as `analyze` writes them; the conflicts are in table and json)
-    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
-    pub format: OutputFormat,
+    #[arg(long, value_parser = super::format::parser(super::format::FIGURES, &[]), default_value = "table")]
+    pub format: Format,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
 }
@@ -184,11 +185,11 @@ fn plan_report(
     domain: &plan::Domain,
     planned: &plan::Planned,
     rows: &[report::PolicyReport],
-    format: OutputFormat,
+    format: Format,
 ) -> String {
     match format {
-        OutputFormat::Csv => report::render_analysis(rows, OutputFormat::Csv),
-        OutputFormat::Json => {
+        Format::Csv => report::render_analysis(rows, Format::Csv),
+        Format::Json => {
             #[derive(serde::Serialize)]
             struct Out<'a> {
                 domain: &'a str,
@@ -236,7 +237,7 @@ fn plan_report(
                 }
             }
             s.push('\n');
-            s.push_str(&report::render_analysis(rows, OutputFormat::Table));
+            s.push_str(&report::render_analysis(rows, Format::Table));
             s
         }
     }

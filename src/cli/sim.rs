@@ -5,32 +5,37 @@
 use super::io::{emit_text, fail, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::output::Format;
 use btfsm_sim::report::{McReport, SimReport, TraceWriter};
 use btfsm_sim::{monte_carlo, plot, run, scenario};
 use clap::Args;
 use std::path::PathBuf;
 
+/// What `sim` prints.
+const SIM_FORMATS: &[Format] = &[Format::Table, Format::Json, Format::Markdown, Format::Csv];
+
+/// The help of `sim`'s formats.
+const SIM_HELP: super::format::Help = &[
+    (
+        Format::Markdown,
+        "GitHub-flavoured markdown tables (with --runs)",
+    ),
+    (
+        Format::Csv,
+        "One row per policy (figures only: the verdicts are in table and json)",
+    ),
+];
+
 /// `--threads` above this many per core are lowered to it.
 pub(crate) const MAX_THREADS_PER_CORE: usize = 4;
-
-/// What `sim` prints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub(crate) enum OutputFormat {
-    Table,
-    Json,
-    /// GitHub-flavoured markdown tables (with --runs)
-    Markdown,
-    /// One row per policy (figures only: the verdicts are in table and json)
-    Csv,
-}
 
 #[derive(Debug, Args)]
 pub(crate) struct SimArgs {
     /// Scenario file (TOML)
     pub scenario: PathBuf,
     /// Output format (table, json or csv; markdown with --runs)
-    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
-    pub format: OutputFormat,
+    #[arg(long, value_parser = super::format::parser(SIM_FORMATS, SIM_HELP), default_value = "table")]
+    pub format: Format,
     /// Write the full trace (every step of every run) as JSON
     #[arg(long, value_name = "OUT.json")]
     pub trace: Option<PathBuf>,
@@ -157,7 +162,7 @@ fn monte_carlo_runs(
         a.format,
         McReport::json,
         McReport::csv,
-        if a.format == OutputFormat::Markdown {
+        if a.format == Format::Markdown {
             McReport::markdown
         } else {
             McReport::table
@@ -177,7 +182,7 @@ fn one_run(
     deadline: Option<std::time::Instant>,
 ) -> u8 {
     let file = a.scenario.display().to_string();
-    if a.format == OutputFormat::Markdown {
+    if a.format == Format::Markdown {
         return fail(Diagnostic::error(
             "`sim` prints markdown with --runs; use `table` or `json` for one run",
         ));
@@ -300,7 +305,7 @@ struct Budget {
 /// object, and the table `note` when the budget ran out.
 fn render<R: serde::Serialize>(
     rep: &R,
-    format: OutputFormat,
+    format: Format,
     json: fn(&R) -> String,
     csv: fn(&R) -> String,
     table: fn(&R) -> String,
@@ -308,10 +313,10 @@ fn render<R: serde::Serialize>(
     note: &str,
 ) -> String {
     match (format, budget) {
-        (OutputFormat::Json, None) => json(rep),
-        (OutputFormat::Json, Some(b)) => with_budget(rep, b),
+        (Format::Json, None) => json(rep),
+        (Format::Json, Some(b)) => with_budget(rep, b),
         // The note goes to stderr: the CSV stays one table.
-        (OutputFormat::Csv, b) => {
+        (Format::Csv, b) => {
             if let Some(b) = b.as_ref().filter(|b| b.exhausted) {
                 eprintln!(
                     "note: the wall-clock budget of {} ms ran out: {note}",
@@ -481,10 +486,7 @@ fn symbolic(
     limits: &btfsm_format::Limits,
 ) -> u8 {
     use btfsm_sim::symbolic::{report, run};
-    if a.trace.is_some()
-        || a.plot.is_some()
-        || matches!(a.format, OutputFormat::Markdown | OutputFormat::Csv)
-    {
+    if a.trace.is_some() || a.plot.is_some() || matches!(a.format, Format::Markdown | Format::Csv) {
         return fail(
             Diagnostic::error("a symbolic scenario has no trace, plot, markdown or csv report")
                 .hint("print `table` or `json`"),
@@ -497,7 +499,7 @@ fn symbolic(
             return EXIT_BAD_INPUT;
         }
     };
-    let json = a.format == OutputFormat::Json;
+    let json = a.format == Format::Json;
     let text = match a.runs {
         Some(n) => {
             let seed = a.seed.unwrap_or(s.seed);

@@ -6,10 +6,10 @@
 use super::EXIT_BAD_INPUT;
 use super::io::{emit_text, fail, print_diagnostics};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::output::Format;
 use btfsm_core::sanitize::shown;
 use btfsm_format as format;
 use btfsm_model::PolicyBody;
-use btfsm_report::OutputFormat;
 use btfsm_tick as tick;
 use clap::Args;
 use std::path::PathBuf;
@@ -22,19 +22,14 @@ pub(crate) struct TickArgs {
     /// Leaf script (TOML), one per tree, in the same order
     #[arg(long = "script", required = true, value_name = "S.toml")]
     pub scripts: Vec<PathBuf>,
-    /// Output format (table or json)
-    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
-    pub format: OutputFormat,
+    /// Output format
+    #[arg(long, value_parser = super::format::parser(&[Format::Table, Format::Json], &[]), default_value = "table")]
+    pub format: Format,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
 }
 
 pub(super) fn execute(a: TickArgs) -> u8 {
-    if a.format == OutputFormat::Csv {
-        return fail(Diagnostic::error(
-            "`tick` prints `table` or `json`, not `csv`",
-        ));
-    }
     if a.trees.len() != a.scripts.len() {
         return fail(
             Diagnostic::error(format!(
@@ -54,7 +49,7 @@ pub(super) fn execute(a: TickArgs) -> u8 {
         let r = one(t, s, &limits, a.format);
         match r {
             Ok(text) => {
-                if a.format == OutputFormat::Table && !out.is_empty() {
+                if a.format == Format::Table && !out.is_empty() {
                     out.push('\n');
                 }
                 out.push_str(&text);
@@ -73,7 +68,7 @@ fn one(
     tree: &std::path::Path,
     script: &std::path::Path,
     limits: &format::Limits,
-    fmt: OutputFormat,
+    fmt: Format,
 ) -> Result<String, Vec<Diagnostic>> {
     let (file, input) = format::read_input(tree, limits)?;
     let f = match input {
@@ -119,7 +114,7 @@ fn one(
     let run = tick::run(bt, &sc);
     let (tn, sn) = (tree.display().to_string(), script.display().to_string());
     Ok(match fmt {
-        OutputFormat::Json => run.json(bt, &tn, &sn),
+        Format::Json => run.json(bt, &tn, &sn),
         _ => run.table(bt, &shown(&tn), &shown(&sn)),
     })
 }

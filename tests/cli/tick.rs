@@ -161,3 +161,32 @@ fn script_errors_are_positioned() {
         "{err}"
     );
 }
+
+/// `--format` takes exactly the formats a command's report is written in:
+/// one the command does not write is a usage error (exit 2) naming the
+/// ones it does, before anything is read.
+#[test]
+fn a_format_a_command_does_not_write_is_a_usage_error() {
+    for (args, offered) in [
+        (
+            &["tick", "x.xml", "--script", "s.toml", "--format", "csv"][..],
+            "table, json",
+        ),
+        (
+            &["compare", "a.toml", "b.toml", "--format", "sarif"][..],
+            "table, json, markdown",
+        ),
+        (
+            &["lint", "a.toml", "--format", "csv"][..],
+            "text, json, sarif",
+        ),
+    ] {
+        let (code, out, err) = btfsm(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(out.is_empty());
+        assert!(
+            err.contains(&format!("[possible values: {offered}]")),
+            "{args:?}: {err}"
+        );
+    }
+}

@@ -369,13 +369,13 @@ pub fn check_diagnostics(diags: &[Diagnostic]) {
 /// (table, JSON, CSV), DOT, the TOML write-back (a fixpoint), the BT → HFSM
 /// and fault-tolerant transforms and effort.
 pub fn exercise(l: &Loaded) {
-    use btfsm_report::OutputFormat;
+    use btfsm_report::{Analysis, Report};
     let g = btfsm_model::graph::policy_graph(&l.policy);
     let _ = btfsm_metrics::complexity::cyclomatic(&g);
     let _ = btfsm_metrics::complexity::essential(&l.policy);
     let row = btfsm_report::analyze(l);
-    for f in [OutputFormat::Table, OutputFormat::Json, OutputFormat::Csv] {
-        let _ = btfsm_report::render_analysis(std::slice::from_ref(&row), f);
+    for &f in Analysis::FORMATS {
+        let _ = Analysis(std::slice::from_ref(&row)).write(f);
     }
     let _ = btfsm_render::dot::policy_dot(&l.policy, &Default::default());
     // Folded, with ports, in both directions: every drawing path.

@@ -2,7 +2,7 @@
 //! the measured effort (named and structural GED to the generated
 //! fault-tolerant FSM; paper sec. IV-B), as a table, JSON or CSV.
 
-use super::{OutputFormat, csv_field, table::Table};
+use super::{Format, Report, csv_field, table::Table};
 use btfsm_metrics::effort::{detect, effort_formula};
 use btfsm_metrics::ged::{GedMode, GedOptions, GedResult, ged};
 use btfsm_model::graph::policy_graph;
@@ -143,10 +143,21 @@ fn structural(r: &EffortRow) -> String {
     }
 }
 
+/// `btfsm effort`'s report: one row per policy.
+pub struct EffortTable<'a>(pub &'a [EffortRow]);
+
+impl Report for EffortTable<'_> {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json, Format::Csv];
+
+    fn write(&self, format: Format) -> String {
+        render_effort(self.0, format)
+    }
+}
+
 /// Renders `effort` results.
-pub fn render_effort(rows: &[EffortRow], format: OutputFormat) -> String {
-    match format {
-        OutputFormat::Json => {
+pub fn render_effort(rows: &[EffortRow], format: Format) -> String {
+    match EffortTable::supported(format) {
+        Format::Json => {
             #[derive(serde::Serialize)]
             struct Out<'a> {
                 policies: &'a [EffortRow],
@@ -157,7 +168,7 @@ pub fn render_effort(rows: &[EffortRow], format: OutputFormat) -> String {
             s.push('\n');
             s
         }
-        OutputFormat::Csv => {
+        Format::Csv => {
             let mut s =
                 String::from("file,name,kind,m_s,m_fc,formula,named_ged,structural_ged,note\n");
             for r in rows {
@@ -176,7 +187,7 @@ pub fn render_effort(rows: &[EffortRow], format: OutputFormat) -> String {
             }
             s
         }
-        OutputFormat::Table => {
+        _ => {
             let mut t = Table::new(&[
                 "file",
                 "kind",

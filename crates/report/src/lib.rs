@@ -15,14 +15,18 @@ use btfsm_model::graph::policy_graph;
 use btfsm_model::{PolicyBody, PolicyKind};
 use std::collections::BTreeMap;
 
+pub use btfsm_core::output::{Format, Report};
 pub use output::write_atomically;
 
-/// Output format for figures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum OutputFormat {
-    Table,
-    Json,
-    Csv,
+/// `btfsm analyze`'s report: one row per policy.
+pub struct Analysis<'a>(pub &'a [PolicyReport]);
+
+impl Report for Analysis<'_> {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json, Format::Csv];
+
+    fn write(&self, format: Format) -> String {
+        render_analysis(self.0, format)
+    }
 }
 
 /// One row of `btfsm analyze` (SPEC §7's JSON contract).
@@ -67,9 +71,9 @@ pub fn analyze(loaded: &Loaded) -> PolicyReport {
 }
 
 /// Renders `analyze` results.
-pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String {
-    match format {
-        OutputFormat::Json => {
+pub fn render_analysis(reports: &[PolicyReport], format: Format) -> String {
+    match Analysis::supported(format) {
+        Format::Json => {
             #[derive(serde::Serialize)]
             struct Out<'a> {
                 policies: &'a [PolicyReport],
@@ -80,7 +84,7 @@ pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String
             s.push('\n');
             s
         }
-        OutputFormat::Csv => {
+        Format::Csv => {
             let mut s = String::from(
                 "file,name,kind,vertices,edges,graphical_elements,active_elements,cc,essential_cc,m,m_fc,graphical_estimate,active_estimate\n",
             );
@@ -104,7 +108,7 @@ pub fn render_analysis(reports: &[PolicyReport], format: OutputFormat) -> String
             }
             s
         }
-        OutputFormat::Table => {
+        _ => {
             let mut t = table::Table::new(&[
                 "file",
                 "kind",

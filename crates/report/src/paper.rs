@@ -16,6 +16,7 @@
 //! ([`expected_toml`]).
 
 use crate::effort::effort;
+use crate::{Format, Report};
 use btfsm_core::diagnostic::{Diagnostic, SourceFile};
 use btfsm_format::{Limits, load};
 use btfsm_metrics::complexity::{cyclomatic, essential};
@@ -136,14 +137,6 @@ impl Row {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct PaperReport {
     pub rows: Vec<Row>,
-}
-
-/// Output format of `btfsm paper`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum PaperFormat {
-    Table,
-    Json,
-    Markdown,
 }
 
 // --- notes: the reasons of SPEC §5 -------------------------------------------
@@ -737,17 +730,25 @@ pub fn build(
 
 // --- rendering ------------------------------------------------------------------
 
+impl Report for PaperReport {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json, Format::Markdown];
+
+    fn write(&self, format: Format) -> String {
+        render(self, format)
+    }
+}
+
 /// Renders the report.
-pub fn render(r: &PaperReport, format: PaperFormat) -> String {
-    match format {
-        PaperFormat::Json => {
+pub fn render(r: &PaperReport, format: Format) -> String {
+    match PaperReport::supported(format) {
+        Format::Json => {
             let mut s =
                 btfsm_core::sanitize::json(serde_json::to_string_pretty(r).expect("serializable"));
             s.push('\n');
             s
         }
-        PaperFormat::Table => render_text(r, false),
-        PaperFormat::Markdown => render_text(r, true),
+        Format::Markdown => render_text(r, true),
+        _ => render_text(r, false),
     }
 }
 
@@ -999,7 +1000,7 @@ mod tests {
 
     #[test]
     fn table_report_snapshot() {
-        insta::assert_snapshot!("paper_table", render(&report(), PaperFormat::Table));
+        insta::assert_snapshot!("paper_table", render(&report(), Format::Table));
     }
 
     #[test]
