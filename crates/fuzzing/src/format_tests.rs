@@ -153,16 +153,9 @@ proptest! {
     }
 }
 
-const PARALLEL: &str = r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" initial="p">
-  <parallel id="p">
-    <state id="r1"><state id="a1"><transition event="go" target="a2"/></state><state id="a2"/><final id="r1done"/></state>
-    <state id="r2" initial="b2"><state id="b1"/><state id="b2"><transition event="x" target="pass"/></state></state>
-    <state id="r3"/>
-    <transition event="done.state.p" target="pass"/>
-  </parallel>
-  <state id="q"><transition event="back" target="b1"/></state>
-  <final id="pass"/>
-</scxml>"#;
+/// The seed of the parallel machines' mutations (the SCXML reader's own
+/// mutation test starts from it too).
+const PARALLEL: &str = include_str!("../../../tests/fixtures/valid/parallel-mutation-seed.scxml");
 
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
