@@ -246,7 +246,10 @@ impl Episodes<'_> {
 /// The workers' results merged: the episodes that came whole (all
 /// policies), up to the first that did not, ordered by policy then
 /// episode, the agreements by episode; and how many episodes that is.
-fn complete_prefix(per_thread: Vec<Results>, runs: u32) -> (Vec<(u32, usize, Res)>, Vec<Agree>, u32) {
+fn complete_prefix(
+    per_thread: Vec<Results>,
+    runs: u32,
+) -> (Vec<(u32, usize, Res)>, Vec<Agree>, u32) {
     let mut all: Vec<(u32, usize, Res)> = Vec::new();
     let mut agree: Vec<Agree> = Vec::new();
     for (o, a) in per_thread {

@@ -758,12 +758,22 @@ impl Ticking<'_> {
     /// Repeat (loops on SUCCESS) and RetryUntilSuccessful (on FAILURE), up
     /// to their count; `prev`: the child's status before its tick.
     #[inline(always)]
-    fn repeat(&mut self, n: usize, prev: St, ret: Option<Status>, leaves: &mut impl Leaves) -> Next {
+    fn repeat(
+        &mut self,
+        n: usize,
+        prev: St,
+        ret: Option<Status>,
+        leaves: &mut impl Leaves,
+    ) -> Next {
         use Status::{Failure as F, Running as R, Success as S};
         let node = &self.bt.nodes[n];
         let len = (node.end - node.start) as usize;
         // Repeat loops on success, Retry on failure.
-        let (again, other) = if node.op == Op::Repeat { (S, F) } else { (F, S) };
+        let (again, other) = if node.op == Op::Repeat {
+            (S, F)
+        } else {
+            (F, S)
+        };
         let do_loop = |ns: &NodeState| node.a < 0 || i64::from(ns.ok) < node.a;
         match ret {
             None => {}

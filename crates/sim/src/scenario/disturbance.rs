@@ -85,12 +85,7 @@ impl Reader {
 
     /// A disturbance's effect, exactly one, and its text for events and
     /// the report.
-    fn effect(
-        &mut self,
-        v: &Val<'_>,
-        t: &DeTable<'_>,
-        world: &World,
-    ) -> Option<(Effect, String)> {
+    fn effect(&mut self, v: &Val<'_>, t: &DeTable<'_>, world: &World) -> Option<(Effect, String)> {
         let effects: Vec<&str> = ["battery", "move", "drop", "fail", "block", "emergency"]
             .into_iter()
             .filter(|k| t.contains_key(*k))
