@@ -22,7 +22,7 @@
 
 use super::Session;
 use super::btlog::{MAGIC, Status};
-use rusqlite::{Connection, OpenFlags, params};
+use rusqlite::{Connection, OpenFlags, OptionalExtension, params};
 use std::collections::BTreeSet;
 use std::io::Read;
 use std::path::Path;
@@ -74,13 +74,76 @@ pub fn open(path: &Path, session: Option<i64>, max_bytes: u64) -> Result<Opened,
 }
 
 /// [`open`] with every query interrupted after `deadline`.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 fn open_within(
     path: &Path,
     session: Option<i64>,
     max_bytes: u64,
     deadline: std::time::Duration,
 ) -> Result<Opened, Db3Error> {
+    let conn = connect(path, max_bytes, deadline)?;
+    check_tables(&conn)?;
+    let uid_col = uid_column(&conn)?;
+    let (sessions, more_sessions) = list_sessions(&conn)?;
+    let last: Option<i64> = conn
+        .query_row("SELECT MAX(session_id) FROM Definitions", [], |r| r.get(0))
+        .map_err(sql)?;
+    let session = match (session, last) {
+        (Some(s), _) => s,
+        (None, Some(l)) => l,
+        (None, None) => return Err(Db3Error("no session in table `Definitions`".into())),
+    };
+    let xml: Option<String> = conn
+        .query_row(
+            "SELECT xml_tree FROM Definitions WHERE session_id = ?1",
+            [session],
+            |r| r.get(0),
+        )
+        .optional()
+        .map_err(sql)?;
+    let Some(xml) = xml else {
+        let ids: Vec<String> = sessions.iter().map(|s| s.id.to_string()).collect();
+        return Err(Db3Error(format!(
+            "no session {session} (the sessions are {})",
+            ids.join(", ")
+        )));
+    };
+    let tree = super::tree::parse(&xml).map_err(|e| Db3Error(format!("session {session}: {e}")))?;
+    let q = "SELECT timestamp FROM Transitions WHERE session_id = ?1 ORDER BY timestamp LIMIT 1";
+    let t0: Option<i64> = conn
+        .query_row(q, [session], |r| r.get(0))
+        .optional()
+        .map_err(sql)?;
+    let t0 = t0.unwrap_or(0);
+    let mut buf = MAGIC.to_vec();
+    buf.push(1);
+    buf.extend((xml.len() as i32).to_le_bytes());
+    buf.extend(xml.as_bytes());
+    buf.extend(t0.to_le_bytes());
+    Ok(Opened {
+        sessions,
+        more_sessions,
+        session,
+        stream: Db3Stream {
+            conn,
+            session,
+            t0,
+            uids: tree.nodes.keys().copied().collect(),
+            uid_col,
+            last: None,
+            buf,
+            pos: 0,
+            done: false,
+        },
+    })
+}
+
+/// Opens the database read-only, values bounded by `max_bytes`, every
+/// query interrupted once `deadline` has passed from now.
+fn connect(
+    path: &Path,
+    max_bytes: u64,
+    deadline: std::time::Duration,
+) -> Result<Connection, Db3Error> {
     let flags = OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX;
     let conn = Connection::open_with_flags(path, flags).map_err(sql)?;
     let len = i32::try_from(max_bytes).unwrap_or(i32::MAX).max(1024);
@@ -90,17 +153,17 @@ fn open_within(
     conn.progress_handler(10_000, Some(move || std::time::Instant::now() > deadline))
         .map_err(sql)?;
     let _ = conn.execute_batch("PRAGMA trusted_schema = OFF;");
-    // The two tables, as tables.
+    Ok(conn)
+}
+
+/// Checks that `Definitions` and `Transitions` are tables (not views).
+fn check_tables(conn: &Connection) -> Result<(), Db3Error> {
     for t in ["Definitions", "Transitions"] {
         let kind: Option<String> = conn
             .query_row("SELECT type FROM sqlite_master WHERE name = ?1", [t], |r| {
                 r.get(0)
             })
-            .map(Some)
-            .or_else(|e| match e {
-                rusqlite::Error::QueryReturnedNoRows => Ok(None),
-                e => Err(e),
-            })
+            .optional()
             .map_err(sql)?;
         match kind.as_deref() {
             Some("table") => {}
@@ -117,6 +180,12 @@ fn open_within(
             }
         }
     }
+    Ok(())
+}
+
+/// The name of the node column of `Transitions` (`uid`, or `node_uid` in
+/// some 4.x releases), once its other columns are checked.
+fn uid_column(conn: &Connection) -> Result<&'static str, Db3Error> {
     let mut cols = Vec::new();
     {
         let mut st = conn
@@ -144,86 +213,32 @@ fn open_within(
             )));
         }
     }
+    Ok(uid_col)
+}
+
+/// The sessions of `Definitions`, at most [`MAX_SESSIONS_LISTED`], and
+/// whether there are more.
+fn list_sessions(conn: &Connection) -> Result<(Vec<Session>, bool), Db3Error> {
     let mut sessions = Vec::new();
     let mut more_sessions = false;
-    {
-        let mut st = conn
-            .prepare("SELECT session_id, date FROM Definitions ORDER BY session_id")
-            .map_err(sql)?;
-        let mut rows = st.query([]).map_err(sql)?;
-        while let Some(r) = rows.next().map_err(sql)? {
-            if sessions.len() == MAX_SESSIONS_LISTED {
-                more_sessions = true;
-                break;
-            }
-            sessions.push(Session {
-                id: r.get(0).map_err(sql)?,
-                date: r
-                    .get::<_, Option<String>>(1)
-                    .map_err(sql)?
-                    .unwrap_or_default(),
-            });
+    let mut st = conn
+        .prepare("SELECT session_id, date FROM Definitions ORDER BY session_id")
+        .map_err(sql)?;
+    let mut rows = st.query([]).map_err(sql)?;
+    while let Some(r) = rows.next().map_err(sql)? {
+        if sessions.len() == MAX_SESSIONS_LISTED {
+            more_sessions = true;
+            break;
         }
+        sessions.push(Session {
+            id: r.get(0).map_err(sql)?,
+            date: r
+                .get::<_, Option<String>>(1)
+                .map_err(sql)?
+                .unwrap_or_default(),
+        });
     }
-    let last: Option<i64> = conn
-        .query_row("SELECT MAX(session_id) FROM Definitions", [], |r| r.get(0))
-        .map_err(sql)?;
-    let session = match (session, last) {
-        (Some(s), _) => s,
-        (None, Some(l)) => l,
-        (None, None) => return Err(Db3Error("no session in table `Definitions`".into())),
-    };
-    let xml: Option<String> = conn
-        .query_row(
-            "SELECT xml_tree FROM Definitions WHERE session_id = ?1",
-            [session],
-            |r| r.get(0),
-        )
-        .map(Some)
-        .or_else(|e| match e {
-            rusqlite::Error::QueryReturnedNoRows => Ok(None),
-            e => Err(e),
-        })
-        .map_err(sql)?;
-    let Some(xml) = xml else {
-        let ids: Vec<String> = sessions.iter().map(|s| s.id.to_string()).collect();
-        return Err(Db3Error(format!(
-            "no session {session} (the sessions are {})",
-            ids.join(", ")
-        )));
-    };
-    let tree = super::tree::parse(&xml).map_err(|e| Db3Error(format!("session {session}: {e}")))?;
-    let q = "SELECT timestamp FROM Transitions WHERE session_id = ?1 ORDER BY timestamp LIMIT 1";
-    let t0: Option<i64> = conn
-        .query_row(q, [session], |r| r.get(0))
-        .map(Some)
-        .or_else(|e| match e {
-            rusqlite::Error::QueryReturnedNoRows => Ok(None),
-            e => Err(e),
-        })
-        .map_err(sql)?;
-    let t0 = t0.unwrap_or(0);
-    let mut buf = MAGIC.to_vec();
-    buf.push(1);
-    buf.extend((xml.len() as i32).to_le_bytes());
-    buf.extend(xml.as_bytes());
-    buf.extend(t0.to_le_bytes());
-    Ok(Opened {
-        sessions,
-        more_sessions,
-        session,
-        stream: Db3Stream {
-            conn,
-            session,
-            t0,
-            uids: tree.nodes.keys().copied().collect(),
-            uid_col,
-            last: None,
-            buf,
-            pos: 0,
-            done: false,
-        },
-    })
+    Ok((sessions, more_sessions))
 }
 
 impl Db3Stream {

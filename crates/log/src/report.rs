@@ -76,7 +76,6 @@ impl Coverage {
 }
 
 /// Reads a whole log, streaming its records; `max_xml` bounds its tree XML.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogError> {
     let mut r = std::io::BufReader::with_capacity(1 << 16, r);
     let h = read_header(&mut r, max_xml)?;
@@ -99,7 +98,35 @@ pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogEr
             )
         })
         .collect();
-    let mut records = Records::new(r, &h);
+    let (count, end) = tally(Records::new(r, &h), &mut stats)?;
+    let nodes_cov = Coverage::of(
+        stats.values().filter(|s| s.activations > 0).count() as u64,
+        stats.len() as u64,
+    );
+    let (branch_coverage, uncovered) = branches(&tree, &stats);
+    Ok(LogReport {
+        file: file.to_string(),
+        layout: h.layout,
+        first_timestamp_usec: h.t0_usec,
+        records: count,
+        duration_usec: end,
+        nodes: stats.into_values().collect(),
+        node_coverage: nodes_cov,
+        branch_coverage,
+        uncovered,
+        session: None,
+        sessions: Vec::new(),
+        more_sessions: false,
+    })
+}
+
+/// Counts every record into its node's figures (activations, status
+/// changes, time RUNNING, until the log's end for a node still RUNNING);
+/// the number of records and the last time, µs.
+fn tally<R: Read>(
+    mut records: Records<R>,
+    stats: &mut BTreeMap<u16, NodeStats>,
+) -> Result<(u64, u64), LogError> {
     let mut count = 0u64;
     let mut end = 0u64;
     loop {
@@ -135,12 +162,13 @@ pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogEr
             s.running_usec += end.saturating_sub(since);
         }
     }
-    // Coverage.
+    Ok((count, end))
+}
+
+/// Branch coverage: every child of a Fallback activated, every condition
+/// seen both SUCCESS and FAILURE; and the branches not covered.
+fn branches(tree: &Tree, stats: &BTreeMap<u16, NodeStats>) -> (Coverage, Vec<String>) {
     let activated = |u: u16| stats.get(&u).is_some_and(|s| s.activations > 0);
-    let nodes_cov = Coverage::of(
-        stats.values().filter(|s| s.activations > 0).count() as u64,
-        stats.len() as u64,
-    );
     let (mut covered, mut total) = (0u64, 0u64);
     let mut uncovered = Vec::new();
     for n in tree.nodes.values() {
@@ -170,20 +198,7 @@ pub fn report(file: &str, r: impl Read, max_xml: u64) -> Result<LogReport, LogEr
             }
         }
     }
-    Ok(LogReport {
-        file: file.to_string(),
-        layout: h.layout,
-        first_timestamp_usec: h.t0_usec,
-        records: count,
-        duration_usec: end,
-        nodes: stats.into_values().collect(),
-        node_coverage: nodes_cov,
-        branch_coverage: Coverage::of(covered, total),
-        uncovered,
-        session: None,
-        sessions: Vec::new(),
-        more_sessions: false,
-    })
+    (Coverage::of(covered, total), uncovered)
 }
 
 /// The report as a table.

@@ -99,7 +99,6 @@ fn tick_step(span_s: f64, n: f64) -> f64 {
 }
 
 /// Draws a log `width` px wide (the plot area); `open` opens it (twice).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn timeline<R: Read>(
     file: &str,
     mut open: impl FnMut() -> std::io::Result<R>,
@@ -115,8 +114,54 @@ pub fn timeline<R: Read>(
         offset: 23.min(h.records_at),
         what,
     })?;
+    let end = last_time(Records::new(r, &h), &tree)?;
+    // Pass 2: each record at its pixel column.
+    let mut r = BufReader::with_capacity(1 << 16, open().map_err(io)?);
+    let h2 = read_header(&mut r, max_xml)?;
+    if h2.xml != h.xml || h2.records_at != h.records_at {
+        return Err(LogError::Io("the log changed while read".into()));
+    }
+    let (rows, count) = place(Records::new(r, &h), &tree, end, width)?;
+    let elements: usize = (rows.values())
+        .map(|r| {
+            r.bars.len()
+                + r.marks
+                    .iter()
+                    .map(|m| m.1.count_ones() as usize)
+                    .sum::<usize>()
+        })
+        .sum();
+    if elements > MAX_ELEMENTS {
+        return Err(LogError::Limit(format!(
+            "the timeline would draw {elements} bars and marks in {} rows, more than {MAX_ELEMENTS}: draw it narrower (--width)",
+            rows.len()
+        )));
+    }
+    let d = Drawing {
+        tree: &tree,
+        rows: &rows,
+        end,
+        width,
+        label_w: 280,
+    };
+    let mut o = String::new();
+    d.head(&mut o, file, count);
+    let (bars, marks) = d.rows(&mut o);
+    d.time_axis(&mut o);
+    o.push_str("</svg>\n");
+    Ok(Timeline {
+        svg: o,
+        rows: rows.len(),
+        records: count,
+        bars,
+        marks,
+    })
+}
+
+/// The time of the last record, µs (every record checked to name a node
+/// of the tree).
+fn last_time<R: Read>(mut records: Records<R>, tree: &Tree) -> Result<u64, LogError> {
     let mut end = 0u64;
-    let mut records = Records::new(r, &h);
     loop {
         let at = records.offset();
         let Some(rec) = records.next() else { break };
@@ -129,23 +174,28 @@ pub fn timeline<R: Read>(
         }
         end = end.max(rec.t_usec);
     }
+    Ok(end)
+}
+
+/// The rows of the leaves that ever left IDLE, each record placed at its
+/// pixel column of `width` over `0..end` µs; and the number of records.
+fn place<R: Read>(
+    records: Records<R>,
+    tree: &Tree,
+    end: u64,
+    width: u32,
+) -> Result<(BTreeMap<u16, Row>, u64), LogError> {
     let span = end.max(1);
     let col = |t: u64| ((t as u128 * (width - 1) as u128) / span as u128) as u32;
-    // Pass 2: each record at its pixel column.
-    let mut r = BufReader::with_capacity(1 << 16, open().map_err(io)?);
-    let h2 = read_header(&mut r, max_xml)?;
-    if h2.xml != h.xml || h2.records_at != h.records_at {
-        return Err(LogError::Io("the log changed while read".into()));
-    }
     let mut rows: BTreeMap<u16, Row> = tree
         .nodes
         .keys()
-        .filter(|&&u| is_leaf(&tree, u))
+        .filter(|&&u| is_leaf(tree, u))
         .map(|&u| (u, Row::default()))
         .collect();
     let mut count = 0u64;
     let mut last_t = 0u64;
-    for rec in Records::new(r, &h) {
+    for rec in records {
         let rec = rec?;
         count += 1;
         // A record older than one before it is drawn at the later time:
@@ -177,132 +227,139 @@ pub fn timeline<R: Read>(
         }
     }
     rows.retain(|_, r| r.ticked);
-    let elements: usize = (rows.values())
-        .map(|r| {
-            r.bars.len()
-                + r.marks
-                    .iter()
-                    .map(|m| m.1.count_ones() as usize)
-                    .sum::<usize>()
-        })
-        .sum();
-    if elements > MAX_ELEMENTS {
-        return Err(LogError::Limit(format!(
-            "the timeline would draw {elements} bars and marks in {} rows, more than {MAX_ELEMENTS}: draw it narrower (--width)",
-            rows.len()
-        )));
-    }
-    // The drawing.
-    let label_w = 280u32;
-    let (w, h_px) = (
-        label_w + width + 30,
-        TOP + ROW_H * rows.len() as u32 + AXIS_H,
-    );
-    let mut o = String::new();
-    let _ = writeln!(
-        o,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h_px}" viewBox="0 0 {w} {h_px}" font-family="Helvetica, Arial, sans-serif" font-size="11">"#
-    );
-    let _ = writeln!(o, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = writeln!(
-        o,
-        r#"<text x="8" y="18" font-size="14">{}</text>"#,
-        esc(
-            &format!("{file}: {count} records, {:.3} s", end as f64 / 1e6),
-            300
-        )
-    );
-    let _ = writeln!(
-        o,
-        r##"<text x="8" y="34" fill="#555">RUNNING bars and marks: gold; SUCCESS: green; FAILURE: red</text>"##
-    );
-    let x0 = label_w;
-    let (mut bars, mut marks) = (0, 0);
-    for (i, (uid, row)) in rows.iter().enumerate() {
-        let y = TOP + ROW_H * i as u32;
-        let n = &tree.nodes[uid];
-        if i % 2 == 1 {
-            let _ = writeln!(
-                o,
-                r##"<rect x="0" y="{y}" width="{w}" height="{ROW_H}" fill="#f4f4f4"/>"##
-            );
-        }
-        let label = if n.name == n.tag {
-            n.name.clone()
-        } else {
-            format!("{} ({})", n.name, n.tag)
-        };
+    Ok((rows, count))
+}
+
+/// What the SVG is drawn from: the tree, its rows, the log's end (µs),
+/// the plot's width and the labels' width (px).
+struct Drawing<'a> {
+    tree: &'a Tree,
+    rows: &'a BTreeMap<u16, Row>,
+    end: u64,
+    width: u32,
+    label_w: u32,
+}
+
+impl Drawing<'_> {
+    /// The `<svg>` element, a white background, the title (the file, its
+    /// `count` records and duration) and the legend.
+    fn head(&self, o: &mut String, file: &str, count: u64) {
+        let (w, h_px) = self.size();
         let _ = writeln!(
             o,
-            r#"<text x="8" y="{}">{}</text>"#,
-            y + 13,
-            esc(&label, 60)
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h_px}" viewBox="0 0 {w} {h_px}" font-family="Helvetica, Arial, sans-serif" font-size="11">"#
         );
-        for &(a, b) in &row.bars {
+        let _ = writeln!(o, r#"<rect width="100%" height="100%" fill="white"/>"#);
+        let _ = writeln!(
+            o,
+            r#"<text x="8" y="18" font-size="14">{}</text>"#,
+            esc(
+                &format!("{file}: {count} records, {:.3} s", self.end as f64 / 1e6),
+                300
+            )
+        );
+        let _ = writeln!(
+            o,
+            r##"<text x="8" y="34" fill="#555">RUNNING bars and marks: gold; SUCCESS: green; FAILURE: red</text>"##
+        );
+    }
+
+    /// The drawing's width and height, px.
+    fn size(&self) -> (u32, u32) {
+        (
+            self.label_w + self.width + 30,
+            TOP + ROW_H * self.rows.len() as u32 + AXIS_H,
+        )
+    }
+
+    /// Every row: its label, bars and marks; how many bars and marks.
+    fn rows(&self, o: &mut String) -> (usize, usize) {
+        let (w, _) = self.size();
+        let x0 = self.label_w;
+        let (mut bars, mut marks) = (0, 0);
+        for (i, (uid, row)) in self.rows.iter().enumerate() {
+            let y = TOP + ROW_H * i as u32;
+            let n = &self.tree.nodes[uid];
+            if i % 2 == 1 {
+                let _ = writeln!(
+                    o,
+                    r##"<rect x="0" y="{y}" width="{w}" height="{ROW_H}" fill="#f4f4f4"/>"##
+                );
+            }
+            let label = if n.name == n.tag {
+                n.name.clone()
+            } else {
+                format!("{} ({})", n.name, n.tag)
+            };
             let _ = writeln!(
                 o,
-                r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{RUNNING}" stroke="goldenrod" stroke-width="0.5"/>"#,
-                x0 + a,
-                y + 4,
-                b - a + 1,
-                ROW_H - 8
+                r#"<text x="8" y="{}">{}</text>"#,
+                y + 13,
+                esc(&label, 60)
             );
-            bars += 1;
-        }
-        for &(x, bits) in &row.marks {
-            for (bit, colour) in [(1u8, RUNNING), (2, SUCCESS), (4, FAILURE)] {
-                if bits & bit != 0 {
-                    let _ = writeln!(
-                        o,
-                        r##"<rect x="{}" y="{}" width="2" height="{}" fill="{colour}" stroke="#333" stroke-width="0.3"/>"##,
-                        x0 + x,
-                        y + 1,
-                        ROW_H - 2
-                    );
-                    marks += 1;
+            for &(a, b) in &row.bars {
+                let _ = writeln!(
+                    o,
+                    r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{RUNNING}" stroke="goldenrod" stroke-width="0.5"/>"#,
+                    x0 + a,
+                    y + 4,
+                    b - a + 1,
+                    ROW_H - 8
+                );
+                bars += 1;
+            }
+            for &(x, bits) in &row.marks {
+                for (bit, colour) in [(1u8, RUNNING), (2, SUCCESS), (4, FAILURE)] {
+                    if bits & bit != 0 {
+                        let _ = writeln!(
+                            o,
+                            r##"<rect x="{}" y="{}" width="2" height="{}" fill="{colour}" stroke="#333" stroke-width="0.3"/>"##,
+                            x0 + x,
+                            y + 1,
+                            ROW_H - 2
+                        );
+                        marks += 1;
+                    }
                 }
             }
         }
+        (bars, marks)
     }
-    // The time axis.
-    let ya = TOP + ROW_H * rows.len() as u32 + 6;
-    let _ = writeln!(
-        o,
-        r##"<line x1="{x0}" y1="{ya}" x2="{}" y2="{ya}" stroke="#333"/>"##,
-        x0 + width
-    );
-    let span_s = span as f64 / 1e6;
-    let step = tick_step(span_s, 10.0);
-    let mut k = 0u64;
-    loop {
-        let t = k as f64 * step;
-        if t > span_s + 1e-12 {
-            break;
-        }
-        let x = x0 as f64 + t / span_s * (width - 1) as f64;
-        let label = format!("{:.*}", decimals(step), t);
+
+    /// The time axis under the rows: its line, ticks and title.
+    fn time_axis(&self, o: &mut String) {
+        let (x0, width) = (self.label_w, self.width);
+        let ya = TOP + ROW_H * self.rows.len() as u32 + 6;
         let _ = writeln!(
             o,
-            r##"<line x1="{x:.1}" y1="{ya}" x2="{x:.1}" y2="{}" stroke="#333"/><text x="{x:.1}" y="{}" text-anchor="middle">{label}</text>"##,
-            ya + 5,
-            ya + 18
+            r##"<line x1="{x0}" y1="{ya}" x2="{}" y2="{ya}" stroke="#333"/>"##,
+            x0 + width
         );
-        k += 1;
+        let span_s = self.end.max(1) as f64 / 1e6;
+        let step = tick_step(span_s, 10.0);
+        let mut k = 0u64;
+        loop {
+            let t = k as f64 * step;
+            if t > span_s + 1e-12 {
+                break;
+            }
+            let x = x0 as f64 + t / span_s * (width - 1) as f64;
+            let label = format!("{:.*}", decimals(step), t);
+            let _ = writeln!(
+                o,
+                r##"<line x1="{x:.1}" y1="{ya}" x2="{x:.1}" y2="{}" stroke="#333"/><text x="{x:.1}" y="{}" text-anchor="middle">{label}</text>"##,
+                ya + 5,
+                ya + 18
+            );
+            k += 1;
+        }
+        let _ = writeln!(
+            o,
+            r#"<text x="{}" y="{}" text-anchor="middle">time (s)</text>"#,
+            x0 + width / 2,
+            ya + 34
+        );
     }
-    let _ = writeln!(
-        o,
-        r#"<text x="{}" y="{}" text-anchor="middle">time (s)</text>"#,
-        x0 + width / 2,
-        ya + 34
-    );
-    o.push_str("</svg>\n");
-    Ok(Timeline {
-        svg: o,
-        rows: rows.len(),
-        records: count,
-        bars,
-        marks,
-    })
 }
 
 /// Decimals to print a multiple of `step`.

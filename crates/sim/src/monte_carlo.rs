@@ -4,7 +4,7 @@
 
 use super::rng::SimRng;
 use super::robot::round3;
-use super::run::{RunOptions, cut_short, prepare, run_policy};
+use super::run::{Prepared, RunOptions, cut_short, prepare, run_policy};
 use super::scenario::{Disturbance, Scenario, mc};
 use super::trace::{Outcome, behavior_matches};
 use std::collections::BTreeMap;
@@ -112,7 +112,6 @@ pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> McResu
 /// k episodes, k the number returned (every episode before k completed for
 /// every policy; `runs` when the deadline never passed). The same k
 /// episodes give the same figures as `monte_carlo(s, k, seed, ..)`.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn monte_carlo_within(
     s: &Scenario,
     runs: u32,
@@ -125,83 +124,132 @@ pub fn monte_carlo_within(
     let pairs: Vec<(usize, usize)> = (0..np)
         .flat_map(|a| (a + 1..np).map(move |b| (a, b)))
         .collect();
-    let pairs = &pairs;
-    let threads = threads.max(1).min(runs.max(1) as usize);
     let stop = AtomicBool::new(false);
-    // results[policy][episode] = (outcome, goal, completion, latencies)
-    type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
-    // Per episode: its seed and, per pair, whether the behavior matched.
-    type Agree = (u32, u64, Vec<bool>);
-    type Results = (Vec<(u32, usize, Res)>, Vec<Agree>);
-    let mut per_thread: Vec<Results> = Vec::new();
-    std::thread::scope(|sc| {
-        let prepared = &prepared;
-        let stop = &stop;
-        // One worker's episodes: t, t + threads, ...
-        let work = move |t: usize| {
-            let mut out = Vec::new();
-            let mut agree = Vec::new();
-            let mut i = t as u32;
-            'episodes: while i < runs {
-                if stop.load(Ordering::Relaxed) {
-                    break;
+    let episodes = Episodes {
+        s,
+        prepared: &prepared,
+        pairs: &pairs,
+        runs,
+        seed,
+        threads: threads.max(1).min(runs.max(1) as usize),
+        deadline,
+        stop: &stop,
+    };
+    let (all, agree, runs) = complete_prefix(episodes.run(), runs);
+    McResult {
+        policies: policy_stats(&prepared, &all, runs),
+        pairs: pair_stats(&prepared, &pairs, &agree, runs),
+        runs,
+    }
+}
+
+/// One policy's figures of an episode: its outcome, whether the goal was
+/// met, its completion time and its recharge latencies.
+type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
+/// Per episode: its index, its seed and, per pair, whether the behavior
+/// matched.
+type Agree = (u32, u64, Vec<bool>);
+/// What a worker made: (episode, policy, figures), and its episodes'
+/// agreements.
+type Results = (Vec<(u32, usize, Res)>, Vec<Agree>);
+
+/// The episodes of a Monte Carlo run, shared by its worker threads.
+struct Episodes<'a> {
+    s: &'a Scenario,
+    prepared: &'a [Prepared],
+    pairs: &'a [(usize, usize)],
+    runs: u32,
+    seed: u64,
+    threads: usize,
+    deadline: Option<Instant>,
+    /// Set by the first worker whose episode the deadline cut short.
+    stop: &'a AtomicBool,
+}
+
+impl Episodes<'_> {
+    /// Runs the episodes on `threads` threads; per thread what it made.
+    fn run(&self) -> Vec<Results> {
+        let mut per_thread: Vec<Results> = Vec::new();
+        std::thread::scope(|sc| {
+            let mut handles = Vec::new();
+            for t in 0..self.threads {
+                // A thread the system refuses (a limit on processes) does its
+                // share on this one instead: the same episodes, the same figures.
+                match std::thread::Builder::new().spawn_scoped(sc, move || self.work(t)) {
+                    Ok(h) => handles.push(h),
+                    Err(_) => per_thread.push(self.work(t)),
                 }
-                let ep_seed = episode_seed(seed, i);
-                let (ds, rates) = episode(s, ep_seed);
-                let first = out.len();
-                let mut ep_runs = Vec::with_capacity(prepared.len());
-                for (k, p) in prepared.iter().enumerate() {
-                    let r = run_policy(
-                        s,
-                        p,
-                        s.world.clone(),
-                        &ds,
-                        rates.clone(),
-                        ep_seed,
-                        RunOptions {
-                            log: false,
-                            trace: false,
-                            deadline,
-                        },
-                    );
-                    if cut_short(s, &r) {
-                        stop.store(true, Ordering::Relaxed);
-                        out.truncate(first);
-                        break 'episodes;
-                    }
-                    out.push((
-                        i,
-                        k,
-                        (
-                            r.outcome,
-                            r.goal_met,
-                            r.completion_s,
-                            r.recharge_latency_s.clone(),
-                        ),
-                    ));
-                    ep_runs.push(r);
+            }
+            for h in handles {
+                per_thread.push(h.join().expect("episode thread"));
+            }
+        });
+        per_thread
+    }
+
+    /// One worker's episodes: t, t + threads, ... until the deadline cuts
+    /// one short (dropped, and every worker stops).
+    fn work(&self, t: usize) -> Results {
+        let s = self.s;
+        let mut out = Vec::new();
+        let mut agree = Vec::new();
+        let mut i = t as u32;
+        'episodes: while i < self.runs {
+            if self.stop.load(Ordering::Relaxed) {
+                break;
+            }
+            let ep_seed = episode_seed(self.seed, i);
+            let (ds, rates) = episode(s, ep_seed);
+            let first = out.len();
+            let mut ep_runs = Vec::with_capacity(self.prepared.len());
+            for (k, p) in self.prepared.iter().enumerate() {
+                let r = run_policy(
+                    s,
+                    p,
+                    s.world.clone(),
+                    &ds,
+                    rates.clone(),
+                    ep_seed,
+                    RunOptions {
+                        log: false,
+                        trace: false,
+                        deadline: self.deadline,
+                    },
+                );
+                if cut_short(s, &r) {
+                    self.stop.store(true, Ordering::Relaxed);
+                    out.truncate(first);
+                    break 'episodes;
                 }
-                let same = (pairs.iter())
-                    .map(|&(a, b)| behavior_matches(&ep_runs[a], &ep_runs[b]))
-                    .collect();
-                agree.push((i, ep_seed, same));
-                i += threads as u32;
+                out.push((
+                    i,
+                    k,
+                    (
+                        r.outcome,
+                        r.goal_met,
+                        r.completion_s,
+                        r.recharge_latency_s.clone(),
+                    ),
+                ));
+                ep_runs.push(r);
             }
-            (out, agree)
-        };
-        let mut handles = Vec::new();
-        for t in 0..threads {
-            // A thread the system refuses (a limit on processes) does its
-            // share on this one instead: the same episodes, the same figures.
-            match std::thread::Builder::new().spawn_scoped(sc, move || work(t)) {
-                Ok(h) => handles.push(h),
-                Err(_) => per_thread.push(work(t)),
-            }
+            let same = (self.pairs.iter())
+                .map(|&(a, b)| behavior_matches(&ep_runs[a], &ep_runs[b]))
+                .collect();
+            agree.push((i, ep_seed, same));
+            i += self.threads as u32;
         }
-        for h in handles {
-            per_thread.push(h.join().expect("episode thread"));
-        }
-    });
+        (out, agree)
+    }
+}
+
+/// The workers' results merged: the episodes that came whole (all
+/// policies), up to the first that did not, ordered by policy then
+/// episode, the agreements by episode; and how many episodes that is.
+fn complete_prefix(
+    per_thread: Vec<Results>,
+    runs: u32,
+) -> (Vec<(u32, usize, Res)>, Vec<Agree>, u32) {
     let mut all: Vec<(u32, usize, Res)> = Vec::new();
     let mut agree: Vec<Agree> = Vec::new();
     for (o, a) in per_thread {
@@ -219,7 +267,18 @@ pub fn monte_carlo_within(
     all.sort_by_key(|(i, k, _)| (*k, *i));
     agree.retain(|(i, _, _)| *i < runs);
     agree.sort_by_key(|(i, _, _)| *i);
-    let pair_stats = (pairs.iter().enumerate())
+    (all, agree, runs)
+}
+
+/// Per pair of policies: how often their behavior matched, and the first
+/// episode where it did not.
+fn pair_stats(
+    prepared: &[Prepared],
+    pairs: &[(usize, usize)],
+    agree: &[Agree],
+    runs: u32,
+) -> Vec<PairStats> {
+    (pairs.iter().enumerate())
         .map(|(x, &(a, b))| {
             let matches = agree.iter().filter(|e| e.2[x]).count() as u32;
             PairStats {
@@ -239,8 +298,12 @@ pub fn monte_carlo_within(
                 }),
             }
         })
-        .collect();
-    let stats = prepared
+        .collect()
+}
+
+/// Per policy: its figures over the episodes (`all`, ordered by policy).
+fn policy_stats(prepared: &[Prepared], all: &[(u32, usize, Res)], runs: u32) -> Vec<McStats> {
+    prepared
         .iter()
         .enumerate()
         .map(|(k, p)| {
@@ -274,16 +337,12 @@ pub fn monte_carlo_within(
                     - count(Outcome::Chattering)
                     - count(Outcome::Timeout),
                 success_ci95: wilson(ok.len() as u32, runs),
+                // The mean before the quantiles, which sort `comp`.
                 mean_completion_s: mean(&comp),
                 completion_quantiles_s: quantiles(&mut comp),
                 mean_recharge_latency_s: mean(&lat),
                 recharges: lat.len() as u32,
             }
         })
-        .collect();
-    McResult {
-        policies: stats,
-        pairs: pair_stats,
-        runs,
-    }
+        .collect()
 }

@@ -475,95 +475,17 @@ fn a_shut_down_without_an_emergency_stays_down() {
 /// objects on tables and floors, blocks, drops, moves, faults, emergencies
 /// and battery drops at random times, for the paper's BTs and FSMs.
 #[test]
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 fn random_worlds_and_disturbances_never_panic() {
     let mut rng = super::rng::SimRng::named(13, "random-worlds");
-    let policies = [
-        "fig01-bt",
-        "fig02-fsm",
-        "fig04-fsm",
-        "fig09a-bt",
-        "fig09b-fsm",
-        "fig15-bt",
-        "fig15-fsm",
-        "fig16a-bt",
-        "fig16b-fsm",
-    ];
     let base = Path::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../policies/scenarios"
     ));
     let mut ran = 0;
     for k in 0..80 {
-        let pick = |rng: &mut super::rng::SimRng, lo: f64, hi: f64| {
-            if rng.chance(0.3) {
-                if rng.chance(0.5) { lo } else { hi }
-            } else {
-                rng.range(lo, hi)
-            }
-        };
-        let mut params = Vec::new();
-        for &(name, lo, hi) in scenario::PARAMS {
-            if rng.chance(0.5) {
-                params.push(format!("{name} = {}", pick(&mut rng, lo, hi)));
-            }
-        }
-        if rng.chance(0.3) {
-            params.push("follow_belief = true".into());
-        }
-        let mut text = format!(
-            "seed = {k}\nmax_steps = 1500\n[world]\nbattery = {}\nparams = {{ {} }}\n[world.objects]\n",
-            pick(&mut rng, 0.0, 100.0),
-            params.join(", ")
-        );
-        for c in 1..=5 {
-            let at = [
-                "east-table",
-                "west-table",
-                "central-table",
-                "[1.2, 1.4]",
-                "[-1.0, -2.0]",
-                "[1.7, -0.8]",
-            ][(rng.next_u64() % 6) as usize];
-            let at = if at.starts_with('[') {
-                at.to_string()
-            } else {
-                format!("\"{at}\"")
-            };
-            text.push_str(&format!(
-                "cube{c} = {{ at = {at}, found = {} }}\n",
-                rng.chance(0.5)
-            ));
-        }
-        for _ in 0..3 {
-            let f = policies[(rng.next_u64() % policies.len() as u64) as usize];
-            text.push_str(&format!("[[policies]]\nfile = \"../paper/{f}.toml\"\n"));
-        }
-        for _ in 0..(rng.next_u64() % 8) {
-            let t = rng.range(0.0, 50.0);
-            let effect = match rng.next_u64() % 7 {
-                0 => format!("battery = {}", pick(&mut rng, 0.0, 100.0)),
-                1 => format!("drop = \"cube{}\"", 1 + rng.next_u64() % 5),
-                2 => format!("move = \"cube{}\"\nto = [1.2, 1.4]", 1 + rng.next_u64() % 5),
-                3 => format!(
-                    "fail = \"{}\"\ntimes = {}",
-                    ["Move-To", "Pick", "Place", "Recharge", "Dock", "Search"]
-                        [(rng.next_u64() % 6) as usize],
-                    1 + rng.next_u64() % 3
-                ),
-                4 => {
-                    let (x, y) = (rng.range(-1.0, 2.0), rng.range(-1.5, 0.0));
-                    format!(
-                        "block = {{ name = \"b\", rect = [{x}, {y}, {}, {}] }}",
-                        x + 0.05,
-                        y + 0.5
-                    )
-                }
-                5 => "emergency = true".into(),
-                _ => "emergency = false".into(),
-            };
-            text.push_str(&format!("[[disturbances]]\nat = {t}\n{effect}\n"));
-        }
+        let mut text = random_world(&mut rng, k);
+        text.push_str(&random_policies(&mut rng));
+        text.push_str(&random_disturbances(&mut rng));
         let f = SourceFile::new("random.toml", &text);
         // A random block may cover a station or the start: refused, fine.
         let s = match scenario::parse(&f, base, &Limits::default()) {
@@ -577,18 +499,125 @@ fn random_worlds_and_disturbances_never_panic() {
             }
         };
         ran += 1;
-        let p = s.world.params.clone();
-        for run in run_scenario(&s, true) {
-            let mut prev = s.world.robot;
-            for st in &run.trace {
-                let d = dist(prev, (st.x, st.y));
-                assert!(d <= p.max_speed * s.dt + 1e-9, "{k}: {d}\n{text}");
-                assert!((0.0..=100.0).contains(&st.battery), "{k}");
-                prev = (st.x, st.y);
-            }
-        }
+        assert_speed_and_battery_bounds(&s, k, &text);
     }
     assert!(ran >= 40, "{ran}");
+}
+
+/// A number from `lo` to `hi`, one of the bounds themselves three times in
+/// ten.
+fn extreme_or_uniform(rng: &mut super::rng::SimRng, lo: f64, hi: f64) -> f64 {
+    if rng.chance(0.3) {
+        if rng.chance(0.5) { lo } else { hi }
+    } else {
+        rng.range(lo, hi)
+    }
+}
+
+/// The top of a random scenario (seed `k`): its `[world]` with random
+/// parameters and battery, and five cubes on tables or floors.
+fn random_world(rng: &mut super::rng::SimRng, k: u32) -> String {
+    let mut params = Vec::new();
+    for &(name, lo, hi) in scenario::PARAMS {
+        if rng.chance(0.5) {
+            params.push(format!("{name} = {}", extreme_or_uniform(rng, lo, hi)));
+        }
+    }
+    if rng.chance(0.3) {
+        params.push("follow_belief = true".into());
+    }
+    let mut text = format!(
+        "seed = {k}\nmax_steps = 1500\n[world]\nbattery = {}\nparams = {{ {} }}\n[world.objects]\n",
+        extreme_or_uniform(rng, 0.0, 100.0),
+        params.join(", ")
+    );
+    for c in 1..=5 {
+        let at = [
+            "east-table",
+            "west-table",
+            "central-table",
+            "[1.2, 1.4]",
+            "[-1.0, -2.0]",
+            "[1.7, -0.8]",
+        ][(rng.next_u64() % 6) as usize];
+        let at = if at.starts_with('[') {
+            at.to_string()
+        } else {
+            format!("\"{at}\"")
+        };
+        text.push_str(&format!(
+            "cube{c} = {{ at = {at}, found = {} }}\n",
+            rng.chance(0.5)
+        ));
+    }
+    text
+}
+
+/// Three `[[policies]]` drawn from the paper's BTs and FSMs.
+fn random_policies(rng: &mut super::rng::SimRng) -> String {
+    let policies = [
+        "fig01-bt",
+        "fig02-fsm",
+        "fig04-fsm",
+        "fig09a-bt",
+        "fig09b-fsm",
+        "fig15-bt",
+        "fig15-fsm",
+        "fig16a-bt",
+        "fig16b-fsm",
+    ];
+    let mut text = String::new();
+    for _ in 0..3 {
+        let f = policies[(rng.next_u64() % policies.len() as u64) as usize];
+        text.push_str(&format!("[[policies]]\nfile = \"../paper/{f}.toml\"\n"));
+    }
+    text
+}
+
+/// Up to seven `[[disturbances]]` at random times, each of a random kind.
+fn random_disturbances(rng: &mut super::rng::SimRng) -> String {
+    let mut text = String::new();
+    for _ in 0..(rng.next_u64() % 8) {
+        let t = rng.range(0.0, 50.0);
+        let effect = match rng.next_u64() % 7 {
+            0 => format!("battery = {}", extreme_or_uniform(rng, 0.0, 100.0)),
+            1 => format!("drop = \"cube{}\"", 1 + rng.next_u64() % 5),
+            2 => format!("move = \"cube{}\"\nto = [1.2, 1.4]", 1 + rng.next_u64() % 5),
+            3 => format!(
+                "fail = \"{}\"\ntimes = {}",
+                ["Move-To", "Pick", "Place", "Recharge", "Dock", "Search"]
+                    [(rng.next_u64() % 6) as usize],
+                1 + rng.next_u64() % 3
+            ),
+            4 => {
+                let (x, y) = (rng.range(-1.0, 2.0), rng.range(-1.5, 0.0));
+                format!(
+                    "block = {{ name = \"b\", rect = [{x}, {y}, {}, {}] }}",
+                    x + 0.05,
+                    y + 0.5
+                )
+            }
+            5 => "emergency = true".into(),
+            _ => "emergency = false".into(),
+        };
+        text.push_str(&format!("[[disturbances]]\nat = {t}\n{effect}\n"));
+    }
+    text
+}
+
+/// Runs every policy of `s` (scenario `k`, written `text`): no step moves
+/// farther than the top speed allows, and the battery stays in 0..=100.
+fn assert_speed_and_battery_bounds(s: &Scenario, k: u32, text: &str) {
+    let p = s.world.params.clone();
+    for run in run_scenario(s, true) {
+        let mut prev = s.world.robot;
+        for st in &run.trace {
+            let d = dist(prev, (st.x, st.y));
+            assert!(d <= p.max_speed * s.dt + 1e-9, "{k}: {d}\n{text}");
+            assert!((0.0..=100.0).contains(&st.battery), "{k}");
+            prev = (st.x, st.y);
+        }
+    }
 }
 
 /// The built-in action domain (`policies/domains/moma.toml`) describes the

@@ -131,12 +131,25 @@ impl SimReport {
         s
     }
 
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    /// The report as text: a table of the runs, each run's skills and
+    /// final world, the verdicts, and the expectations.
     pub fn table(&self) -> String {
         let mut out = format!(
             "scenario `{}` (seed {}, step {} s)\n\n",
             self.scenario, self.seed, self.dt
         );
+        out.push_str(&self.runs_table());
+        for r in &self.policies {
+            run_details(&mut out, r);
+        }
+        self.verdicts_text(&mut out);
+        self.skipped_text(&mut out);
+        self.expectations_text(&mut out);
+        out
+    }
+
+    /// One row per run: kind, outcome, goal, times, distance, skills.
+    fn runs_table(&self) -> String {
         let mut t = Table::new(&[
             "policy",
             "kind",
@@ -166,107 +179,124 @@ impl SimReport {
                 r.skills.len().to_string(),
             ]);
         }
-        out.push_str(&t.render());
-        for r in &self.policies {
-            out.push_str(&format!(
-                "\n{} — {}: {}\n",
-                r.policy,
-                r.outcome.as_str(),
-                r.reason
-            ));
-            for (i, s) in r.skills.iter().enumerate() {
-                out.push_str(&format!(
-                    "  {:>3}. {:>7.1} s  {}\n",
-                    i + 1,
-                    s.start,
-                    s.text()
-                ));
-            }
-            let w = &r.final_world;
-            let objs: Vec<String> = w
-                .objects
-                .iter()
-                .map(|(n, o)| {
-                    let place = if o.held {
-                        "held".to_string()
-                    } else {
-                        o.at.clone()
-                            .unwrap_or_else(|| format!("({:.2}, {:.2})", o.x, o.y))
-                    };
-                    format!("{n} {place}")
-                })
-                .collect();
-            out.push_str(&format!(
-                "  final: robot {}, battery {:.1}%, holding {}, arm {}, {}\n",
-                w.robot_at
-                    .clone()
-                    .unwrap_or_else(|| format!("({:.2}, {:.2})", w.robot[0], w.robot[1])),
-                w.battery,
-                w.holding.as_deref().unwrap_or("nothing"),
-                if w.arm_tucked { "tucked" } else { "out" },
-                objs.join(", ")
-            ));
-        }
-        if !self.verdicts.is_empty() {
-            out.push_str("\nbehavior match (same executed skills with arguments, outcomes and start times within a step, same goal outcome, same final world):\n");
-            for v in &self.verdicts {
-                let what = if v.matches {
-                    "MATCH".to_string()
-                } else {
-                    let mut why = Vec::new();
-                    if !v.same_skills {
-                        why.push("skills differ");
-                    }
-                    if !v.same_outcome {
-                        why.push("outcomes differ");
-                    }
-                    if !v.same_final_world {
-                        why.push("final worlds differ");
-                    }
-                    format!("DIFFER ({})", why.join(", "))
-                };
-                out.push_str(&format!(
-                    "  {} vs {}: {what}, trajectory distance {:.3} m at equal times ({:.3} m between the paths)\n",
-                    v.a, v.b, v.trajectory_distance_m, v.path_distance_m
-                ));
-                if let Some(d) = &v.first_divergence {
-                    out.push_str(&format!("    first divergence {}\n", d.summary()));
-                }
-            }
-        }
-        if !self.skipped_verdicts.is_empty() {
-            let n = self.skipped_verdicts.len();
-            let shown: Vec<String> = (self.skipped_verdicts.iter().take(10))
-                .map(|[a, b]| format!("{a} vs {b}"))
-                .collect();
-            out.push_str(&format!(
-                "\n{n} verdict{} skipped, the wall-clock budget ran out first: {}{}\n",
-                if n == 1 { "" } else { "s" },
-                shown.join("; "),
-                if n > 10 {
-                    format!("; and {} more", n - 10)
-                } else {
-                    String::new()
-                }
-            ));
-        }
-        if !self.expectations.is_empty() {
-            out.push_str(&format!(
-                "\nexpectations: {} of {} hold\n",
-                self.expectations.len() - self.expectations_failed,
-                self.expectations.len()
-            ));
-            for e in &self.expectations {
-                let st = match e.status {
-                    Status::Pass => "ok  ",
-                    Status::Fail => "FAIL",
-                    Status::Undecided => "UNDECIDED",
-                };
-                out.push_str(&format!("  {st} {} ({})\n", e.name, e.found));
-            }
-        }
-        out
+        t.render()
     }
+
+    /// The behavior-match verdicts, with why a pair differs and where it
+    /// first diverged.
+    fn verdicts_text(&self, out: &mut String) {
+        if self.verdicts.is_empty() {
+            return;
+        }
+        out.push_str("\nbehavior match (same executed skills with arguments, outcomes and start times within a step, same goal outcome, same final world):\n");
+        for v in &self.verdicts {
+            let what = if v.matches {
+                "MATCH".to_string()
+            } else {
+                let mut why = Vec::new();
+                if !v.same_skills {
+                    why.push("skills differ");
+                }
+                if !v.same_outcome {
+                    why.push("outcomes differ");
+                }
+                if !v.same_final_world {
+                    why.push("final worlds differ");
+                }
+                format!("DIFFER ({})", why.join(", "))
+            };
+            out.push_str(&format!(
+                "  {} vs {}: {what}, trajectory distance {:.3} m at equal times ({:.3} m between the paths)\n",
+                v.a, v.b, v.trajectory_distance_m, v.path_distance_m
+            ));
+            if let Some(d) = &v.first_divergence {
+                out.push_str(&format!("    first divergence {}\n", d.summary()));
+            }
+        }
+    }
+
+    /// The verdicts the wall-clock budget left out (the first ten named).
+    fn skipped_text(&self, out: &mut String) {
+        if self.skipped_verdicts.is_empty() {
+            return;
+        }
+        let n = self.skipped_verdicts.len();
+        let shown: Vec<String> = (self.skipped_verdicts.iter().take(10))
+            .map(|[a, b]| format!("{a} vs {b}"))
+            .collect();
+        out.push_str(&format!(
+            "\n{n} verdict{} skipped, the wall-clock budget ran out first: {}{}\n",
+            if n == 1 { "" } else { "s" },
+            shown.join("; "),
+            if n > 10 {
+                format!("; and {} more", n - 10)
+            } else {
+                String::new()
+            }
+        ));
+    }
+
+    /// The expectations checked: how many hold, and each one's status.
+    fn expectations_text(&self, out: &mut String) {
+        if self.expectations.is_empty() {
+            return;
+        }
+        out.push_str(&format!(
+            "\nexpectations: {} of {} hold\n",
+            self.expectations.len() - self.expectations_failed,
+            self.expectations.len()
+        ));
+        for e in &self.expectations {
+            let st = match e.status {
+                Status::Pass => "ok  ",
+                Status::Fail => "FAIL",
+                Status::Undecided => "UNDECIDED",
+            };
+            out.push_str(&format!("  {st} {} ({})\n", e.name, e.found));
+        }
+    }
+}
+
+/// A run's outcome and reason, its executed skills, and its final world.
+fn run_details(out: &mut String, r: &Run) {
+    out.push_str(&format!(
+        "\n{} — {}: {}\n",
+        r.policy,
+        r.outcome.as_str(),
+        r.reason
+    ));
+    for (i, s) in r.skills.iter().enumerate() {
+        out.push_str(&format!(
+            "  {:>3}. {:>7.1} s  {}\n",
+            i + 1,
+            s.start,
+            s.text()
+        ));
+    }
+    let w = &r.final_world;
+    let objs: Vec<String> = w
+        .objects
+        .iter()
+        .map(|(n, o)| {
+            let place = if o.held {
+                "held".to_string()
+            } else {
+                o.at.clone()
+                    .unwrap_or_else(|| format!("({:.2}, {:.2})", o.x, o.y))
+            };
+            format!("{n} {place}")
+        })
+        .collect();
+    out.push_str(&format!(
+        "  final: robot {}, battery {:.1}%, holding {}, arm {}, {}\n",
+        w.robot_at
+            .clone()
+            .unwrap_or_else(|| format!("({:.2}, {:.2})", w.robot[0], w.robot[1])),
+        w.battery,
+        w.holding.as_deref().unwrap_or("nothing"),
+        if w.arm_tucked { "tucked" } else { "out" },
+        objs.join(", ")
+    ));
 }
 
 /// What `sim SCENARIO --runs N --format json` prints.

@@ -17,6 +17,7 @@ use super::trace::{FinalWorld, Outcome, Run, Step, compact_track, compact_trajec
 use super::world::{P2, World, dist};
 use btfsm_model::PolicyBody;
 use std::collections::BTreeMap;
+use std::ops::ControlFlow;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -149,7 +150,6 @@ pub type StepSink<'a> = &'a mut dyn FnMut(&Step);
 /// [`run_policy`], handing each step of the trace (`opts.trace`) to `sink`
 /// when there is one.
 #[allow(clippy::too_many_arguments)]
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn run_policy_into(
     s: &Scenario,
     p: &Prepared,
@@ -163,272 +163,408 @@ pub fn run_policy_into(
     // The goal's terms are evaluated every step too (progress toward it).
     let goal_terms_n = s.goal.as_ref().map_or(0, Vec::len);
     let every = clock_every(p, disturbances, &world, goal_terms_n);
-    let n = p.keys.len();
-    let mut robot = Robot::new(world, s.dt, n, Faults::new(seed, rates), opts.log);
-    enum Ex {
-        Bt(BtExec),
-        M(MachineExec),
-    }
-    let keep_ticking = p.after_success == Afterwards::KeepTicking;
-    let mut ex = match &p.exec {
-        Compiled::Bt(b) => Ex::Bt(BtExec::new(b.clone(), opts.trace)),
-        Compiled::Machine(m) => {
-            let mut m = MachineExec::new(m.clone(), opts.trace);
-            m.keep_ticking = keep_ticking;
-            m.reenter_on_failure = p.after_failure == Afterwards::KeepTicking;
-            Ex::M(m)
-        }
-    };
-    // `after_success = "stop"`: the policy is no longer ticked once it has
-    // reported SUCCESS (a machine ends at its outcome by itself).
-    let mut stopped = false;
-    let mut livelock = Livelock::new(s.livelock_repeats);
-    let goal_terms: &[(Call, bool)] = s.goal.as_deref().unwrap_or(&[]);
-    let mut track: Vec<(u64, P2)> = Vec::new();
-    let mut fired = vec![false; disturbances.len()];
-    // Timed disturbances not yet fired (a run is not over while one is).
-    let mut pending_timed = (disturbances.iter())
-        .filter(|d| matches!(d.when, When::At(_) | When::AfterDone(_)))
-        .count();
-    let mut first_done: Option<f64> = None;
-    let mut completion: Option<f64> = None;
-    let mut low = false;
-    let mut trajectory: Vec<P2> = Vec::new();
-    let mut trace: Vec<Step> = Vec::new();
+    let mut e = Episode::new(s, p, world, disturbances, rates, seed, opts);
     let mut ended: Option<(Outcome, String)> = None;
-    let mut steps = 0;
-    let mut last = Status::Running;
-    if opts.log {
-        trajectory.push(robot.world.robot);
-        track.push((0, robot.world.robot));
-    }
-    while steps < s.max_steps {
-        if let Some(d) = opts.deadline
-            && steps % every == 0
-            && Instant::now() >= d
-        {
-            ended = Some((
-                Outcome::Timeout,
-                format!("wall-clock budget exhausted at step {steps}"),
-            ));
+    while e.steps < s.max_steps {
+        if let ControlFlow::Break(end) = e.step(every, &mut sink) {
+            ended = end;
             break;
         }
-        steps += 1;
-        let now = robot.world.time + 1e-9;
+    }
+    e.into_run(ended)
+}
+
+/// The executor of a run: a BT's or a machine's.
+enum Ex {
+    Bt(BtExec),
+    M(MachineExec),
+}
+
+impl Ex {
+    /// The executor of `p`, noting every node's status when `trace`.
+    fn new(p: &Prepared, trace: bool) -> Self {
+        match &p.exec {
+            Compiled::Bt(b) => Ex::Bt(BtExec::new(b.clone(), trace)),
+            Compiled::Machine(m) => {
+                let mut m = MachineExec::new(m.clone(), trace);
+                m.keep_ticking = p.after_success == Afterwards::KeepTicking;
+                m.reenter_on_failure = p.after_failure == Afterwards::KeepTicking;
+                Ex::M(m)
+            }
+        }
+    }
+
+    /// The outcome a machine ended with, and why (a BT never ends by itself).
+    fn finished(&self) -> Option<(String, String)> {
+        match self {
+            Ex::Bt(_) => None,
+            Ex::M(m) => m.finished.clone(),
+        }
+    }
+}
+
+/// What ends a run early: its outcome and why (`None`: the policy's own).
+type Ended = Option<(Outcome, String)>;
+
+/// A run in progress: the robot, the policy's executor, and what the step
+/// loop carries from one step to the next.
+struct Episode<'a> {
+    s: &'a Scenario,
+    p: &'a Prepared,
+    disturbances: &'a [Disturbance],
+    opts: RunOptions,
+    robot: Robot,
+    ex: Ex,
+    /// `after_success = "keep-ticking"`.
+    keep_ticking: bool,
+    /// `after_success = "stop"`: the policy is no longer ticked once it has
+    /// reported SUCCESS (a machine ends at its outcome by itself).
+    stopped: bool,
+    livelock: Livelock,
+    goal_terms: &'a [(Call, bool)],
+    track: Vec<(u64, P2)>,
+    fired: Vec<bool>,
+    /// Timed disturbances not yet fired (a run is not over while one is).
+    pending_timed: usize,
+    first_done: Option<f64>,
+    completion: Option<f64>,
+    low: bool,
+    trajectory: Vec<P2>,
+    trace: Vec<Step>,
+    steps: u64,
+    last: Status,
+}
+
+impl<'a> Episode<'a> {
+    /// The run at step 0: the robot in `world`, its faults drawn from `seed`.
+    fn new(
+        s: &'a Scenario,
+        p: &'a Prepared,
+        world: World,
+        disturbances: &'a [Disturbance],
+        rates: BTreeMap<String, f64>,
+        seed: u64,
+        opts: RunOptions,
+    ) -> Self {
+        let n = p.keys.len();
+        let robot = Robot::new(world, s.dt, n, Faults::new(seed, rates), opts.log);
+        let mut trajectory: Vec<P2> = Vec::new();
+        let mut track: Vec<(u64, P2)> = Vec::new();
+        if opts.log {
+            trajectory.push(robot.world.robot);
+            track.push((0, robot.world.robot));
+        }
+        Episode {
+            s,
+            p,
+            disturbances,
+            opts,
+            ex: Ex::new(p, opts.trace),
+            keep_ticking: p.after_success == Afterwards::KeepTicking,
+            stopped: false,
+            livelock: Livelock::new(s.livelock_repeats),
+            goal_terms: s.goal.as_deref().unwrap_or(&[]),
+            track,
+            fired: vec![false; disturbances.len()],
+            pending_timed: (disturbances.iter())
+                .filter(|d| matches!(d.when, When::At(_) | When::AfterDone(_)))
+                .count(),
+            first_done: None,
+            completion: None,
+            low: false,
+            trajectory,
+            trace: Vec::new(),
+            steps: 0,
+            last: Status::Running,
+            robot,
+        }
+    }
+
+    /// One step: the clock read, disturbances fired, the policy ticked, the
+    /// world advanced and recorded; `Break` when the run ends with it.
+    fn step(&mut self, every: u64, sink: &mut Option<StepSink<'_>>) -> ControlFlow<Ended> {
+        if let Some(d) = self.opts.deadline
+            && self.steps.is_multiple_of(every)
+            && Instant::now() >= d
+        {
+            let steps = self.steps;
+            return ControlFlow::Break(Some((
+                Outcome::Timeout,
+                format!("wall-clock budget exhausted at step {steps}"),
+            )));
+        }
+        self.steps += 1;
+        let disturbed = self.fire_disturbances();
+        self.note_battery();
+        if !self.stopped
+            && let Some(end) = self.tick_policy()
+        {
+            return ControlFlow::Break(Some(end));
+        }
+        self.robot.end_step();
+        self.robot.world.advance(self.s.dt);
+        if self.opts.log {
+            self.record_position();
+        }
+        if self.opts.trace {
+            self.record_trace(sink);
+        }
+        self.settle(disturbed)
+    }
+
+    /// Fires the disturbances due at this step; whether any fired.
+    fn fire_disturbances(&mut self) -> bool {
+        let now = self.robot.world.time + 1e-9;
         let mut disturbed = false;
-        for (i, d) in disturbances.iter().enumerate() {
-            if fired[i] {
+        for (i, d) in self.disturbances.iter().enumerate() {
+            if self.fired[i] {
                 continue;
             }
             let go = match &d.when {
                 When::At(t) => now >= *t,
-                When::AfterDone(dl) => first_done.is_some_and(|f| now >= f + dl),
-                When::Holds(terms) => holds(terms, &robot.world),
+                When::AfterDone(dl) => self.first_done.is_some_and(|f| now >= f + dl),
+                When::Holds(terms) => holds(terms, &self.robot.world),
             };
             if go {
-                fired[i] = true;
+                self.fired[i] = true;
                 if !matches!(d.when, When::Holds(_)) {
-                    pending_timed -= 1;
+                    self.pending_timed -= 1;
                 }
-                apply(d, &mut robot);
+                apply(d, &mut self.robot);
                 disturbed = true;
             }
         }
+        disturbed
+    }
+
+    /// Notes the battery going low (an event, once per time it falls).
+    fn note_battery(&mut self) {
+        let robot = &mut self.robot;
         let lowb = robot.world.battery <= robot.world.params.low_battery;
-        if lowb && !low {
+        if lowb && !self.low {
             robot.low_at = Some(robot.world.time);
             let b = robot.world.battery;
             robot.event("battery-low", format!("battery at {b:.1}%"));
         }
-        low = lowb;
-        if !stopped {
-            // A policy whose root failed because an action failed, and
-            // which goes on (a BT, a machine re-entered after FAILURE), is
-            // ticked again in the same step, as an FSM's failure arc starts
-            // its next action in the step of the failure: no representation
-            // gets a step for free. Bounded: MAX_TICKS_PER_STEP ticks.
-            let mut ticks = 0;
-            loop {
-                ticks += 1;
-                let failed = robot.failed_ends;
-                last = match &mut ex {
-                    Ex::Bt(b) => b.tick(&mut robot),
-                    Ex::M(m) => m.step(&mut robot),
-                };
-                let goes_on = match &ex {
-                    Ex::Bt(_) => p.after_failure == Afterwards::KeepTicking,
-                    Ex::M(m) => m.finished.is_none(),
-                };
-                if last != Status::Failure
-                    || !goes_on
-                    || robot.failed_ends == failed
-                    || ticks >= MAX_TICKS_PER_STEP
-                {
-                    break;
-                }
-                // The last tick of the step says which actions go on.
-                robot.untick();
-            }
-            if last == Status::Success && !keep_ticking && matches!(ex, Ex::Bt(_)) {
-                stopped = true;
-            }
-            // `after_failure = "stop"` for a BT: its root's FAILURE ends the
-            // run (a machine ends at its outcome by itself).
-            if last == Status::Failure
-                && p.after_failure == Afterwards::Stop
-                && matches!(ex, Ex::Bt(_))
+        self.low = lowb;
+    }
+
+    /// Ticks the policy for this step and applies `after_success` and
+    /// `after_failure`; `Some` when a BT's FAILURE stops the run.
+    fn tick_policy(&mut self) -> Option<(Outcome, String)> {
+        self.tick_until_settled();
+        let bt = matches!(self.ex, Ex::Bt(_));
+        if self.last == Status::Success && !self.keep_ticking && bt {
+            self.stopped = true;
+        }
+        // `after_failure = "stop"` for a BT: its root's FAILURE ends the
+        // run (a machine ends at its outcome by itself).
+        if self.last == Status::Failure && self.p.after_failure == Afterwards::Stop && bt {
+            self.robot.end_step();
+            return Some((
+                Outcome::Failure,
+                "the root returned FAILURE (after_failure = \"stop\")".into(),
+            ));
+        }
+        None
+    }
+
+    /// Ticks the policy, and again in the same step while its root fails
+    /// because an action failed and it goes on.
+    fn tick_until_settled(&mut self) {
+        // A policy whose root failed because an action failed, and which
+        // goes on (a BT, a machine re-entered after FAILURE), is ticked
+        // again in the same step, as an FSM's failure arc starts its next
+        // action in the step of the failure: no representation gets a step
+        // for free. Bounded: MAX_TICKS_PER_STEP ticks.
+        let mut ticks = 0;
+        loop {
+            ticks += 1;
+            let failed = self.robot.failed_ends;
+            self.last = match &mut self.ex {
+                Ex::Bt(b) => b.tick(&mut self.robot),
+                Ex::M(m) => m.step(&mut self.robot),
+            };
+            let goes_on = match &self.ex {
+                Ex::Bt(_) => self.p.after_failure == Afterwards::KeepTicking,
+                Ex::M(m) => m.finished.is_none(),
+            };
+            if self.last != Status::Failure
+                || !goes_on
+                || self.robot.failed_ends == failed
+                || ticks >= MAX_TICKS_PER_STEP
             {
-                robot.end_step();
-                ended = Some((
-                    Outcome::Failure,
-                    "the root returned FAILURE (after_failure = \"stop\")".into(),
-                ));
                 break;
             }
+            // The last tick of the step says which actions go on.
+            self.robot.untick();
         }
-        robot.end_step();
-        robot.world.advance(s.dt);
-        if opts.log {
-            trajectory.push(robot.world.robot);
-            if track
-                .last()
-                .is_none_or(|&(_, q)| dist(q, robot.world.robot) > 1e-6)
-            {
-                track.push((steps, robot.world.robot));
-            }
+    }
+
+    /// Records the robot's position: every step in the trajectory, where it
+    /// moved in the track.
+    fn record_position(&mut self) {
+        let at = self.robot.world.robot;
+        self.trajectory.push(at);
+        if self.track.last().is_none_or(|&(_, q)| dist(q, at) > 1e-6) {
+            self.track.push((self.steps, at));
         }
-        if opts.trace {
-            let st = match &ex {
-                Ex::Bt(b) => b.statuses.as_ref(),
-                Ex::M(m) => m.statuses.as_ref(),
-            };
-            let running = robot
-                .live
-                .iter()
-                .flatten()
-                // An outcome reached while moving is no longer running.
-                .filter(|r| r.result.is_none())
-                .map(|r| {
-                    robot.records[r.record]
-                        .text()
-                        .trim_end_matches(" -> running")
-                        .to_string()
-                })
-                .collect();
-            let step = Step {
-                t: round3(robot.world.time),
-                x: robot.world.robot.0,
-                y: robot.world.robot.1,
-                yaw: robot.world.yaw,
-                battery: (robot.world.battery * 100.0).round() / 100.0,
-                running,
-                statuses: st
-                    .map(|v| {
-                        v.iter()
-                            .map(|(k, s)| (p.keys[*k].clone(), s.as_str().to_string()))
-                            .collect()
-                    })
-                    .unwrap_or_default(),
-            };
-            match sink.as_mut() {
-                Some(f) => f(&step),
-                None => trace.push(step),
-            }
-        }
-        let finished = match &ex {
-            Ex::Bt(_) => None,
-            Ex::M(m) => m.finished.clone(),
+    }
+
+    /// Hands the step's trace record (pose, battery, running skills,
+    /// statuses) to `sink`, or keeps it.
+    fn record_trace(&mut self, sink: &mut Option<StepSink<'_>>) {
+        let robot = &self.robot;
+        let st = match &self.ex {
+            Ex::Bt(b) => b.statuses.as_ref(),
+            Ex::M(m) => m.statuses.as_ref(),
         };
-        let done = last == Status::Success && finished.as_ref().is_none_or(|f| f.0 == "SUCCESS");
-        if done {
-            if completion.is_none() || first_done.is_none() {
-                robot.event("done", "the policy reports SUCCESS".into());
-            }
-            first_done.get_or_insert(robot.world.time);
-            completion.get_or_insert(robot.world.time);
-        } else {
-            completion = None;
+        let running = robot
+            .live
+            .iter()
+            .flatten()
+            // An outcome reached while moving is no longer running.
+            .filter(|r| r.result.is_none())
+            .map(|r| {
+                robot.records[r.record]
+                    .text()
+                    .trim_end_matches(" -> running")
+                    .to_string()
+            })
+            .collect();
+        let keys = &self.p.keys;
+        let step = Step {
+            t: round3(robot.world.time),
+            x: robot.world.robot.0,
+            y: robot.world.robot.1,
+            yaw: robot.world.yaw,
+            battery: (robot.world.battery * 100.0).round() / 100.0,
+            running,
+            statuses: st
+                .map(|v| {
+                    v.iter()
+                        .map(|(k, s)| (keys[*k].clone(), s.as_str().to_string()))
+                        .collect()
+                })
+                .unwrap_or_default(),
+        };
+        match sink.as_mut() {
+            Some(f) => f(&step),
+            None => self.trace.push(step),
         }
-        let pending = pending_timed > 0;
+    }
+
+    /// After the step: notes the policy done, and ends the run on a full
+    /// record, a livelock, too many failures, or the policy done with no
+    /// timed disturbance pending.
+    fn settle(&mut self, disturbed: bool) -> ControlFlow<Ended> {
+        let finished = self.ex.finished();
+        let done =
+            self.last == Status::Success && finished.as_ref().is_none_or(|f| f.0 == "SUCCESS");
+        self.note_done(done);
+        let pending = self.pending_timed > 0;
+        let robot = &mut self.robot;
         if robot.full {
-            ended = Some((
+            let steps = self.steps;
+            return ControlFlow::Break(Some((
                 Outcome::Timeout,
                 format!(
                     "record budget exhausted at step {steps}: a run records at most {MAX_SKILL_RECORDS} executed skills and {MAX_EVENTS} events"
                 ),
-            ));
-            break;
+            )));
         }
-        let measure = (goal_terms.iter())
+        let measure = (self.goal_terms.iter())
             .filter(|(c, neg)| skills::condition(c, &robot.world) != *neg)
             .count()
             + usize::from(done);
         let fresh = !robot.started.is_empty();
-        let state = abstract_state(&robot);
+        let state = abstract_state(robot);
         robot.started.clear();
-        if let Some(n) = livelock.step(state, fresh, measure, disturbed) {
+        if let Some(n) = self.livelock.step(state, fresh, measure, disturbed) {
             let text = format!(
                 "livelock: an abstract state (world facts, running skills) entered {n} times without progress toward the goal"
             );
             robot.event("chattering", text.clone());
-            ended = Some((Outcome::Chattering, text));
-            break;
+            return ControlFlow::Break(Some((Outcome::Chattering, text)));
         }
-        if robot.failures > s.max_failures {
+        if robot.failures > self.s.max_failures {
             let text = format!(
                 "gave up after {} failed actions without progress",
                 robot.failures
             );
-            ended = Some((Outcome::Failure, text));
-            break;
+            return ControlFlow::Break(Some((Outcome::Failure, text)));
         }
         if !pending && (done || finished.is_some()) {
-            break;
+            return ControlFlow::Break(None);
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// Notes whether the policy is done at this step: the first time (an
+    /// event), and since when it has been without a break (completion).
+    fn note_done(&mut self, done: bool) {
+        if done {
+            if self.completion.is_none() || self.first_done.is_none() {
+                self.robot
+                    .event("done", "the policy reports SUCCESS".into());
+            }
+            self.first_done.get_or_insert(self.robot.world.time);
+            self.completion.get_or_insert(self.robot.world.time);
+        } else {
+            self.completion = None;
         }
     }
-    // Whatever still runs at the end stays `running` in the records.
-    let finished = match &ex {
-        Ex::Bt(_) => None,
-        Ex::M(m) => m.finished.clone(),
-    };
-    let (outcome, reason) = ended.unwrap_or_else(|| match finished {
-        Some((o, why)) if o == "SUCCESS" => (Outcome::Success, why),
-        Some((_, why)) => (Outcome::Failure, why),
-        None if last == Status::Success => (
-            Outcome::Success,
-            match &ex {
-                Ex::Bt(_) => "the root returned SUCCESS".into(),
-                Ex::M(_) => "reached the outcome SUCCESS (and ticks on)".into(),
-            },
-        ),
-        None => (
-            Outcome::Timeout,
-            format!("step budget of {} steps exhausted", s.max_steps),
-        ),
-    });
-    let goal_met = s.goal.as_ref().map(|g| holds(g, &robot.world));
-    Run {
-        policy: p.name.clone(),
-        file: p.file.clone(),
-        kind: p.kind.clone(),
-        convert: p.convert.clone(),
-        outcome,
-        reason,
-        goal_met,
-        steps,
-        dt: s.dt,
-        after_success: p.after_success.as_str(),
-        after_failure: p.after_failure.as_str(),
-        completion_s: completion.map(round3),
-        duration_s: round3(robot.world.time),
-        distance_m: round3(robot.world.odometer),
-        skills: robot.records,
-        events: robot.events,
-        final_world: FinalWorld::of(&robot.world),
-        recharge_latency_s: robot.latencies,
-        trajectory,
-        track,
-        trace,
+
+    /// The outcome and reason of a run the loop did not end early: the
+    /// machine's outcome, the BT's SUCCESS, or the step budget.
+    fn own_outcome(&self) -> (Outcome, String) {
+        match self.ex.finished() {
+            Some((o, why)) if o == "SUCCESS" => (Outcome::Success, why),
+            Some((_, why)) => (Outcome::Failure, why),
+            None if self.last == Status::Success => (
+                Outcome::Success,
+                match &self.ex {
+                    Ex::Bt(_) => "the root returned SUCCESS".into(),
+                    Ex::M(_) => "reached the outcome SUCCESS (and ticks on)".into(),
+                },
+            ),
+            None => (
+                Outcome::Timeout,
+                format!("step budget of {} steps exhausted", self.s.max_steps),
+            ),
+        }
+    }
+
+    /// The record of the run once its loop has ended (`ended`: how, when
+    /// the loop decided it).
+    fn into_run(self, ended: Ended) -> Run {
+        // Whatever still runs at the end stays `running` in the records.
+        let (outcome, reason) = ended.unwrap_or_else(|| self.own_outcome());
+        let (s, p, robot) = (self.s, self.p, self.robot);
+        let goal_met = s.goal.as_ref().map(|g| holds(g, &robot.world));
+        Run {
+            policy: p.name.clone(),
+            file: p.file.clone(),
+            kind: p.kind.clone(),
+            convert: p.convert.clone(),
+            outcome,
+            reason,
+            goal_met,
+            steps: self.steps,
+            dt: s.dt,
+            after_success: p.after_success.as_str(),
+            after_failure: p.after_failure.as_str(),
+            completion_s: self.completion.map(round3),
+            duration_s: round3(robot.world.time),
+            distance_m: round3(robot.world.odometer),
+            skills: robot.records,
+            events: robot.events,
+            final_world: FinalWorld::of(&robot.world),
+            recharge_latency_s: robot.latencies,
+            trajectory: self.trajectory,
+            track: self.track,
+            trace: self.trace,
+        }
     }
 }
 

@@ -531,7 +531,6 @@ fn key_spans<'k>(
 /// policy file at the node or state.
 /// The file is read again only to position the messages, and bounded as
 /// when it was loaded (`--max-file-bytes`; a device or pipe stops there).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn check_bindings(
     p: &Policy,
     path: &str,
@@ -539,100 +538,126 @@ pub fn check_bindings(
     world: &World,
     diags: &mut Vec<Diagnostic>,
 ) {
-    /// Where a problem is: a span of the policy file, or the include of
-    /// the subtree it comes from (its key, found in the file's text).
-    enum Pos {
-        Span(Option<Range<usize>>),
-        Include(String),
-    }
-    let mut problems: Vec<(String, Pos, Unresolved)> = Vec::new();
-    let mut push = |what: String, pos: Pos, u: Unresolved| problems.push((what, pos, u));
+    let mut problems: Vec<Problem> = Vec::new();
     match &p.body {
-        PolicyBody::Bt(bt) => {
-            for n in &bt.nodes {
-                // Nodes of an included subtree (`include/...`) have spans in
-                // the included file: point at the include in this file.
-                let span = || match n.id.split_once('/') {
-                    None => Pos::Span(n.span.clone()),
-                    Some((inc, _)) => Pos::Include(inc.to_string()),
-                };
-                if let Some(t) = crate::exec::refused(n) {
-                    push(
-                        format!("node `{}`", n.id),
-                        span(),
-                        Unresolved {
-                            message: format!("the simulator does not model the node type {t}"),
-                            hint: "it executes the node types of docs/bt-semantics.md (sequence, fallback, sequence_memory, fallback_memory, parallel, inverter, force_success, force_failure, repeat, retry, timeout; IfThenElse, WhileDoElse, KeepRunningUntilFailure, ...)".into(),
-                        },
-                    );
-                }
-                if n.kind.arity() != btfsm_model::bt::Arity::Leaf {
-                    continue;
-                }
-                let span = span();
-                match &n.skill {
-                    Some(c) => {
-                        if let Err(u) = skills::resolve(c, world) {
-                            push(format!("node `{}`", n.id), span, u);
-                        }
-                    }
-                    None => push(
-                        format!("node `{}`", n.id),
-                        span,
-                        Unresolved {
-                            message: "no skill binding".into(),
-                            hint: "the simulator needs `skill = \"...\"` on every leaf".into(),
-                        },
-                    ),
-                }
-            }
-        }
-        PolicyBody::Machine(m) => {
-            for (i, s) in m.states.iter().enumerate() {
-                if s.pseudo.is_some() {
-                    push(
-                        format!("state `{}`", m.path(i)),
-                        Pos::Span(s.span.clone()),
-                        Unresolved {
-                            message: "the simulator does not execute history pseudo-states".into(),
-                            hint: "re-entering a container at its last active state is not modelled; give the container an initial state instead".into(),
-                        },
-                    );
-                    continue;
-                }
-                let mut calls: Vec<&SkillCall> = Vec::new();
-                match &s.body {
-                    StateBody::Task(Some(c)) => calls.push(c),
-                    StateBody::Task(None) => push(
-                        format!("state `{}`", m.path(i)),
-                        Pos::Span(s.span.clone()),
-                        Unresolved {
-                            message: "no skill binding".into(),
-                            hint: "the simulator needs `skill = \"...\"` on every state that is not a decision or container".into(),
-                        },
-                    ),
-                    _ => {}
-                }
-                for t in &s.transitions {
-                    if let btfsm_model::Trigger::Guard(g) = &t.trigger {
-                        calls.extend(g.all.iter().map(|x| &x.condition));
-                    }
-                }
-                for c in calls {
-                    if let Err(u) = skills::resolve(c, world) {
-                        push(
-                            format!("state `{}`", m.path(i)),
-                            Pos::Span(s.span.clone()),
-                            u,
-                        );
-                    }
-                }
-            }
-        }
+        PolicyBody::Bt(bt) => bt_binding_problems(bt, world, &mut problems),
+        PolicyBody::Machine(m) => machine_binding_problems(m, world, &mut problems),
     }
     if problems.is_empty() {
         return;
     }
+    report_binding_problems(problems, path, limits, diags);
+}
+
+/// Where a problem is: a span of the policy file, or the include of
+/// the subtree it comes from (its key, found in the file's text).
+enum Pos {
+    Span(Option<Range<usize>>),
+    Include(String),
+}
+
+/// A binding problem: what has it (``node `x` ``), where, and why.
+type Problem = (String, Pos, Unresolved);
+
+/// The binding problems of a BT: node types the simulator does not model,
+/// leaves without a skill or with one that does not resolve.
+fn bt_binding_problems(bt: &btfsm_model::bt::Bt, world: &World, problems: &mut Vec<Problem>) {
+    for n in &bt.nodes {
+        // Nodes of an included subtree (`include/...`) have spans in
+        // the included file: point at the include in this file.
+        let span = || match n.id.split_once('/') {
+            None => Pos::Span(n.span.clone()),
+            Some((inc, _)) => Pos::Include(inc.to_string()),
+        };
+        if let Some(t) = crate::exec::refused(n) {
+            problems.push((
+                format!("node `{}`", n.id),
+                span(),
+                Unresolved {
+                    message: format!("the simulator does not model the node type {t}"),
+                    hint: "it executes the node types of docs/bt-semantics.md (sequence, fallback, sequence_memory, fallback_memory, parallel, inverter, force_success, force_failure, repeat, retry, timeout; IfThenElse, WhileDoElse, KeepRunningUntilFailure, ...)".into(),
+                },
+            ));
+        }
+        if n.kind.arity() != btfsm_model::bt::Arity::Leaf {
+            continue;
+        }
+        let span = span();
+        match &n.skill {
+            Some(c) => {
+                if let Err(u) = skills::resolve(c, world) {
+                    problems.push((format!("node `{}`", n.id), span, u));
+                }
+            }
+            None => problems.push((
+                format!("node `{}`", n.id),
+                span,
+                Unresolved {
+                    message: "no skill binding".into(),
+                    hint: "the simulator needs `skill = \"...\"` on every leaf".into(),
+                },
+            )),
+        }
+    }
+}
+
+/// The binding problems of a machine: history pseudo-states, tasks
+/// without a skill, skills and guards that do not resolve.
+fn machine_binding_problems(
+    m: &btfsm_model::StateMachine,
+    world: &World,
+    problems: &mut Vec<Problem>,
+) {
+    for (i, s) in m.states.iter().enumerate() {
+        if s.pseudo.is_some() {
+            problems.push((
+                format!("state `{}`", m.path(i)),
+                Pos::Span(s.span.clone()),
+                Unresolved {
+                    message: "the simulator does not execute history pseudo-states".into(),
+                    hint: "re-entering a container at its last active state is not modelled; give the container an initial state instead".into(),
+                },
+            ));
+            continue;
+        }
+        let mut calls: Vec<&SkillCall> = Vec::new();
+        match &s.body {
+            StateBody::Task(Some(c)) => calls.push(c),
+            StateBody::Task(None) => problems.push((
+                format!("state `{}`", m.path(i)),
+                Pos::Span(s.span.clone()),
+                Unresolved {
+                    message: "no skill binding".into(),
+                    hint: "the simulator needs `skill = \"...\"` on every state that is not a decision or container".into(),
+                },
+            )),
+            _ => {}
+        }
+        for t in &s.transitions {
+            if let btfsm_model::Trigger::Guard(g) = &t.trigger {
+                calls.extend(g.all.iter().map(|x| &x.condition));
+            }
+        }
+        for c in calls {
+            if let Err(u) = skills::resolve(c, world) {
+                problems.push((
+                    format!("state `{}`", m.path(i)),
+                    Pos::Span(s.span.clone()),
+                    u,
+                ));
+            }
+        }
+    }
+}
+
+/// The binding problems as diagnostics, at most 200 (the rest counted),
+/// positioned by reading the policy file at `path` once more.
+fn report_binding_problems(
+    mut problems: Vec<Problem>,
+    path: &str,
+    limits: &Limits,
+    diags: &mut Vec<Diagnostic>,
+) {
     // At most this many messages per policy (the rest are counted), as the
     // policy readers do.
     const MAX_MESSAGES: usize = 200;

@@ -9,7 +9,7 @@
 //! them. Every input string in the HTML itself is escaped by [`esc`].
 
 use super::timeline::{self, Axis};
-use super::{CHECKPOINT_EVERY, Replay, ViewError};
+use super::{CHECKPOINT_EVERY, Panel, Replay, ViewError};
 use btfsm_render::dot::{DotOptions, RenderFormat, Status, policy_dot, render, svg_id};
 use serde::Serialize;
 use std::fmt::Write;
@@ -94,7 +94,6 @@ fn round(t: f64) -> f64 {
 }
 
 /// The page of a replay; each diagram rendered by Graphviz within `timeout`.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
     let mut body = String::new();
     let mut panels = Vec::new();
@@ -113,36 +112,64 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
         .filter(|t| t.is_finite())
         .fold(0.0f64, f64::max);
     for (i, p) in r.panels.iter().enumerate() {
-        let prefix = format!("p{i}");
-        let opts = DotOptions {
-            svg_ids: true,
-            ..Default::default()
-        };
-        let svg = render(&policy_dot(&p.policy, &opts), RenderFormat::Svg, timeout)?;
-        let svg = inline_svg(&String::from_utf8_lossy(&svg), &prefix);
-        let (tl, axis) = timeline::svg(&prefix, &p.rows, &p.marks, t_end);
-        let _ = write!(
-            body,
-            r#"<section class="panel" id="{prefix}"><h2>{}</h2><p class="sub">{}</p><p class="now" id="{prefix}-now"></p><div class="diagram">{svg}</div><div class="tl">{tl}</div></section>"#,
-            esc(&p.title),
-            esc(&p.subtitle),
-        );
-        panels.push(PanelData {
-            ids: p.rec.keys.iter().map(|k| svg_id(k)).collect(),
-            keys: &p.rec.keys,
-            times: p.rec.times.iter().map(|&t| round(t)).collect(),
-            deltas: p
-                .rec
-                .deltas
-                .iter()
-                .map(|d| d.iter().flat_map(|&(n, s)| [n, s as u32]).collect())
-                .collect(),
-            axis,
-            digits: timeline::digits(t_end / 100.0).max(2),
-        });
+        panels.push(panel(&mut body, i, p, t_end, timeout)?);
     }
-    let divergences: Vec<Divergence> = r
-        .divergences
+    let data = Data {
+        checkpoint: CHECKPOINT_EVERY,
+        fill: [
+            "",
+            Status::Running.fill_color(),
+            Status::Success.fill_color(),
+            Status::Failure.fill_color(),
+        ],
+        panels,
+        divergences: divergence_steps(r, steps),
+    };
+    Ok(document(r, &body, &divergence_list(r), &data, steps))
+}
+
+/// Panel `i`'s section (its diagram and timeline) appended to `body`, and
+/// the data the page's script needs to replay it.
+fn panel<'a>(
+    body: &mut String,
+    i: usize,
+    p: &'a Panel,
+    t_end: f64,
+    timeout: Duration,
+) -> Result<PanelData<'a>, ViewError> {
+    let prefix = format!("p{i}");
+    let opts = DotOptions {
+        svg_ids: true,
+        ..Default::default()
+    };
+    let svg = render(&policy_dot(&p.policy, &opts), RenderFormat::Svg, timeout)?;
+    let svg = inline_svg(&String::from_utf8_lossy(&svg), &prefix);
+    let (tl, axis) = timeline::svg(&prefix, &p.rows, &p.marks, t_end);
+    let _ = write!(
+        body,
+        r#"<section class="panel" id="{prefix}"><h2>{}</h2><p class="sub">{}</p><p class="now" id="{prefix}-now"></p><div class="diagram">{svg}</div><div class="tl">{tl}</div></section>"#,
+        esc(&p.title),
+        esc(&p.subtitle),
+    );
+    Ok(PanelData {
+        ids: p.rec.keys.iter().map(|k| svg_id(k)).collect(),
+        keys: &p.rec.keys,
+        times: p.rec.times.iter().map(|&t| round(t)).collect(),
+        deltas: p
+            .rec
+            .deltas
+            .iter()
+            .map(|d| d.iter().flat_map(|&(n, s)| [n, s as u32]).collect())
+            .collect(),
+        axis,
+        digits: timeline::digits(t_end / 100.0).max(2),
+    })
+}
+
+/// Each divergence with the step it is at (in its first panel's steps,
+/// at most the last of the page's `steps`).
+fn divergence_steps(r: &Replay, steps: usize) -> Vec<Divergence<'_>> {
+    r.divergences
         .iter()
         .map(|d| Divergence {
             a: d.a,
@@ -154,7 +181,12 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
                 .partition_point(|&t| t < d.t - 1e-9)
                 .min(steps.saturating_sub(1)),
         })
-        .collect();
+        .collect()
+}
+
+/// The header's list of divergences, each with a button that goes to it
+/// (or a line saying the runs are the same).
+fn divergence_list(r: &Replay) -> String {
     let mut divs = String::new();
     if !r.divergences.is_empty() {
         divs.push_str(r#"<ul class="divs">"#);
@@ -171,17 +203,12 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
     } else if r.panels.len() > 1 {
         divs.push_str(r#"<p class="same">The executed skills of all the runs are the same, in the same order.</p>"#);
     }
-    let data = Data {
-        checkpoint: CHECKPOINT_EVERY,
-        fill: [
-            "",
-            Status::Running.fill_color(),
-            Status::Success.fill_color(),
-            Status::Failure.fill_color(),
-        ],
-        panels,
-        divergences,
-    };
+    divs
+}
+
+/// The whole HTML document: head, controls, the panels' `body`, the data
+/// and the script.
+fn document(r: &Replay, body: &str, divs: &str, data: &Data<'_>, steps: usize) -> String {
     let swatch = |s: Status, name: &str| {
         format!(
             r#"<span class="sw" style="background:{}"></span>{name} "#,
@@ -219,7 +246,7 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
         s = swatch(Status::Success, "SUCCESS"),
         f = swatch(Status::Failure, "FAILURE"),
         step_name = esc(&r.step_name),
-        json = script_json(&data),
+        json = script_json(data),
         // Four panels as two rows of two, more in rows of three.
         cols = match r.panels.len() {
             0 | 1 => 1,
@@ -227,7 +254,7 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
             _ => 3,
         },
     );
-    Ok(html)
+    html
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ use super::{Panel, Recorder, Replay, Row, Span, ViewError, code, drawn_keys};
 use btfsm_format::Limits;
 use btfsm_log::btlog::Status as LogStatus;
 use btfsm_log::replay::{Opened, ReplayError, open};
+use btfsm_model::bt::Bt;
 use btfsm_render::dot::Status;
 use std::collections::HashMap;
 
@@ -21,7 +22,6 @@ fn drawn(s: LogStatus) -> u8 {
 }
 
 /// Replays a log read from `r` (shown as `shown`).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn from_log(r: impl std::io::Read, shown: &str, limits: &Limits) -> Result<Replay, ViewError> {
     let fail = |e: ReplayError| ViewError::Input(format!("{shown}: {e}"));
     let Opened {
@@ -32,28 +32,10 @@ pub fn from_log(r: impl std::io::Read, shown: &str, limits: &Limits) -> Result<R
     let btfsm_model::PolicyBody::Bt(bt) = &policy.body else {
         return Err(ViewError::Input(format!("{shown}: not a behavior tree")));
     };
-    // Leaves in pre-order: the timeline's rows, when they ever change.
-    let leaf_row: HashMap<&str, usize> = bt
-        .preorder()
-        .into_iter()
-        .filter(|&n| bt.nodes[n].children.is_empty())
-        .enumerate()
-        .map(|(i, n)| (bt.nodes[n].id.as_str(), i))
-        .collect();
-    let mut rows: Vec<Row> = bt
-        .preorder()
-        .into_iter()
-        .filter(|&n| bt.nodes[n].children.is_empty())
-        .map(|n| Row {
-            label: bt.nodes[n].label.clone(),
-            spans: Vec::new(),
-        })
-        .collect();
-    let mut open_span: Vec<Option<usize>> = vec![None; rows.len()];
+    let (leaf_row, mut leaves) = LeafSpans::of(bt);
     let (keys, alias) = drawn_keys(&policy);
     let mut rec = Recorder::new(keys, &alias);
     let name = shown.to_string();
-    let mut spans = 0usize;
     let mut t = 0.0;
     for r in records {
         let r = r.map_err(|e| fail(e.into()))?;
@@ -63,52 +45,11 @@ pub fn from_log(r: impl std::io::Read, shown: &str, limits: &Limits) -> Result<R
             continue;
         };
         rec.change(&name, t, id, drawn(r.status))?;
-        let Some(&row) = leaf_row.get(id.as_str()) else {
-            continue;
-        };
-        let spans_of = &mut rows[row].spans;
-        match (r.status, open_span[row]) {
-            (LogStatus::Running, None) => {
-                spans_of.push(Span {
-                    start: t,
-                    end: None,
-                    outcome: "running".into(),
-                    index: spans,
-                });
-                spans += 1;
-                open_span[row] = Some(spans_of.len() - 1);
-            }
-            (LogStatus::Success | LogStatus::Failure, open) => {
-                let outcome = if r.status == LogStatus::Success {
-                    "success"
-                } else {
-                    "failure"
-                };
-                match open {
-                    Some(k) => {
-                        spans_of[k].end = Some(t);
-                        spans_of[k].outcome = outcome.into();
-                    }
-                    None => {
-                        spans_of.push(Span {
-                            start: t,
-                            end: Some(t),
-                            outcome: outcome.into(),
-                            index: spans,
-                        });
-                        spans += 1;
-                    }
-                }
-                open_span[row] = None;
-            }
-            (LogStatus::Idle | LogStatus::Skipped, Some(k)) => {
-                spans_of[k].end = Some(t);
-                spans_of[k].outcome = "cancelled".into();
-                open_span[row] = None;
-            }
-            _ => {}
+        if let Some(&row) = leaf_row.get(id.as_str()) {
+            leaves.change(row, r.status, t);
         }
     }
+    let mut rows = leaves.rows;
     rows.retain(|r| !r.spans.is_empty());
     let steps = rec.times.len();
     let title = policy.name.clone();
@@ -129,4 +70,94 @@ pub fn from_log(r: impl std::io::Read, shown: &str, limits: &Limits) -> Result<R
         }],
         divergences: Vec::new(),
     })
+}
+
+/// The timeline rows of a tree's leaves as the log is replayed, with the
+/// span each has open.
+struct LeafSpans {
+    rows: Vec<Row>,
+    /// Per row, its span still RUNNING.
+    open: Vec<Option<usize>>,
+    /// Spans made so far (a span's index).
+    spans: usize,
+}
+
+impl LeafSpans {
+    /// The rows of `bt`'s leaves, in pre-order, and each leaf's row by id.
+    fn of(bt: &Bt) -> (HashMap<&str, usize>, Self) {
+        // Leaves in pre-order: the timeline's rows, when they ever change.
+        let leaf_row: HashMap<&str, usize> = bt
+            .preorder()
+            .into_iter()
+            .filter(|&n| bt.nodes[n].children.is_empty())
+            .enumerate()
+            .map(|(i, n)| (bt.nodes[n].id.as_str(), i))
+            .collect();
+        let rows: Vec<Row> = bt
+            .preorder()
+            .into_iter()
+            .filter(|&n| bt.nodes[n].children.is_empty())
+            .map(|n| Row {
+                label: bt.nodes[n].label.clone(),
+                spans: Vec::new(),
+            })
+            .collect();
+        let open = vec![None; rows.len()];
+        (
+            leaf_row,
+            LeafSpans {
+                rows,
+                open,
+                spans: 0,
+            },
+        )
+    }
+
+    /// The leaf of row `row` changed to `status` at `t`: RUNNING opens a
+    /// span, SUCCESS and FAILURE end it (or make an instant one), IDLE
+    /// cancels it (halted).
+    fn change(&mut self, row: usize, status: LogStatus, t: f64) {
+        let spans_of = &mut self.rows[row].spans;
+        match (status, self.open[row]) {
+            (LogStatus::Running, None) => {
+                spans_of.push(Span {
+                    start: t,
+                    end: None,
+                    outcome: "running".into(),
+                    index: self.spans,
+                });
+                self.spans += 1;
+                self.open[row] = Some(spans_of.len() - 1);
+            }
+            (LogStatus::Success | LogStatus::Failure, open) => {
+                let outcome = if status == LogStatus::Success {
+                    "success"
+                } else {
+                    "failure"
+                };
+                match open {
+                    Some(k) => {
+                        spans_of[k].end = Some(t);
+                        spans_of[k].outcome = outcome.into();
+                    }
+                    None => {
+                        spans_of.push(Span {
+                            start: t,
+                            end: Some(t),
+                            outcome: outcome.into(),
+                            index: self.spans,
+                        });
+                        self.spans += 1;
+                    }
+                }
+                self.open[row] = None;
+            }
+            (LogStatus::Idle | LogStatus::Skipped, Some(k)) => {
+                spans_of[k].end = Some(t);
+                spans_of[k].outcome = "cancelled".into();
+                self.open[row] = None;
+            }
+            _ => {}
+        }
+    }
 }

@@ -180,91 +180,129 @@ fn str_of<'a>(v: &'a serde_json::Value, what: &str) -> Result<&'a str, ViewError
 /// A trace of `btfsm sim --trace`: the policies it names read from their
 /// files (paths as `sim` wrote them: relative to the current directory,
 /// and inside `root` unless it is `None`).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn from_trace(
     text: &str,
     shown: &str,
     root: Option<&Path>,
     limits: &Limits,
 ) -> Result<Replay, ViewError> {
-    let bad = |m: String| {
-        ViewError::Input(format!(
-            "`{shown}` is not a trace written by `btfsm sim --trace`: {m}"
-        ))
-    };
+    let bad = |m: String| not_a_trace(shown, m);
     let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
     let runs = v["policies"]
         .as_array()
         .ok_or_else(|| bad("no `policies` array".into()))?;
     let mut panels = Vec::new();
     for (i, run) in runs.iter().enumerate() {
-        let name = str_of(&run["policy"], "policy").map_err(|e| bad(e.to_string()))?;
-        let file = str_of(&run["file"], "file").map_err(|e| bad(e.to_string()))?;
-        let path = btfsm_format::source::resolve(root, Path::new("."), file).map_err(|r| {
-            ViewError::Diagnostics(vec![
-                btfsm_core::diagnostic::Diagnostic::error(format!(
-                    "{shown}: policy {} names the file `{}`: {}",
-                    i + 1,
-                    btfsm_core::sanitize::shown(file),
-                    r.message,
-                ))
-                .hint(r.hint),
-            ])
-        })?;
-        let loaded = btfsm_format::load(&path, limits).map_err(ViewError::Diagnostics)?;
-        let mut policy = if run["convert"] == "hfsm" {
-            btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&loaded.policy)
-                .map_err(|e| ViewError::Input(format!("{file}: {}", e[0])))?
-        } else {
-            loaded.policy
-        };
-        // Named as it ran (a scenario may rename it).
-        policy.name = name.to_string();
-        let (keys, alias) = drawn_keys(&policy);
-        let mut rec = Recorder::new(keys, &alias);
-        let empty = Vec::new();
-        for st in run["trace"].as_array().unwrap_or(&empty) {
-            let t = st["t"].as_f64().unwrap_or(f64::NAN);
-            let pairs = st["statuses"].as_array().unwrap_or(&empty);
-            let statuses = pairs
-                .iter()
-                .filter_map(|p| Some((p[0].as_str()?, status_code(p[1].as_str().unwrap_or("")))));
-            rec.snapshot(name, t, statuses)?;
-        }
-        let skills = run["skills"].as_array().unwrap_or(&empty);
-        let rows = rows_of(skills.iter().enumerate().map(|(i, k)| {
-            let args: Vec<(String, String)> = k["args"]
-                .as_object()
-                .map(|o| {
-                    o.iter()
-                        .map(|(a, b)| (a.clone(), b.as_str().unwrap_or("").to_string()))
-                        .collect()
-                })
-                .unwrap_or_default();
-            (
-                skill_label(k["skill"].as_str().unwrap_or("?"), &args),
-                Span {
-                    start: k["start"].as_f64().unwrap_or(0.0),
-                    end: k["end"].as_f64(),
-                    outcome: k["outcome"].as_str().unwrap_or("").to_string(),
-                    index: i,
-                },
-            )
-        }));
-        panels.push(Panel {
-            title: name.to_string(),
-            subtitle: subtitle(
-                file,
-                run["outcome"].as_str().unwrap_or("?"),
-                run["reason"].as_str().unwrap_or(""),
-                run["steps"].as_u64().unwrap_or(rec.times.len() as u64),
-            ),
-            policy,
-            rec,
-            rows,
-            marks: Vec::new(),
-        });
+        panels.push(trace_panel(i, run, shown, root, limits)?);
     }
+    let (divs, index) = trace_divergences(&v, &panels);
+    mark(&mut panels, &divs, &index);
+    let scenario = v["scenario"].as_str().unwrap_or("trace");
+    Ok(Replay {
+        title: format!("{scenario} (seed {})", v["seed"].as_u64().unwrap_or(0)),
+        subtitle: format!("trace {shown}"),
+        step_name: format!("step of {} s", v["dt"].as_f64().unwrap_or(0.0)),
+        panels,
+        divergences: divs,
+    })
+}
+
+/// The error of a file `shown` that is not a trace, and why.
+fn not_a_trace(shown: &str, m: String) -> ViewError {
+    ViewError::Input(format!(
+        "`{shown}` is not a trace written by `btfsm sim --trace`: {m}"
+    ))
+}
+
+/// The panel of run `i` of a trace: its policy read from the file it
+/// names, its steps' statuses, its executed skills.
+fn trace_panel(
+    i: usize,
+    run: &serde_json::Value,
+    shown: &str,
+    root: Option<&Path>,
+    limits: &Limits,
+) -> Result<Panel, ViewError> {
+    let bad = |e: ViewError| not_a_trace(shown, e.to_string());
+    let name = str_of(&run["policy"], "policy").map_err(bad)?;
+    let file = str_of(&run["file"], "file").map_err(bad)?;
+    let path = btfsm_format::source::resolve(root, Path::new("."), file).map_err(|r| {
+        ViewError::Diagnostics(vec![
+            btfsm_core::diagnostic::Diagnostic::error(format!(
+                "{shown}: policy {} names the file `{}`: {}",
+                i + 1,
+                btfsm_core::sanitize::shown(file),
+                r.message,
+            ))
+            .hint(r.hint),
+        ])
+    })?;
+    let loaded = btfsm_format::load(&path, limits).map_err(ViewError::Diagnostics)?;
+    let mut policy = if run["convert"] == "hfsm" {
+        btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&loaded.policy)
+            .map_err(|e| ViewError::Input(format!("{file}: {}", e[0])))?
+    } else {
+        loaded.policy
+    };
+    // Named as it ran (a scenario may rename it).
+    policy.name = name.to_string();
+    let (keys, alias) = drawn_keys(&policy);
+    let mut rec = Recorder::new(keys, &alias);
+    let empty = Vec::new();
+    for st in run["trace"].as_array().unwrap_or(&empty) {
+        let t = st["t"].as_f64().unwrap_or(f64::NAN);
+        let pairs = st["statuses"].as_array().unwrap_or(&empty);
+        let statuses = pairs
+            .iter()
+            .filter_map(|p| Some((p[0].as_str()?, status_code(p[1].as_str().unwrap_or("")))));
+        rec.snapshot(name, t, statuses)?;
+    }
+    let rows = trace_rows(run["skills"].as_array().unwrap_or(&empty));
+    Ok(Panel {
+        title: name.to_string(),
+        subtitle: subtitle(
+            file,
+            run["outcome"].as_str().unwrap_or("?"),
+            run["reason"].as_str().unwrap_or(""),
+            run["steps"].as_u64().unwrap_or(rec.times.len() as u64),
+        ),
+        policy,
+        rec,
+        rows,
+        marks: Vec::new(),
+    })
+}
+
+/// Timeline rows of a trace's executed skills (missing fields read as
+/// empty).
+fn trace_rows(skills: &[serde_json::Value]) -> Vec<Row> {
+    rows_of(skills.iter().enumerate().map(|(i, k)| {
+        let args: Vec<(String, String)> = k["args"]
+            .as_object()
+            .map(|o| {
+                o.iter()
+                    .map(|(a, b)| (a.clone(), b.as_str().unwrap_or("").to_string()))
+                    .collect()
+            })
+            .unwrap_or_default();
+        (
+            skill_label(k["skill"].as_str().unwrap_or("?"), &args),
+            Span {
+                start: k["start"].as_f64().unwrap_or(0.0),
+                end: k["end"].as_f64(),
+                outcome: k["outcome"].as_str().unwrap_or("").to_string(),
+                index: i,
+            },
+        )
+    }))
+}
+
+/// The first divergences a trace's verdicts record between two of its
+/// panels, and the index of the skill each is at in both.
+fn trace_divergences(
+    v: &serde_json::Value,
+    panels: &[Panel],
+) -> (Vec<Divergence>, Vec<(usize, usize)>) {
     let pos = |n: &serde_json::Value| panels.iter().position(|p| n == p.title.as_str());
     let mut divs = Vec::new();
     let mut index = Vec::new();
@@ -292,15 +330,7 @@ pub fn from_trace(
             index.push((k as usize, k as usize));
         }
     }
-    mark(&mut panels, &divs, &index);
-    let scenario = v["scenario"].as_str().unwrap_or("trace");
-    Ok(Replay {
-        title: format!("{scenario} (seed {})", v["seed"].as_u64().unwrap_or(0)),
-        subtitle: format!("trace {shown}"),
-        step_name: format!("step of {} s", v["dt"].as_f64().unwrap_or(0.0)),
-        panels,
-        divergences: divs,
-    })
+    (divs, index)
 }
 
 #[cfg(test)]

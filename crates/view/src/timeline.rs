@@ -6,7 +6,7 @@
 //! the cursor the page's script moves to the current step.
 
 use super::html::esc;
-use super::{Mark, Row};
+use super::{Mark, Row, Span};
 use btfsm_render::dot::Status;
 use std::fmt::Write;
 
@@ -76,7 +76,6 @@ fn num_with(x: f64, d: usize) -> String {
 
 /// The timeline SVG of a panel (`id` prefixes its element ids), over
 /// `0..t_end` seconds, and its axis.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis) {
     let t_end = if t_end.is_finite() && t_end > 0.0 {
         t_end
@@ -85,7 +84,13 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
     };
     let scale = PLOT_W / t_end;
     let axis = Axis { x0: LABEL_W, scale };
-    let x = |t: f64| LABEL_W + t.clamp(0.0, t_end) * scale;
+    let step = tick_step(t_end);
+    let tx = TimeX {
+        t_end,
+        scale,
+        step,
+        d: digits(step),
+    };
     let shown_rows = rows.len().min(MAX_ROWS);
     let extra_row = rows.len() > MAX_ROWS;
     let n_rows = shown_rows + usize::from(extra_row);
@@ -97,82 +102,8 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
         r#"<svg xmlns="http://www.w3.org/2000/svg" class="timeline" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="Helvetica, Arial, sans-serif" font-size="11">"#
     );
     let bottom = TOP + ROW_H * n_rows.max(1) as f64;
-    // Axis and ticks.
-    let _ = write!(
-        s,
-        r##"<line x1="{LABEL_W}" y1="{bottom}" x2="{}" y2="{bottom}" stroke="#444"/>"##,
-        LABEL_W + PLOT_W
-    );
-    let step = tick_step(t_end);
-    let d = digits(step);
-    let num = |x: f64| num_with(x, d + 2);
-    let mut k = 0u32;
-    while (k as f64) * step <= t_end + 1e-9 && k <= 20 {
-        let t = k as f64 * step;
-        let xt = x(t);
-        let _ = write!(
-            s,
-            r##"<line x1="{xt}" y1="{TOP}" x2="{xt}" y2="{}" stroke="#ddd"/><text x="{xt}" y="{}" text-anchor="middle" fill="#444">{}</text>"##,
-            bottom + 4.0,
-            bottom + 15.0,
-            num_with(t, d)
-        );
-        k += 1;
-    }
-    let _ = write!(
-        s,
-        r##"<text x="{}" y="{}" text-anchor="end" fill="#444">time (s)</text>"##,
-        LABEL_W - 6.0,
-        bottom + 15.0
-    );
-    let mut spans_left = MAX_SPANS;
-    let mut spans_cut = 0usize;
-    for (r, row) in rows.iter().take(shown_rows).enumerate() {
-        let y = TOP + ROW_H * r as f64;
-        let _ = write!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="end">{}</text>"#,
-            LABEL_W - 6.0,
-            y + ROW_H - 4.0,
-            esc(&btfsm_core::sanitize::shown_max(&row.label, 32))
-        );
-        for sp in &row.spans {
-            if spans_left == 0 {
-                spans_cut += 1;
-                continue;
-            }
-            spans_left -= 1;
-            let x0 = x(sp.start);
-            let x1 = x(sp.end.unwrap_or(t_end)).max(x0 + 1.5);
-            let marked = marks.iter().any(|m| m.index == sp.index);
-            let stroke = if marked { "#d00000" } else { "goldenrod" };
-            let _ = write!(
-                s,
-                r#"<g class="span{}"><title>{} {}: {} s to {} s</title><rect x="{x0:.2}" y="{}" width="{:.2}" height="{}" fill="{}" stroke="{stroke}" stroke-width="{}"/>"#,
-                if marked { " diverged" } else { "" },
-                esc(&btfsm_core::sanitize::shown(&row.label)),
-                esc(&sp.outcome),
-                num(sp.start),
-                sp.end.map_or("the end".to_string(), num),
-                y + 3.0,
-                x1 - x0,
-                ROW_H - 6.0,
-                Status::Running.fill_color(),
-                if marked { 2 } else { 1 },
-            );
-            if sp.end.is_some() {
-                let _ = write!(
-                    s,
-                    r##"<rect x="{:.2}" y="{}" width="5" height="{}" fill="{}" stroke="#333" stroke-width="0.7"/>"##,
-                    x1 - 2.5,
-                    y + 1.0,
-                    ROW_H - 2.0,
-                    outcome_fill(&sp.outcome)
-                );
-            }
-            s.push_str("</g>");
-        }
-    }
+    time_axis(&mut s, &tx, bottom);
+    let spans_cut = draw_rows(&mut s, &tx, &rows[..shown_rows], marks);
     if extra_row || spans_cut > 0 {
         let y = TOP + ROW_H * shown_rows as f64;
         let _ = write!(
@@ -189,7 +120,7 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
         );
     }
     for m in marks {
-        let xm = x(m.t);
+        let xm = tx.x(m.t);
         let _ = write!(
             s,
             r##"<g class="divergence"><title>{}</title><line x1="{xm:.2}" y1="{}" x2="{xm:.2}" y2="{bottom}" stroke="#d00000" stroke-width="1.5" stroke-dasharray="4 3"/><text x="{xm:.2}" y="{}" fill="#d00000" font-size="10">≠</text></g>"##,
@@ -206,10 +137,115 @@ pub fn svg(id: &str, rows: &[Row], marks: &[Mark], t_end: f64) -> (String, Axis)
     (s, axis)
 }
 
+/// How a timeline places time: its span `0..t_end` s at `scale` px per
+/// second, its tick `step` and the decimals `d` its ticks are shown with.
+struct TimeX {
+    t_end: f64,
+    scale: f64,
+    step: f64,
+    d: usize,
+}
+
+impl TimeX {
+    /// The x of time `t` (clamped to the span), px.
+    fn x(&self, t: f64) -> f64 {
+        LABEL_W + t.clamp(0.0, self.t_end) * self.scale
+    }
+}
+
+/// The time axis under the rows (at `bottom`): its line, ticks with grid
+/// lines, and title.
+fn time_axis(s: &mut String, tx: &TimeX, bottom: f64) {
+    let _ = write!(
+        s,
+        r##"<line x1="{LABEL_W}" y1="{bottom}" x2="{}" y2="{bottom}" stroke="#444"/>"##,
+        LABEL_W + PLOT_W
+    );
+    let mut k = 0u32;
+    while (k as f64) * tx.step <= tx.t_end + 1e-9 && k <= 20 {
+        let t = k as f64 * tx.step;
+        let xt = tx.x(t);
+        let _ = write!(
+            s,
+            r##"<line x1="{xt}" y1="{TOP}" x2="{xt}" y2="{}" stroke="#ddd"/><text x="{xt}" y="{}" text-anchor="middle" fill="#444">{}</text>"##,
+            bottom + 4.0,
+            bottom + 15.0,
+            num_with(t, tx.d)
+        );
+        k += 1;
+    }
+    let _ = write!(
+        s,
+        r##"<text x="{}" y="{}" text-anchor="end" fill="#444">time (s)</text>"##,
+        LABEL_W - 6.0,
+        bottom + 15.0
+    );
+}
+
+/// The rows: each one's label and spans, at most [`MAX_SPANS`] spans in
+/// all; how many spans were left out.
+fn draw_rows(s: &mut String, tx: &TimeX, rows: &[Row], marks: &[Mark]) -> usize {
+    let mut spans_left = MAX_SPANS;
+    let mut spans_cut = 0usize;
+    for (r, row) in rows.iter().enumerate() {
+        let y = TOP + ROW_H * r as f64;
+        let _ = write!(
+            s,
+            r#"<text x="{}" y="{}" text-anchor="end">{}</text>"#,
+            LABEL_W - 6.0,
+            y + ROW_H - 4.0,
+            esc(&btfsm_core::sanitize::shown_max(&row.label, 32))
+        );
+        for sp in &row.spans {
+            if spans_left == 0 {
+                spans_cut += 1;
+                continue;
+            }
+            spans_left -= 1;
+            let marked = marks.iter().any(|m| m.index == sp.index);
+            span_bar(s, tx, &row.label, sp, y, marked);
+        }
+    }
+    spans_cut
+}
+
+/// One span of a row at `y`: a RUNNING bar (red-edged where the run
+/// diverged: `marked`) and, if it ended, a mark in its outcome's colour.
+fn span_bar(s: &mut String, tx: &TimeX, label: &str, sp: &Span, y: f64, marked: bool) {
+    let num = |x: f64| num_with(x, tx.d + 2);
+    let x0 = tx.x(sp.start);
+    let x1 = tx.x(sp.end.unwrap_or(tx.t_end)).max(x0 + 1.5);
+    let stroke = if marked { "#d00000" } else { "goldenrod" };
+    let _ = write!(
+        s,
+        r#"<g class="span{}"><title>{} {}: {} s to {} s</title><rect x="{x0:.2}" y="{}" width="{:.2}" height="{}" fill="{}" stroke="{stroke}" stroke-width="{}"/>"#,
+        if marked { " diverged" } else { "" },
+        esc(&btfsm_core::sanitize::shown(label)),
+        esc(&sp.outcome),
+        num(sp.start),
+        sp.end.map_or("the end".to_string(), num),
+        y + 3.0,
+        x1 - x0,
+        ROW_H - 6.0,
+        Status::Running.fill_color(),
+        if marked { 2 } else { 1 },
+    );
+    if sp.end.is_some() {
+        let _ = write!(
+            s,
+            r##"<rect x="{:.2}" y="{}" width="5" height="{}" fill="{}" stroke="#333" stroke-width="0.7"/>"##,
+            x1 - 2.5,
+            y + 1.0,
+            ROW_H - 2.0,
+            outcome_fill(&sp.outcome)
+        );
+    }
+    s.push_str("</g>");
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Span;
 
     #[test]
     fn ticks_are_round_numbers() {

@@ -5,6 +5,7 @@
 use super::Leaves;
 use crate::skills::{Call, Status};
 use btfsm_model::{StateBody, StateMachine, Target, Trigger};
+use std::ops::ControlFlow;
 use std::sync::Arc;
 
 /// One guard: all terms (`call`, negated) must hold.
@@ -111,10 +112,20 @@ pub struct MachineExec {
     pub reenter_on_failure: bool,
 }
 
+/// Where a step goes next.
 enum Flow<'a> {
     Enter(usize),
     /// An outcome of the region of the state's parent (`None`: top level).
     Up(Option<usize>, &'a str),
+}
+
+/// What entering a state did.
+enum Entered<'a> {
+    /// It was left at once: by a guard, or a container for its initial
+    /// target.
+    Left(Flow<'a>),
+    /// It ran, with this status.
+    Ran(Status),
 }
 
 impl MachineExec {
@@ -157,7 +168,6 @@ impl MachineExec {
 
     /// Runs one step; `Some` once the machine has ended (SUCCESS for the
     /// outcome `SUCCESS`, FAILURE for any other).
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub fn step(&mut self, leaves: &mut impl Leaves) -> Status {
         if let Some((o, _)) = &self.finished {
             return if o == "SUCCESS" {
@@ -172,24 +182,7 @@ impl MachineExec {
         let c = self.c.clone();
         let limit = 4 * c.m.states.len() + 16;
         let mut hops = 0;
-        // Guards of the enclosing containers, outermost first.
-        let mut anc = Vec::new();
-        let mut p = c.m.states[self.current].parent;
-        while let Some(a) = p {
-            anc.push(a);
-            p = c.m.states[a].parent;
-        }
-        let mut flow = Flow::Enter(self.current);
-        'anc: for &a in anc.iter().rev() {
-            for (g, t) in &c.guards[a] {
-                if Self::holds(a, g, leaves) {
-                    // The running state is left: its action is halted now.
-                    leaves.halt(self.current);
-                    flow = Self::follow(&c, a, t);
-                    break 'anc;
-                }
-            }
-        }
+        let mut flow = self.preempted(&c, leaves);
         loop {
             hops += 1;
             if hops > limit {
@@ -197,102 +190,153 @@ impl MachineExec {
                 return Status::Running;
             }
             let (from, outcome) = match flow {
-                Flow::Up(None, o) => {
-                    if o == "RUNNING" {
-                        self.current = Self::start(&c);
-                        return Status::Running;
+                Flow::Up(None, o) => return self.top_outcome(&c, o),
+                Flow::Up(Some(container), o) => (container, o),
+                Flow::Enter(s) => match self.enter(&c, s, leaves) {
+                    Entered::Left(f) => {
+                        flow = f;
+                        continue;
                     }
-                    if o == "SUCCESS" && self.keep_ticking {
-                        self.current = Self::start(&c);
-                        return Status::Success;
+                    Entered::Ran(st) => (s, st.as_str()),
+                },
+            };
+            match self.on_outcome(&c, from, outcome) {
+                ControlFlow::Continue(f) => flow = f,
+                ControlFlow::Break(st) => return st,
+            }
+        }
+    }
+
+    /// Where the step starts: the current state, or where the first guard
+    /// that holds of its enclosing containers (outermost first) leads.
+    fn preempted<'a>(&self, c: &'a CompiledMachine, leaves: &mut impl Leaves) -> Flow<'a> {
+        // Guards of the enclosing containers, outermost first.
+        let mut anc = Vec::new();
+        let mut p = c.m.states[self.current].parent;
+        while let Some(a) = p {
+            anc.push(a);
+            p = c.m.states[a].parent;
+        }
+        for &a in anc.iter().rev() {
+            for (g, t) in &c.guards[a] {
+                if Self::holds(a, g, leaves) {
+                    // The running state is left: its action is halted now.
+                    leaves.halt(self.current);
+                    return Self::follow(c, a, t);
+                }
+            }
+        }
+        Flow::Enter(self.current)
+    }
+
+    /// Reaching the top-level outcome `o`: the machine is re-entered (at
+    /// RUNNING, or as `keep_ticking` and `reenter_on_failure` say) or ends.
+    fn top_outcome(&mut self, c: &CompiledMachine, o: &str) -> Status {
+        if o == "RUNNING" {
+            self.current = Self::start(c);
+            return Status::Running;
+        }
+        if o == "SUCCESS" && self.keep_ticking {
+            self.current = Self::start(c);
+            return Status::Success;
+        }
+        // `after_failure = "keep-ticking"` (the default of a tick-driven
+        // machine, top-level outcome RUNNING, as the BT -> HFSM
+        // construction makes): re-entered after a failure, as a BT's root
+        // is ticked again.
+        if o != "SUCCESS" && self.reenter_on_failure {
+            self.current = Self::start(c);
+            return Status::Failure;
+        }
+        let st = if o == "SUCCESS" {
+            Status::Success
+        } else {
+            Status::Failure
+        };
+        self.finished = Some((o.to_string(), format!("reached the outcome {o}")));
+        st
+    }
+
+    /// Enters state `s`: a guard that holds leaves it, a container goes on
+    /// at its initial target, a task runs its skill (noted).
+    fn enter<'a>(
+        &mut self,
+        c: &'a CompiledMachine,
+        s: usize,
+        leaves: &mut impl Leaves,
+    ) -> Entered<'a> {
+        // A state left by a guard runs nothing (and is not noted).
+        if let Some((_, t)) = c.guards[s].iter().find(|(g, _)| Self::holds(s, g, leaves)) {
+            // Preempted: a running action of the state is halted at once (a
+            // state entered afresh has none).
+            leaves.halt(s);
+            return Entered::Left(Self::follow(c, s, t));
+        }
+        let st = match &c.m.states[s].body {
+            StateBody::Container(r) => {
+                return Entered::Left(match &r.initial {
+                    Target::State(i) => Flow::Enter(*i),
+                    Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
+                        Flow::Up(Some(s), o)
                     }
-                    // `after_failure = "keep-ticking"` (the default of a
-                    // tick-driven machine, top-level outcome RUNNING, as the
-                    // BT -> HFSM construction makes): re-entered after a
-                    // failure, as a BT's root is ticked again.
-                    if o != "SUCCESS" && self.reenter_on_failure {
-                        self.current = Self::start(&c);
-                        return Status::Failure;
-                    }
-                    let st = if o == "SUCCESS" {
+                });
+            }
+            StateBody::Decision => Status::Running,
+            StateBody::Task(_) => match &c.call[s] {
+                Some(call) if call.is_action() => leaves.action(s, call),
+                Some(call) => {
+                    if leaves.condition(s, call) {
                         Status::Success
                     } else {
                         Status::Failure
-                    };
-                    self.finished = Some((o.to_string(), format!("reached the outcome {o}")));
-                    return st;
-                }
-                Flow::Up(Some(container), o) => (container, o),
-                Flow::Enter(s) => {
-                    // A state left by a guard runs nothing (and is not noted).
-                    if let Some((_, t)) =
-                        c.guards[s].iter().find(|(g, _)| Self::holds(s, g, leaves))
-                    {
-                        // Preempted: a running action of the state is halted
-                        // at once (a state entered afresh has none).
-                        leaves.halt(s);
-                        flow = Self::follow(&c, s, t);
-                        continue;
                     }
-                    let st = match &c.m.states[s].body {
-                        StateBody::Container(r) => {
-                            flow = match &r.initial {
-                                Target::State(i) => Flow::Enter(*i),
-                                Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
-                                    Flow::Up(Some(s), o)
-                                }
-                            };
-                            continue;
-                        }
-                        StateBody::Decision => Status::Running,
-                        StateBody::Task(_) => match &c.call[s] {
-                            Some(call) if call.is_action() => leaves.action(s, call),
-                            Some(call) => {
-                                if leaves.condition(s, call) {
-                                    Status::Success
-                                } else {
-                                    Status::Failure
-                                }
-                            }
-                            None => Status::Failure,
-                        },
-                    };
-                    self.note(s, st);
-                    (s, st.as_str())
                 }
-            };
-            let transitions = &c.m.states[from].transitions;
-            let tr = match status_index(outcome) {
-                Some(k) => c.on_status[from][k].map(|i| &transitions[i as usize]),
-                None => (transitions.iter())
-                    .find(|t| matches!(&t.trigger, Trigger::Outcome(o) if *o == outcome)),
-            };
-            match tr {
-                Some(t) => match Self::follow(&c, from, &t.target) {
-                    Flow::Enter(next) if outcome == "RUNNING" => {
-                        self.current = next;
-                        return Status::Running;
-                    }
-                    f => flow = f,
-                },
-                None if outcome == "RUNNING" => {
-                    self.current = from;
-                    return Status::Running;
+                None => Status::Failure,
+            },
+        };
+        self.note(s, st);
+        Entered::Ran(st)
+    }
+
+    /// State `from` ended with `outcome`: its transition for it is followed
+    /// (`Continue`), or the step ends with a status (`Break`).
+    fn on_outcome<'a>(
+        &mut self,
+        c: &'a CompiledMachine,
+        from: usize,
+        outcome: &str,
+    ) -> ControlFlow<Status, Flow<'a>> {
+        let transitions = &c.m.states[from].transitions;
+        let tr = match status_index(outcome) {
+            Some(k) => c.on_status[from][k].map(|i| &transitions[i as usize]),
+            None => (transitions.iter())
+                .find(|t| matches!(&t.trigger, Trigger::Outcome(o) if *o == outcome)),
+        };
+        match tr {
+            Some(t) => match Self::follow(c, from, &t.target) {
+                Flow::Enter(next) if outcome == "RUNNING" => {
+                    self.current = next;
+                    ControlFlow::Break(Status::Running)
                 }
-                None if self.reenter_on_failure && outcome != "SUCCESS" => {
-                    self.current = Self::start(&c);
-                    return Status::Failure;
-                }
-                None => {
-                    self.finished = Some((
-                        "FAILURE".into(),
-                        format!(
-                            "state `{}` returned {outcome} and has no transition for it",
-                            c.m.path(from)
-                        ),
-                    ));
-                    return Status::Failure;
-                }
+                f => ControlFlow::Continue(f),
+            },
+            None if outcome == "RUNNING" => {
+                self.current = from;
+                ControlFlow::Break(Status::Running)
+            }
+            None if self.reenter_on_failure && outcome != "SUCCESS" => {
+                self.current = Self::start(c);
+                ControlFlow::Break(Status::Failure)
+            }
+            None => {
+                self.finished = Some((
+                    "FAILURE".into(),
+                    format!(
+                        "state `{}` returned {outcome} and has no transition for it",
+                        c.m.path(from)
+                    ),
+                ));
+                ControlFlow::Break(Status::Failure)
             }
         }
     }

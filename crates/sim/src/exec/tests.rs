@@ -513,13 +513,12 @@ impl<'a> Reference<'a> {
         }
     }
 
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    /// Ticks node `n` (`executeTick` of its type), noting its status.
     fn exec(&mut self, n: usize, leaves: &mut impl Leaves) -> Status {
         use BtNodeKind as K;
         use Status::{Failure as F, Running as R, Success as S};
         let kind = self.bt.nodes[n].kind;
         let kids = self.bt.nodes[n].children.clone();
-        let k = kids.len();
         let s = match kind {
             K::Condition => match &self.calls[n] {
                 Some(c) if leaves.condition(n, c) => S,
@@ -531,114 +530,12 @@ impl<'a> Reference<'a> {
                 (_, Some(c)) => leaves.action(n, c),
                 (_, None) => F,
             },
-            K::Sequence | K::Fallback => {
-                let go_on = if kind == K::Sequence { S } else { F };
-                let mut out = None;
-                for (i, &c) in kids.iter().enumerate() {
-                    match self.exec(c, leaves) {
-                        R => {
-                            for (j, &o) in kids.iter().enumerate() {
-                                if j != i {
-                                    self.halt_child(o, leaves);
-                                }
-                            }
-                            out = Some(R);
-                            break;
-                        }
-                        s if s == go_on => {}
-                        s => {
-                            self.reset_children(n, leaves);
-                            out = Some(s);
-                            break;
-                        }
-                    }
-                }
-                out.unwrap_or_else(|| {
-                    self.reset_children(n, leaves);
-                    go_on
-                })
-            }
+            K::Sequence | K::Fallback => self.reactive(n, kind == K::Sequence, &kids, leaves),
             K::SequenceMemory | K::FallbackMemory => {
-                let go_on = if kind == K::SequenceMemory { S } else { F };
-                let mut out = None;
-                while self.idx[n] < k {
-                    match self.exec(kids[self.idx[n]], leaves) {
-                        R => {
-                            out = Some(R);
-                            break;
-                        }
-                        s if s == go_on => self.idx[n] += 1,
-                        s => {
-                            self.reset_children(n, leaves);
-                            self.idx[n] = 0;
-                            out = Some(s);
-                            break;
-                        }
-                    }
-                }
-                out.unwrap_or_else(|| {
-                    self.reset_children(n, leaves);
-                    self.idx[n] = 0;
-                    go_on
-                })
+                self.with_memory(n, kind == K::SequenceMemory, &kids, leaves)
             }
-            K::Parallel { success } => {
-                let fail = k - success + 1;
-                let mut out = R;
-                for &c in &kids {
-                    if !matches!(self.st[c], Some(S | F)) {
-                        match self.exec(c, leaves) {
-                            S => self.ok[n] += 1,
-                            F => self.bad[n] += 1,
-                            R => {}
-                        }
-                    }
-                    let done = if self.ok[n] >= success {
-                        Some(S)
-                    } else if k - self.bad[n] < success || self.bad[n] == fail {
-                        Some(F)
-                    } else {
-                        None
-                    };
-                    if let Some(s) = done {
-                        (self.ok[n], self.bad[n]) = (0, 0);
-                        self.reset_children(n, leaves);
-                        out = s;
-                        break;
-                    }
-                }
-                out
-            }
-            K::Repeat { .. } | K::Retry { .. } => {
-                let (again, other, limit) = match kind {
-                    K::Repeat { times } => (S, F, times.map_or(-1, i64::from)),
-                    K::Retry { times } => (F, S, i64::from(times)),
-                    _ => unreachable!(),
-                };
-                let c = kids[0];
-                loop {
-                    if limit >= 0 && self.cnt[n] >= limit {
-                        self.cnt[n] = 0;
-                        break again;
-                    }
-                    let prev = self.st[c];
-                    match self.exec(c, leaves) {
-                        R => break R,
-                        s if s == again => {
-                            self.cnt[n] += 1;
-                            self.halt_child(c, leaves);
-                            if prev.is_none() && (limit < 0 || self.cnt[n] < limit) {
-                                break R;
-                            }
-                        }
-                        _ => {
-                            self.cnt[n] = 0;
-                            self.halt_child(c, leaves);
-                            break other;
-                        }
-                    }
-                }
-            }
+            K::Parallel { success } => self.parallel(n, success, &kids, leaves),
+            K::Repeat { .. } | K::Retry { .. } => self.repeat(n, kind, kids[0], leaves),
             K::Timeout { ms } => {
                 if self.st[n] != Some(R) {
                     self.t0[n] = self.now;
@@ -666,6 +563,134 @@ impl<'a> Reference<'a> {
         self.st[n] = Some(s);
         self.noted.push((n, s));
         s
+    }
+
+    /// ReactiveSequence (`sequence`) or ReactiveFallback: every child from
+    /// the first, a RUNNING one halting the others.
+    fn reactive(
+        &mut self,
+        n: usize,
+        sequence: bool,
+        kids: &[usize],
+        leaves: &mut impl Leaves,
+    ) -> Status {
+        use Status::{Failure as F, Running as R, Success as S};
+        let go_on = if sequence { S } else { F };
+        for (i, &c) in kids.iter().enumerate() {
+            match self.exec(c, leaves) {
+                R => {
+                    for (j, &o) in kids.iter().enumerate() {
+                        if j != i {
+                            self.halt_child(o, leaves);
+                        }
+                    }
+                    return R;
+                }
+                s if s == go_on => {}
+                s => {
+                    self.reset_children(n, leaves);
+                    return s;
+                }
+            }
+        }
+        self.reset_children(n, leaves);
+        go_on
+    }
+
+    /// Sequence (`sequence_memory`) or Fallback: from the child it is at.
+    fn with_memory(
+        &mut self,
+        n: usize,
+        sequence: bool,
+        kids: &[usize],
+        leaves: &mut impl Leaves,
+    ) -> Status {
+        use Status::{Failure as F, Running as R, Success as S};
+        let go_on = if sequence { S } else { F };
+        while self.idx[n] < kids.len() {
+            match self.exec(kids[self.idx[n]], leaves) {
+                R => return R,
+                s if s == go_on => self.idx[n] += 1,
+                s => {
+                    self.reset_children(n, leaves);
+                    self.idx[n] = 0;
+                    return s;
+                }
+            }
+        }
+        self.reset_children(n, leaves);
+        self.idx[n] = 0;
+        go_on
+    }
+
+    /// Parallel with `success` children to succeed: a child that finished
+    /// is not ticked again until the node finishes.
+    fn parallel(
+        &mut self,
+        n: usize,
+        success: usize,
+        kids: &[usize],
+        leaves: &mut impl Leaves,
+    ) -> Status {
+        use Status::{Failure as F, Running as R, Success as S};
+        let k = kids.len();
+        let fail = k - success + 1;
+        for &c in kids {
+            if !matches!(self.st[c], Some(S | F)) {
+                match self.exec(c, leaves) {
+                    S => self.ok[n] += 1,
+                    F => self.bad[n] += 1,
+                    R => {}
+                }
+            }
+            let done = if self.ok[n] >= success {
+                Some(S)
+            } else if k - self.bad[n] < success || self.bad[n] == fail {
+                Some(F)
+            } else {
+                None
+            };
+            if let Some(s) = done {
+                (self.ok[n], self.bad[n]) = (0, 0);
+                self.reset_children(n, leaves);
+                return s;
+            }
+        }
+        R
+    }
+
+    /// Repeat (again on SUCCESS) or RetryUntilSuccessful (on FAILURE) of
+    /// child `c`, yielding RUNNING after a child that finished at once.
+    fn repeat(&mut self, n: usize, kind: BtNodeKind, c: usize, leaves: &mut impl Leaves) -> Status {
+        use BtNodeKind as K;
+        use Status::{Failure as F, Running as R, Success as S};
+        let (again, other, limit) = match kind {
+            K::Repeat { times } => (S, F, times.map_or(-1, i64::from)),
+            K::Retry { times } => (F, S, i64::from(times)),
+            _ => unreachable!(),
+        };
+        loop {
+            if limit >= 0 && self.cnt[n] >= limit {
+                self.cnt[n] = 0;
+                break again;
+            }
+            let prev = self.st[c];
+            match self.exec(c, leaves) {
+                R => break R,
+                s if s == again => {
+                    self.cnt[n] += 1;
+                    self.halt_child(c, leaves);
+                    if prev.is_none() && (limit < 0 || self.cnt[n] < limit) {
+                        break R;
+                    }
+                }
+                _ => {
+                    self.cnt[n] = 0;
+                    self.halt_child(c, leaves);
+                    break other;
+                }
+            }
+        }
     }
 }
 

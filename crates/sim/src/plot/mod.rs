@@ -13,7 +13,7 @@ mod tests;
 
 use super::scenario::Scenario;
 use super::trace::Run;
-use super::world::Place;
+use super::world::{Layout, Place};
 use btfsm_core::sanitize;
 use labels::{BBox, Ink, Placer};
 use std::collections::{BTreeMap, HashMap};
@@ -189,7 +189,6 @@ fn names(list: &[&str]) -> String {
 }
 
 /// The SVG text.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn svg(s: &Scenario, runs: &[Run]) -> String {
     let l = &s.world.layout;
     let r = &l.room;
@@ -210,6 +209,49 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
         x1: f.px(r.x1),
         y1: f.py(r.y0),
     });
+    head(&mut o, &f, s, (w, h));
+    axes(&mut o, &f, r);
+    marks::obstacles(&mut o, &f, s, &mut ink);
+    marks::trajectories(&mut o, &f, runs, &mut ink);
+    stations_and_waypoints(&mut o, &f, l, &mut ink);
+    let starts = object_starts(&mut o, &f, s, &mut ink);
+    let end_labels = object_ends(&mut o, &f, runs, &starts, &mut ink);
+    // Labels, the most important first: they take the best places.
+    for (n, p) in &l.stations {
+        label(
+            &mut o,
+            &mut ink,
+            (f.px(p.0), f.py(p.1)),
+            6.0,
+            n,
+            (11.0, "#333"),
+        );
+    }
+    for (q, n) in &starts {
+        label(&mut o, &mut ink, *q, 5.0, n, (10.0, "#000"));
+    }
+    for (q, n) in &end_labels {
+        label(&mut o, &mut ink, *q, 4.0, n, (10.0, "#5a4800"));
+    }
+    for (i, p) in l.waypoints.iter().enumerate() {
+        label(
+            &mut o,
+            &mut ink,
+            (f.px(p.0), f.py(p.1)),
+            3.0,
+            &format!("w{}", i + 1),
+            (9.0, "#999"),
+        );
+    }
+    marks::legend(&mut o, runs, &groups, room_bottom + BELOW);
+    o.push_str("</svg>\n");
+    o
+}
+
+/// The drawing's opening: the `<svg>` element `w` x `h` px, a white
+/// background, the title, and the room's walls.
+fn head(o: &mut String, f: &Frame, s: &Scenario, (w, h): (f64, f64)) {
+    let r = &s.world.layout.room;
     let _ = writeln!(
         o,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.0} {h:.0}" font-family="Helvetica, Arial, sans-serif">"#
@@ -229,10 +271,11 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
         (r.x1 - r.x0) * SCALE,
         (r.y1 - r.y0) * SCALE
     );
-    axes(&mut o, &f, r);
-    marks::obstacles(&mut o, &f, s, &mut ink);
-    marks::trajectories(&mut o, &f, runs, &mut ink);
-    // Stations and waypoints (their labels come once all marks are down).
+}
+
+/// Stations (crosses) and waypoints (circles); their labels come once all
+/// marks are down.
+fn stations_and_waypoints(o: &mut String, f: &Frame, l: &Layout, ink: &mut Placer) {
     for (_, p) in &l.stations {
         let (x, y) = (f.px(p.0), f.py(p.1));
         let _ = writeln!(
@@ -251,7 +294,16 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
         );
         ink.mark(BBox::around(x, y, 3.0), Ink::Mark);
     }
-    // Objects: hollow where they started, solid where the runs left them.
+}
+
+/// The objects where they started (hollow squares); their positions (px)
+/// and names, for their labels.
+fn object_starts<'s>(
+    o: &mut String,
+    f: &Frame,
+    s: &'s Scenario,
+    ink: &mut Placer,
+) -> Vec<((f64, f64), &'s str)> {
     let mut starts: Vec<((f64, f64), &str)> = Vec::new();
     for ob in &s.world.objects {
         if let Place::At(p) | Place::Floor(p) = ob.place {
@@ -267,6 +319,18 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
             starts.push(((x, y), ob.name.as_str()));
         }
     }
+    starts
+}
+
+/// The objects where the runs left them (solid squares); the labels of
+/// those moved from their start, one per cluster of nearby squares.
+fn object_ends(
+    o: &mut String,
+    f: &Frame,
+    runs: &[Run],
+    starts: &[((f64, f64), &str)],
+    ink: &mut Placer,
+) -> Vec<((f64, f64), String)> {
     let ends = ends(runs);
     let mut end_labels: Vec<((f64, f64), Vec<String>)> = Vec::new();
     let mut end_cells: HashMap<(i64, i64), usize> = HashMap::new();
@@ -311,7 +375,7 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
             end_labels[at].1.extend(moved.iter().map(|n| n.to_string()));
         }
     }
-    let end_labels: Vec<((f64, f64), String)> = end_labels
+    end_labels
         .into_iter()
         .map(|(q, mut ns)| {
             ns.sort();
@@ -319,44 +383,26 @@ pub fn svg(s: &Scenario, runs: &[Run]) -> String {
             let ns: Vec<&str> = ns.iter().map(String::as_str).collect();
             (q, names(&ns))
         })
-        .collect();
-    // Labels, the most important first: they take the best places.
-    let mut label = |o: &mut String,
-                     (x, y): (f64, f64),
-                     r: f64,
-                     text: &str,
-                     size: f64,
-                     fill: &str| {
-        let spot = ink.place(x, y, r, text, size);
-        let _ = writeln!(
-            o,
-            r#"<text x="{:.1}" y="{:.1}" font-size="{size}" text-anchor="{}" fill="{fill}" {HALO}>{}</text>"#,
-            spot.x,
-            spot.y,
-            spot.anchor,
-            esc(text)
-        );
-    };
-    for (n, p) in &l.stations {
-        label(&mut o, (f.px(p.0), f.py(p.1)), 6.0, n, 11.0, "#333");
-    }
-    for (q, n) in &starts {
-        label(&mut o, *q, 5.0, n, 10.0, "#000");
-    }
-    for (q, n) in &end_labels {
-        label(&mut o, *q, 4.0, n, 10.0, "#5a4800");
-    }
-    for (i, p) in l.waypoints.iter().enumerate() {
-        label(
-            &mut o,
-            (f.px(p.0), f.py(p.1)),
-            3.0,
-            &format!("w{}", i + 1),
-            9.0,
-            "#999",
-        );
-    }
-    marks::legend(&mut o, runs, &groups, room_bottom + BELOW);
-    o.push_str("</svg>\n");
-    o
+        .collect()
+}
+
+/// A label for a mark of radius `r` at `(x, y)`, where it covers no
+/// other mark; `(size, fill)` of its text.
+fn label(
+    o: &mut String,
+    ink: &mut Placer,
+    (x, y): (f64, f64),
+    r: f64,
+    text: &str,
+    (size, fill): (f64, &str),
+) {
+    let spot = ink.place(x, y, r, text, size);
+    let _ = writeln!(
+        o,
+        r#"<text x="{:.1}" y="{:.1}" font-size="{size}" text-anchor="{}" fill="{fill}" {HALO}>{}</text>"#,
+        spot.x,
+        spot.y,
+        spot.anchor,
+        esc(text)
+    );
 }

@@ -20,7 +20,7 @@ use crate::trace::{Outcome, Run, Verdict};
 use btfsm_core::diagnostic::suggest;
 use serde::Serialize;
 use std::ops::Range;
-use toml::de::DeValue;
+use toml::de::{DeTable, DeValue};
 
 /// What one expectation checks (policy indices into the scenario's list).
 #[derive(Debug, Clone, PartialEq)]
@@ -160,7 +160,6 @@ impl Reader {
     }
 
     /// Reads `[expect]` once the policies (and their names) are known.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn expect(
         &mut self,
         v: &Val<'_>,
@@ -172,7 +171,36 @@ impl Reader {
         };
         self.keys(t, KEYS, "field of `expect`");
         let mut out = Vec::new();
-        let name = |i: usize| names[i].clone();
+        self.expect_goals(t, names, has_goal, &mut out);
+        if let Some(x) = t.get("outcome") {
+            self.expect_outcomes(x, names, &mut out);
+        }
+        self.expect_verdicts(t, names, &mut out);
+        if let Some(x) = t.get("completion_s") {
+            self.expect_completions(x, names, &mut out);
+        }
+        if out.len() > MAX_EXPECTATIONS {
+            self.err(
+                v.span(),
+                format!(
+                    "{} expectations, more than the limit of {MAX_EXPECTATIONS}",
+                    out.len()
+                ),
+                format!("a scenario holds at most {MAX_EXPECTATIONS} expectations (a fixed limit)"),
+            );
+        }
+        out
+    }
+
+    /// `reach_goal` and `miss_goal`: lists of policies (the scenario needs
+    /// a `goal`).
+    fn expect_goals(
+        &mut self,
+        t: &DeTable<'_>,
+        names: &[String],
+        has_goal: bool,
+        out: &mut Vec<Expectation>,
+    ) {
         for key in ["reach_goal", "miss_goal"] {
             if let Some(x) = t.get(key) {
                 if !has_goal {
@@ -187,98 +215,98 @@ impl Reader {
                     out.push(if key == "reach_goal" {
                         Expectation {
                             check: Check::ReachGoal(i),
-                            name: format!("{} reaches the goal", name(i)),
+                            name: format!("{} reaches the goal", names[i]),
                         }
                     } else {
                         Expectation {
                             check: Check::MissGoal(i),
-                            name: format!("{} misses the goal", name(i)),
+                            name: format!("{} misses the goal", names[i]),
                         }
                     });
                 }
             }
         }
-        if let Some(x) = t.get("outcome")
-            && let Some(ot) = self.table(x, "`outcome`")
-        {
-            for (k, v) in ot.iter() {
-                let Some(i) = self.expect_policy(k.span(), k.get_ref(), names) else {
+    }
+
+    /// `outcome`: a table of policies and the outcome each ends with.
+    fn expect_outcomes(&mut self, x: &Val<'_>, names: &[String], out: &mut Vec<Expectation>) {
+        let Some(ot) = self.table(x, "`outcome`") else {
+            return;
+        };
+        for (k, v) in ot.iter() {
+            let Some(i) = self.expect_policy(k.span(), k.get_ref(), names) else {
+                continue;
+            };
+            let o = match v.get_ref().as_str() {
+                Some("success") => Outcome::Success,
+                Some("failure") => Outcome::Failure,
+                Some("chattering") => Outcome::Chattering,
+                Some("timeout") => Outcome::Timeout,
+                _ => {
+                    self.err(
+                        v.span(),
+                        "an expected outcome is `success`, `failure`, `chattering` or `timeout`",
+                        "write e.g. `\"chattering\"`",
+                    );
                     continue;
-                };
-                let o = match v.get_ref().as_str() {
-                    Some("success") => Outcome::Success,
-                    Some("failure") => Outcome::Failure,
-                    Some("chattering") => Outcome::Chattering,
-                    Some("timeout") => Outcome::Timeout,
-                    _ => {
-                        self.err(
-                            v.span(),
-                            "an expected outcome is `success`, `failure`, `chattering` or `timeout`",
-                            "write e.g. `\"chattering\"`",
-                        );
-                        continue;
-                    }
-                };
-                out.push(Expectation {
-                    check: Check::Outcome(i, o),
-                    name: format!("{} ends with {}", name(i), o.as_str()),
-                });
-            }
+                }
+            };
+            out.push(Expectation {
+                check: Check::Outcome(i, o),
+                name: format!("{} ends with {}", names[i], o.as_str()),
+            });
         }
+    }
+
+    /// `match` and `differ`: lists of pairs of policies.
+    fn expect_verdicts(&mut self, t: &DeTable<'_>, names: &[String], out: &mut Vec<Expectation>) {
         for key in ["match", "differ"] {
             if let Some(x) = t.get(key) {
                 for (a, b) in self.expect_pairs(x, &format!("`{key}`"), names) {
                     out.push(if key == "match" {
                         Expectation {
                             check: Check::Match(a, b),
-                            name: format!("{} matches {}", name(a), name(b)),
+                            name: format!("{} matches {}", names[a], names[b]),
                         }
                     } else {
                         Expectation {
                             check: Check::Differ(a, b),
-                            name: format!("{} differs from {}", name(a), name(b)),
+                            name: format!("{} differs from {}", names[a], names[b]),
                         }
                     });
                 }
             }
         }
-        if let Some(x) = t.get("completion_s")
-            && let Some(ct) = self.table(x, "`completion_s`")
-        {
-            for (k, v) in ct.iter() {
-                let Some(i) = self.expect_policy(k.span(), k.get_ref(), names) else {
-                    continue;
-                };
-                let range = match v.get_ref() {
-                    DeValue::Array(_) => self.range(v, "a completion time", 0.0, 1e9),
-                    _ => self
-                        .number(v, "a completion time", 0.0, 1e9)
-                        .map(|h| (0.0, h)),
-                };
-                if let Some((lo, hi)) = range {
-                    out.push(Expectation {
-                        check: Check::Completion(i, lo, hi),
-                        name: format!(
-                            "{} completes within [{}, {}] s",
-                            name(i),
-                            super::show(lo),
-                            super::show(hi)
-                        ),
-                    });
-                }
+    }
+
+    /// `completion_s`: a table of policies and the range (or upper bound)
+    /// of their completion times.
+    fn expect_completions(&mut self, x: &Val<'_>, names: &[String], out: &mut Vec<Expectation>) {
+        let Some(ct) = self.table(x, "`completion_s`") else {
+            return;
+        };
+        for (k, v) in ct.iter() {
+            let Some(i) = self.expect_policy(k.span(), k.get_ref(), names) else {
+                continue;
+            };
+            let range = match v.get_ref() {
+                DeValue::Array(_) => self.range(v, "a completion time", 0.0, 1e9),
+                _ => self
+                    .number(v, "a completion time", 0.0, 1e9)
+                    .map(|h| (0.0, h)),
+            };
+            if let Some((lo, hi)) = range {
+                out.push(Expectation {
+                    check: Check::Completion(i, lo, hi),
+                    name: format!(
+                        "{} completes within [{}, {}] s",
+                        names[i],
+                        super::show(lo),
+                        super::show(hi)
+                    ),
+                });
             }
         }
-        if out.len() > MAX_EXPECTATIONS {
-            self.err(
-                v.span(),
-                format!(
-                    "{} expectations, more than the limit of {MAX_EXPECTATIONS}",
-                    out.len()
-                ),
-                format!("a scenario holds at most {MAX_EXPECTATIONS} expectations (a fixed limit)"),
-            );
-        }
-        out
     }
 }
 

@@ -21,6 +21,7 @@ use crate::rng::SimRng;
 use crate::world::{P2, Rect, World};
 use btfsm_core::diagnostic::suggest;
 use std::collections::BTreeMap;
+use toml::de::DeTable;
 
 /// `(probability, level range in percent, time window in s)` of a random
 /// battery drop.
@@ -110,7 +111,6 @@ impl Reader {
     }
 
     /// Reads `[monte_carlo]`.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn monte_carlo(&mut self, m: &Val<'_>, world: &World) -> Option<MonteCarlo> {
         let mut out = MonteCarlo::default();
         let mt = self.table(m, "`monte_carlo`")?;
@@ -122,105 +122,129 @@ impl Reader {
             let Some(b) = mt.get(*key) else {
                 continue;
             };
-            let bt = self.table(b, &format!("`{key}`"))?;
-            let fields: &[&str] = match *key {
-                "battery_drop" => &["probability", "level", "window"],
-                "move" => &["probability", "objects", "to", "window"],
-                "move_after_done" => &["probability", "objects", "to", "delay"],
-                "drop" => &["probability", "objects", "window"],
-                "block" => &["probability", "rects", "window"],
-                _ => &["probability", "window", "duration"],
-            };
-            self.keys(bt, fields, &format!("field of `{key}`"));
-            let p = bt
-                .get("probability")
-                .and_then(|v| self.number(v, "`probability`", 0.0, 1.0))
-                .unwrap_or(0.5);
-            let range = |r: &mut Self, k: &str, max: f64, default: (f64, f64)| {
-                bt.get(k)
-                    .and_then(|v| r.range(v, &format!("`{k}`"), 0.0, max))
-                    .unwrap_or(default)
-            };
-            let window = range(self, "window", 1e9, (5.0, 60.0));
-            let effect = match *key {
-                "battery_drop" => {
-                    let level = range(self, "level", 100.0, (5.0, 19.0));
-                    out.battery_drop = Some((p, level, window));
-                    continue;
-                }
-                "move" | "move_after_done" => {
-                    let objects = self.names_of(bt.get("objects"), world, "`objects`")?;
-                    let Some(to) = bt.get("to") else {
-                        self.err(
-                            b.span(),
-                            format!("`{key}` needs `to`"),
-                            "write `to = [\"west-table\"]`",
-                        );
-                        return None;
-                    };
-                    let ta = self.array(to, "`to`")?;
-                    if !self.at_most(to.span(), ta.len(), MAX_STATIONS, "places") || ta.is_empty() {
-                        self.err(to.span(), "`to` must list at least one place", "");
-                        return None;
-                    }
-                    let mut places = Vec::new();
-                    for x in ta {
-                        places.push(self.pose(
-                            x,
-                            "a place",
-                            &world.layout,
-                            world.params.robot_radius,
-                        )?);
-                    }
-                    RandomEffect::Move {
-                        objects,
-                        to: places,
-                    }
-                }
-                "drop" => RandomEffect::Drop {
-                    objects: self.names_of(bt.get("objects"), world, "`objects`")?,
-                },
-                "block" => {
-                    let Some(rs) = bt.get("rects") else {
-                        self.err(
-                            b.span(),
-                            "`block` needs `rects`",
-                            "write `rects = [{ name = \"box\", rect = [1.0, 1.3, 2.9, 1.6] }]`",
-                        );
-                        return None;
-                    };
-                    let ra = self.array(rs, "`rects`")?;
-                    if !self.at_most(rs.span(), ra.len(), MAX_OBSTACLES, "obstacles") {
-                        return None;
-                    }
-                    let mut rects = Vec::new();
-                    for x in ra {
-                        rects.push(self.rect(x)?);
-                    }
-                    if rects.is_empty() {
-                        self.err(rs.span(), "`rects` must list at least one obstacle", "");
-                        return None;
-                    }
-                    RandomEffect::Block(rects)
-                }
-                _ => {
-                    let (d0, d1) = range(self, "duration", 1e9, (1.0, 5.0));
-                    RandomEffect::Emergency(d0, d1)
-                }
-            };
-            let when = if *key == "move_after_done" {
-                let (d0, d1) = range(self, "delay", 1e9, (1.0, 5.0));
-                RandomWhen::AfterDone(d0, d1)
-            } else {
-                RandomWhen::Window(window.0, window.1)
-            };
-            out.random.push(Random {
-                probability: p,
-                when,
-                effect,
-            });
+            self.random(key, b, world, &mut out)?;
         }
         Some(out)
+    }
+
+    /// The random disturbance `key` of `[monte_carlo]` (its table `b`):
+    /// the battery drop, or one of [`MonteCarlo::random`].
+    fn random(
+        &mut self,
+        key: &str,
+        b: &Val<'_>,
+        world: &World,
+        out: &mut MonteCarlo,
+    ) -> Option<()> {
+        let bt = self.table(b, &format!("`{key}`"))?;
+        let fields: &[&str] = match key {
+            "battery_drop" => &["probability", "level", "window"],
+            "move" => &["probability", "objects", "to", "window"],
+            "move_after_done" => &["probability", "objects", "to", "delay"],
+            "drop" => &["probability", "objects", "window"],
+            "block" => &["probability", "rects", "window"],
+            _ => &["probability", "window", "duration"],
+        };
+        self.keys(bt, fields, &format!("field of `{key}`"));
+        let p = bt
+            .get("probability")
+            .and_then(|v| self.number(v, "`probability`", 0.0, 1.0))
+            .unwrap_or(0.5);
+        let window = self.range_or(bt, "window", 1e9, (5.0, 60.0));
+        let effect = match key {
+            "battery_drop" => {
+                let level = self.range_or(bt, "level", 100.0, (5.0, 19.0));
+                out.battery_drop = Some((p, level, window));
+                return Some(());
+            }
+            "move" | "move_after_done" => self.random_move(key, b, bt, world)?,
+            "drop" => RandomEffect::Drop {
+                objects: self.names_of(bt.get("objects"), world, "`objects`")?,
+            },
+            "block" => self.random_block(b, bt)?,
+            _ => {
+                let (d0, d1) = self.range_or(bt, "duration", 1e9, (1.0, 5.0));
+                RandomEffect::Emergency(d0, d1)
+            }
+        };
+        let when = if key == "move_after_done" {
+            let (d0, d1) = self.range_or(bt, "delay", 1e9, (1.0, 5.0));
+            RandomWhen::AfterDone(d0, d1)
+        } else {
+            RandomWhen::Window(window.0, window.1)
+        };
+        out.random.push(Random {
+            probability: p,
+            when,
+            effect,
+        });
+        Some(())
+    }
+
+    /// The range `k` of a random disturbance's table, `default` when it
+    /// is missing or refused.
+    fn range_or(&mut self, bt: &DeTable<'_>, k: &str, max: f64, default: (f64, f64)) -> (f64, f64) {
+        bt.get(k)
+            .and_then(|v| self.range(v, &format!("`{k}`"), 0.0, max))
+            .unwrap_or(default)
+    }
+
+    /// `move` and `move_after_done`: the objects and the places (`to`, at
+    /// least one) they may be moved to.
+    fn random_move(
+        &mut self,
+        key: &str,
+        b: &Val<'_>,
+        bt: &DeTable<'_>,
+        world: &World,
+    ) -> Option<RandomEffect> {
+        let objects = self.names_of(bt.get("objects"), world, "`objects`")?;
+        let Some(to) = bt.get("to") else {
+            self.err(
+                b.span(),
+                format!("`{key}` needs `to`"),
+                "write `to = [\"west-table\"]`",
+            );
+            return None;
+        };
+        let ta = self.array(to, "`to`")?;
+        if !self.at_most(to.span(), ta.len(), MAX_STATIONS, "places") || ta.is_empty() {
+            self.err(to.span(), "`to` must list at least one place", "");
+            return None;
+        }
+        let mut places = Vec::new();
+        for x in ta {
+            places.push(self.pose(x, "a place", &world.layout, world.params.robot_radius)?);
+        }
+        Some(RandomEffect::Move {
+            objects,
+            to: places,
+        })
+    }
+
+    /// `block`: the obstacles (`rects`, at least one) that may block the way.
+    fn random_block(&mut self, b: &Val<'_>, bt: &DeTable<'_>) -> Option<RandomEffect> {
+        let Some(rs) = bt.get("rects") else {
+            self.err(
+                b.span(),
+                "`block` needs `rects`",
+                "write `rects = [{ name = \"box\", rect = [1.0, 1.3, 2.9, 1.6] }]`",
+            );
+            return None;
+        };
+        let ra = self.array(rs, "`rects`")?;
+        if !self.at_most(rs.span(), ra.len(), MAX_OBSTACLES, "obstacles") {
+            return None;
+        }
+        let mut rects = Vec::new();
+        for x in ra {
+            rects.push(self.rect(x)?);
+        }
+        if rects.is_empty() {
+            self.err(rs.span(), "`rects` must list at least one obstacle", "");
+            return None;
+        }
+        Some(RandomEffect::Block(rects))
     }
 }
 

@@ -4,7 +4,8 @@
 use super::*;
 
 impl Reader {
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    /// The whole scenario: its top-level keys, world, rates, goal,
+    /// disturbances, Monte Carlo table, policies and expectations.
     pub(super) fn scenario(
         &mut self,
         t: &DeTable<'_>,
@@ -23,6 +24,55 @@ impl Reader {
             Some(d) => self.string(d, "`description`"),
             None => None,
         };
+        let run = self.settings(t);
+        let world = self.world(t.get("world"))?;
+        let rates = match t.get("rates") {
+            Some(r) => self.rates(r)?,
+            None => BTreeMap::new(),
+        };
+        let goal = match t.get("goal") {
+            Some(g) => Some(self.terms(g, &world)?),
+            None => None,
+        };
+        let disturbances = match t.get("disturbances") {
+            Some(d) => self.disturbances(d, &world)?,
+            None => Vec::new(),
+        };
+        let monte_carlo = match t.get("monte_carlo") {
+            Some(m) => self.monte_carlo(m, &world)?,
+            None => MonteCarlo::default(),
+        };
+        let policies = self.policies(t.get("policies"), base, limits, &world)?;
+        let expect = match t.get("expect") {
+            Some(e) => {
+                let names: Vec<String> = policies.iter().map(|p| p.policy.name.clone()).collect();
+                self.expect(e, &names, goal.is_some())
+            }
+            None => Vec::new(),
+        };
+        Some(Scenario {
+            expect,
+            warnings: Vec::new(),
+            name,
+            description,
+            seed: run.seed,
+            dt: run.dt,
+            max_steps: run.max_steps,
+            livelock_repeats: run.livelock_repeats,
+            max_failures: run.max_failures,
+            world,
+            policies,
+            rates,
+            disturbances,
+            goal,
+            monte_carlo,
+        })
+    }
+
+    /// The numbers of the runs (`seed`, `dt`, `max_steps`,
+    /// `livelock_repeats`, `max_failures`), defaults for those missing or
+    /// refused; a warning for the retired `chatter_switches`.
+    fn settings(&mut self, t: &DeTable<'_>) -> Settings {
         let seed = t
             .get("seed")
             .and_then(|v| self.integer(v, "`seed`", 0, i64::MAX as u64))
@@ -54,50 +104,59 @@ impl Reader {
             .get("max_failures")
             .and_then(|v| self.integer(v, "`max_failures`", 1, 1_000_000))
             .unwrap_or(50) as u32;
-        let world = self.world(t.get("world"))?;
-        let rates = match t.get("rates") {
-            Some(r) => self.rates(r)?,
-            None => BTreeMap::new(),
-        };
-        let goal = match t.get("goal") {
-            Some(g) => Some(self.terms(g, &world)?),
-            None => None,
-        };
+        Settings {
+            seed,
+            dt,
+            max_steps,
+            livelock_repeats,
+            max_failures,
+        }
+    }
+
+    /// `[[disturbances]]` (`None`: not an array, or too many of them or of
+    /// the obstacles they add; a disturbance with a problem is left out).
+    fn disturbances(&mut self, d: &Val<'_>, world: &World) -> Option<Vec<Disturbance>> {
+        let a = self.array(d, "`disturbances`")?;
+        if !self.at_most(d.span(), a.len(), MAX_DISTURBANCES, "disturbances") {
+            return None;
+        }
+        // Every `block` adds an obstacle.
+        let blocks = (a.iter())
+            .filter(|x| {
+                x.get_ref()
+                    .as_table()
+                    .is_some_and(|t| t.contains_key("block"))
+            })
+            .count();
+        let obstacles = world.layout.obstacles.len() + blocks;
+        if !self.at_most(
+            d.span(),
+            obstacles,
+            MAX_OBSTACLES,
+            "obstacles (`block` disturbances included)",
+        ) {
+            return None;
+        }
         let mut disturbances = Vec::new();
-        if let Some(d) = t.get("disturbances") {
-            let a = self.array(d, "`disturbances`")?;
-            if !self.at_most(d.span(), a.len(), MAX_DISTURBANCES, "disturbances") {
-                return None;
-            }
-            // Every `block` adds an obstacle.
-            let blocks = (a.iter())
-                .filter(|x| {
-                    x.get_ref()
-                        .as_table()
-                        .is_some_and(|t| t.contains_key("block"))
-                })
-                .count();
-            let obstacles = world.layout.obstacles.len() + blocks;
-            if !self.at_most(
-                d.span(),
-                obstacles,
-                MAX_OBSTACLES,
-                "obstacles (`block` disturbances included)",
-            ) {
-                return None;
-            }
-            for x in a {
-                if let Some(d) = self.disturbance(x, &world) {
-                    disturbances.push(d);
-                }
+        for x in a {
+            if let Some(d) = self.disturbance(x, world) {
+                disturbances.push(d);
             }
         }
-        let monte_carlo = match t.get("monte_carlo") {
-            Some(m) => self.monte_carlo(m, &world)?,
-            None => MonteCarlo::default(),
-        };
+        Some(disturbances)
+    }
+
+    /// `[[policies]]`, at least one (`None`: not an array, or too many; a
+    /// policy with a problem is left out).
+    fn policies(
+        &mut self,
+        p: Option<&Val<'_>>,
+        base: &Path,
+        limits: &Limits,
+        world: &World,
+    ) -> Option<Vec<PolicyEntry>> {
         let mut policies = Vec::new();
-        match t.get("policies") {
+        match p {
             None => self.err(
                 0..0,
                 "a scenario needs at least one policy",
@@ -109,36 +168,13 @@ impl Reader {
                     return None;
                 }
                 for e in a {
-                    if let Some(pe) = self.policy(e, base, limits, &world) {
+                    if let Some(pe) = self.policy(e, base, limits, world) {
                         policies.push(pe);
                     }
                 }
             }
         }
-        let expect = match t.get("expect") {
-            Some(e) => {
-                let names: Vec<String> = policies.iter().map(|p| p.policy.name.clone()).collect();
-                self.expect(e, &names, goal.is_some())
-            }
-            None => Vec::new(),
-        };
-        Some(Scenario {
-            expect,
-            warnings: Vec::new(),
-            name,
-            description,
-            seed,
-            dt,
-            max_steps,
-            livelock_repeats,
-            max_failures,
-            world,
-            policies,
-            rates,
-            disturbances,
-            goal,
-            monte_carlo,
-        })
+        Some(policies)
     }
 
     /// `after_success` / `after_failure`: `"stop"` or `"keep-ticking"`.
@@ -169,7 +205,8 @@ impl Reader {
         }
     }
 
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    /// A `[[policies]]` entry: its file read (converted when asked),
+    /// checked against the world, named, with what it does afterwards.
     pub(super) fn policy(
         &mut self,
         v: &Val<'_>,
@@ -192,39 +229,8 @@ impl Reader {
             return None;
         };
         let rel = self.string(f, "`file`")?;
-        let root = format::source::root_for(limits, base);
-        let path = match format::source::resolve(root.as_deref(), base, &rel) {
-            Ok(p) => p,
-            Err(r) if r.message == "no such file" => {
-                self.err(
-                    f.span(),
-                    format!("policy file `{rel}` not found"),
-                    format!(
-                        "paths are relative to the scenario's folder (`{}`)",
-                        base.display()
-                    ),
-                );
-                return None;
-            }
-            Err(r) => {
-                self.err(
-                    f.span(),
-                    format!("policy file `{rel}`: {}", r.message),
-                    r.hint,
-                );
-                return None;
-            }
-        };
-        let convert = match t.get("convert") {
-            None => None,
-            Some(c) => match c.get_ref().as_str() {
-                Some("hfsm") => Some("hfsm".to_string()),
-                _ => {
-                    self.err(c.span(), "`convert` must be \"hfsm\"", "write `convert = \"hfsm\"` to run the BT converted to an HFSM (Fig. 5 -> Fig. 6)");
-                    return None;
-                }
-            },
-        };
+        let path = self.policy_path(f, &rel, base, limits)?;
+        let convert = self.convert(t)?;
         let loaded = match format::load(&path, limits) {
             Ok(l) => l,
             Err(d) => {
@@ -234,77 +240,12 @@ impl Reader {
         };
         let mut policy = loaded.policy;
         if convert.is_some() {
-            if !matches!(policy.body, PolicyBody::Bt(_)) {
-                self.err(
-                    f.span(),
-                    format!("`{rel}` is not a BT and cannot be converted"),
-                    "remove `convert`",
-                );
-                return None;
-            }
-            if let PolicyBody::Bt(bt) = &policy.body
-                && let Some(&n) = btfsm_transform::bt_to_hfsm::memory_nodes(bt).first()
-            {
-                let node = &bt.nodes[n];
-                self.err(
-                    f.span(),
-                    format!(
-                        "the HFSM of `{rel}` would not behave as the BT: its `{}` node `{}` keeps memory, and the construction re-enters containers at their first state every tick",
-                        node.kind.keyword(),
-                        node.id
-                    ),
-                    "run the BT itself, or make the node reactive (sequence / fallback); `btfsm convert --to hfsm` still gives the HFSM to count",
-                );
-                return None;
-            }
-            match btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
-                Ok(p) => policy = p,
-                Err(e) => {
-                    self.err(
-                        f.span(),
-                        e[0].to_string(),
-                        "only sequence, fallback and simple decorators convert",
-                    );
-                    return None;
-                }
-            }
+            policy = self.converted(policy, f, &rel)?;
         }
         check_bindings(&policy, &loaded.path, limits, world, &mut self.diags);
-        // The executor runs one state per region, from a state.
-        if let PolicyBody::Machine(m) = &policy.body {
-            if m.has_parallel() {
-                self.err(
-                    f.span(),
-                    format!("`{rel}` has parallel regions (SCXML `<parallel>`): the simulator runs one state at a time"),
-                    "simulate each region as its own machine; `analyze`, `dot` and `compare` take the whole machine",
-                );
-                return None;
-            }
-            if m.top.initial_state().is_none() {
-                self.err(
-                    f.span(),
-                    format!("`{rel}` starts in an outcome: it has no state to run"),
-                    "give the machine a state to start in",
-                );
-                return None;
-            }
-        }
-        if convert.is_none()
-            && let PolicyBody::Machine(m) = &policy.body
-            && m.top.outcomes.iter().any(|o| o == "RUNNING")
-            && let Some(st) = (m.states.iter()).find(|st| {
-                matches!(st.body, StateBody::Container(_))
-                    && (st.label == "Sequence*" || st.label == "Fallback*")
-            })
-        {
-            self.diags.push(
-                Diagnostic::warning(format!(
-                    "`{rel}` looks converted from a BT with memory: its container `{}` ({}) is re-entered at its first state every tick, so it forgets the running child and does not behave as the BT",
-                    st.name, st.label
-                ))
-                .at(&self.file, f.span())
-                .hint("run the BT itself, or convert a BT whose composites are reactive (sequence / fallback)"),
-            );
+        self.runs_one_state_at_a_time(&policy, f, &rel)?;
+        if convert.is_none() {
+            self.warn_forgetful(&policy, f, &rel);
         }
         if let Some(n) = t.get("name") {
             policy.name = self.string(n, "`name`")?;
@@ -328,4 +269,146 @@ impl Reader {
             after_failure,
         })
     }
+
+    /// The path of policy file `rel` (at `f`), resolved against the
+    /// scenario's folder, inside its root.
+    fn policy_path(
+        &mut self,
+        f: &Val<'_>,
+        rel: &str,
+        base: &Path,
+        limits: &Limits,
+    ) -> Option<PathBuf> {
+        let root = format::source::root_for(limits, base);
+        match format::source::resolve(root.as_deref(), base, rel) {
+            Ok(p) => Some(p),
+            Err(r) if r.message == "no such file" => {
+                self.err(
+                    f.span(),
+                    format!("policy file `{rel}` not found"),
+                    format!(
+                        "paths are relative to the scenario's folder (`{}`)",
+                        base.display()
+                    ),
+                );
+                None
+            }
+            Err(r) => {
+                self.err(
+                    f.span(),
+                    format!("policy file `{rel}`: {}", r.message),
+                    r.hint,
+                );
+                None
+            }
+        }
+    }
+
+    /// A policy entry's `convert`: `Some(None)` without one, `None` when it
+    /// is not `"hfsm"`.
+    fn convert(&mut self, t: &DeTable<'_>) -> Option<Option<String>> {
+        match t.get("convert") {
+            None => Some(None),
+            Some(c) => match c.get_ref().as_str() {
+                Some("hfsm") => Some(Some("hfsm".to_string())),
+                _ => {
+                    self.err(c.span(), "`convert` must be \"hfsm\"", "write `convert = \"hfsm\"` to run the BT converted to an HFSM (Fig. 5 -> Fig. 6)");
+                    None
+                }
+            },
+        }
+    }
+
+    /// The HFSM of a BT (`convert = "hfsm"`): refused for a machine, a BT
+    /// with memory, or one the construction does not convert.
+    fn converted(&mut self, policy: Policy, f: &Val<'_>, rel: &str) -> Option<Policy> {
+        if !matches!(policy.body, PolicyBody::Bt(_)) {
+            self.err(
+                f.span(),
+                format!("`{rel}` is not a BT and cannot be converted"),
+                "remove `convert`",
+            );
+            return None;
+        }
+        if let PolicyBody::Bt(bt) = &policy.body
+            && let Some(&n) = btfsm_transform::bt_to_hfsm::memory_nodes(bt).first()
+        {
+            let node = &bt.nodes[n];
+            self.err(
+                f.span(),
+                format!(
+                    "the HFSM of `{rel}` would not behave as the BT: its `{}` node `{}` keeps memory, and the construction re-enters containers at their first state every tick",
+                    node.kind.keyword(),
+                    node.id
+                ),
+                "run the BT itself, or make the node reactive (sequence / fallback); `btfsm convert --to hfsm` still gives the HFSM to count",
+            );
+            return None;
+        }
+        match btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&policy) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                self.err(
+                    f.span(),
+                    e[0].to_string(),
+                    "only sequence, fallback and simple decorators convert",
+                );
+                None
+            }
+        }
+    }
+
+    /// Refuses a machine the executor cannot run (it runs one state per
+    /// region, from a state): parallel regions, or no state to start in.
+    fn runs_one_state_at_a_time(&mut self, policy: &Policy, f: &Val<'_>, rel: &str) -> Option<()> {
+        if let PolicyBody::Machine(m) = &policy.body {
+            if m.has_parallel() {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` has parallel regions (SCXML `<parallel>`): the simulator runs one state at a time"),
+                    "simulate each region as its own machine; `analyze`, `dot` and `compare` take the whole machine",
+                );
+                return None;
+            }
+            if m.top.initial_state().is_none() {
+                self.err(
+                    f.span(),
+                    format!("`{rel}` starts in an outcome: it has no state to run"),
+                    "give the machine a state to start in",
+                );
+                return None;
+            }
+        }
+        Some(())
+    }
+
+    /// Warns about a tick-driven machine that looks converted from a BT
+    /// with memory (its containers forget their running child).
+    fn warn_forgetful(&mut self, policy: &Policy, f: &Val<'_>, rel: &str) {
+        if let PolicyBody::Machine(m) = &policy.body
+            && m.top.outcomes.iter().any(|o| o == "RUNNING")
+            && let Some(st) = (m.states.iter()).find(|st| {
+                matches!(st.body, StateBody::Container(_))
+                    && (st.label == "Sequence*" || st.label == "Fallback*")
+            })
+        {
+            self.diags.push(
+                Diagnostic::warning(format!(
+                    "`{rel}` looks converted from a BT with memory: its container `{}` ({}) is re-entered at its first state every tick, so it forgets the running child and does not behave as the BT",
+                    st.name, st.label
+                ))
+                .at(&self.file, f.span())
+                .hint("run the BT itself, or convert a BT whose composites are reactive (sequence / fallback)"),
+            );
+        }
+    }
+}
+
+/// The numbers of a scenario's runs.
+struct Settings {
+    seed: u64,
+    dt: f64,
+    max_steps: u64,
+    livelock_repeats: u32,
+    max_failures: u32,
 }

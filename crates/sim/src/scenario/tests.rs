@@ -198,13 +198,23 @@ fn policies_objects_obstacles_and_disturbances_are_capped() {
     );
 }
 
-/// NaN and infinities passed the wall and obstacle checks, the battery
-/// drop took any level and window, and `max_steps = 1.5` was read as 1.
+/// Refuses each scenario made of (top-level keys, lines of `[world]`,
+/// tables after the policy) with a message containing the last string.
+fn assert_refused(cases: &[(&str, &str, &str, &str)]) {
+    for (top, world, tail, want) in cases {
+        let text = format!("{top}[world]\n{CUBE}{world}{ONE_POLICY}{tail}");
+        let all = match parse_text(&text) {
+            Ok(_) => panic!("accepted:\n{text}"),
+            Err(e) => e.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(""),
+        };
+        assert!(all.contains(want), "{text}\n=> {all}");
+    }
+}
+
+/// NaN and infinities passed the wall and obstacle checks of `[world]`.
 #[test]
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
-fn numbers_are_finite_integers_where_counted_and_in_range() {
-    // (top-level keys, lines of [world], tables after the policy, message)
-    let cases: &[(&str, &str, &str, &str)] = &[
+fn world_numbers_are_finite() {
+    assert_refused(&[
         ("", "robot = [nan, 0.0]\n", "", "s.toml:3:9"),
         (
             "",
@@ -237,6 +247,14 @@ fn numbers_are_finite_integers_where_counted_and_in_range() {
             "",
             "`max_speed` must be a finite number, found inf",
         ),
+    ]);
+}
+
+/// `max_steps = 1.5` was read as 1: the counted top-level numbers are
+/// integers in range, the others finite.
+#[test]
+fn top_level_numbers_are_finite_integers_where_counted_and_in_range() {
+    assert_refused(&[
         (
             "max_steps = 1.5\n",
             "",
@@ -280,6 +298,20 @@ fn numbers_are_finite_integers_where_counted_and_in_range() {
             "",
             "`dt` must be a finite number, found NaN",
         ),
+    ]);
+    // Integers written as TOML integers still read, in any radix.
+    let s = parse_text(&format!(
+        "seed = 0x10\nmax_steps = 1_000\n[world]\n{CUBE}{ONE_POLICY}"
+    ))
+    .expect("integers");
+    assert_eq!((s.seed, s.max_steps), (16, 1000));
+}
+
+/// The battery drop took any level and window: the numbers of
+/// disturbances, `[monte_carlo]` and `[rates]` are finite and in range.
+#[test]
+fn disturbance_and_monte_carlo_numbers_are_finite_and_in_range() {
+    assert_refused(&[
         (
             "",
             "",
@@ -340,6 +372,13 @@ fn numbers_are_finite_integers_where_counted_and_in_range() {
             "[rates]\nPick = nan\n",
             "failure rate of `Pick` must be a finite number",
         ),
+    ]);
+}
+
+/// A condition's numeric arguments are finite and in range.
+#[test]
+fn condition_arguments_are_finite_and_in_range() {
+    assert_refused(&[
         (
             "goal = [{ if = \"Battery-Level\", args = { min = nan } }]\n",
             "",
@@ -358,21 +397,7 @@ fn numbers_are_finite_integers_where_counted_and_in_range() {
             "",
             "s.toml:1:48",
         ),
-    ];
-    for (top, world, tail, want) in cases {
-        let text = format!("{top}[world]\n{CUBE}{world}{ONE_POLICY}{tail}");
-        let all = match parse_text(&text) {
-            Ok(_) => panic!("accepted:\n{text}"),
-            Err(e) => e.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(""),
-        };
-        assert!(all.contains(want), "{text}\n=> {all}");
-    }
-    // Integers written as TOML integers still read, in any radix.
-    let s = parse_text(&format!(
-        "seed = 0x10\nmax_steps = 1_000\n[world]\n{CUBE}{ONE_POLICY}"
-    ))
-    .expect("integers");
-    assert_eq!((s.seed, s.max_steps), (16, 1000));
+    ]);
 }
 
 /// The bindings are positioned by reading the policy again, bounded by

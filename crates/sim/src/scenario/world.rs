@@ -93,7 +93,8 @@ impl Reader {
         Some(out)
     }
 
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    /// `[world]`: the paper's room, with the parameters, obstacles,
+    /// stations, battery, start and objects the scenario sets.
     pub(super) fn world(&mut self, v: Option<&Val<'_>>) -> Option<World> {
         let mut layout = Layout::paper_room();
         let mut params = Params::default();
@@ -118,101 +119,15 @@ impl Reader {
             "field of `world`",
         );
         if let Some(p) = t.get("params") {
-            let pt = self.table(p, "`world.params`")?;
-            self.keys(
-                pt,
-                &(PARAMS.iter().map(|p| p.0))
-                    .chain(["follow_belief"])
-                    .collect::<Vec<_>>(),
-                "world parameter",
-            );
-            for (k, v) in pt.iter() {
-                if k.get_ref().as_ref() == "follow_belief" {
-                    match v.get_ref() {
-                        DeValue::Boolean(b) => params.follow_belief = *b,
-                        _ => self.err(
-                            v.span(),
-                            "`follow_belief` must be true or false",
-                            "write `follow_belief = true`",
-                        ),
-                    }
-                    continue;
-                }
-                let Some(&(name, lo, hi)) = PARAMS.iter().find(|p| p.0 == k.get_ref().as_ref())
-                else {
-                    continue;
-                };
-                let Some(x) = self.number(v, &format!("`{name}`"), lo, hi) else {
-                    continue;
-                };
-                match name {
-                    "max_speed" => params.max_speed = x,
-                    "max_turn_rate" => params.max_turn_rate = x,
-                    "drain_per_m" => params.drain_per_m = x,
-                    "drain_per_s" => params.drain_per_s = x,
-                    "charge_per_s" => params.charge_per_s = x,
-                    "low_battery" => params.low_battery = x,
-                    "camera_range" => params.camera_range = x,
-                    "object_tolerance" => params.object_tolerance = x,
-                    "reach" => params.reach = x,
-                    "stall_s" => params.stall_s = x,
-                    "manipulation_s" => params.manipulation_s = x,
-                    "arm_s" => params.arm_s = x,
-                    _ => {}
-                }
-            }
+            self.world_params(p, &mut params)?;
         }
         if let Some(o) = t.get("obstacles") {
-            let a = self.array(o, "`world.obstacles`")?;
-            if !self.at_most(o.span(), a.len(), MAX_OBSTACLES, "obstacles") {
-                return None;
-            }
-            for ob in a.iter() {
-                if let Some(r) = self.rect(ob) {
-                    placed.push((ob.span(), layout.obstacles.len()));
-                    layout.obstacles.push(r);
-                }
-            }
+            self.obstacles(o, &mut layout, &mut placed)?;
         }
         if let Some(s) = t.get("stations") {
-            let st = self.table(s, "`world.stations`")?;
-            // The paper room's stations count too (a scenario may move them).
-            let new = st
-                .iter()
-                .filter(|(k, _)| layout.station(k.get_ref()).is_none());
-            let n = layout.stations.len() + new.count();
-            if !self.at_most(s.span(), n, MAX_STATIONS, "stations") {
-                return None;
-            }
-            for (k, v) in st.iter() {
-                if let Some(p) = self.point(v, "a station") {
-                    layout.set_station(k.get_ref(), p);
-                }
-            }
-            // Checked after every obstacle is known.
-            for (k, v) in self.table(s, "`world.stations`")?.iter() {
-                let _ = self.pose(
-                    v,
-                    &format!("station `{}`", k.get_ref()),
-                    &layout,
-                    params.robot_radius,
-                );
-            }
+            self.stations(s, &mut layout, params.robot_radius)?;
         }
-        // The room's stations the scenario keeps where they are must stay
-        // free (those it sets were checked above, at their own position).
-        let set: Vec<&str> = match t.get("stations").and_then(|s| s.get_ref().as_table()) {
-            Some(st) => st.iter().map(|(k, _)| k.get_ref().as_ref()).collect(),
-            None => Vec::new(),
-        };
-        let kept: Vec<(String, P2)> = (layout.stations.iter())
-            .filter(|(n, _)| !set.contains(&n.as_str()))
-            .cloned()
-            .collect();
-        for (span, i) in placed {
-            let r = layout.obstacles[i].clone();
-            self.covers_no_station(span, &r, &kept, params.robot_radius, "obstacle");
-        }
+        self.obstacles_clear_of_kept_stations(t, &layout, placed, params.robot_radius);
         if let Some(b) = t.get("battery")
             && let Some(x) = self.number(b, "`battery`", 0.0, 100.0)
         {
@@ -224,53 +139,175 @@ impl Reader {
             robot = p;
         }
         if let Some(ov) = t.get("objects") {
-            let ot = self.table(ov, "`world.objects`")?;
-            if !self.at_most(ov.span(), ot.len(), MAX_OBJECTS, "objects") {
-                return None;
-            }
-            for (k, v) in ot.iter() {
-                let name = k.get_ref().to_string();
-                let Some(ot) = self.table(v, &format!("object `{name}`")) else {
-                    continue;
-                };
-                self.keys(ot, &["at", "found"], "field of an object");
-                let Some(at) = ot.get("at") else {
-                    self.err(
-                        v.span(),
-                        format!("object `{name}` needs `at`"),
-                        "write `at = \"east-table\"` or `at = [1.7, 0.0]`",
-                    );
-                    continue;
-                };
-                let Some(p) = self.pose(
-                    at,
-                    &format!("object `{name}`"),
-                    &layout,
-                    params.robot_radius,
-                ) else {
-                    continue;
-                };
-                let found = match ot.get("found") {
-                    Some(f) => match f.get_ref() {
-                        DeValue::Boolean(b) => *b,
-                        _ => {
-                            self.err(f.span(), "`found` must be true or false", "");
-                            true
-                        }
-                    },
-                    None => true,
-                };
-                // On the table in front of its pose, or on the floor.
-                let place = match layout.surface_near(p, params.robot_radius) {
-                    Some(_) => Place::At(p),
-                    None => Place::Floor(p),
-                };
-                objects.push(Object::new(&name, place, p, found));
-            }
+            objects = self.objects(ov, &layout, params.robot_radius)?;
         }
         let mut w = World::new(layout, params, robot, objects);
         w.battery = battery;
         Some(w)
+    }
+
+    /// `[world] params` into `params` (`None`: not a table).
+    fn world_params(&mut self, p: &Val<'_>, params: &mut Params) -> Option<()> {
+        let pt = self.table(p, "`world.params`")?;
+        self.keys(
+            pt,
+            &(PARAMS.iter().map(|p| p.0))
+                .chain(["follow_belief"])
+                .collect::<Vec<_>>(),
+            "world parameter",
+        );
+        for (k, v) in pt.iter() {
+            if k.get_ref().as_ref() == "follow_belief" {
+                match v.get_ref() {
+                    DeValue::Boolean(b) => params.follow_belief = *b,
+                    _ => self.err(
+                        v.span(),
+                        "`follow_belief` must be true or false",
+                        "write `follow_belief = true`",
+                    ),
+                }
+                continue;
+            }
+            let Some(&(name, lo, hi)) = PARAMS.iter().find(|p| p.0 == k.get_ref().as_ref()) else {
+                continue;
+            };
+            let Some(x) = self.number(v, &format!("`{name}`"), lo, hi) else {
+                continue;
+            };
+            match name {
+                "max_speed" => params.max_speed = x,
+                "max_turn_rate" => params.max_turn_rate = x,
+                "drain_per_m" => params.drain_per_m = x,
+                "drain_per_s" => params.drain_per_s = x,
+                "charge_per_s" => params.charge_per_s = x,
+                "low_battery" => params.low_battery = x,
+                "camera_range" => params.camera_range = x,
+                "object_tolerance" => params.object_tolerance = x,
+                "reach" => params.reach = x,
+                "stall_s" => params.stall_s = x,
+                "manipulation_s" => params.manipulation_s = x,
+                "arm_s" => params.arm_s = x,
+                _ => {}
+            }
+        }
+        Some(())
+    }
+
+    /// `[world] obstacles` added to the layout, each noted in `placed` with
+    /// its span (`None`: not an array, or too many).
+    fn obstacles(
+        &mut self,
+        o: &Val<'_>,
+        layout: &mut Layout,
+        placed: &mut Vec<(Range<usize>, usize)>,
+    ) -> Option<()> {
+        let a = self.array(o, "`world.obstacles`")?;
+        if !self.at_most(o.span(), a.len(), MAX_OBSTACLES, "obstacles") {
+            return None;
+        }
+        for ob in a.iter() {
+            if let Some(r) = self.rect(ob) {
+                placed.push((ob.span(), layout.obstacles.len()));
+                layout.obstacles.push(r);
+            }
+        }
+        Some(())
+    }
+
+    /// `[world.stations]` set in the layout, each checked free once every
+    /// one is placed (`None`: not a table, or too many).
+    fn stations(&mut self, s: &Val<'_>, layout: &mut Layout, radius: f64) -> Option<()> {
+        let st = self.table(s, "`world.stations`")?;
+        // The paper room's stations count too (a scenario may move them).
+        let new = st
+            .iter()
+            .filter(|(k, _)| layout.station(k.get_ref()).is_none());
+        let n = layout.stations.len() + new.count();
+        if !self.at_most(s.span(), n, MAX_STATIONS, "stations") {
+            return None;
+        }
+        for (k, v) in st.iter() {
+            if let Some(p) = self.point(v, "a station") {
+                layout.set_station(k.get_ref(), p);
+            }
+        }
+        // Checked after every obstacle is known.
+        for (k, v) in self.table(s, "`world.stations`")?.iter() {
+            let _ = self.pose(v, &format!("station `{}`", k.get_ref()), layout, radius);
+        }
+        Some(())
+    }
+
+    /// Refuses the obstacles (`placed`) over a station of the room that the
+    /// scenario keeps where it is (those it sets were checked at their own
+    /// position).
+    fn obstacles_clear_of_kept_stations(
+        &mut self,
+        t: &DeTable<'_>,
+        layout: &Layout,
+        placed: Vec<(Range<usize>, usize)>,
+        radius: f64,
+    ) {
+        let set: Vec<&str> = match t.get("stations").and_then(|s| s.get_ref().as_table()) {
+            Some(st) => st.iter().map(|(k, _)| k.get_ref().as_ref()).collect(),
+            None => Vec::new(),
+        };
+        let kept: Vec<(String, P2)> = (layout.stations.iter())
+            .filter(|(n, _)| !set.contains(&n.as_str()))
+            .cloned()
+            .collect();
+        for (span, i) in placed {
+            let r = layout.obstacles[i].clone();
+            self.covers_no_station(span, &r, &kept, radius, "obstacle");
+        }
+    }
+
+    /// `[world.objects]` (`None`: not a table, or too many; an object with
+    /// a problem is left out).
+    fn objects(&mut self, ov: &Val<'_>, layout: &Layout, radius: f64) -> Option<Vec<Object>> {
+        let ot = self.table(ov, "`world.objects`")?;
+        if !self.at_most(ov.span(), ot.len(), MAX_OBJECTS, "objects") {
+            return None;
+        }
+        let mut objects = Vec::new();
+        for (k, v) in ot.iter() {
+            if let Some(o) = self.object(k.get_ref(), v, layout, radius) {
+                objects.push(o);
+            }
+        }
+        Some(objects)
+    }
+
+    /// Object `name`: where it is (`at`, on the table in front of that pose
+    /// or on the floor) and whether it was `found`.
+    fn object(&mut self, name: &str, v: &Val<'_>, layout: &Layout, radius: f64) -> Option<Object> {
+        let ot = self.table(v, &format!("object `{name}`"))?;
+        self.keys(ot, &["at", "found"], "field of an object");
+        let Some(at) = ot.get("at") else {
+            self.err(
+                v.span(),
+                format!("object `{name}` needs `at`"),
+                "write `at = \"east-table\"` or `at = [1.7, 0.0]`",
+            );
+            return None;
+        };
+        let p = self.pose(at, &format!("object `{name}`"), layout, radius)?;
+        let found = match ot.get("found") {
+            Some(f) => match f.get_ref() {
+                DeValue::Boolean(b) => *b,
+                _ => {
+                    self.err(f.span(), "`found` must be true or false", "");
+                    true
+                }
+            },
+            None => true,
+        };
+        // On the table in front of its pose, or on the floor.
+        let place = match layout.surface_near(p, radius) {
+            Some(_) => Place::At(p),
+            None => Place::Floor(p),
+        };
+        Some(Object::new(name, place, p, found))
     }
 
     /// Refuses an obstacle or a `block` over a station (or the robot's

@@ -10,6 +10,7 @@ use btfsm_plan::Domain;
 use btfsm_plan::fact::Fact;
 use serde::Deserialize;
 use std::collections::BTreeMap;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use toml::Spanned;
@@ -147,216 +148,39 @@ pub fn looks_symbolic(text: &str) -> bool {
 
 /// Parses a symbolic scenario from its text (its domain and policies too:
 /// paths relative to `base`, confined as every file a file names).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn parse(
     file: &Arc<SourceFile>,
     base: &Path,
     limits: &Limits,
 ) -> Result<SymScenario, Vec<Diagnostic>> {
-    let raw: Raw = toml::from_str(&file.text).map_err(|e| {
-        let d = Diagnostic::error(format!("invalid symbolic scenario: {}", e.message().trim()))
-            .hint("see docs/guide/sim.md (\"Symbolic simulation\") for the format");
-        vec![match e.span() {
-            Some(s) => d.at(file, s),
-            None => d,
-        }]
-    })?;
-    let mut diags: Vec<Diagnostic> = Vec::new();
-    let mut err = |span: std::ops::Range<usize>, msg: String, hint: String| {
-        diags.push(Diagnostic::error(msg).at(file, span).hint(hint));
+    let raw = read_raw(file)?;
+    let mut pb = Problems {
+        file,
+        diags: Vec::new(),
     };
-    let root = format::source::root_for(limits, base);
-    let resolve = |rel: &str| format::source::resolve(root.as_deref(), base, rel);
-    // The domain.
-    let domain = match resolve(raw.domain.get_ref()) {
-        Ok(p) => {
-            let shown = p.display().to_string();
-            match format::source::read(&p, &shown, limits, true) {
-                Ok(f) => match btfsm_plan::load(&f) {
-                    Ok(d) => Some(d),
-                    Err(ds) => return Err(ds),
-                },
-                Err(ds) => return Err(ds),
-            }
-        }
-        Err(r) => {
-            err(
-                raw.domain.span(),
-                format!(
-                    "domain `{}`: {}",
-                    btfsm_core::sanitize::shown(raw.domain.get_ref()),
-                    r.message
-                ),
-                r.hint,
-            );
-            None
-        }
+    let files = Files {
+        root: format::source::root_for(limits, base),
+        base,
+        limits,
     };
-    let Some(mut domain) = domain else {
-        return Err(diags);
+    let Some(mut domain) = load_domain(&raw.domain, &files, &mut pb)? else {
+        return Err(pb.diags);
     };
     if let Some(t) = &raw.task
         && let Err(e) = domain.select_task(t.get_ref())
     {
-        err(t.span(), e, "name a `[tasks.NAME]` of the domain".into());
+        pb.err(t.span(), e, "name a `[tasks.NAME]` of the domain".into());
     }
-    let facts = |list: &[Spanned<String>],
-                 diags_err: &mut dyn FnMut(std::ops::Range<usize>, String, String)|
-     -> Vec<Fact> {
-        let mut out = Vec::new();
-        for f in list {
-            match domain.ground_fact(f.get_ref()) {
-                Ok(g) => out.push(g),
-                Err((m, h)) => diags_err(f.span(), m, h),
-            }
-        }
-        out
-    };
-    let initial = facts(&raw.facts, &mut err);
-    let mut disturbances = Vec::new();
-    if raw.disturbances.len() > MAX_ENTRIES || raw.policies.len() > MAX_ENTRIES {
-        err(
-            0..0,
-            format!("more than {MAX_ENTRIES} policies or disturbances"),
-            "split the scenario".into(),
-        );
-    }
-    for d in raw.disturbances.iter().take(MAX_ENTRIES) {
-        let set = facts(&d.set, &mut err);
-        let unset = facts(&d.unset, &mut err);
-        disturbances.push(Disturbance {
-            at: d.at,
-            set,
-            unset,
-        });
-    }
+    let initial = ground(&domain, &raw.facts, &mut pb);
+    let disturbances = read_disturbances(&domain, &raw, &mut pb);
     let mut rates = BTreeMap::new();
-    let mut mc = Mc::default();
-    let check_rates =
-        |table: &BTreeMap<String, Spanned<f64>>,
-         out: &mut BTreeMap<String, f64>,
-         err: &mut dyn FnMut(std::ops::Range<usize>, String, String)| {
-            for (name, p) in table {
-                if !domain.actions.iter().any(|a| &a.name == name) {
-                    let h = suggest(name, domain.actions.iter().map(|a| a.name.as_str()));
-                    err(
-                        p.span(),
-                        format!(
-                            "no action `{}` in the domain",
-                            btfsm_core::sanitize::shown(name)
-                        ),
-                        h,
-                    );
-                } else if !(0.0..=1.0).contains(p.get_ref()) {
-                    err(
-                        p.span(),
-                        format!("a failure rate is a probability, found {}", p.get_ref()),
-                        "write a number from 0 to 1".into(),
-                    );
-                } else {
-                    out.insert(name.clone(), *p.get_ref());
-                }
-            }
-        };
-    check_rates(&raw.rates, &mut rates, &mut err);
-    if let Some(m) = &raw.monte_carlo {
-        check_rates(&m.rates, &mut mc.rates, &mut err);
-        if let Some(u) = &m.unset {
-            let p = *u.probability.get_ref();
-            if !(0.0..=1.0).contains(&p) {
-                err(
-                    u.probability.span(),
-                    format!("`probability` must be from 0 to 1, found {p}"),
-                    "write e.g. `probability = 0.3`".into(),
-                );
-            }
-            let fs = facts(&u.facts, &mut err);
-            if u.window[0] > u.window[1] {
-                err(
-                    u.probability.span(),
-                    "`window` must be [first, last] with first <= last".into(),
-                    "write e.g. `window = [2, 20]`".into(),
-                );
-            }
-            mc.unset = Some((p, fs, u.window));
-        }
-    }
-    let mut durations = BTreeMap::new();
-    for (name, v) in &raw.durations {
-        if !domain.actions.iter().any(|a| &a.name == name) {
-            let h = suggest(name, domain.actions.iter().map(|a| a.name.as_str()));
-            err(
-                v.span(),
-                format!(
-                    "no action `{}` in the domain",
-                    btfsm_core::sanitize::shown(name)
-                ),
-                h,
-            );
-        } else if *v.get_ref() == 0 || *v.get_ref() > 10_000 {
-            err(
-                v.span(),
-                format!("a duration is 1 to 10000 steps, found {}", v.get_ref()),
-                "write e.g. `Move-To = 3`".into(),
-            );
-        } else {
-            durations.insert(name.clone(), *v.get_ref());
-        }
-    }
-    if raw.max_steps == 0 || raw.max_steps > MAX_STEPS {
-        err(
-            0..0,
-            format!(
-                "`max_steps` must be 1 to {MAX_STEPS}, found {}",
-                raw.max_steps
-            ),
-            "write e.g. `max_steps = 1000`".into(),
-        );
-    }
-    if raw.livelock_repeats < 2 {
-        err(
-            0..0,
-            "`livelock_repeats` must be at least 2".into(),
-            "the default is 3".into(),
-        );
-    }
-    let mut policies = Vec::new();
-    let mut loaded_errors = Vec::new();
-    for p in raw.policies.iter().take(MAX_ENTRIES) {
-        let rel = p.file.get_ref();
-        let path = match resolve(rel) {
-            Ok(x) => x,
-            Err(r) => {
-                err(
-                    p.file.span(),
-                    format!(
-                        "policy file `{}`: {}",
-                        btfsm_core::sanitize::shown(rel),
-                        r.message
-                    ),
-                    r.hint,
-                );
-                continue;
-            }
-        };
-        match format::load(&path, limits) {
-            Ok(l) => match unbound(&domain, &l.policy) {
-                None => policies.push((path, l.policy)),
-                Some(why) => err(
-                    p.file.span(),
-                    format!("policy `{}`: {why}", btfsm_core::sanitize::shown(rel)),
-                    format!(
-                        "bind every leaf to a skill that domain `{}` has a predicate or action for",
-                        btfsm_core::sanitize::shown(&domain.name)
-                    ),
-                ),
-            },
-            Err(ds) => loaded_errors.extend(ds),
-        }
-    }
-    diags.extend(loaded_errors);
-    if !diags.is_empty() {
-        return Err(diags);
+    check_rates(&domain, &raw.rates, &mut rates, &mut pb);
+    let mc = read_mc(&domain, raw.monte_carlo.as_ref(), &mut pb);
+    let durations = read_durations(&domain, &raw.durations, &mut pb);
+    check_bounds(&raw, &mut pb);
+    let policies = load_policies(&domain, &raw.policies, &files, &mut pb);
+    if !pb.diags.is_empty() {
+        return Err(pb.diags);
     }
     Ok(SymScenario {
         name: raw.name,
@@ -374,6 +198,274 @@ pub fn parse(
         disturbances,
         mc,
     })
+}
+
+/// The problems found in a symbolic scenario, positioned in its file.
+struct Problems<'f> {
+    file: &'f Arc<SourceFile>,
+    diags: Vec<Diagnostic>,
+}
+
+impl Problems<'_> {
+    /// An error at `span` of the scenario, with a hint.
+    fn err(&mut self, span: Range<usize>, msg: String, hint: String) {
+        self.diags
+            .push(Diagnostic::error(msg).at(self.file, span).hint(hint));
+    }
+}
+
+/// Where the files a scenario names are read: relative to `base`, inside
+/// `root` when there is one, within `limits`.
+struct Files<'a> {
+    root: Option<PathBuf>,
+    base: &'a Path,
+    limits: &'a Limits,
+}
+
+impl Files<'_> {
+    /// The path of a file the scenario names.
+    fn resolve(&self, rel: &str) -> Result<PathBuf, format::source::Refusal> {
+        format::source::resolve(self.root.as_deref(), self.base, rel)
+    }
+}
+
+/// The scenario's TOML as written (a syntax or type error is the one
+/// diagnostic).
+fn read_raw(file: &Arc<SourceFile>) -> Result<Raw, Vec<Diagnostic>> {
+    toml::from_str(&file.text).map_err(|e| {
+        let d = Diagnostic::error(format!("invalid symbolic scenario: {}", e.message().trim()))
+            .hint("see docs/guide/sim.md (\"Symbolic simulation\") for the format");
+        vec![match e.span() {
+            Some(s) => d.at(file, s),
+            None => d,
+        }]
+    })
+}
+
+/// Loads the scenario's domain: `Ok(None)` (with an error) when its path
+/// is refused, `Err` with the domain file's own problems.
+fn load_domain(
+    domain: &Spanned<String>,
+    files: &Files<'_>,
+    pb: &mut Problems<'_>,
+) -> Result<Option<Domain>, Vec<Diagnostic>> {
+    match files.resolve(domain.get_ref()) {
+        Ok(p) => {
+            let shown = p.display().to_string();
+            let f = format::source::read(&p, &shown, files.limits, true)?;
+            btfsm_plan::load(&f).map(Some)
+        }
+        Err(r) => {
+            pb.err(
+                domain.span(),
+                format!(
+                    "domain `{}`: {}",
+                    btfsm_core::sanitize::shown(domain.get_ref()),
+                    r.message
+                ),
+                r.hint,
+            );
+            Ok(None)
+        }
+    }
+}
+
+/// Grounds facts written as text in the domain (an error for each that
+/// does not ground).
+fn ground(domain: &Domain, list: &[Spanned<String>], pb: &mut Problems<'_>) -> Vec<Fact> {
+    let mut out = Vec::new();
+    for f in list {
+        match domain.ground_fact(f.get_ref()) {
+            Ok(g) => out.push(g),
+            Err((m, h)) => pb.err(f.span(), m, h),
+        }
+    }
+    out
+}
+
+/// The disturbances, their facts grounded (at most [`MAX_ENTRIES`]; more
+/// policies or disturbances are an error).
+fn read_disturbances(domain: &Domain, raw: &Raw, pb: &mut Problems<'_>) -> Vec<Disturbance> {
+    let mut disturbances = Vec::new();
+    if raw.disturbances.len() > MAX_ENTRIES || raw.policies.len() > MAX_ENTRIES {
+        pb.err(
+            0..0,
+            format!("more than {MAX_ENTRIES} policies or disturbances"),
+            "split the scenario".into(),
+        );
+    }
+    for d in raw.disturbances.iter().take(MAX_ENTRIES) {
+        let set = ground(domain, &d.set, pb);
+        let unset = ground(domain, &d.unset, pb);
+        disturbances.push(Disturbance {
+            at: d.at,
+            set,
+            unset,
+        });
+    }
+    disturbances
+}
+
+/// Whether the domain has an action `name` (if not, an error at `span`
+/// with the nearest name).
+fn known_action(domain: &Domain, name: &str, span: Range<usize>, pb: &mut Problems<'_>) -> bool {
+    if domain.actions.iter().any(|a| a.name == name) {
+        return true;
+    }
+    let h = suggest(name, domain.actions.iter().map(|a| a.name.as_str()));
+    pb.err(
+        span,
+        format!(
+            "no action `{}` in the domain",
+            btfsm_core::sanitize::shown(name)
+        ),
+        h,
+    );
+    false
+}
+
+/// Checks a table of failure rates (actions of the domain, probabilities)
+/// into `out`.
+fn check_rates(
+    domain: &Domain,
+    table: &BTreeMap<String, Spanned<f64>>,
+    out: &mut BTreeMap<String, f64>,
+    pb: &mut Problems<'_>,
+) {
+    for (name, p) in table {
+        if !known_action(domain, name, p.span(), pb) {
+            continue;
+        }
+        if !(0.0..=1.0).contains(p.get_ref()) {
+            pb.err(
+                p.span(),
+                format!("a failure rate is a probability, found {}", p.get_ref()),
+                "write a number from 0 to 1".into(),
+            );
+        } else {
+            out.insert(name.clone(), *p.get_ref());
+        }
+    }
+}
+
+/// The `[monte_carlo]` table: its rates and the fact it may unset.
+fn read_mc(domain: &Domain, m: Option<&RawMc>, pb: &mut Problems<'_>) -> Mc {
+    let mut mc = Mc::default();
+    let Some(m) = m else {
+        return mc;
+    };
+    check_rates(domain, &m.rates, &mut mc.rates, pb);
+    if let Some(u) = &m.unset {
+        let p = *u.probability.get_ref();
+        if !(0.0..=1.0).contains(&p) {
+            pb.err(
+                u.probability.span(),
+                format!("`probability` must be from 0 to 1, found {p}"),
+                "write e.g. `probability = 0.3`".into(),
+            );
+        }
+        let fs = ground(domain, &u.facts, pb);
+        if u.window[0] > u.window[1] {
+            pb.err(
+                u.probability.span(),
+                "`window` must be [first, last] with first <= last".into(),
+                "write e.g. `window = [2, 20]`".into(),
+            );
+        }
+        mc.unset = Some((p, fs, u.window));
+    }
+    mc
+}
+
+/// The steps per action (actions of the domain, 1 to 10000 steps).
+fn read_durations(
+    domain: &Domain,
+    table: &BTreeMap<String, Spanned<u32>>,
+    pb: &mut Problems<'_>,
+) -> BTreeMap<String, u32> {
+    let mut durations = BTreeMap::new();
+    for (name, v) in table {
+        if !known_action(domain, name, v.span(), pb) {
+            continue;
+        }
+        if *v.get_ref() == 0 || *v.get_ref() > 10_000 {
+            pb.err(
+                v.span(),
+                format!("a duration is 1 to 10000 steps, found {}", v.get_ref()),
+                "write e.g. `Move-To = 3`".into(),
+            );
+        } else {
+            durations.insert(name.clone(), *v.get_ref());
+        }
+    }
+    durations
+}
+
+/// Checks `max_steps` and `livelock_repeats`.
+fn check_bounds(raw: &Raw, pb: &mut Problems<'_>) {
+    if raw.max_steps == 0 || raw.max_steps > MAX_STEPS {
+        pb.err(
+            0..0,
+            format!(
+                "`max_steps` must be 1 to {MAX_STEPS}, found {}",
+                raw.max_steps
+            ),
+            "write e.g. `max_steps = 1000`".into(),
+        );
+    }
+    if raw.livelock_repeats < 2 {
+        pb.err(
+            0..0,
+            "`livelock_repeats` must be at least 2".into(),
+            "the default is 3".into(),
+        );
+    }
+}
+
+/// Loads the policies (at most [`MAX_ENTRIES`]), each checked to run in the
+/// domain's world; the policy files' own problems come after the others.
+fn load_policies(
+    domain: &Domain,
+    list: &[RawPolicy],
+    files: &Files<'_>,
+    pb: &mut Problems<'_>,
+) -> Vec<(PathBuf, Policy)> {
+    let mut policies = Vec::new();
+    let mut loaded_errors = Vec::new();
+    for p in list.iter().take(MAX_ENTRIES) {
+        let rel = p.file.get_ref();
+        let path = match files.resolve(rel) {
+            Ok(x) => x,
+            Err(r) => {
+                pb.err(
+                    p.file.span(),
+                    format!(
+                        "policy file `{}`: {}",
+                        btfsm_core::sanitize::shown(rel),
+                        r.message
+                    ),
+                    r.hint,
+                );
+                continue;
+            }
+        };
+        match format::load(&path, files.limits) {
+            Ok(l) => match unbound(domain, &l.policy) {
+                None => policies.push((path, l.policy)),
+                Some(why) => pb.err(
+                    p.file.span(),
+                    format!("policy `{}`: {why}", btfsm_core::sanitize::shown(rel)),
+                    format!(
+                        "bind every leaf to a skill that domain `{}` has a predicate or action for",
+                        btfsm_core::sanitize::shown(&domain.name)
+                    ),
+                ),
+            },
+            Err(ds) => loaded_errors.extend(ds),
+        }
+    }
+    pb.diags.extend(loaded_errors);
+    policies
 }
 
 /// Why a policy cannot run in the domain's world (a leaf or guard bound to
