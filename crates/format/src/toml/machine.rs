@@ -54,6 +54,8 @@ struct Reading<'t, 'i> {
 }
 
 impl Loader {
+    /// Reads an FSM (or, `hierarchical`, an HFSM) document, collecting every
+    /// problem at once.
     pub(super) fn machine<'t, 'i>(
         &mut self,
         cx: &Ctx<'_>,
