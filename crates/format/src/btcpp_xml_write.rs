@@ -46,7 +46,6 @@ fn is_xml_name(s: &str) -> bool {
         && c.all(|ch| ch.is_ascii_alphanumeric() || matches!(ch, '_' | '-' | '.'))
 }
 
-/// The type a node is written as, and its category when it is not built in.
 /// A format-3 blackboard reference `${key}` as format 4 writes it, `{key}`.
 fn v4_port(v: &str) -> String {
     match v.strip_prefix("${").and_then(|r| r.strip_suffix('}')) {
@@ -55,6 +54,7 @@ fn v4_port(v: &str) -> String {
     }
 }
 
+/// The type a node is written as, and its category when it is not built in.
 fn node_type(n: &BtNode) -> (String, Category) {
     let cat = match n.kind {
         BtNodeKind::Action => Category::Action,
@@ -84,7 +84,7 @@ fn node_type(n: &BtNode) -> (String, Category) {
     (ty, cat)
 }
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+/// XML text of BT `bt` named `name`.
 fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
     let types: Vec<(String, Category)> = bt.nodes.iter().map(node_type).collect();
     // The `name` attribute: written when the label is not the type.
@@ -115,7 +115,22 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
     }
     out.push_str(">\n");
     let _ = writeln!(out, "  <BehaviorTree ID=\"{}\">", escape_attr(name));
-    // Pre-order with explicit close events (no recursion).
+    write_nodes(&mut out, bt, &types, &names, &explicit);
+    out.push_str("  </BehaviorTree>\n");
+    write_nodes_model(&mut out, bt, &types);
+    out.push_str("</root>\n");
+    out
+}
+
+/// Writes the tree's elements in pre-order, with explicit close events (no
+/// recursion).
+fn write_nodes(
+    out: &mut String,
+    bt: &Bt,
+    types: &[(String, Category)],
+    names: &[Option<String>],
+    explicit: &[bool],
+) {
     let mut stack: Vec<(usize, usize, bool)> = vec![(bt.root, 2, false)];
     while let Some((i, depth, close)) = stack.pop() {
         let n = &bt.nodes[i];
@@ -133,39 +148,7 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
             let _ = writeln!(out, "{pad}</{end}>");
             continue;
         }
-        let mut attrs: Vec<(String, String)> = Vec::new();
-        if let Some(nm) = &names[i] {
-            attrs.push(("name".into(), nm.clone()));
-        }
-        if explicit[i] {
-            attrs.push(("btfsm:id".into(), n.id.clone()));
-        }
-        match n.kind {
-            BtNodeKind::Parallel { success } if n.type_name.is_none() => {
-                attrs.push(("success_count".into(), success.to_string()));
-                // The paper's Parallel fails when it can no longer succeed.
-                if !n.ports.contains_key("failure_count") {
-                    let fail = n.children.len().saturating_sub(success) + 1;
-                    attrs.push(("failure_count".into(), fail.to_string()));
-                }
-            }
-            BtNodeKind::Repeat { times } => attrs.push((
-                "num_cycles".into(),
-                times.map_or("-1".to_string(), |t| t.to_string()),
-            )),
-            BtNodeKind::Retry { times } => attrs.push(("num_attempts".into(), times.to_string())),
-            BtNodeKind::Timeout { ms } => attrs.push(("msec".into(), ms.to_string())),
-            _ => {}
-        }
-        if let Some(call) = &n.skill {
-            for (k, v) in &call.args {
-                attrs.push((k.clone(), v.to_string()));
-            }
-        }
-        for (k, v) in &n.ports {
-            attrs.push((k.clone(), v4_port(v)));
-        }
-        let attr_text: String = attrs
+        let attr_text: String = node_attrs(n, names[i].as_ref(), explicit[i])
             .iter()
             .map(|(k, v)| format!(" {k}=\"{}\"", escape_attr(v)))
             .collect();
@@ -179,10 +162,51 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
             }
         }
     }
-    out.push_str("  </BehaviorTree>\n");
-    // Types that are not built in, with the ports they are given.
+}
+
+/// A node's attributes, unescaped: its `name`, its id when not derived
+/// (`btfsm:id`), its kind's parameters, skill arguments and ports.
+fn node_attrs(n: &BtNode, name: Option<&String>, explicit: bool) -> Vec<(String, String)> {
+    let mut attrs: Vec<(String, String)> = Vec::new();
+    if let Some(nm) = name {
+        attrs.push(("name".into(), nm.clone()));
+    }
+    if explicit {
+        attrs.push(("btfsm:id".into(), n.id.clone()));
+    }
+    match n.kind {
+        BtNodeKind::Parallel { success } if n.type_name.is_none() => {
+            attrs.push(("success_count".into(), success.to_string()));
+            // The paper's Parallel fails when it can no longer succeed.
+            if !n.ports.contains_key("failure_count") {
+                let fail = n.children.len().saturating_sub(success) + 1;
+                attrs.push(("failure_count".into(), fail.to_string()));
+            }
+        }
+        BtNodeKind::Repeat { times } => attrs.push((
+            "num_cycles".into(),
+            times.map_or("-1".to_string(), |t| t.to_string()),
+        )),
+        BtNodeKind::Retry { times } => attrs.push(("num_attempts".into(), times.to_string())),
+        BtNodeKind::Timeout { ms } => attrs.push(("msec".into(), ms.to_string())),
+        _ => {}
+    }
+    if let Some(call) = &n.skill {
+        for (k, v) in &call.args {
+            attrs.push((k.clone(), v.to_string()));
+        }
+    }
+    for (k, v) in &n.ports {
+        attrs.push((k.clone(), v4_port(v)));
+    }
+    attrs
+}
+
+/// Writes `<TreeNodesModel>`: the types that are not built in, with the
+/// ports they are given.
+fn write_nodes_model(out: &mut String, bt: &Bt, types: &[(String, Category)]) {
     let mut model: BTreeMap<String, (Category, BTreeSet<String>)> = BTreeMap::new();
-    for (n, (ty, cat)) in bt.nodes.iter().zip(&types) {
+    for (n, (ty, cat)) in bt.nodes.iter().zip(types) {
         if BUILTINS.iter().any(|(b, _)| b == ty) {
             continue;
         }
@@ -214,8 +238,6 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
         }
         out.push_str("  </TreeNodesModel>\n");
     }
-    out.push_str("</root>\n");
-    out
 }
 
 #[cfg(test)]

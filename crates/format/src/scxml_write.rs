@@ -21,7 +21,9 @@
 
 use super::scxml::guard_label;
 use super::xml::{BTFSM_NS, escape_attr, escape_comment};
-use btfsm_model::{Policy, PolicyBody, Pseudo, StateBody, StateMachine, Target, Trigger};
+use btfsm_model::{
+    Policy, PolicyBody, Pseudo, StateBody, StateMachine, Target, Transition, Trigger,
+};
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
@@ -105,102 +107,147 @@ fn outcome_index(outcomes: &[String]) -> HashMap<&str, usize> {
     at
 }
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
-fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> String {
-    // Names of every state and every final; ids must be unique.
-    let mut count: HashMap<&str, usize> = HashMap::new();
-    for s in &m.states {
-        *count.entry(s.name.as_str()).or_default() += 1;
-        if let StateBody::Container(r) = &s.body {
-            for o in &r.outcomes {
-                *count.entry(o.as_str()).or_default() += 1;
-            }
-        }
-    }
-    for o in &m.top.outcomes {
-        *count.entry(o.as_str()).or_default() += 1;
-    }
-    let mut used: HashSet<String> = HashSet::new();
-    // Per clashing candidate, the next suffix to try (no rescans from 2).
-    let mut next_suffix: HashMap<String, usize> = HashMap::new();
-    let mut unique = |cand: String| {
+/// Unique SCXML ids handed out in turn: a clashing candidate gets the next
+/// free `~k` suffix.
+#[derive(Default)]
+struct UniqueIds {
+    used: HashSet<String>,
+    /// Per clashing candidate, the next suffix to try (no rescans from 2).
+    next_suffix: HashMap<String, usize>,
+}
+
+impl UniqueIds {
+    /// The id for a name: the name as an XML id, made unique.
+    fn unique(&mut self, cand: String) -> String {
         let cand = xml_id(&cand);
         let mut id = cand.clone();
-        if used.contains(&id) {
-            let k = next_suffix.entry(cand.clone()).or_insert(2);
+        if self.used.contains(&id) {
+            let k = self.next_suffix.entry(cand.clone()).or_insert(2);
             loop {
                 id = format!("{cand}~{k}");
                 *k += 1;
-                if !used.contains(&id) {
+                if !self.used.contains(&id) {
                     break;
                 }
             }
         }
-        used.insert(id.clone());
+        self.used.insert(id.clone());
         id
-    };
-    // Length of each state's path, without building it.
-    let mut path_len: Vec<usize> = vec![0; m.states.len()];
-    for c in m.parents_first() {
-        let own = m.states[c].name.len();
-        path_len[c] = m.states[c].parent.map_or(own, |p| path_len[p] + 1 + own);
     }
-    // Top-level finals keep their names (they are vertices, keyed by name).
-    let top_final: Vec<String> = m.top.outcomes.iter().map(|o| unique(o.clone())).collect();
-    let state_id: Vec<String> = (0..m.states.len())
-        .map(|i| {
-            let n = &m.states[i].name;
-            unique(if count[n.as_str()] == 1 {
-                n.clone()
-            } else if path_len[i] <= MAX_PATH_ID_BYTES {
-                m.path(i)
-            } else {
-                format!("s{i}")
+}
+
+/// The ids of a machine's elements: every state's, the finals of every
+/// container and of the top region, and where each outcome's final is.
+struct Ids<'m> {
+    state: Vec<String>,
+    /// Per state, the ids of its finals (a container's outcomes).
+    finals: Vec<Vec<String>>,
+    top_final: Vec<String>,
+    top_at: HashMap<&'m str, usize>,
+    /// Per state, where each outcome of its region is (containers only).
+    region_at: Vec<Option<HashMap<&'m str, usize>>>,
+}
+
+impl<'m> Ids<'m> {
+    /// Gives every state and final an id: its name when no other has it,
+    /// else its path while short enough, else a generated one.
+    fn of(m: &'m StateMachine) -> Ids<'m> {
+        // Names of every state and every final; ids must be unique.
+        let mut count: HashMap<&str, usize> = HashMap::new();
+        for s in &m.states {
+            *count.entry(s.name.as_str()).or_default() += 1;
+            if let StateBody::Container(r) = &s.body {
+                for o in &r.outcomes {
+                    *count.entry(o.as_str()).or_default() += 1;
+                }
+            }
+        }
+        for o in &m.top.outcomes {
+            *count.entry(o.as_str()).or_default() += 1;
+        }
+        let mut ids = UniqueIds::default();
+        // Length of each state's path, without building it.
+        let mut path_len: Vec<usize> = vec![0; m.states.len()];
+        for c in m.parents_first() {
+            let own = m.states[c].name.len();
+            path_len[c] = m.states[c].parent.map_or(own, |p| path_len[p] + 1 + own);
+        }
+        // Top-level finals keep their names (they are vertices, keyed by name).
+        let top_final: Vec<String> = m
+            .top
+            .outcomes
+            .iter()
+            .map(|o| ids.unique(o.clone()))
+            .collect();
+        let state: Vec<String> = (0..m.states.len())
+            .map(|i| {
+                let n = &m.states[i].name;
+                ids.unique(if count[n.as_str()] == 1 {
+                    n.clone()
+                } else if path_len[i] <= MAX_PATH_ID_BYTES {
+                    m.path(i)
+                } else {
+                    format!("s{i}")
+                })
             })
-        })
-        .collect();
-    let final_id: Vec<Vec<String>> = (0..m.states.len())
-        .map(|i| match &m.states[i].body {
-            StateBody::Container(r) => r
-                .outcomes
-                .iter()
-                .enumerate()
-                .map(|(k, o)| {
-                    unique(if count[o.as_str()] == 1 {
-                        o.clone()
-                    } else if path_len[i] + 1 + o.len() <= MAX_PATH_ID_BYTES {
-                        format!("{}/{o}", m.path(i))
-                    } else {
-                        format!("f{i}_{k}")
+            .collect();
+        let finals: Vec<Vec<String>> = (0..m.states.len())
+            .map(|i| match &m.states[i].body {
+                StateBody::Container(r) => r
+                    .outcomes
+                    .iter()
+                    .enumerate()
+                    .map(|(k, o)| {
+                        ids.unique(if count[o.as_str()] == 1 {
+                            o.clone()
+                        } else if path_len[i] + 1 + o.len() <= MAX_PATH_ID_BYTES {
+                            format!("{}/{o}", m.path(i))
+                        } else {
+                            format!("f{i}_{k}")
+                        })
                     })
+                    .collect(),
+                _ => vec![],
+            })
+            .collect();
+        Ids {
+            state,
+            finals,
+            top_final,
+            top_at: outcome_index(&m.top.outcomes),
+            region_at: m
+                .states
+                .iter()
+                .map(|s| match &s.body {
+                    StateBody::Container(r) => Some(outcome_index(&r.outcomes)),
+                    _ => None,
                 })
                 .collect(),
-            _ => vec![],
-        })
-        .collect();
-    let top_at = outcome_index(&m.top.outcomes);
-    let region_at: Vec<Option<HashMap<&str, usize>>> = m
-        .states
-        .iter()
-        .map(|s| match &s.body {
-            StateBody::Container(r) => Some(outcome_index(&r.outcomes)),
-            _ => None,
-        })
-        .collect();
-    let mut out = String::new();
-    // The final id of outcome `o` in the region of container `owner`
-    // (`None`: the top region).
-    let outcome_id = |owner: Option<usize>, o: &str| -> String {
+        }
+    }
+
+    /// The final id of outcome `o` in the region of container `owner`
+    /// (`None`: the top region).
+    fn outcome(&self, owner: Option<usize>, o: &str) -> String {
         match owner {
-            None => top_at
+            None => self
+                .top_at
                 .get(o)
-                .map_or(o.to_string(), |&k| top_final[k].clone()),
-            Some(p) => match &region_at[p] {
-                Some(at) => at.get(o).map_or(o.to_string(), |&k| final_id[p][k].clone()),
+                .map_or(o.to_string(), |&k| self.top_final[k].clone()),
+            Some(p) => match &self.region_at[p] {
+                Some(at) => at
+                    .get(o)
+                    .map_or(o.to_string(), |&k| self.finals[p][k].clone()),
                 None => o.to_string(),
             },
         }
-    };
+    }
+}
+
+/// SCXML text of machine `m` named `name`.
+fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> String {
+    let ids = Ids::of(m);
+    let mut out = String::new();
     // Pre-order with close events.
     let mut stack: Vec<(usize, usize, bool)> =
         m.top.states.iter().rev().map(|&s| (s, 1, false)).collect();
@@ -218,7 +265,7 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             if let StateBody::Container(r) = &s.body
                 && !r.parallel
             {
-                for (k, fid) in final_id[i].iter().enumerate() {
+                for (k, fid) in ids.finals[i].iter().enumerate() {
                     let _ = write!(out, "{pad}  <final id=\"{}\"", escape_attr(fid));
                     if *fid != r.outcomes[k] {
                         let _ = write!(out, " btfsm:name=\"{}\"", escape_attr(&r.outcomes[k]));
@@ -229,52 +276,7 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             let _ = writeln!(out, "{pad}</{tag}>");
             continue;
         }
-        let mut attrs = format!(" id=\"{}\"", escape_attr(&state_id[i]));
-        match s.pseudo {
-            Some(Pseudo::ShallowHistory) => attrs.push_str(" type=\"shallow\""),
-            Some(Pseudo::DeepHistory) => attrs.push_str(" type=\"deep\""),
-            None => {}
-        }
-        if let StateBody::Container(r) = &s.body
-            && !r.parallel
-        {
-            let init = match &r.initial {
-                Target::State(j) => state_id[*j].clone(),
-                Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
-                    outcome_id(Some(i), o)
-                }
-            };
-            let _ = write!(attrs, " initial=\"{}\"", escape_attr(&init));
-        }
-        // A parallel state's outcomes (yasmin's OrthogonalState; SCXML's
-        // `<parallel>` holds no `<final>`).
-        if let StateBody::Container(r) = &s.body
-            && r.parallel
-            && !r.outcomes.is_empty()
-        {
-            let _ = write!(
-                attrs,
-                " btfsm:outcomes=\"{}\"",
-                escape_attr(&r.outcomes.join(" "))
-            );
-        }
-        if state_id[i] != s.name {
-            let _ = write!(attrs, " btfsm:name=\"{}\"", escape_attr(&s.name));
-        }
-        if s.label != s.name {
-            let _ = write!(attrs, " btfsm:label=\"{}\"", escape_attr(&s.label));
-        }
-        match &s.body {
-            StateBody::Task(Some(call)) => {
-                let _ = write!(attrs, " btfsm:skill=\"{}\"", escape_attr(&call.skill));
-                for (k, v) in &call.args {
-                    let _ = write!(attrs, " btfsm:arg.{k}=\"{}\"", escape_attr(&v.to_string()));
-                }
-            }
-            StateBody::Decision if s.pseudo.is_none() => attrs.push_str(" btfsm:decision=\"true\""),
-            _ => {}
-        }
-        let _ = writeln!(out, "{pad}<{tag}{attrs}>");
+        let _ = writeln!(out, "{pad}<{tag}{}>", state_attrs(&ids, m, i));
         // Outcomes the reader takes an `event` for (see `format::scxml`).
         let outcomes: Vec<&str> = match &s.body {
             StateBody::Container(r) => r.outcomes.iter().map(String::as_str).collect(),
@@ -282,49 +284,7 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             StateBody::Task(_) => vec!["SUCCESS", "FAILURE", "RUNNING"],
         };
         for t in &s.transitions {
-            let (event, cond) = match &t.trigger {
-                Trigger::Outcome(o) => (Some(o.as_str()), None),
-                Trigger::Guard(g) => split_label(&g.label),
-            };
-            // What SCXML cannot say, in btfsm's namespace: the exact label,
-            // the library conditions, and a guard that looks like an outcome.
-            let mut extra = String::new();
-            if let Trigger::Guard(g) = &t.trigger {
-                if guard_label(event, cond) != g.label {
-                    let _ = write!(extra, " btfsm:label=\"{}\"", escape_attr(&g.label));
-                }
-                if !g.all.is_empty() {
-                    let terms: Vec<String> = g.all.iter().map(ToString::to_string).collect();
-                    let _ = write!(extra, " btfsm:terms=\"{}\"", escape_attr(&terms.join("; ")));
-                }
-                if cond.is_none() && event.is_some_and(|e| outcomes.contains(&e)) {
-                    extra.push_str(" btfsm:guard=\"true\"");
-                }
-            }
-            // An outcome the reader would take for an event (a state without
-            // a skill returns any outcome, as yasmin states do).
-            if let Trigger::Outcome(o) = &t.trigger
-                && !outcomes.contains(&o.as_str())
-            {
-                extra.push_str(" btfsm:outcome=\"true\"");
-            }
-            let target = match &t.target {
-                Target::State(j) => state_id[*j].clone(),
-                Target::Outcome(o) => outcome_id(s.parent, o),
-                Target::OuterOutcome { owner, outcome } => outcome_id(*owner, outcome),
-            };
-            let mut ta = String::new();
-            if let Some(e) = event {
-                let _ = write!(ta, " event=\"{}\"", escape_attr(e));
-            }
-            if let Some(c) = cond {
-                let _ = write!(ta, " cond=\"{}\"", escape_attr(c));
-            }
-            let _ = writeln!(
-                out,
-                "{pad}  <transition{ta} target=\"{}\"{extra}/>",
-                escape_attr(&target)
-            );
+            write_transition(&mut out, &ids, s.parent, t, &outcomes, &pad);
         }
         stack.push((i, depth, true));
         if let StateBody::Container(r) = &s.body {
@@ -333,7 +293,7 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
             }
         }
     }
-    for (fid, o) in top_final.iter().zip(&m.top.outcomes) {
+    for (fid, o) in ids.top_final.iter().zip(&m.top.outcomes) {
         let _ = write!(out, "  <final id=\"{}\"", escape_attr(fid));
         if fid != o {
             let _ = write!(out, " btfsm:name=\"{}\"", escape_attr(o));
@@ -351,8 +311,8 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
         "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" name=\"{}\" initial=\"{}\"",
         escape_attr(name),
         escape_attr(&match &m.top.initial {
-            Target::State(j) => state_id[*j].clone(),
-            Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => outcome_id(None, o),
+            Target::State(j) => ids.state[*j].clone(),
+            Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => ids.outcome(None, o),
         })
     );
     if out.contains(" btfsm:") {
@@ -360,6 +320,112 @@ fn write_machine(name: &str, description: Option<&str>, m: &StateMachine) -> Str
     }
     head.push_str(">\n");
     head + &out
+}
+
+/// The attributes of state `i`'s start tag: id, history type, initial,
+/// and in btfsm's namespace a parallel state's outcomes, name, label,
+/// skill binding and decision flag.
+fn state_attrs(ids: &Ids<'_>, m: &StateMachine, i: usize) -> String {
+    let s = &m.states[i];
+    let mut attrs = format!(" id=\"{}\"", escape_attr(&ids.state[i]));
+    match s.pseudo {
+        Some(Pseudo::ShallowHistory) => attrs.push_str(" type=\"shallow\""),
+        Some(Pseudo::DeepHistory) => attrs.push_str(" type=\"deep\""),
+        None => {}
+    }
+    if let StateBody::Container(r) = &s.body
+        && !r.parallel
+    {
+        let init = match &r.initial {
+            Target::State(j) => ids.state[*j].clone(),
+            Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => ids.outcome(Some(i), o),
+        };
+        let _ = write!(attrs, " initial=\"{}\"", escape_attr(&init));
+    }
+    // A parallel state's outcomes (yasmin's OrthogonalState; SCXML's
+    // `<parallel>` holds no `<final>`).
+    if let StateBody::Container(r) = &s.body
+        && r.parallel
+        && !r.outcomes.is_empty()
+    {
+        let _ = write!(
+            attrs,
+            " btfsm:outcomes=\"{}\"",
+            escape_attr(&r.outcomes.join(" "))
+        );
+    }
+    if ids.state[i] != s.name {
+        let _ = write!(attrs, " btfsm:name=\"{}\"", escape_attr(&s.name));
+    }
+    if s.label != s.name {
+        let _ = write!(attrs, " btfsm:label=\"{}\"", escape_attr(&s.label));
+    }
+    match &s.body {
+        StateBody::Task(Some(call)) => {
+            let _ = write!(attrs, " btfsm:skill=\"{}\"", escape_attr(&call.skill));
+            for (k, v) in &call.args {
+                let _ = write!(attrs, " btfsm:arg.{k}=\"{}\"", escape_attr(&v.to_string()));
+            }
+        }
+        StateBody::Decision if s.pseudo.is_none() => attrs.push_str(" btfsm:decision=\"true\""),
+        _ => {}
+    }
+    attrs
+}
+
+/// Writes one `<transition>` of a state whose parent is `parent` and which
+/// returns `outcomes`.
+fn write_transition(
+    out: &mut String,
+    ids: &Ids<'_>,
+    parent: Option<usize>,
+    t: &Transition,
+    outcomes: &[&str],
+    pad: &str,
+) {
+    let (event, cond) = match &t.trigger {
+        Trigger::Outcome(o) => (Some(o.as_str()), None),
+        Trigger::Guard(g) => split_label(&g.label),
+    };
+    // What SCXML cannot say, in btfsm's namespace: the exact label,
+    // the library conditions, and a guard that looks like an outcome.
+    let mut extra = String::new();
+    if let Trigger::Guard(g) = &t.trigger {
+        if guard_label(event, cond) != g.label {
+            let _ = write!(extra, " btfsm:label=\"{}\"", escape_attr(&g.label));
+        }
+        if !g.all.is_empty() {
+            let terms: Vec<String> = g.all.iter().map(ToString::to_string).collect();
+            let _ = write!(extra, " btfsm:terms=\"{}\"", escape_attr(&terms.join("; ")));
+        }
+        if cond.is_none() && event.is_some_and(|e| outcomes.contains(&e)) {
+            extra.push_str(" btfsm:guard=\"true\"");
+        }
+    }
+    // An outcome the reader would take for an event (a state without
+    // a skill returns any outcome, as yasmin states do).
+    if let Trigger::Outcome(o) = &t.trigger
+        && !outcomes.contains(&o.as_str())
+    {
+        extra.push_str(" btfsm:outcome=\"true\"");
+    }
+    let target = match &t.target {
+        Target::State(j) => ids.state[*j].clone(),
+        Target::Outcome(o) => ids.outcome(parent, o),
+        Target::OuterOutcome { owner, outcome } => ids.outcome(*owner, outcome),
+    };
+    let mut ta = String::new();
+    if let Some(e) = event {
+        let _ = write!(ta, " event=\"{}\"", escape_attr(e));
+    }
+    if let Some(c) = cond {
+        let _ = write!(ta, " cond=\"{}\"", escape_attr(c));
+    }
+    let _ = writeln!(
+        out,
+        "{pad}  <transition{ta} target=\"{}\"{extra}/>",
+        escape_attr(&target)
+    );
 }
 
 #[cfg(test)]

@@ -48,138 +48,181 @@ pub struct Repair {
 
 /// The repaired text, its offset map and the repairs made; `None` when there
 /// is nothing to repair.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn repair(text: &str) -> Option<(String, OffsetMap, Vec<Repair>)> {
     let b = text.as_bytes();
-    let mut out = String::with_capacity(text.len() + 64);
-    let mut map = OffsetMap::default();
-    let mut fixes: Vec<Repair> = Vec::new();
-    let mut i = 0;
+    let mut r = Repairer {
+        text,
+        i: 0,
+        out: String::with_capacity(text.len() + 64),
+        map: OffsetMap::default(),
+        fixes: Vec::new(),
+    };
     let mut seen_root = false;
-    // Copies text[from..to] unchanged.
-    let copy = |out: &mut String, from: usize, to: usize| out.push_str(&text[from..to]);
-    while i < b.len() {
-        if text[i..].starts_with("<!--") {
-            // The comment's content ends at `-->` (or at the end of an
-            // unterminated comment, which stays an error): ASCII boundaries.
-            let close = text[i + 4..].find("-->").map(|e| i + 4 + e);
-            let inner_end = close.unwrap_or(b.len());
-            let end = close.map_or(b.len(), |c| c + 3);
-            let inner = &text[i + 4..inner_end];
-            if inner.contains("--") {
-                fixes.push(Repair {
-                    span: i..i + 4,
-                    what: "`--` inside a comment",
-                });
-                out.push_str("<!--");
-                out.push_str(&inner.replace("--", "~~"));
-                out.push_str(&text[inner_end..end]);
-            } else {
-                copy(&mut out, i, end);
-            }
-            i = end;
-        } else if text[i..].starts_with("<![CDATA[") {
-            let end = text[i..].find("]]>").map_or(b.len(), |e| i + e + 3);
-            copy(&mut out, i, end);
-            i = end;
-        } else if text[i..].starts_with("<?") || text[i..].starts_with("<!") {
-            let end = text[i..].find('>').map_or(b.len(), |e| i + e + 1);
-            copy(&mut out, i, end);
-            i = end;
+    while r.i < b.len() {
+        let i = r.i;
+        let rest = &text[i..];
+        if rest.starts_with("<!--") {
+            r.comment();
+        } else if rest.starts_with("<![CDATA[") {
+            r.copy_to(rest.find("]]>").map_or(b.len(), |e| i + e + 3));
+        } else if rest.starts_with("<?") || rest.starts_with("<!") {
+            r.copy_to(rest.find('>').map_or(b.len(), |e| i + e + 1));
         } else if b[i] == b'<' {
-            // A tag: copy up to its end, escaping `&` and `<` inside quoted
-            // attribute values.
             if b.get(i + 1).is_some_and(|c| *c != b'/') {
                 seen_root = true;
             }
-            out.push('<');
-            i += 1;
-            let mut quote: Option<u8> = None;
-            let mut fixed_here = false;
-            while i < b.len() {
-                let c = b[i];
-                match quote {
-                    None if c == b'>' => {
-                        out.push('>');
-                        i += 1;
-                        break;
-                    }
-                    None if c == b'"' || c == b'\'' => quote = Some(c),
-                    Some(q) if c == q => {
-                        quote = None;
-                        out.push(c as char);
-                        i += 1;
-                        // `a="1"b="2"`: a space where the next attribute starts.
-                        if b.get(i)
-                            .is_some_and(|n| n.is_ascii_alphabetic() || *n == b'_')
-                        {
-                            fixes.push(Repair {
-                                span: i..i + 1,
-                                what: "no space between two attributes",
-                            });
-                            out.push(' ');
-                            map.marks.push((out.len(), i));
-                        }
-                        continue;
-                    }
-                    Some(_) if c == b'<' || (c == b'&' && !entity_at(&text[i..])) => {
-                        let (what, escape) = if c == b'<' {
-                            ("a bare `<` in an attribute value", "&lt;")
-                        } else {
-                            ("a bare `&` in an attribute value", "&amp;")
-                        };
-                        if !fixed_here {
-                            fixes.push(Repair {
-                                span: i..i + 1,
-                                what,
-                            });
-                            fixed_here = true;
-                        }
-                        out.push_str(escape);
-                        i += 1;
-                        map.marks.push((out.len(), i));
-                        continue;
-                    }
-                    _ => {}
-                }
-                // Copy one character (UTF-8 aware).
-                let len = utf8_len(c);
-                copy(&mut out, i, (i + len).min(b.len()));
-                i += len;
-            }
-        } else if b[i] == b'&' && !entity_at(&text[i..]) {
-            fixes.push(Repair {
+            r.tag();
+        } else if b[i] == b'&' && !entity_at(rest) {
+            r.fixes.push(Repair {
                 span: i..i + 1,
                 what: "a bare `&` in text",
             });
-            out.push_str("&amp;");
-            i += 1;
-            map.marks.push((out.len(), i));
+            r.escape("&amp;");
         } else if !seen_root && !b[i].is_ascii_whitespace() {
-            // Stray text before the document element: blanked, same length.
-            let end = text[i..].find('<').map_or(b.len(), |e| i + e);
-            let shown_end = text[i..end].find('\n').map_or(end, |e| i + e);
-            fixes.push(Repair {
-                span: i..shown_end,
-                what: "text before the document element",
-            });
-            for ch in text[i..end].chars() {
-                if ch == '\n' || ch == '\r' {
-                    out.push(ch);
-                } else {
-                    for _ in 0..ch.len_utf8() {
-                        out.push(' ');
-                    }
-                }
-            }
-            i = end;
+            r.stray_text();
         } else {
-            let len = utf8_len(b[i]);
-            copy(&mut out, i, (i + len).min(b.len()));
-            i += len;
+            r.copy_char();
         }
     }
+    let Repairer {
+        out, map, fixes, ..
+    } = r;
     (!fixes.is_empty()).then_some((out, map, fixes))
+}
+
+/// A repair under way: the text, how far it is read (`i`), the repaired
+/// text written so far, its offset map and the repairs made.
+struct Repairer<'a> {
+    text: &'a str,
+    i: usize,
+    out: String,
+    map: OffsetMap,
+    fixes: Vec<Repair>,
+}
+
+impl Repairer<'_> {
+    /// Copies the text up to `end` unchanged.
+    fn copy_to(&mut self, end: usize) {
+        self.out.push_str(&self.text[self.i..end]);
+        self.i = end;
+    }
+
+    /// Copies one character (UTF-8 aware).
+    fn copy_char(&mut self) {
+        let b = self.text.as_bytes();
+        let len = utf8_len(b[self.i]);
+        self.out
+            .push_str(&self.text[self.i..(self.i + len).min(b.len())]);
+        self.i += len;
+    }
+
+    /// Writes `escape` for the one character at `i`.
+    fn escape(&mut self, escape: &str) {
+        self.out.push_str(escape);
+        self.i += 1;
+        self.map.marks.push((self.out.len(), self.i));
+    }
+
+    /// A comment, with `--` inside it written `~~`.
+    fn comment(&mut self) {
+        let (text, i) = (self.text, self.i);
+        // The comment's content ends at `-->` (or at the end of an
+        // unterminated comment, which stays an error): ASCII boundaries.
+        let close = text[i + 4..].find("-->").map(|e| i + 4 + e);
+        let inner_end = close.unwrap_or(text.len());
+        let end = close.map_or(text.len(), |c| c + 3);
+        let inner = &text[i + 4..inner_end];
+        if inner.contains("--") {
+            self.fixes.push(Repair {
+                span: i..i + 4,
+                what: "`--` inside a comment",
+            });
+            self.out.push_str("<!--");
+            self.out.push_str(&inner.replace("--", "~~"));
+            self.out.push_str(&text[inner_end..end]);
+            self.i = end;
+        } else {
+            self.copy_to(end);
+        }
+    }
+
+    /// A tag: copied up to its end, escaping `&` and `<` inside quoted
+    /// attribute values (one repair per tag) and putting a space between
+    /// attributes written together.
+    fn tag(&mut self) {
+        let b = self.text.as_bytes();
+        self.out.push('<');
+        self.i += 1;
+        let mut quote: Option<u8> = None;
+        let mut fixed_here = false;
+        while self.i < b.len() {
+            let (c, i) = (b[self.i], self.i);
+            match quote {
+                None if c == b'>' => {
+                    self.out.push('>');
+                    self.i += 1;
+                    break;
+                }
+                None if c == b'"' || c == b'\'' => quote = Some(c),
+                Some(q) if c == q => {
+                    quote = None;
+                    self.out.push(c as char);
+                    self.i += 1;
+                    // `a="1"b="2"`: a space where the next attribute starts.
+                    if b.get(self.i)
+                        .is_some_and(|n| n.is_ascii_alphabetic() || *n == b'_')
+                    {
+                        self.fixes.push(Repair {
+                            span: self.i..self.i + 1,
+                            what: "no space between two attributes",
+                        });
+                        self.out.push(' ');
+                        self.map.marks.push((self.out.len(), self.i));
+                    }
+                    continue;
+                }
+                Some(_) if c == b'<' || (c == b'&' && !entity_at(&self.text[i..])) => {
+                    let (what, escape) = if c == b'<' {
+                        ("a bare `<` in an attribute value", "&lt;")
+                    } else {
+                        ("a bare `&` in an attribute value", "&amp;")
+                    };
+                    if !fixed_here {
+                        self.fixes.push(Repair {
+                            span: i..i + 1,
+                            what,
+                        });
+                        fixed_here = true;
+                    }
+                    self.escape(escape);
+                    continue;
+                }
+                _ => {}
+            }
+            self.copy_char();
+        }
+    }
+
+    /// Stray text before the document element: blanked, same length.
+    fn stray_text(&mut self) {
+        let (text, i) = (self.text, self.i);
+        let end = text[i..].find('<').map_or(text.len(), |e| i + e);
+        let shown_end = text[i..end].find('\n').map_or(end, |e| i + e);
+        self.fixes.push(Repair {
+            span: i..shown_end,
+            what: "text before the document element",
+        });
+        for ch in text[i..end].chars() {
+            if ch == '\n' || ch == '\r' {
+                self.out.push(ch);
+            } else {
+                for _ in 0..ch.len_utf8() {
+                    self.out.push(' ');
+                }
+            }
+        }
+        self.i = end;
+    }
 }
 
 fn utf8_len(first: u8) -> usize {

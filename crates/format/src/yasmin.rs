@@ -39,7 +39,7 @@ use btfsm_core::diagnostic::{Diagnostic, SourceFile};
 use btfsm_model::{
     Policy, PolicyBody, Region, State, StateBody, StateMachine, Target, Transition, Trigger,
 };
-use std::collections::{HashMap, VecDeque};
+use std::collections::{HashMap, HashSet, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -104,6 +104,13 @@ struct Pending {
     depth: usize,
     /// Canonical paths of the files included on the way here (cycles).
     chain: Vec<PathBuf>,
+}
+
+/// The states of one machine element: by name, and as `(element, state)`
+/// in document order.
+struct MachineStates {
+    names: HashMap<String, usize>,
+    made: Vec<(usize, usize)>,
 }
 
 struct Reader<'l> {
@@ -194,163 +201,19 @@ impl Reader<'_> {
 
     /// Reads the states of one machine element into region of `p.state`,
     /// queueing its nested machines.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     fn region(&mut self, m: &mut StateMachine, p: Pending, queue: &mut VecDeque<Pending>) {
         let (doc, elem) = (p.doc, p.elem);
-        let machine_span = self.docs[doc].0.elems[elem].span.clone();
-        let outer_span = machine_span.clone();
-        // Outcomes: the attribute, then `<FinalOutcome>`s not already named.
-        // (A set beside the list: nothing is quadratic in the outcome count.)
-        let mut outcome_set: std::collections::HashSet<String> = Default::default();
-        let mut outcomes: Vec<String> = Vec::new();
-        for o in self.docs[doc].0.elems[elem]
-            .attr("outcomes")
-            .unwrap_or_default()
-            .split_whitespace()
-        {
-            if outcome_set.insert(o.to_string()) {
-                outcomes.push(o.to_string());
-            }
-        }
-        let kids: Vec<usize> = self.docs[doc].0.elems[elem].children.clone();
+        let outer_span = self.docs[doc].0.elems[elem].span.clone();
         // An `<OrthogonalState>`: its states are its `<Region>`s, all run at
         // once; its outcomes also those its `<OutcomeMap>`s and
         // `default_outcome` give (yasmin's OrthogonalState).
         let orth = self.docs[doc].0.elems[elem].name == "OrthogonalState";
-        let mut mapped_outcomes: Vec<&str> = Vec::new();
-        if orth {
-            let e = &self.docs[doc].0.elems[elem];
-            mapped_outcomes.extend(e.attr("default_outcome").filter(|o| !o.is_empty()));
-            for &c in &kids {
-                let k = &self.docs[doc].0.elems[c];
-                if k.name == "OutcomeMap"
-                    && let Some(o) = k.attr("outcome")
-                {
-                    mapped_outcomes.push(o);
-                }
-            }
-        }
-        for &c in &kids {
-            let e = &self.docs[doc].0.elems[c];
-            if e.name == "FinalOutcome"
-                && let Some(n) = e.attr("name")
-            {
-                mapped_outcomes.push(n);
-            }
-        }
-        for n in mapped_outcomes {
-            if outcome_set.insert(n.to_string()) {
-                outcomes.push(n.to_string());
-            }
-        }
-        // States, in document order.
-        let mut names: HashMap<String, usize> = HashMap::new();
-        let mut made: Vec<(usize, usize)> = Vec::new(); // (element, state)
-        for &c in &kids {
-            let e = &self.docs[doc].0.elems[c];
-            let container = match (orth, e.name.as_str()) {
-                (false, "State") => false,
-                (false, "StateMachine" | "OrthogonalState") | (true, "Region") => true,
-                _ => continue,
-            };
-            let Some(name) = e.attr("name").map(str::to_string) else {
-                let span = e.span.clone();
-                let what = e.name.clone();
-                self.err(
-                    doc,
-                    span,
-                    format!("`<{what}>` needs a `name`"),
-                    "write `<State name=\"Foo\" ...>`",
-                );
-                continue;
-            };
-            if name.len() > self.limits.max_name_bytes {
-                let span = e.span.clone();
-                self.err(
-                    doc,
-                    span,
-                    format!(
-                        "state name `{}` is {} bytes long, more than the limit of {} bytes",
-                        shown(&name),
-                        name.len(),
-                        self.limits.max_name_bytes
-                    ),
-                    "shorten it, or raise the limit with --max-name-bytes",
-                );
-                continue;
-            }
-            if names.contains_key(&name) {
-                let span = e.span.clone();
-                self.err(
-                    doc,
-                    span,
-                    format!("duplicate state `{}` in this machine", shown(&name)),
-                    "state names are unique within their machine (yasmin's add_state refuses a second one)",
-                );
-                continue;
-            }
-            if outcomes.contains(&name) {
-                let span = e.span.clone();
-                self.err(
-                    doc,
-                    span,
-                    format!(
-                        "state `{}` has the name of an outcome of this machine",
-                        shown(&name)
-                    ),
-                    "rename the state or the outcome (yasmin's add_state refuses a state named like an outcome)",
-                );
-                continue;
-            }
-            if m.states.len() >= self.limits.max_nodes {
-                let span = e.span.clone();
-                self.err(
-                    doc,
-                    span,
-                    format!("more than {} states", self.limits.max_nodes),
-                    "raise the limit with --max-nodes",
-                );
-                return;
-            }
-            let span = (doc == 0).then(|| e.span.clone());
-            let body = if container {
-                StateBody::Container(Region {
-                    parallel: e.name == "OrthogonalState",
-                    ..Region::unset(vec![])
-                })
-            } else {
-                StateBody::Task(None)
-            };
-            let idx = m.states.len();
-            m.states.push(State {
-                name: name.clone(),
-                label: name.clone(),
-                parent: p.state,
-                body,
-                transitions: Vec::new(),
-                pseudo: None,
-                span,
-            });
-            names.insert(name, idx);
-            made.push((c, idx));
-        }
-        // The start state.
-        let start = match self.docs[doc].0.elems[elem].attr_full("start_state") {
-            Some(a) => match names.get(a.value.as_str()) {
-                Some(&s) => Some(s),
-                None => {
-                    let (v, span) = (a.value.clone(), a.span.clone());
-                    self.err(
-                        doc,
-                        span,
-                        format!("start state `{}` is not a state of this machine", shown(&v)),
-                        "name one of the machine's own `<State>` or `<StateMachine>` children",
-                    );
-                    None
-                }
-            },
-            None => made.first().map(|&(_, s)| s),
+        let (outcome_set, outcomes) = machine_outcomes(&self.docs[doc].0, elem, orth);
+        let Some(MachineStates { names, made }) = self.machine_states(m, &p, orth, &outcomes)
+        else {
+            return;
         };
+        let start = self.start_state(doc, elem, &names, &made);
         let start = if orth {
             made.first().map(|&(_, s)| s)
         } else {
@@ -377,60 +240,7 @@ impl Reader<'_> {
         // region of an orthogonal state has none: yasmin reads only its
         // states).
         for &(c, s) in made.iter().filter(|_| !orth) {
-            let tkids: Vec<usize> = self.docs[doc].0.elems[c].children.clone();
-            // An outcome maps to one target (yasmin keeps transitions in a
-            // dict): a second one is an error, not a silent overwrite.
-            let mut mapped: std::collections::HashSet<String> = Default::default();
-            for t in tkids {
-                let te = &self.docs[doc].0.elems[t];
-                if te.name != "Transition" {
-                    continue;
-                }
-                let tspan = te.span.clone();
-                let (Some(from), Some(to)) = (te.attr("from"), te.attr_full("to")) else {
-                    self.err(
-                        doc,
-                        tspan,
-                        "`<Transition>` needs `from` and `to`".into(),
-                        "write `<Transition from=\"OUTCOME\" to=\"STATE_OR_OUTCOME\"/>`",
-                    );
-                    continue;
-                };
-                let (from, to_v, to_span) = (from.to_string(), to.value.clone(), to.span.clone());
-                if !mapped.insert(from.clone()) {
-                    self.err(
-                        doc,
-                        tspan,
-                        format!("a second transition from outcome `{}`", shown(&from)),
-                        "each outcome of a state has one transition; remove one",
-                    );
-                    continue;
-                }
-                let target = if outcome_set.contains(&to_v) {
-                    Target::Outcome(to_v)
-                } else if let Some(&n) = names.get(to_v.as_str()) {
-                    Target::State(n)
-                } else {
-                    self.err(
-                        doc,
-                        to_span,
-                        format!(
-                            "`{}` is neither a state nor an outcome of this machine",
-                            shown(&to_v)
-                        ),
-                        "`to` names a sibling state or one of the machine's `outcomes`",
-                    );
-                    continue;
-                };
-                if container_state(&self.docs[doc].0.elems[c]) {
-                    self.maps.push((s, doc, tspan.clone(), from.clone()));
-                }
-                m.states[s].transitions.push(Transition {
-                    trigger: Trigger::Outcome(from),
-                    target,
-                    span: (doc == 0).then_some(tspan),
-                });
-            }
+            self.state_transitions(m, doc, (c, s), &outcome_set, &names);
         }
         // Install the region.
         let Some(start) = start else {
@@ -445,8 +255,234 @@ impl Reader<'_> {
             None => m.top = region,
             Some(c) => m.states[c].body = StateBody::Container(region),
         }
-        // Nested machines: their content, inline or from their file.
-        for &(c, s) in &made {
+        self.queue_nested(&p, &made, queue);
+        // A container's outcome map may name outcomes its content lacks:
+        // checked once its content is read (it is later in the queue).
+    }
+
+    /// The states of a machine element, in document order, added to `m`:
+    /// by name, and as `(element, state)`. `None` when the node limit is
+    /// hit.
+    fn machine_states(
+        &mut self,
+        m: &mut StateMachine,
+        p: &Pending,
+        orth: bool,
+        outcomes: &[String],
+    ) -> Option<MachineStates> {
+        let doc = p.doc;
+        let kids: Vec<usize> = self.docs[doc].0.elems[p.elem].children.clone();
+        let mut names: HashMap<String, usize> = HashMap::new();
+        let mut made: Vec<(usize, usize)> = Vec::new(); // (element, state)
+        for &c in &kids {
+            let e = &self.docs[doc].0.elems[c];
+            let container = match (orth, e.name.as_str()) {
+                (false, "State") => false,
+                (false, "StateMachine" | "OrthogonalState") | (true, "Region") => true,
+                _ => continue,
+            };
+            let Some(name) = self.state_name(doc, c, &names, outcomes) else {
+                continue;
+            };
+            let e = &self.docs[doc].0.elems[c];
+            if m.states.len() >= self.limits.max_nodes {
+                let span = e.span.clone();
+                self.err(
+                    doc,
+                    span,
+                    format!("more than {} states", self.limits.max_nodes),
+                    "raise the limit with --max-nodes",
+                );
+                return None;
+            }
+            let span = (doc == 0).then(|| e.span.clone());
+            let body = if container {
+                StateBody::Container(Region {
+                    parallel: e.name == "OrthogonalState",
+                    ..Region::unset(vec![])
+                })
+            } else {
+                StateBody::Task(None)
+            };
+            let idx = m.states.len();
+            m.states.push(State {
+                name: name.clone(),
+                label: name.clone(),
+                parent: p.state,
+                body,
+                transitions: Vec::new(),
+                pseudo: None,
+                span,
+            });
+            names.insert(name, idx);
+            made.push((c, idx));
+        }
+        Some(MachineStates { names, made })
+    }
+
+    /// The name of state element `c`: it must have one, within the length
+    /// limit, unique in its machine and not an outcome's (else an error and
+    /// `None`).
+    fn state_name(
+        &mut self,
+        doc: usize,
+        c: usize,
+        names: &HashMap<String, usize>,
+        outcomes: &[String],
+    ) -> Option<String> {
+        let e = &self.docs[doc].0.elems[c];
+        let span = e.span.clone();
+        let Some(name) = e.attr("name").map(str::to_string) else {
+            let what = e.name.clone();
+            self.err(
+                doc,
+                span,
+                format!("`<{what}>` needs a `name`"),
+                "write `<State name=\"Foo\" ...>`",
+            );
+            return None;
+        };
+        if name.len() > self.limits.max_name_bytes {
+            self.err(
+                doc,
+                span,
+                format!(
+                    "state name `{}` is {} bytes long, more than the limit of {} bytes",
+                    shown(&name),
+                    name.len(),
+                    self.limits.max_name_bytes
+                ),
+                "shorten it, or raise the limit with --max-name-bytes",
+            );
+            return None;
+        }
+        if names.contains_key(&name) {
+            self.err(
+                doc,
+                span,
+                format!("duplicate state `{}` in this machine", shown(&name)),
+                "state names are unique within their machine (yasmin's add_state refuses a second one)",
+            );
+            return None;
+        }
+        if outcomes.contains(&name) {
+            self.err(
+                doc,
+                span,
+                format!(
+                    "state `{}` has the name of an outcome of this machine",
+                    shown(&name)
+                ),
+                "rename the state or the outcome (yasmin's add_state refuses a state named like an outcome)",
+            );
+            return None;
+        }
+        Some(name)
+    }
+
+    /// The start state of a machine element: its `start_state` (an error
+    /// when it names none of its states), else its first state.
+    fn start_state(
+        &mut self,
+        doc: usize,
+        elem: usize,
+        names: &HashMap<String, usize>,
+        made: &[(usize, usize)],
+    ) -> Option<usize> {
+        match self.docs[doc].0.elems[elem].attr_full("start_state") {
+            Some(a) => match names.get(a.value.as_str()) {
+                Some(&s) => Some(s),
+                None => {
+                    let (v, span) = (a.value.clone(), a.span.clone());
+                    self.err(
+                        doc,
+                        span,
+                        format!("start state `{}` is not a state of this machine", shown(&v)),
+                        "name one of the machine's own `<State>` or `<StateMachine>` children",
+                    );
+                    None
+                }
+            },
+            None => made.first().map(|&(_, s)| s),
+        }
+    }
+
+    /// Reads the `<Transition>`s of state element `c` (model state `s`)
+    /// into `m`; a container's are checked against its outcomes later.
+    fn state_transitions(
+        &mut self,
+        m: &mut StateMachine,
+        doc: usize,
+        (c, s): (usize, usize),
+        outcome_set: &HashSet<String>,
+        names: &HashMap<String, usize>,
+    ) {
+        let tkids: Vec<usize> = self.docs[doc].0.elems[c].children.clone();
+        // An outcome maps to one target (yasmin keeps transitions in a
+        // dict): a second one is an error, not a silent overwrite.
+        let mut mapped: HashSet<String> = Default::default();
+        for t in tkids {
+            let te = &self.docs[doc].0.elems[t];
+            if te.name != "Transition" {
+                continue;
+            }
+            let tspan = te.span.clone();
+            let (Some(from), Some(to)) = (te.attr("from"), te.attr_full("to")) else {
+                self.err(
+                    doc,
+                    tspan,
+                    "`<Transition>` needs `from` and `to`".into(),
+                    "write `<Transition from=\"OUTCOME\" to=\"STATE_OR_OUTCOME\"/>`",
+                );
+                continue;
+            };
+            let (from, to_v, to_span) = (from.to_string(), to.value.clone(), to.span.clone());
+            if !mapped.insert(from.clone()) {
+                self.err(
+                    doc,
+                    tspan,
+                    format!("a second transition from outcome `{}`", shown(&from)),
+                    "each outcome of a state has one transition; remove one",
+                );
+                continue;
+            }
+            let target = if outcome_set.contains(&to_v) {
+                Target::Outcome(to_v)
+            } else if let Some(&n) = names.get(to_v.as_str()) {
+                Target::State(n)
+            } else {
+                self.err(
+                    doc,
+                    to_span,
+                    format!(
+                        "`{}` is neither a state nor an outcome of this machine",
+                        shown(&to_v)
+                    ),
+                    "`to` names a sibling state or one of the machine's `outcomes`",
+                );
+                continue;
+            };
+            if container_state(&self.docs[doc].0.elems[c]) {
+                self.maps.push((s, doc, tspan.clone(), from.clone()));
+            }
+            m.states[s].transitions.push(Transition {
+                trigger: Trigger::Outcome(from),
+                target,
+                span: (doc == 0).then_some(tspan),
+            });
+        }
+    }
+
+    /// Queues the nested machines of a machine element: their content,
+    /// inline or from their file.
+    fn queue_nested(
+        &mut self,
+        p: &Pending,
+        made: &[(usize, usize)],
+        queue: &mut VecDeque<Pending>,
+    ) {
+        let doc = p.doc;
+        for &(c, s) in made {
             if !matches!(
                 self.docs[doc].0.elems[c].name.as_str(),
                 "StateMachine" | "OrthogonalState" | "Region"
@@ -488,8 +524,6 @@ impl Reader<'_> {
                 }
             }
         }
-        // A container's outcome map may name outcomes its content lacks:
-        // checked once its content is read (it is later in the queue).
     }
 
     /// Reads the file a `file_path` names: its document index, and the
@@ -572,6 +606,48 @@ impl Reader<'_> {
         chain.push(canon);
         Some((self.docs.len() - 1, chain))
     }
+}
+
+/// The outcomes of a machine element: its `outcomes` attribute, then (an
+/// `<OrthogonalState>`'s) its `default_outcome` and `<OutcomeMap>`
+/// outcomes, then its `<FinalOutcome>`s, each once; as a set and a list
+/// (nothing is quadratic in the outcome count).
+fn machine_outcomes(x: &XDoc, elem: usize, orth: bool) -> (HashSet<String>, Vec<String>) {
+    let e = &x.elems[elem];
+    // Outcomes: the attribute, then `<FinalOutcome>`s not already named.
+    let mut outcome_set: HashSet<String> = Default::default();
+    let mut outcomes: Vec<String> = Vec::new();
+    for o in e.attr("outcomes").unwrap_or_default().split_whitespace() {
+        if outcome_set.insert(o.to_string()) {
+            outcomes.push(o.to_string());
+        }
+    }
+    let mut mapped_outcomes: Vec<&str> = Vec::new();
+    if orth {
+        mapped_outcomes.extend(e.attr("default_outcome").filter(|o| !o.is_empty()));
+        for &c in &e.children {
+            let k = &x.elems[c];
+            if k.name == "OutcomeMap"
+                && let Some(o) = k.attr("outcome")
+            {
+                mapped_outcomes.push(o);
+            }
+        }
+    }
+    for &c in &e.children {
+        let k = &x.elems[c];
+        if k.name == "FinalOutcome"
+            && let Some(n) = k.attr("name")
+        {
+            mapped_outcomes.push(n);
+        }
+    }
+    for n in mapped_outcomes {
+        if outcome_set.insert(n.to_string()) {
+            outcomes.push(n.to_string());
+        }
+    }
+    (outcome_set, outcomes)
 }
 
 /// Is the element a nested machine (a container)?

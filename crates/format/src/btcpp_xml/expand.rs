@@ -3,7 +3,7 @@
 //! port remappings through the chain of enclosing expansions
 //! (BehaviorTree.CPP 4 "Remapping ports between Trees and SubTrees").
 
-use super::super::xml::shown;
+use super::super::xml::{XElem, shown};
 use super::derive_ids;
 use super::loader::Loader;
 use super::ports::{Key, KeyUse, SCRIPT_ATTRS, SubTreeFlow};
@@ -11,58 +11,76 @@ use btfsm_core::diagnostic::suggest;
 use btfsm_model::{Bt, BtNode};
 use std::collections::{BTreeMap, HashMap};
 
+/// An element waiting in the expansion's walk.
+struct Item {
+    d: usize,
+    e: usize,
+    parent: Option<usize>,
+    /// Levels below the root (a SubTree's root takes its place).
+    depth: usize,
+    /// Index into `frames`: the SubTree expansion this element is in.
+    frame: usize,
+    /// `name` of the SubTree element this root replaces.
+    name_override: Option<String>,
+    /// ID of the (outermost) SubTree this root replaces.
+    subtree: Option<String>,
+}
+
+/// An expansion under way: the SubTree expansions made, the elements still
+/// to read, the nodes made so far with their names, and what the limits
+/// still allow.
+struct Walk {
+    frames: Vec<Frame>,
+    /// SubTree elements whose root node is the next node made.
+    pending: Vec<usize>,
+    /// The expansions enclosing the element being read: recursion and
+    /// port remapping are looked up in O(1) per SubTree and port.
+    chain: Chain,
+    stack: Vec<Item>,
+    nodes: Vec<BtNode>,
+    names: Vec<Option<String>>,
+    explicit: Vec<Option<String>>,
+    failed: bool,
+    budget: usize,
+    /// SubTree elements are no nodes, but expanding one is work: at most
+    /// as many expansions as nodes.
+    expansions: usize,
+}
+
 impl Loader<'_> {
     /// Expands the tree from its root element into the arena (pre-order, explicit
     /// stack), resolving every node's type and expanding SubTrees. Depth and
     /// name lengths are checked here, at the element, as it is read.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn expand(&mut self, tree_id: &str, d0: usize, e0: usize) -> Option<Bt> {
-        struct Item {
-            d: usize,
-            e: usize,
-            parent: Option<usize>,
-            /// Levels below the root (a SubTree's root takes its place).
-            depth: usize,
-            /// Index into `frames`: the SubTree expansion this element is in.
-            frame: usize,
-            /// `name` of the SubTree element this root replaces.
-            name_override: Option<String>,
-            /// ID of the (outermost) SubTree this root replaces.
-            subtree: Option<String>,
-        }
-        let mut frames: Vec<Frame> = vec![Frame {
-            id: tree_id.to_string(),
-            parent: None,
-            remap: BTreeMap::new(),
-            keys: BTreeMap::new(),
-            autoremap: false,
-        }];
-        // SubTree elements whose root node is the next node made.
-        let mut pending: Vec<usize> = Vec::new();
-        // The expansions enclosing the element being read: recursion and
-        // port remapping are looked up in O(1) per SubTree and port.
-        let mut chain = Chain::default();
-        chain.push(&frames, 0);
-        let root_el = self.docs[d0].elems[e0].children[0];
-        let mut stack = vec![Item {
-            d: d0,
-            e: root_el,
-            parent: None,
-            depth: 0,
-            frame: 0,
-            name_override: None,
-            subtree: None,
-        }];
-        let mut nodes: Vec<BtNode> = Vec::new();
-        let mut names: Vec<Option<String>> = Vec::new();
-        let mut explicit: Vec<Option<String>> = Vec::new();
-        let mut failed = false;
-        let mut budget = self.limits.max_nodes;
-        // SubTree elements are no nodes, but expanding one is work: at most
-        // as many expansions as nodes.
-        let mut expansions = self.limits.max_nodes;
-        while let Some(it) = stack.pop() {
-            chain.enter(&frames, it.frame);
+        let mut w = Walk {
+            frames: vec![Frame {
+                id: tree_id.to_string(),
+                parent: None,
+                remap: BTreeMap::new(),
+                keys: BTreeMap::new(),
+                autoremap: false,
+            }],
+            pending: Vec::new(),
+            chain: Chain::default(),
+            stack: vec![Item {
+                d: d0,
+                e: self.docs[d0].elems[e0].children[0],
+                parent: None,
+                depth: 0,
+                frame: 0,
+                name_override: None,
+                subtree: None,
+            }],
+            nodes: Vec::new(),
+            names: Vec::new(),
+            explicit: Vec::new(),
+            failed: false,
+            budget: self.limits.max_nodes,
+            expansions: self.limits.max_nodes,
+        };
+        w.chain.push(&w.frames, 0);
+        while let Some(it) = w.stack.pop() {
+            w.chain.enter(&w.frames, it.frame);
             let el = self.docs[it.d].elems[it.e].clone();
             if self.names_too_long(it.d, &el) {
                 return None;
@@ -84,206 +102,19 @@ impl Loader<'_> {
             let tag = el.name.as_str();
             // SubTree: the referenced tree's root takes this element's place.
             if tag == "SubTree" || tag == "SubTreePlus" {
-                let Some(id) = el.attr("ID").map(str::to_string) else {
-                    self.err(it.d, el.span.clone(), "`<SubTree>` needs an `ID`");
-                    failed = true;
-                    continue;
-                };
-                let Some(&(sd, se)) = self.trees.get(&id) else {
-                    if let Some(files) = self.ambiguous.get(&id) {
-                        let files = files.join(", ");
-                        self.err(
-                            it.d,
-                            el.span.clone(),
-                            format!(
-                                "tree `{}` in `<SubTree>` is defined by several files given together: {files}",
-                                shown(&id)
-                            ),
-                        )
-                        .hint = Some(
-                            "`<include path>` the one you mean, or give only that file with this one"
-                                .into(),
-                        );
-                        failed = true;
-                        continue;
-                    }
-                    let h = if self.hinting() {
-                        suggest(&id, self.trees.keys().map(String::as_str))
-                    } else {
-                        String::new()
-                    };
-                    self.err(
-                        it.d,
-                        el.span.clone(),
-                        format!("unknown tree `{}` in `<SubTree>`", shown(&id)),
-                    )
-                    .hint = Some(format!(
-                        "{h}; a tree of another file is found when that file is `<include>`d, or given with this one (`btfsm analyze main.xml subtrees/`)"
-                    ));
-                    failed = true;
-                    continue;
-                };
-                if chain.trees.get(&id).is_some_and(|&c| c > 0) {
-                    let chain: Vec<String> =
-                        chain.frames.iter().map(|&f| frames[f].id.clone()).collect();
-                    let at = chain.iter().position(|c| *c == id).unwrap_or(0);
-                    let mut shown_chain: Vec<String> =
-                        chain.iter().map(|c| shown(c).into_owned()).collect();
-                    shown_chain.push(shown(&id).into_owned());
-                    // The cycle itself, and at most a few trees before it.
-                    let from = at.saturating_sub(3);
-                    let mut cycle = shown_chain[from..].to_vec();
-                    if cycle.len() > 12 {
-                        let n = cycle.len();
-                        cycle.splice(6..n - 6, [format!("... ({} trees) ...", n - 12)]);
-                    }
-                    if from > 0 {
-                        cycle.insert(0, "...".into());
-                    }
-                    self.err(it.d, el.span.clone(), format!("recursive subtree: {}", cycle.join(" -> ")))
-                        .set_code("subtree-recursion")
-                        .hint = Some("a tree must not contain itself as a `<SubTree>`, directly or through others".into());
-                    failed = true;
-                    continue;
-                }
-                if expansions == 0 {
-                    self.err(
-                        it.d,
-                        el.span.clone(),
-                        format!("more than {} SubTree expansions", self.limits.max_nodes),
-                    )
-                    .hint = Some("raise the limit with --max-nodes".into());
-                    return None;
-                }
-                expansions -= 1;
-                // Its ports remap the subtree's blackboard entries: a
-                // reference is resolved in the enclosing expansion now, so
-                // that the subtree's nodes get the value or the outer entry.
-                // Format 3's `<SubTree>` (not `<SubTreePlus>`) maps an
-                // entry to an outer entry by its bare name: `target="goal"`
-                // is format 4's `target="{goal}"`.
-                let keys_by_name = tag == "SubTree" && self.format_3(it.d);
-                let mut remap = BTreeMap::new();
-                let mut keys = BTreeMap::new();
-                let mut flow_remap = Vec::new();
-                let me = frames.len();
-                for a in el
-                    .attrs
-                    .iter()
-                    .filter(|a| a.ns.is_none() && !SUBTREE_ATTRS.contains(&a.name.as_str()))
-                {
-                    let v = if a.value == "{=}" {
-                        format!("{{{}}}", a.name)
-                    } else if keys_by_name && port_key(&a.value).is_none() {
-                        format!("{{{}}}", a.value)
-                    } else {
-                        a.value.clone()
-                    };
-                    // The entry the port designates: an outer one, or its
-                    // own, set to the literal.
-                    let key = port_key(&v).map(|k| chain.resolve_key(&frames, k));
-                    let inner = key.clone().unwrap_or_else(|| Key {
-                        scope: me,
-                        name: a.name.clone(),
-                    });
-                    if !a.name.starts_with('_') {
-                        if key.is_none() {
-                            self.flow.given.push(inner.clone());
-                        }
-                        flow_remap.push((a.name.clone(), a.value.clone(), key, a.span.clone()));
-                    }
-                    keys.insert(a.name.clone(), inner);
-                    remap.insert(a.name.clone(), chain.resolve(&frames, &v));
-                }
-                let autoremap = ["_autoremap", "__autoremap", "__shared_blackboard"]
-                    .iter()
-                    .any(|k| el.attr(k) == Some("true") || el.attr(k) == Some("1"));
-                pending.push(self.flow.subtrees.len());
-                let mut script_keys = Vec::new();
-                for a in el
-                    .attrs
-                    .iter()
-                    .filter(|a| a.ns.is_none() && SCRIPT_ATTRS.contains(&a.name.as_str()))
-                {
-                    for (name, access) in super::ports::script_keys(&a.value) {
-                        script_keys.push(KeyUse {
-                            key: chain.resolve_key(&frames, &name),
-                            access,
-                            port: a.name.clone(),
-                            ty: None,
-                            span: a.span.clone(),
-                        });
-                    }
-                }
-                self.flow.subtrees.push(SubTreeFlow {
-                    id: id.clone(),
-                    doc: it.d,
-                    span: el.span.clone(),
-                    node: usize::MAX,
-                    remap: flow_remap,
-                    keys: script_keys,
-                });
-                frames.push(Frame {
-                    id,
-                    parent: Some(it.frame),
-                    remap,
-                    keys,
-                    autoremap,
-                });
-                let child = self.docs[sd].elems[se].children[0];
-                stack.push(Item {
-                    d: sd,
-                    e: child,
-                    parent: it.parent,
-                    depth: it.depth,
-                    frame: frames.len() - 1,
-                    name_override: el.attr("name").map(str::to_string).or(it.name_override),
-                    subtree: it.subtree.or(Some(frames[frames.len() - 1].id.clone())),
-                });
-                continue;
-            }
-            if budget == 0 {
-                self.err(
-                    it.d,
-                    el.span.clone(),
-                    format!("more than {} nodes", self.limits.max_nodes),
-                )
-                .hint = Some("raise the limit with --max-nodes".into());
-                return None;
-            }
-            budget -= 1;
-            let Some(mut node) = self.node(it.d, &el, |v| chain.resolve(&frames, v)) else {
-                failed = true;
-                continue;
-            };
-            node.subtree = it.subtree;
-            let idx = nodes.len();
-            for p in pending.drain(..) {
-                self.flow.subtrees[p].node = idx;
-            }
-            let flow = self.node_flow(it.d, &el, idx, |k| chain.resolve_key(&frames, k));
-            self.flow.nodes.push(flow);
-            if let Some(p) = it.parent {
-                nodes[p].children.push(idx);
-            }
-            names.push(
-                it.name_override
-                    .or_else(|| el.attr("name").map(str::to_string)),
-            );
-            explicit.push(el.btfsm_attr("id").map(str::to_string));
-            nodes.push(node);
-            for &c in el.children.iter().rev() {
-                stack.push(Item {
-                    d: it.d,
-                    e: c,
-                    parent: Some(idx),
-                    depth: it.depth + 1,
-                    frame: it.frame,
-                    name_override: None,
-                    subtree: None,
-                });
+                self.expand_subtree(&mut w, it, &el)?;
+            } else {
+                self.expand_node(&mut w, it, &el)?;
             }
         }
+        let Walk {
+            frames,
+            mut nodes,
+            names,
+            explicit,
+            failed,
+            ..
+        } = w;
         if failed || nodes.is_empty() {
             return None;
         }
@@ -295,6 +126,252 @@ impl Loader<'_> {
         self.flow.scopes = frames.iter().map(|f| f.id.clone()).collect();
         Some(Bt { nodes, root: 0 })
     }
+
+    /// Expands a `<SubTree>` element: the tree it names is entered as a new
+    /// expansion whose root takes the element's place. `None` when the
+    /// expansion limit is hit.
+    fn expand_subtree(&mut self, w: &mut Walk, it: Item, el: &XElem) -> Option<()> {
+        let Some((id, sd, se)) = self.subtree_target(w, it.d, el) else {
+            w.failed = true;
+            return Some(());
+        };
+        if w.expansions == 0 {
+            self.err(
+                it.d,
+                el.span.clone(),
+                format!("more than {} SubTree expansions", self.limits.max_nodes),
+            )
+            .hint = Some("raise the limit with --max-nodes".into());
+            return None;
+        }
+        w.expansions -= 1;
+        let frame = self.subtree_frame(w, &it, el, id);
+        w.frames.push(frame);
+        let child = self.docs[sd].elems[se].children[0];
+        w.stack.push(Item {
+            d: sd,
+            e: child,
+            parent: it.parent,
+            depth: it.depth,
+            frame: w.frames.len() - 1,
+            name_override: el.attr("name").map(str::to_string).or(it.name_override),
+            subtree: it.subtree.or(Some(w.frames[w.frames.len() - 1].id.clone())),
+        });
+        Some(())
+    }
+
+    /// The tree a `<SubTree>` element of document `d` names: its ID,
+    /// document and `<BehaviorTree>` element. `None` after an error when it
+    /// names none, a tree several companions define, an unknown tree, or a
+    /// tree it is inside of (recursion).
+    fn subtree_target(&mut self, w: &Walk, d: usize, el: &XElem) -> Option<(String, usize, usize)> {
+        let Some(id) = el.attr("ID").map(str::to_string) else {
+            self.err(d, el.span.clone(), "`<SubTree>` needs an `ID`");
+            return None;
+        };
+        let Some(&(sd, se)) = self.trees.get(&id) else {
+            if let Some(files) = self.ambiguous.get(&id) {
+                let files = files.join(", ");
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!(
+                        "tree `{}` in `<SubTree>` is defined by several files given together: {files}",
+                        shown(&id)
+                    ),
+                )
+                .hint = Some(
+                    "`<include path>` the one you mean, or give only that file with this one"
+                        .into(),
+                );
+                return None;
+            }
+            let h = if self.hinting() {
+                suggest(&id, self.trees.keys().map(String::as_str))
+            } else {
+                String::new()
+            };
+            self.err(
+                d,
+                el.span.clone(),
+                format!("unknown tree `{}` in `<SubTree>`", shown(&id)),
+            )
+            .hint = Some(format!(
+                "{h}; a tree of another file is found when that file is `<include>`d, or given with this one (`btfsm analyze main.xml subtrees/`)"
+            ));
+            return None;
+        };
+        if w.chain.trees.get(&id).is_some_and(|&c| c > 0) {
+            let cycle = recursion(w, &id);
+            self.err(d, el.span.clone(), format!("recursive subtree: {cycle}"))
+                .set_code("subtree-recursion")
+                .hint = Some(
+                "a tree must not contain itself as a `<SubTree>`, directly or through others"
+                    .into(),
+            );
+            return None;
+        }
+        Some((id, sd, se))
+    }
+
+    /// The expansion a `<SubTree>` element of tree `id` starts, its port
+    /// remappings resolved in the enclosing expansions; the SubTree's
+    /// dataflow is recorded.
+    fn subtree_frame(&mut self, w: &mut Walk, it: &Item, el: &XElem, id: String) -> Frame {
+        // Its ports remap the subtree's blackboard entries: a
+        // reference is resolved in the enclosing expansion now, so
+        // that the subtree's nodes get the value or the outer entry.
+        // Format 3's `<SubTree>` (not `<SubTreePlus>`) maps an
+        // entry to an outer entry by its bare name: `target="goal"`
+        // is format 4's `target="{goal}"`.
+        let keys_by_name = el.name == "SubTree" && self.format_3(it.d);
+        let mut remap = BTreeMap::new();
+        let mut keys = BTreeMap::new();
+        let mut flow_remap = Vec::new();
+        let me = w.frames.len();
+        for a in el
+            .attrs
+            .iter()
+            .filter(|a| a.ns.is_none() && !SUBTREE_ATTRS.contains(&a.name.as_str()))
+        {
+            let v = if a.value == "{=}" {
+                format!("{{{}}}", a.name)
+            } else if keys_by_name && port_key(&a.value).is_none() {
+                format!("{{{}}}", a.value)
+            } else {
+                a.value.clone()
+            };
+            // The entry the port designates: an outer one, or its
+            // own, set to the literal.
+            let key = port_key(&v).map(|k| w.chain.resolve_key(&w.frames, k));
+            let inner = key.clone().unwrap_or_else(|| Key {
+                scope: me,
+                name: a.name.clone(),
+            });
+            if !a.name.starts_with('_') {
+                if key.is_none() {
+                    self.flow.given.push(inner.clone());
+                }
+                flow_remap.push((a.name.clone(), a.value.clone(), key, a.span.clone()));
+            }
+            keys.insert(a.name.clone(), inner);
+            remap.insert(a.name.clone(), w.chain.resolve(&w.frames, &v));
+        }
+        let autoremap = ["_autoremap", "__autoremap", "__shared_blackboard"]
+            .iter()
+            .any(|k| el.attr(k) == Some("true") || el.attr(k) == Some("1"));
+        w.pending.push(self.flow.subtrees.len());
+        self.flow.subtrees.push(SubTreeFlow {
+            id: id.clone(),
+            doc: it.d,
+            span: el.span.clone(),
+            node: usize::MAX,
+            remap: flow_remap,
+            keys: script_key_uses(w, el),
+        });
+        Frame {
+            id,
+            parent: Some(it.frame),
+            remap,
+            keys,
+            autoremap,
+        }
+    }
+
+    /// Reads a node element into the arena and queues its children. `None`
+    /// when the node limit is hit.
+    fn expand_node(&mut self, w: &mut Walk, it: Item, el: &XElem) -> Option<()> {
+        if w.budget == 0 {
+            self.err(
+                it.d,
+                el.span.clone(),
+                format!("more than {} nodes", self.limits.max_nodes),
+            )
+            .hint = Some("raise the limit with --max-nodes".into());
+            return None;
+        }
+        w.budget -= 1;
+        let Some(mut node) = self.node(it.d, el, |v| w.chain.resolve(&w.frames, v)) else {
+            w.failed = true;
+            return Some(());
+        };
+        node.subtree = it.subtree;
+        let idx = w.nodes.len();
+        for p in w.pending.drain(..) {
+            self.flow.subtrees[p].node = idx;
+        }
+        let flow = self.node_flow(it.d, el, idx, |k| w.chain.resolve_key(&w.frames, k));
+        self.flow.nodes.push(flow);
+        if let Some(p) = it.parent {
+            w.nodes[p].children.push(idx);
+        }
+        w.names.push(
+            it.name_override
+                .or_else(|| el.attr("name").map(str::to_string)),
+        );
+        w.explicit.push(el.btfsm_attr("id").map(str::to_string));
+        w.nodes.push(node);
+        for &c in el.children.iter().rev() {
+            w.stack.push(Item {
+                d: it.d,
+                e: c,
+                parent: Some(idx),
+                depth: it.depth + 1,
+                frame: it.frame,
+                name_override: None,
+                subtree: None,
+            });
+        }
+        Some(())
+    }
+}
+
+/// The chain of trees a recursive `<SubTree>` of tree `id` closes, as
+/// shown: the cycle itself and at most a few trees before it, a long cycle
+/// cut in the middle.
+fn recursion(w: &Walk, id: &str) -> String {
+    let chain: Vec<String> = w
+        .chain
+        .frames
+        .iter()
+        .map(|&f| w.frames[f].id.clone())
+        .collect();
+    let at = chain.iter().position(|c| *c == id).unwrap_or(0);
+    let mut shown_chain: Vec<String> = chain.iter().map(|c| shown(c).into_owned()).collect();
+    shown_chain.push(shown(id).into_owned());
+    // The cycle itself, and at most a few trees before it.
+    let from = at.saturating_sub(3);
+    let mut cycle = shown_chain[from..].to_vec();
+    if cycle.len() > 12 {
+        let n = cycle.len();
+        cycle.splice(6..n - 6, [format!("... ({} trees) ...", n - 12)]);
+    }
+    if from > 0 {
+        cycle.insert(0, "...".into());
+    }
+    cycle.join(" -> ")
+}
+
+/// The blackboard entries the script attributes of a `<SubTree>` element
+/// use, resolved in the enclosing expansions.
+fn script_key_uses(w: &Walk, el: &XElem) -> Vec<KeyUse> {
+    let mut script_keys = Vec::new();
+    for a in el
+        .attrs
+        .iter()
+        .filter(|a| a.ns.is_none() && SCRIPT_ATTRS.contains(&a.name.as_str()))
+    {
+        for (name, access) in super::ports::script_keys(&a.value) {
+            script_keys.push(KeyUse {
+                key: w.chain.resolve_key(&w.frames, &name),
+                access,
+                port: a.name.clone(),
+                ty: None,
+                span: a.span.clone(),
+            });
+        }
+    }
+    script_keys
 }
 
 impl Loader<'_> {

@@ -21,6 +21,14 @@ pub(super) struct ModelEntry {
     pub(super) ports: Vec<super::ports::PortDecl>,
 }
 
+/// The files being included, outermost first: their canonical paths (for
+/// cycles) and their paths as the user sees them (canonical ones differ by
+/// machine).
+struct IncludeChain {
+    canon: Vec<PathBuf>,
+    shown: Vec<String>,
+}
+
 pub(super) struct Loader<'l> {
     pub(super) limits: &'l Limits,
     pub(super) diags: xml::Sink,
@@ -171,20 +179,20 @@ impl Loader<'_> {
 
     /// Loads `<include path>` files depth-first with an explicit stack; a file
     /// including one of its includers is a cycle.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn includes(&mut self, start: usize, identity: PathBuf) {
         self.seen.insert(identity.clone());
-        let mut chain: Vec<PathBuf> = vec![identity];
-        // The same chain as the user sees the paths (canonical ones differ by machine).
-        let mut shown_chain: Vec<String> = vec![self.docs[start].file.path.clone()];
+        let mut chain = IncludeChain {
+            canon: vec![identity],
+            shown: vec![self.docs[start].file.path.clone()],
+        };
         let mut work: Vec<(usize, usize)> = vec![(start, 0)];
         while let Some(&mut (d, ref mut pos)) = work.last_mut() {
             let root = self.docs[d].root;
             let kids = &self.docs[d].elems[root].children;
             if *pos >= kids.len() {
                 work.pop();
-                chain.pop();
-                shown_chain.pop();
+                chain.canon.pop();
+                chain.shown.pop();
                 continue;
             }
             let e = kids[*pos];
@@ -193,46 +201,13 @@ impl Loader<'_> {
             if el.name != "include" {
                 continue;
             }
-            if el.attr("ros_pkg").is_some() {
-                self.err(
-                    d,
-                    el.span.clone(),
-                    "includes from ROS packages (`ros_pkg`) are not supported",
-                )
-                .hint = Some("give `path` relative to this file".into());
-                continue;
-            }
-            let Some(p) = el.attr_full("path") else {
-                self.err(d, el.span.clone(), "`<include>` needs a `path`")
-                    .hint = Some("write `<include path=\"subtrees/other.xml\"/>`".into());
+            let Some((full, canon, pspan)) = self.include_path(d, &el, &chain) else {
                 continue;
             };
-            let (pval, pspan) = (p.value.clone(), p.span.clone());
-            let full = match crate::source::resolve(self.root.as_deref(), &self.dirs[d], &pval) {
-                Ok(p) => p,
-                Err(r) => {
-                    self.err(d, pspan, format!("cannot include this file: {}", r.message))
-                        .hint = Some(r.hint);
-                    continue;
-                }
-            };
-            let canon = crate::toml::canonical(&full);
-            if let Some(at) = chain.iter().position(|c| *c == canon) {
-                let mut names: Vec<String> = shown_chain[at..]
-                    .iter()
-                    .map(|n| shown(n).into_owned())
-                    .collect();
-                names.push(shown(&full.display().to_string()).into_owned());
-                self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
-                    .set_code("include-cycle")
-                    .hint =
-                    Some("a file must not include itself, directly or through others".into());
-                continue;
-            }
             if self.seen.contains(&canon) {
                 continue; // already read through another include
             }
-            if chain.len() > self.limits.max_include_depth {
+            if chain.canon.len() > self.limits.max_include_depth {
                 self.err(
                     d,
                     pspan,
@@ -244,42 +219,105 @@ impl Loader<'_> {
                 continue;
             }
             let shown = full.display().to_string();
-            let file = match crate::toml::read_included(&full, &shown, self.limits) {
-                Ok(f) => f,
-                Err(mut ds) => {
-                    let msg = ds.remove(0).message;
-                    self.err(d, pspan, msg).hint =
-                        Some("`path` is relative to the including file".into());
-                    continue;
-                }
-            };
-            let doc = match self.parse_charged(&file) {
-                Ok(doc) => doc,
-                Err(diag) => {
-                    self.diags.push(diag);
-                    continue;
-                }
-            };
-            if doc.elems[doc.root].name != "root" {
-                let span = doc.elems[doc.root].span.clone();
-                self.docs.push(doc);
-                let nd = self.docs.len() - 1;
-                self.err(
-                    nd,
-                    span,
-                    "expected `<root>` as the document element of an included file",
-                );
-                self.docs.pop();
+            let Some(doc) = self.included_doc(d, &full, &shown, pspan) else {
                 continue;
-            }
+            };
             self.seen.insert(canon.clone());
             self.docs.push(doc);
             self.dirs
                 .push(full.parent().unwrap_or(Path::new("")).to_path_buf());
-            chain.push(canon);
-            shown_chain.push(shown);
+            chain.canon.push(canon);
+            chain.shown.push(shown);
             work.push((self.docs.len() - 1, 0));
         }
+    }
+
+    /// The file an `<include>` element of document `d` names (as resolved,
+    /// canonical) and the span of its `path`; `None` when it names none, is
+    /// outside the root or includes one of its includers.
+    fn include_path(
+        &mut self,
+        d: usize,
+        el: &XElem,
+        chain: &IncludeChain,
+    ) -> Option<(PathBuf, PathBuf, Range<usize>)> {
+        if el.attr("ros_pkg").is_some() {
+            self.err(
+                d,
+                el.span.clone(),
+                "includes from ROS packages (`ros_pkg`) are not supported",
+            )
+            .hint = Some("give `path` relative to this file".into());
+            return None;
+        }
+        let Some(p) = el.attr_full("path") else {
+            self.err(d, el.span.clone(), "`<include>` needs a `path`")
+                .hint = Some("write `<include path=\"subtrees/other.xml\"/>`".into());
+            return None;
+        };
+        let (pval, pspan) = (p.value.clone(), p.span.clone());
+        let full = match crate::source::resolve(self.root.as_deref(), &self.dirs[d], &pval) {
+            Ok(p) => p,
+            Err(r) => {
+                self.err(d, pspan, format!("cannot include this file: {}", r.message))
+                    .hint = Some(r.hint);
+                return None;
+            }
+        };
+        let canon = crate::toml::canonical(&full);
+        if let Some(at) = chain.canon.iter().position(|c| *c == canon) {
+            let mut names: Vec<String> = chain.shown[at..]
+                .iter()
+                .map(|n| shown(n).into_owned())
+                .collect();
+            names.push(shown(&full.display().to_string()).into_owned());
+            self.err(d, pspan, format!("cyclic include: {}", names.join(" -> ")))
+                .set_code("include-cycle")
+                .hint = Some("a file must not include itself, directly or through others".into());
+            return None;
+        }
+        Some((full, canon, pspan))
+    }
+
+    /// Reads and parses an included file (`shown` as the user sees its
+    /// path), which must be a `<root>`; errors at the `path` of the
+    /// `<include>` in document `d`.
+    fn included_doc(
+        &mut self,
+        d: usize,
+        full: &Path,
+        shown: &str,
+        pspan: Range<usize>,
+    ) -> Option<XDoc> {
+        let file = match crate::toml::read_included(full, shown, self.limits) {
+            Ok(f) => f,
+            Err(mut ds) => {
+                let msg = ds.remove(0).message;
+                self.err(d, pspan, msg).hint =
+                    Some("`path` is relative to the including file".into());
+                return None;
+            }
+        };
+        let doc = match self.parse_charged(&file) {
+            Ok(doc) => doc,
+            Err(diag) => {
+                self.diags.push(diag);
+                return None;
+            }
+        };
+        if doc.elems[doc.root].name != "root" {
+            let span = doc.elems[doc.root].span.clone();
+            self.docs.push(doc);
+            let nd = self.docs.len() - 1;
+            self.err(
+                nd,
+                span,
+                "expected `<root>` as the document element of an included file",
+            );
+            self.docs.pop();
+            return None;
+        }
+        Some(doc)
     }
 
     /// Reads and parses a file named on the command line (a `--nodes-model`

@@ -6,162 +6,56 @@ use super::super::xml::{XElem, shown};
 use super::loader::Loader;
 use super::*;
 
+/// How an element's type reads: the node kind and category, the attributes
+/// the kind carries (not kept as ports), and whether the type name is kept.
+struct Typed {
+    kind: BtNodeKind,
+    cat: Category,
+    consumed: &'static [&'static str],
+    type_kept: bool,
+}
+
+impl Typed {
+    /// A type read as its category's generic kind.
+    fn generic(cat: Category) -> Typed {
+        Typed {
+            kind: generic(cat),
+            cat,
+            consumed: &[],
+            type_kept: true,
+        }
+    }
+
+    /// The built-in type `ty` on element `el` with `n` children.
+    fn builtin(ty: &str, cat: Category, el: &XElem, n: usize) -> Typed {
+        let (kind, consumed, type_kept) = builtin_kind(ty, el, n);
+        Typed {
+            kind,
+            cat,
+            consumed,
+            type_kept,
+        }
+    }
+}
+
 impl Loader<'_> {
     /// One node: its kind, label, type name and ports; arity is checked here
     /// on the element (a SubTree child counts as one).
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn node(
         &mut self,
         d: usize,
         el: &XElem,
         resolve: impl Fn(&str) -> String,
     ) -> Option<BtNode> {
-        let tag = el.name.as_str();
         let n = el.children.len();
-        let (mut ty, explicit_cat): (String, Option<Category>) = match tag {
-            "Action" | "Condition" | "Control" | "Decorator" => {
-                let cat = match tag {
-                    "Action" => Category::Action,
-                    "Condition" => Category::Condition,
-                    "Control" => Category::Control,
-                    _ => Category::Decorator,
-                };
-                match el.attr("ID") {
-                    Some(id) => (id.to_string(), Some(cat)),
-                    None => {
-                        self.err(
-                            d,
-                            el.span.clone(),
-                            format!("`<{tag}>` needs an `ID` naming its type"),
-                        )
-                        .hint = Some(format!(
-                            "write `<{tag} ID=\"MyNode\"/>`, or the compact `<MyNode/>`"
-                        ));
-                        return None;
-                    }
-                }
-            }
-            _ => (tag.to_string(), None),
-        };
-        let mut type_kept = true;
-        let mut consumed: &[&str] = &[];
-        let (kind, cat) = if let Some(cat) = builtin(&ty) {
-            let (k, c, keep) = builtin_kind(&ty, el, n);
-            consumed = c;
-            type_kept = keep;
-            (k, cat)
-        } else if let Some(cat) = explicit_cat {
-            (generic(cat), cat)
-        } else if let Some(m) = self.models.get(&ty) {
-            (generic(m.cat), m.cat)
-        } else if let Some((real, cat)) = BUILTINS.iter().find(|(b, _)| b.eq_ignore_ascii_case(&ty))
-        {
-            self.warn(
-                d,
-                el.span.clone(),
-                format!(
-                    "`{}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`",
-                    shown(&ty)
-                ),
-            )
-            .hint = Some(format!(
-                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{}>`)",
-                shown(&ty)
-            ));
-            let (k, c, keep) = builtin_kind(real, el, n);
-            consumed = c;
-            type_kept = keep;
-            ty = real.to_string();
-            (k, *cat)
-        } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
-            match a {
-                AssumeLeaf::Action => (BtNodeKind::Action, Category::Action),
-                AssumeLeaf::Condition => (BtNodeKind::Condition, Category::Condition),
-            }
-        } else if !self.unknown.insert(ty.clone()) {
-            // Reported at its first use already.
-            match n {
-                0 => return None,
-                1 => (BtNodeKind::Decorator, Category::Decorator),
-                _ => (BtNodeKind::Control, Category::Control),
-            }
-        } else {
-            // Hints only for messages that will be shown (the rest are
-            // counted): bounded work under a million unknown types.
-            let did = if self.hinting() {
-                let cands = BUILTINS
-                    .iter()
-                    .map(|(b, _)| *b)
-                    .chain(self.models.keys().map(String::as_str));
-                suggest(&ty, cands)
-            } else {
-                String::new()
-            };
-            let ty = shown(&ty);
-            let remedy = if n == 0 {
-                format!(
-                    "declare it as `<Action ID=\"{ty}\"/>` or `<Condition ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition"
-                )
-            } else {
-                format!(
-                    "declare it as `<Control ID=\"{ty}\"/>` or `<Decorator ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE)"
-                )
-            };
-            let hint = if did.starts_with("did you mean") {
-                format!("{did} or {remedy}")
-            } else {
-                remedy
-            };
-            self.err(
-                d,
-                el.span.clone(),
-                format!(
-                    "unknown node type `{ty}` ({n} child{})",
-                    if n == 1 { "" } else { "ren" }
-                ),
-            )
-            .hint = Some(hint);
-            // A node with children is read on as a placeholder of its
-            // shape, so that the unknown types below it are reported in the
-            // same run (the file fails with these errors anyway); a leaf has
-            // nothing below it and costs nothing more.
-            match n {
-                0 => return None,
-                1 => (BtNodeKind::Decorator, Category::Decorator),
-                _ => (BtNodeKind::Control, Category::Control),
-            }
-        };
-        // Arity of the element (a SubTree child is one node).
-        let bad = match cat {
-            Category::Action | Category::Condition => n != 0,
-            Category::Decorator => n != 1,
-            Category::Control => n == 0,
-        };
-        if bad {
-            let want = match cat {
-                Category::Action | Category::Condition => "no children",
-                Category::Decorator => "exactly one child",
-                Category::Control => "at least one child",
-            };
-            self.err(
-                d,
-                el.span.clone(),
-                format!(
-                    "`{}` is a {} and takes {want}, found {n}",
-                    shown(&ty),
-                    cat.tag().to_lowercase()
-                ),
-            )
-            .set_code(if cat == Category::Control {
-                "empty-composite"
-            } else {
-                "wrong-child-count"
-            })
-            .hint = Some(match cat {
-                Category::Decorator => "wrap several children in a `<Sequence>`".into(),
-                Category::Control => "give it children, or use a leaf".into(),
-                _ => "a leaf has no children; is the type right in the `<TreeNodesModel>`?".into(),
-            });
+        let (mut ty, explicit_cat) = self.element_type(d, el)?;
+        let Typed {
+            kind,
+            cat,
+            consumed,
+            mut type_kept,
+        } = self.node_kind(d, el, &mut ty, explicit_cat)?;
+        if !self.arity_fits(d, el, &ty, cat) {
             return None;
         }
         // BehaviorTree.CPP's own rules for built-ins it checks when the
@@ -176,54 +70,10 @@ impl Loader<'_> {
             e.code = code;
             return None;
         }
-        let mut ports: BTreeMap<String, String> = el
-            .attrs
-            .iter()
-            .filter(|a| {
-                a.ns.is_none()
-                    && a.name != "name"
-                    && a.name != "ID"
-                    && !consumed.contains(&a.name.as_str())
-            })
-            .map(|a| (a.name.clone(), resolve(&a.value)))
-            .collect();
-        // BehaviorTree.CPP 4's Parallel fails at its first failure unless
-        // told otherwise; the model's Parallel without `failure_count` is the
-        // paper's, which fails when it can no longer succeed
-        // (docs/bt-semantics.md).
-        if matches!(kind, BtNodeKind::Parallel { .. })
-            && ty == "Parallel"
-            && el.attr("success_threshold").is_none()
-            && el.attr("threshold").is_none()
-        {
-            ports
-                .entry("failure_count".into())
-                .or_insert_with(|| "1".into());
-        }
-        // A leaf whose type is a skill of the shared library, with arguments
-        // that fit the skill, is bound to it.
-        let mut skill_call = None;
-        if let (BtNodeKind::Action | BtNodeKind::Condition, Some(sk), Some(params)) =
-            (kind, skill::skill_kind(&ty), skill::skill_params(&ty))
-        {
-            let want = if kind == BtNodeKind::Action {
-                SkillKind::Action
-            } else {
-                SkillKind::Condition
-            };
-            let fits = sk == want
-                && ports.keys().all(|k| params.iter().any(|(p, _)| p == k))
-                && params.iter().all(|(p, req)| !req || ports.contains_key(*p));
-            if fits {
-                skill_call = Some(SkillCall {
-                    skill: ty.clone(),
-                    args: std::mem::take(&mut ports)
-                        .into_iter()
-                        .map(|(k, v)| (k, arg_value(&v)))
-                        .collect(),
-                });
-                type_kept = false;
-            }
+        let mut ports = node_ports(el, consumed, kind, &ty, resolve);
+        let skill_call = bind_skill(kind, &ty, &mut ports);
+        if skill_call.is_some() {
+            type_kept = false;
         }
         let label = el
             .attr("name")
@@ -243,8 +93,236 @@ impl Loader<'_> {
             span: Some(el.span.clone()),
         })
     }
+
+    /// An element's node type, and its category when the explicit syntax
+    /// (`<Action ID="...">`) gives it.
+    fn element_type(&mut self, d: usize, el: &XElem) -> Option<(String, Option<Category>)> {
+        let tag = el.name.as_str();
+        let cat = match tag {
+            "Action" => Category::Action,
+            "Condition" => Category::Condition,
+            "Control" => Category::Control,
+            "Decorator" => Category::Decorator,
+            _ => return Some((tag.to_string(), None)),
+        };
+        match el.attr("ID") {
+            Some(id) => Some((id.to_string(), Some(cat))),
+            None => {
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!("`<{tag}>` needs an `ID` naming its type"),
+                )
+                .hint = Some(format!(
+                    "write `<{tag} ID=\"MyNode\"/>`, or the compact `<MyNode/>`"
+                ));
+                None
+            }
+        }
+    }
+
+    /// How type `ty` reads: built in, of the explicit category, from a
+    /// `<TreeNodesModel>`, a built-in miswritten in case (`ty` becomes the
+    /// built-in), `--assume-leaf`, or an unknown type (an error at its first
+    /// use; `None` for a leaf, else a placeholder of its shape).
+    fn node_kind(
+        &mut self,
+        d: usize,
+        el: &XElem,
+        ty: &mut String,
+        explicit_cat: Option<Category>,
+    ) -> Option<Typed> {
+        let n = el.children.len();
+        Some(if let Some(cat) = builtin(ty) {
+            Typed::builtin(ty, cat, el, n)
+        } else if let Some(cat) = explicit_cat {
+            Typed::generic(cat)
+        } else if let Some(m) = self.models.get(ty.as_str()) {
+            Typed::generic(m.cat)
+        } else if let Some((real, cat)) = BUILTINS.iter().find(|(b, _)| b.eq_ignore_ascii_case(ty))
+        {
+            self.warn(
+                d,
+                el.span.clone(),
+                format!(
+                    "`{}` is not a BehaviorTree.CPP node type; read as the built-in `{real}`",
+                    shown(ty)
+                ),
+            )
+            .hint = Some(format!(
+                "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{}>`)",
+                shown(ty)
+            ));
+            *ty = real.to_string();
+            Typed::builtin(real, *cat, el, n)
+        } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
+            match a {
+                AssumeLeaf::Action => Typed::generic(Category::Action),
+                AssumeLeaf::Condition => Typed::generic(Category::Condition),
+            }
+        } else {
+            // Reported at its first use only.
+            if self.unknown.insert(ty.clone()) {
+                self.unknown_type(d, el, ty);
+            }
+            // A node with children is read on as a placeholder of its
+            // shape, so that the unknown types below it are reported in the
+            // same run (the file fails with these errors anyway); a leaf has
+            // nothing below it and costs nothing more.
+            match n {
+                0 => return None,
+                1 => Typed::generic(Category::Decorator),
+                _ => Typed::generic(Category::Control),
+            }
+        })
+    }
+
+    /// The error of an unknown node type, with how to declare it.
+    fn unknown_type(&mut self, d: usize, el: &XElem, ty: &str) {
+        let n = el.children.len();
+        // Hints only for messages that will be shown (the rest are
+        // counted): bounded work under a million unknown types.
+        let did = if self.hinting() {
+            let cands = BUILTINS
+                .iter()
+                .map(|(b, _)| *b)
+                .chain(self.models.keys().map(String::as_str));
+            suggest(ty, cands)
+        } else {
+            String::new()
+        };
+        let ty = shown(ty);
+        let remedy = if n == 0 {
+            format!(
+                "declare it as `<Action ID=\"{ty}\"/>` or `<Condition ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE), or read unknown leaves with --assume-leaf action|condition"
+            )
+        } else {
+            format!(
+                "declare it as `<Control ID=\"{ty}\"/>` or `<Decorator ID=\"{ty}\"/>` in a `<TreeNodesModel>` (in this file or with --nodes-model FILE)"
+            )
+        };
+        let hint = if did.starts_with("did you mean") {
+            format!("{did} or {remedy}")
+        } else {
+            remedy
+        };
+        self.err(
+            d,
+            el.span.clone(),
+            format!(
+                "unknown node type `{ty}` ({n} child{})",
+                if n == 1 { "" } else { "ren" }
+            ),
+        )
+        .hint = Some(hint);
+    }
+
+    /// Whether the element's number of children fits its category (a
+    /// SubTree child is one node); an error when not.
+    fn arity_fits(&mut self, d: usize, el: &XElem, ty: &str, cat: Category) -> bool {
+        let n = el.children.len();
+        let bad = match cat {
+            Category::Action | Category::Condition => n != 0,
+            Category::Decorator => n != 1,
+            Category::Control => n == 0,
+        };
+        if !bad {
+            return true;
+        }
+        let want = match cat {
+            Category::Action | Category::Condition => "no children",
+            Category::Decorator => "exactly one child",
+            Category::Control => "at least one child",
+        };
+        self.err(
+            d,
+            el.span.clone(),
+            format!(
+                "`{}` is a {} and takes {want}, found {n}",
+                shown(ty),
+                cat.tag().to_lowercase()
+            ),
+        )
+        .set_code(if cat == Category::Control {
+            "empty-composite"
+        } else {
+            "wrong-child-count"
+        })
+        .hint = Some(match cat {
+            Category::Decorator => "wrap several children in a `<Sequence>`".into(),
+            Category::Control => "give it children, or use a leaf".into(),
+            _ => "a leaf has no children; is the type right in the `<TreeNodesModel>`?".into(),
+        });
+        false
+    }
 }
 
+/// A node's ports: its attributes but `name`, `ID`, namespaced ones and
+/// those its kind carries, values resolved.
+fn node_ports(
+    el: &XElem,
+    consumed: &[&str],
+    kind: BtNodeKind,
+    ty: &str,
+    resolve: impl Fn(&str) -> String,
+) -> BTreeMap<String, String> {
+    let mut ports: BTreeMap<String, String> = el
+        .attrs
+        .iter()
+        .filter(|a| {
+            a.ns.is_none()
+                && a.name != "name"
+                && a.name != "ID"
+                && !consumed.contains(&a.name.as_str())
+        })
+        .map(|a| (a.name.clone(), resolve(&a.value)))
+        .collect();
+    // BehaviorTree.CPP 4's Parallel fails at its first failure unless
+    // told otherwise; the model's Parallel without `failure_count` is the
+    // paper's, which fails when it can no longer succeed
+    // (docs/bt-semantics.md).
+    if matches!(kind, BtNodeKind::Parallel { .. })
+        && ty == "Parallel"
+        && el.attr("success_threshold").is_none()
+        && el.attr("threshold").is_none()
+    {
+        ports
+            .entry("failure_count".into())
+            .or_insert_with(|| "1".into());
+    }
+    ports
+}
+
+/// A leaf whose type is a skill of the shared library, with arguments that
+/// fit the skill, is bound to it: its ports become the skill's arguments.
+fn bind_skill(
+    kind: BtNodeKind,
+    ty: &str,
+    ports: &mut BTreeMap<String, String>,
+) -> Option<SkillCall> {
+    let (BtNodeKind::Action | BtNodeKind::Condition, Some(sk), Some(params)) =
+        (kind, skill::skill_kind(ty), skill::skill_params(ty))
+    else {
+        return None;
+    };
+    let want = if kind == BtNodeKind::Action {
+        SkillKind::Action
+    } else {
+        SkillKind::Condition
+    };
+    let fits = sk == want
+        && ports.keys().all(|k| params.iter().any(|(p, _)| p == k))
+        && params.iter().all(|(p, req)| !req || ports.contains_key(*p));
+    fits.then(|| SkillCall {
+        skill: ty.to_string(),
+        args: std::mem::take(ports)
+            .into_iter()
+            .map(|(k, v)| (k, arg_value(&v)))
+            .collect(),
+    })
+}
+
+/// The model kind of a category's generic node.
 fn generic(cat: Category) -> BtNodeKind {
     match cat {
         Category::Action => BtNodeKind::Action,

@@ -127,7 +127,6 @@ pub(super) fn ids<'d>(doc: &'d XDoc, found: &[Entry]) -> Vec<Cow<'d, str>> {
 
 /// The model's states (not finals) in document order, their regions and
 /// outcomes; `(machine, state of each entry, entry of each state)`.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub(super) fn states(
     doc: &XDoc,
     found: &[Entry],
@@ -143,63 +142,22 @@ pub(super) fn states(
         let name = el.btfsm_attr("name").unwrap_or(&ids[k]).to_string();
         let pstate = parent.and_then(|p| state_of[p]);
         if let Kind::Final = kind {
-            match pstate {
-                None => m.top.outcomes.push(name),
-                Some(p) => {
-                    if let StateBody::Container(r) = &mut m.states[p].body {
-                        if r.parallel {
-                            // SCXML 3.4: a `<parallel>` holds no `<final>`.
-                            diags.push(
-                                Diagnostic::error(format!(
-                                    "final state `{}` directly inside `<parallel>`",
-                                    shown(&ids[k])
-                                ))
-                                .at(f, el.span.clone())
-                                .hint("a parallel state completes when each of its regions reaches a final state: put the `<final>` inside a region's `<state>`"),
-                            );
-                            continue;
-                        }
-                        r.outcomes.push(name);
-                    } else {
-                        m.states[p].body = StateBody::Container(Region::unset(vec![name]));
-                    }
-                }
+            if !add_final(&mut m, pstate, name) {
+                // SCXML 3.4: a `<parallel>` holds no `<final>`.
+                diags.push(
+                    Diagnostic::error(format!(
+                        "final state `{}` directly inside `<parallel>`",
+                        shown(&ids[k])
+                    ))
+                    .at(f, el.span.clone())
+                    .hint("a parallel state completes when each of its regions reaches a final state: put the `<final>` inside a region's `<state>`"),
+                );
             }
             continue;
         }
         let si = m.states.len();
         state_of[k] = Some(si);
-        let body = match kind {
-            Kind::History(_) => StateBody::Decision,
-            // Its regions are added as they are read.
-            // Outcomes only in `btfsm:outcomes` (a yasmin OrthogonalState's).
-            Kind::Parallel => StateBody::Container(Region {
-                parallel: true,
-                ..Region::unset(
-                    el.btfsm_attr("outcomes")
-                        .unwrap_or_default()
-                        .split_whitespace()
-                        .map(str::to_string)
-                        .collect(),
-                )
-            }),
-            _ if el.btfsm_attr("decision") == Some("true") => StateBody::Decision,
-            _ => StateBody::Task(el.btfsm_attr("skill").map(|s| {
-                SkillCall {
-                    skill: s.to_string(),
-                    args: el
-                        .attrs
-                        .iter()
-                        .filter(|a| a.ns.as_deref() == Some(BTFSM_NS))
-                        .filter_map(|a| {
-                            a.name
-                                .strip_prefix("arg.")
-                                .map(|k| (k.to_string(), arg_value(&a.value)))
-                        })
-                        .collect::<BTreeMap<_, _>>(),
-                }
-            })),
-        };
+        let body = state_body(el, kind);
         // A skill binding is checked as the TOML reader checks it (so that
         // the machine converts to TOML that reads back).
         if let StateBody::Task(Some(call)) = &body
@@ -219,18 +177,7 @@ pub(super) fn states(
             },
             span: Some(el.span.clone()),
         });
-        match pstate {
-            None => m.top.states.push(si),
-            Some(p) => match &mut m.states[p].body {
-                StateBody::Container(r) => r.states.push(si),
-                _ => {
-                    m.states[p].body = StateBody::Container(Region {
-                        states: vec![si],
-                        ..Region::unset(vec![])
-                    })
-                }
-            },
-        }
+        add_to_region(&mut m, pstate, si);
     }
     // A `<parallel>` with no states inside is entered and stays, as a
     // plain state.
@@ -251,4 +198,78 @@ pub(super) fn states(
         }
     }
     (m, state_of, entry_of)
+}
+
+/// Adds a final state as an outcome of its region: the machine's, or that
+/// of its parent state (which becomes a container). `false` when the parent
+/// is a `<parallel>`, which holds no final.
+fn add_final(m: &mut StateMachine, parent: Option<usize>, name: String) -> bool {
+    match parent {
+        None => m.top.outcomes.push(name),
+        Some(p) => {
+            if let StateBody::Container(r) = &mut m.states[p].body {
+                if r.parallel {
+                    return false;
+                }
+                r.outcomes.push(name);
+            } else {
+                m.states[p].body = StateBody::Container(Region::unset(vec![name]));
+            }
+        }
+    }
+    true
+}
+
+/// What a state-like element (not a final) is: a history's decision, a
+/// parallel container (its regions added as they are read), a decision
+/// state, or a task with its skill binding.
+fn state_body(el: &XElem, kind: &Kind) -> StateBody {
+    match kind {
+        Kind::History(_) => StateBody::Decision,
+        // Its regions are added as they are read.
+        // Outcomes only in `btfsm:outcomes` (a yasmin OrthogonalState's).
+        Kind::Parallel => StateBody::Container(Region {
+            parallel: true,
+            ..Region::unset(
+                el.btfsm_attr("outcomes")
+                    .unwrap_or_default()
+                    .split_whitespace()
+                    .map(str::to_string)
+                    .collect(),
+            )
+        }),
+        _ if el.btfsm_attr("decision") == Some("true") => StateBody::Decision,
+        _ => StateBody::Task(el.btfsm_attr("skill").map(|s| {
+            SkillCall {
+                skill: s.to_string(),
+                args: el
+                    .attrs
+                    .iter()
+                    .filter(|a| a.ns.as_deref() == Some(BTFSM_NS))
+                    .filter_map(|a| {
+                        a.name
+                            .strip_prefix("arg.")
+                            .map(|k| (k.to_string(), arg_value(&a.value)))
+                    })
+                    .collect::<BTreeMap<_, _>>(),
+            }
+        })),
+    }
+}
+
+/// Adds state `si` to its region: the machine's, or that of its parent
+/// state (which becomes a container).
+fn add_to_region(m: &mut StateMachine, parent: Option<usize>, si: usize) {
+    match parent {
+        None => m.top.states.push(si),
+        Some(p) => match &mut m.states[p].body {
+            StateBody::Container(r) => r.states.push(si),
+            _ => {
+                m.states[p].body = StateBody::Container(Region {
+                    states: vec![si],
+                    ..Region::unset(vec![])
+                })
+            }
+        },
+    }
 }

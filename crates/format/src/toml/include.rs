@@ -108,7 +108,6 @@ impl Loader {
     }
 
     /// Reads an included subtree file the first time (see [`Self::include`]).
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn read_include(
         &mut self,
         cx: &Ctx<'_>,
@@ -119,29 +118,7 @@ impl Loader {
         canon: PathBuf,
     ) -> Option<Bt> {
         let tval = t.get("subtree").expect("a subtree node");
-        let shown = path.display().to_string();
-        let file = match read_included(path, &shown, &self.limits) {
-            Ok(f) => f,
-            Err(mut ds) => {
-                let msg = ds.remove(0).message;
-                self.err(cx, tval.span(), format!("subtree of node `{id}`: {msg}"));
-                return None;
-            }
-        };
-        let len = file.text.len() as u64;
-        if len > self.include_bytes {
-            self.err(
-                cx,
-                tval.span(),
-                format!(
-                    "subtree includes read more than {} bytes in total",
-                    self.limits.max_file_bytes
-                ),
-            )
-            .hint = Some("raise the limit with --max-file-bytes".into());
-            return None;
-        }
-        self.include_bytes -= len;
+        let file = self.included_file(cx, id, tval, path)?;
         let doc = self.parse_doc(&file)?;
         let sub_table = doc.get_ref();
         let sub_cx0 = Ctx {
@@ -169,57 +146,8 @@ impl Loader {
             "top-level key",
         );
         // Parameters: declared defaults in the subtree file, overridden by `with`.
-        let mut params = BTreeMap::new();
-        if let Some(pv) = sub_table.get("params") {
-            match pv.get_ref() {
-                DeValue::Table(pt) => {
-                    for (k, v) in pt.iter() {
-                        params.insert(k.get_ref().to_string(), scalar_text(v.get_ref()));
-                    }
-                }
-                other => {
-                    self.err(
-                        &sub_cx0,
-                        pv.span(),
-                        format!("`params` must be a table, found {}", type_name(other)),
-                    );
-                }
-            }
-        }
-        if let Some(wv) = t.get("with") {
-            match wv.get_ref() {
-                DeValue::Table(wt) => {
-                    for (k, v) in wt.iter() {
-                        if !params.contains_key(k.get_ref().as_ref()) {
-                            let declared: Vec<&str> = params.keys().map(String::as_str).collect();
-                            let h = if declared.is_empty() {
-                                format!("`{rel}` declares no `[params]`")
-                            } else {
-                                self.suggest(k.get_ref(), declared)
-                            };
-                            self.err(
-                                cx,
-                                k.span(),
-                                format!("subtree `{rel}` has no parameter `{}`", k.get_ref()),
-                            )
-                            .hint = Some(h);
-                            continue;
-                        }
-                        params.insert(k.get_ref().to_string(), cx.subst(&scalar_text(v.get_ref())));
-                    }
-                }
-                other => {
-                    self.err(
-                        cx,
-                        wv.span(),
-                        format!(
-                            "`with` of node `{id}` must be a table, found {}",
-                            type_name(other)
-                        ),
-                    );
-                }
-            }
-        }
+        let mut params = self.declared_params(&sub_cx0, sub_table);
+        self.with_params(cx, id, t, rel, &mut params);
         let sub_cx = Ctx {
             file: &file,
             base: sub_cx0.base,
@@ -230,6 +158,115 @@ impl Loader {
         let bt = self.bt(&sub_cx, sub_table, doc.span(), Some(""));
         self.stack.pop();
         bt
+    }
+
+    /// Reads the file a `subtree` names (`tval`), charging its bytes to
+    /// what includes may still read.
+    fn included_file(
+        &mut self,
+        cx: &Ctx<'_>,
+        id: &str,
+        tval: &Val<'_>,
+        path: &Path,
+    ) -> Option<Arc<SourceFile>> {
+        let shown = path.display().to_string();
+        let file = match read_included(path, &shown, &self.limits) {
+            Ok(f) => f,
+            Err(mut ds) => {
+                let msg = ds.remove(0).message;
+                self.err(cx, tval.span(), format!("subtree of node `{id}`: {msg}"));
+                return None;
+            }
+        };
+        let len = file.text.len() as u64;
+        if len > self.include_bytes {
+            self.err(
+                cx,
+                tval.span(),
+                format!(
+                    "subtree includes read more than {} bytes in total",
+                    self.limits.max_file_bytes
+                ),
+            )
+            .hint = Some("raise the limit with --max-file-bytes".into());
+            return None;
+        }
+        self.include_bytes -= len;
+        Some(file)
+    }
+
+    /// The parameters a subtree file declares (`[params]`), with their
+    /// default values as text.
+    fn declared_params(
+        &mut self,
+        sub_cx: &Ctx<'_>,
+        sub_table: &DeTable<'_>,
+    ) -> BTreeMap<String, String> {
+        let mut params = BTreeMap::new();
+        if let Some(pv) = sub_table.get("params") {
+            match pv.get_ref() {
+                DeValue::Table(pt) => {
+                    for (k, v) in pt.iter() {
+                        params.insert(k.get_ref().to_string(), scalar_text(v.get_ref()));
+                    }
+                }
+                other => {
+                    self.err(
+                        sub_cx,
+                        pv.span(),
+                        format!("`params` must be a table, found {}", type_name(other)),
+                    );
+                }
+            }
+        }
+        params
+    }
+
+    /// Overrides declared parameters with the including node's `with`
+    /// values (substituted in the including file's parameters).
+    fn with_params(
+        &mut self,
+        cx: &Ctx<'_>,
+        id: &str,
+        t: &DeTable<'_>,
+        rel: &str,
+        params: &mut BTreeMap<String, String>,
+    ) {
+        let Some(wv) = t.get("with") else {
+            return;
+        };
+        match wv.get_ref() {
+            DeValue::Table(wt) => {
+                for (k, v) in wt.iter() {
+                    if !params.contains_key(k.get_ref().as_ref()) {
+                        let declared: Vec<&str> = params.keys().map(String::as_str).collect();
+                        let h = if declared.is_empty() {
+                            format!("`{rel}` declares no `[params]`")
+                        } else {
+                            self.suggest(k.get_ref(), declared)
+                        };
+                        self.err(
+                            cx,
+                            k.span(),
+                            format!("subtree `{rel}` has no parameter `{}`", k.get_ref()),
+                        )
+                        .hint = Some(h);
+                        continue;
+                    }
+                    params.insert(k.get_ref().to_string(), cx.subst(&scalar_text(v.get_ref())));
+                }
+            }
+            other => {
+                self.err(
+                    cx,
+                    wv.span(),
+                    format!(
+                        "`with` of node `{id}` must be a table, found {}",
+                        type_name(other)
+                    ),
+                );
+            }
+        }
     }
 
     // ---------------------------------------------------------------- FSM

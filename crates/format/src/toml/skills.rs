@@ -5,7 +5,6 @@ use super::*;
 
 impl Loader {
     /// Reads `skill = "..."` and `args = {...}` of a leaf or state.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn skill_call(
         &mut self,
         cx: &Ctx<'_>,
@@ -34,13 +33,7 @@ impl Loader {
         // domains"): its arguments are the domain's to check (symbolic
         // simulation checks them against the domain when it binds them).
         if let Some((dom, own)) = name.split_once(':') {
-            let named = |x: &str| {
-                !x.is_empty()
-                    && x.len() <= 128
-                    && x.chars()
-                        .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
-            };
-            if named(dom) && named(own) {
+            if is_domain_word(dom) && is_domain_word(own) {
                 return Some(SkillCall { skill: name, args });
             }
             self.err(cx, sv.span(), format!("`{name}` is not a skill name"))
@@ -48,16 +41,39 @@ impl Loader {
                 Some("a domain's own skill is `domain:Name`: letters, digits, `-` and `_`".into());
             return None;
         }
-        match skill::skill_kind(&name) {
+        if !self.skill_of_kind(cx, sv.span(), &name, owner, want) {
+            return None;
+        }
+        let args_v = t.get("args");
+        let args_span = args_v.map_or(sv.span(), |a| a.span());
+        let args_table = match args_v.map(|a| a.get_ref()) {
+            Some(DeValue::Table(at)) => Some(at),
+            _ => None,
+        };
+        let ok = self.skill_args_fit(cx, &name, owner, &args, args_span, args_table);
+        ok.then_some(SkillCall { skill: name, args })
+    }
+
+    /// Whether `name` is a skill of the library, of the kind wanted (an
+    /// error when not).
+    fn skill_of_kind(
+        &mut self,
+        cx: &Ctx<'_>,
+        span: Range<usize>,
+        name: &str,
+        owner: &str,
+        want: Option<SkillKind>,
+    ) -> bool {
+        match skill::skill_kind(name) {
             None => {
                 let cands: Vec<&str> = match want {
                     Some(k) => skill::skill_names(k),
                     None => skill::SKILLS.iter().map(|s| s.0).collect(),
                 };
-                let h = self.suggest(&name, cands.iter().copied());
-                self.err(cx, sv.span(), format!("unknown skill `{name}` in {owner}"))
+                let h = self.suggest(name, cands.iter().copied());
+                self.err(cx, span, format!("unknown skill `{name}` in {owner}"))
                     .hint = Some(h);
-                return None;
+                false
             }
             Some(k) if want.is_some_and(|w| w != k) => {
                 let w = want.expect("checked");
@@ -72,7 +88,7 @@ impl Loader {
                 );
                 self.err(
                     cx,
-                    sv.span(),
+                    span,
                     format!(
                         "{owner} is {} but `{name}` is {} skill",
                         article_kind(w),
@@ -80,18 +96,31 @@ impl Loader {
                     ),
                 )
                 .hint = Some(h);
-                return None;
+                false
             }
-            Some(_) => {}
+            Some(_) => true,
         }
-        let params = skill::skill_params(&name).unwrap_or(&[]);
+    }
+
+    /// Checks a skill's arguments against its parameters: every required
+    /// one given (an error at `args_span`), no unknown one in the `args`
+    /// table. `false` when one is wrong.
+    fn skill_args_fit(
+        &mut self,
+        cx: &Ctx<'_>,
+        name: &str,
+        owner: &str,
+        args: &BTreeMap<String, ArgValue>,
+        args_span: Range<usize>,
+        args_table: Option<&DeTable<'_>>,
+    ) -> bool {
+        let params = skill::skill_params(name).unwrap_or(&[]);
         let mut ok = true;
         for (p, required) in params {
             if *required && !args.contains_key(*p) {
-                let span = t.get("args").map_or(sv.span(), |a| a.span());
                 self.err(
                     cx,
-                    span,
+                    args_span.clone(),
                     format!("skill `{name}` of {owner} needs argument `{p}`"),
                 )
                 .hint = Some(format!(
@@ -105,7 +134,7 @@ impl Loader {
                 ok = false;
             }
         }
-        if let Some(DeValue::Table(at)) = t.get("args").map(|a| a.get_ref()) {
+        if let Some(at) = args_table {
             for (k, _) in at.iter() {
                 if !params.iter().any(|(p, _)| *p == k.get_ref().as_ref()) {
                     let h = if params.is_empty() {
@@ -123,7 +152,7 @@ impl Loader {
                 }
             }
         }
-        ok.then_some(SkillCall { skill: name, args })
+        ok
     }
 
     pub(super) fn args(
@@ -176,4 +205,13 @@ impl Loader {
     }
 
     // ---------------------------------------------------------------- BT
+}
+
+/// Whether a part of `domain:Name` is a name: 1 to 128 letters, digits, `-`
+/// and `_`.
+fn is_domain_word(x: &str) -> bool {
+    !x.is_empty()
+        && x.len() <= 128
+        && x.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
 }
