@@ -634,20 +634,24 @@ fn link_after(
     if spec.kind == AddKind::Sequential
         && let (Some(s), Some(g)) = (selector, &spec.selector_guard)
     {
-        let k = spec.selector_guard_index.unwrap_or_else(|| {
-            m.states[s]
-                .transitions
-                .iter()
-                .position(|t| {
-                    matches!(t.trigger, Trigger::Guard(_)) && t.target == Target::State(p)
-                })
-                .unwrap_or(usize::MAX)
-        });
-        insert_guard(&mut m.states[s], k, guard_transition(g, n));
+        add_resume_guard(&mut m.states[s], spec.selector_guard_index, g, p, n);
         touched.modified += 1;
         touched.transitions_added += 1;
     }
     Ok(())
+}
+
+/// Gives the SELECTOR `sel` the guard `g` resuming the task at the new
+/// state `n`, at guard position `index` (default: right before its guard
+/// to the predecessor `p`).
+fn add_resume_guard(sel: &mut State, index: Option<usize>, g: &Guard, p: usize, n: usize) {
+    let k = index.unwrap_or_else(|| {
+        sel.transitions
+            .iter()
+            .position(|t| matches!(t.trigger, Trigger::Guard(_)) && t.target == Target::State(p))
+            .unwrap_or(usize::MAX)
+    });
+    insert_guard(sel, k, guard_transition(g, n));
 }
 
 /// Links a connected state `new` (Algorithm 1): a guarded arc from every
