@@ -90,8 +90,7 @@ fn paper_check_names_the_cell_a_policy_edit_changes() {
 }
 
 #[test]
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
-fn paper_json_holds_the_values_of_spec_section_5() {
+fn paper_json_rows_have_the_contract_fields() {
     let j = paper_json();
     for r in j["rows"].as_array().expect("rows") {
         let mut keys: Vec<&str> = r
@@ -111,7 +110,12 @@ fn paper_json_holds_the_values_of_spec_section_5() {
         assert!(differs || r["status"] == "match");
         assert_eq!(r["note"].is_string(), differs, "{r}");
     }
-    // Table II: BT, FSM structural, FSM named, Eq. 3.
+}
+
+/// SPEC §5, Table II: BT, FSM structural, FSM named, Eq. 3.
+#[test]
+fn paper_json_holds_the_values_of_table_ii() {
+    let j = paper_json();
     for (row, bt, fs, fnm, eq3) in [
         ("Tuck arm", 6, 5, 7, 12),
         ("Safe-Move-To", 2, 6, 6, 4),
@@ -133,7 +137,12 @@ fn paper_json_holds_the_values_of_spec_section_5() {
     assert!(safe["note"].as_str().expect("note").contains("NetworkX"));
     let eq = cell(&j, "Table II", "Recharge", "HFSM structural GED");
     assert!(eq["note"].as_str().expect("note").contains("Eq. 3"));
-    // Table III: CC, GED, graphical, active (BT / FSM).
+}
+
+/// SPEC §5, Table III: CC, GED, graphical, active (BT / FSM).
+#[test]
+fn paper_json_holds_the_values_of_table_iii() {
+    let j = paper_json();
     for (row, cc, ged, gr, ac) in [
         ("Development baseline", (1, 14), None, (27, 24), (14, 24)),
         (
@@ -186,7 +195,13 @@ fn paper_json_holds_the_values_of_spec_section_5() {
     let dock = cell(&j, "Table III", "Development docking", "GED FSM structural");
     assert_eq!(dock["computed"], 6);
     assert_eq!(dock["status"], "differs");
-    // Effort: 15 and 22, by formula and by named GED; structural 14 for Fig. 10.
+}
+
+/// SPEC §5, effort: 15 and 22, by formula and by named GED; structural 14
+/// for Fig. 10.
+#[test]
+fn paper_json_holds_the_effort_values() {
+    let j = paper_json();
     for (row, e) in [("Fig. 2 -> Fig. 4", 15), ("Fig. 10 -> Fig. 11", 22)] {
         let c = |col: &str| cell(&j, "Effort", row, col)["computed"].clone();
         assert_eq!(c("Eq. 4"), e);

@@ -89,7 +89,6 @@ fn state_name(d: &Domain, s: &Step<'_>) -> String {
 }
 
 /// The fault-tolerant FSM of the planned tree (see the module docs).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
     let all = steps(d, p);
     // Steps restoring a volatile goal fact (a battery level) are connected
@@ -115,9 +114,29 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         .collect();
     let ks = kernels(&steps, &goal);
     let n = steps.len();
-    let sel = n;
+    let names = state_names(d, &steps, &connected);
+    let to_connected = connected_guards(d, &connected, &volatile, n);
+    let mut states: Vec<State> = Vec::new();
+    for (i, s) in steps.iter().enumerate() {
+        states.push(step_state(s, i, n, &names[i], &to_connected));
+    }
+    states.push(selector(d, &ks, to_connected));
+    for (c, s) in connected.iter().enumerate() {
+        states.push(connected_state(s, n + 1 + c, n, &names[n + c]));
+    }
+    let count = states.len();
+    Ok(StateMachine {
+        hierarchical: false,
+        top: Region::at(0, vec!["SUCCESS".into()], (0..count).collect()),
+        states,
+    })
+}
+
+/// The states' names, the chain's steps then the connected ones: each
+/// step's label, numbered " (2)", " (3)"… when taken (or "SELECTOR").
+fn state_names(d: &Domain, steps: &[Step<'_>], connected: &[Step<'_>]) -> Vec<String> {
     let mut names: Vec<String> = Vec::new();
-    for s in steps.iter().chain(&connected) {
+    for s in steps.iter().chain(connected) {
         let mut name = state_name(d, s);
         let mut k = 2;
         while names.contains(&name) || name == "SELECTOR" {
@@ -126,7 +145,17 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         }
         names.push(name);
     }
-    // Entering a connected state: the guard "its fact does not hold".
+    names
+}
+
+/// The transitions into the connected states (numbered from `n + 1`), each
+/// guarded by "its volatile fact does not hold".
+fn connected_guards(
+    d: &Domain,
+    connected: &[Step<'_>],
+    volatile: &[&Fact],
+    n: usize,
+) -> Vec<Transition> {
     let mut to_connected: Vec<Transition> = Vec::new();
     for (c, s) in connected.iter().enumerate() {
         let f = s
@@ -144,80 +173,68 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
             span: None,
         });
     }
-    let task = |s: &Step<'_>| {
-        StateBody::Task(s.action.skill.as_ref().map(|skill| {
-            let objs: Vec<String> = s
-                .action
-                .params
-                .iter()
-                .map(|p| s.bind[&p.name].clone())
-                .collect();
-            Domain::skill_call(skill, &s.action.params, &objs)
-        }))
+    to_connected
+}
+
+/// A step's body: the task calling its action's skill, if it has one.
+fn task(s: &Step<'_>) -> StateBody {
+    StateBody::Task(s.action.skill.as_ref().map(|skill| {
+        let objs: Vec<String> = s
+            .action
+            .params
+            .iter()
+            .map(|p| s.bind[&p.name].clone())
+            .collect();
+        Domain::skill_call(skill, &s.action.params, &objs)
+    }))
+}
+
+/// The state of step `i` of `n` in the chain: the connected states' guards
+/// first, then on `SUCCESS` the next step (or `SUCCESS`), on `FAILURE` the
+/// SELECTOR (state `n`), and itself on `RUNNING`.
+fn step_state(s: &Step<'_>, i: usize, n: usize, name: &str, to_connected: &[Transition]) -> State {
+    let next = if i + 1 < n {
+        Target::State(i + 1)
+    } else {
+        Target::Outcome("SUCCESS".into())
     };
-    let mut states: Vec<State> = Vec::new();
-    for (i, s) in steps.iter().enumerate() {
-        let next = if i + 1 < n {
-            Target::State(i + 1)
-        } else {
-            Target::Outcome("SUCCESS".into())
-        };
-        let mut transitions = to_connected.clone();
-        transitions.extend([
-            Transition::on_outcome("SUCCESS", next),
-            Transition::on_outcome("FAILURE", Target::State(sel)),
-            Transition::on_outcome("RUNNING", Target::State(i)),
-        ]);
-        states.push(State {
-            name: names[i].clone(),
-            label: names[i].clone(),
-            parent: None,
-            body: task(s),
-            transitions,
-            pseudo: None,
-            span: None,
-        });
+    let mut transitions = to_connected.to_vec();
+    transitions.extend([
+        Transition::on_outcome("SUCCESS", next),
+        Transition::on_outcome("FAILURE", Target::State(n)),
+        Transition::on_outcome("RUNNING", Target::State(i)),
+    ]);
+    State {
+        name: name.to_string(),
+        label: name.to_string(),
+        parent: None,
+        body: task(s),
+        transitions,
+        pseudo: None,
+        span: None,
     }
-    let label = |fs: &[Fact]| {
-        fs.iter()
-            .map(ToString::to_string)
-            .collect::<Vec<_>>()
-            .join(" and ")
-    };
-    let mut guards = to_connected.clone();
+}
+
+/// Facts joined with " and ", as a guard's label.
+fn facts_label(fs: &[Fact]) -> String {
+    fs.iter()
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(" and ")
+}
+
+/// The SELECTOR (state `n`, with `ks` the `n + 1` kernels): after the
+/// connected states' guards `guards`, one guard per kernel, latest first,
+/// resuming at its step (the last one at `SUCCESS`); itself on `RUNNING`.
+fn selector(d: &Domain, ks: &[Vec<Fact>], mut guards: Vec<Transition>) -> State {
+    let n = ks.len() - 1;
     for k in (0..=n).rev() {
-        let target = if k == n {
-            Target::Outcome("SUCCESS".into())
-        } else {
-            Target::State(k)
-        };
-        let (all, text) = if !ks[k].is_empty() {
-            let all: Vec<_> = ks[k].iter().map(|f| d.fact_term(f, false)).collect();
-            let text = if k == n {
-                format!("done: {}", label(&ks[k]))
-            } else {
-                label(&ks[k])
-            };
-            (all, text)
-        } else {
-            // Nothing needed: every later kernel failed. Written as "not the
-            // next kernel's first fact", which the SELECTOR knows here.
-            match ks.get(k + 1).and_then(|next| next.first()) {
-                Some(f) => (vec![d.fact_term(f, true)], "restart the task".to_string()),
-                None => (vec![], "restart the task".to_string()),
-            }
-        };
-        if all.is_empty() {
-            continue;
+        if let Some(t) = kernel_guard(d, ks, k) {
+            guards.push(t);
         }
-        guards.push(Transition {
-            trigger: Trigger::Guard(Guard { all, label: text }),
-            target,
-            span: None,
-        });
     }
-    guards.push(Transition::on_outcome("RUNNING", Target::State(sel)));
-    states.push(State {
+    guards.push(Transition::on_outcome("RUNNING", Target::State(n)));
+    State {
         name: "SELECTOR".into(),
         label: "SELECTOR".into(),
         parent: None,
@@ -225,26 +242,57 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         transitions: guards,
         pseudo: None,
         span: None,
-    });
-    for (c, s) in connected.iter().enumerate() {
-        let i = n + 1 + c;
-        states.push(State {
-            name: names[n + c].clone(),
-            label: names[n + c].clone(),
-            parent: None,
-            body: task(s),
-            transitions: vec![
-                Transition::on_outcome("SUCCESS", Target::State(sel)),
-                Transition::on_outcome("RUNNING", Target::State(i)),
-            ],
-            pseudo: None,
-            span: None,
-        });
     }
-    let count = states.len();
-    Ok(StateMachine {
-        hierarchical: false,
-        top: Region::at(0, vec!["SUCCESS".into()], (0..count).collect()),
-        states,
+}
+
+/// The SELECTOR's guard resuming at step `k` when kernel `ks[k]` holds (at
+/// `SUCCESS` for the goal's kernel); `None` when there is nothing to test.
+fn kernel_guard(d: &Domain, ks: &[Vec<Fact>], k: usize) -> Option<Transition> {
+    let n = ks.len() - 1;
+    let target = if k == n {
+        Target::Outcome("SUCCESS".into())
+    } else {
+        Target::State(k)
+    };
+    let (all, text) = if !ks[k].is_empty() {
+        let all: Vec<_> = ks[k].iter().map(|f| d.fact_term(f, false)).collect();
+        let text = if k == n {
+            format!("done: {}", facts_label(&ks[k]))
+        } else {
+            facts_label(&ks[k])
+        };
+        (all, text)
+    } else {
+        // Nothing needed: every later kernel failed. Written as "not the
+        // next kernel's first fact", which the SELECTOR knows here.
+        match ks.get(k + 1).and_then(|next| next.first()) {
+            Some(f) => (vec![d.fact_term(f, true)], "restart the task".to_string()),
+            None => (vec![], "restart the task".to_string()),
+        }
+    };
+    if all.is_empty() {
+        return None;
+    }
+    Some(Transition {
+        trigger: Trigger::Guard(Guard { all, label: text }),
+        target,
+        span: None,
     })
+}
+
+/// Connected state `i`: back to the SELECTOR (state `sel`) on `SUCCESS`,
+/// itself on `RUNNING`.
+fn connected_state(s: &Step<'_>, i: usize, sel: usize, name: &str) -> State {
+    State {
+        name: name.to_string(),
+        label: name.to_string(),
+        parent: None,
+        body: task(s),
+        transitions: vec![
+            Transition::on_outcome("SUCCESS", Target::State(sel)),
+            Transition::on_outcome("RUNNING", Target::State(i)),
+        ],
+        pseudo: None,
+        span: None,
+    }
 }

@@ -168,28 +168,10 @@ impl Validator {
         self.diags.push(d);
     }
 
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    /// The whole domain: objects, limits, name, predicates, actions, the
+    /// goal and the tasks, in that order (so are the diagnostics).
     fn domain(&mut self, raw: RawDomain) -> Domain {
-        let mut objects = BTreeMap::new();
-        for (name, o) in &raw.objects {
-            if !fact::is_name(name.get_ref()) {
-                self.err(
-                    name.span(),
-                    format!(
-                        "object `{}` is not a name",
-                        btfsm_core::sanitize::shown(name.get_ref())
-                    ),
-                    "letters, digits, `-` and `_`",
-                );
-            }
-            objects.insert(
-                name.get_ref().clone(),
-                Object {
-                    types: o.types.clone(),
-                    short: o.short.clone().unwrap_or_else(|| name.get_ref().clone()),
-                },
-            );
-        }
+        let objects = self.objects(&raw.objects);
         let too_many = [
             ("objects", objects.len()),
             ("predicates", raw.predicates.0.len()),
@@ -222,97 +204,13 @@ impl Validator {
             ..Domain::default()
         };
         for (name, p) in raw.predicates.0 {
-            let p = p.into_inner();
-            let params = self.params(&p.params, &d);
-            let exclusive = p.exclusive.as_ref().and_then(|x| {
-                let at = params.iter().position(|q| &q.name == x.get_ref());
-                if at.is_none() {
-                    self.err(
-                        x.span(),
-                        format!(
-                            "`exclusive` names `{}`, not a parameter of `{}`",
-                            btfsm_core::sanitize::shown(x.get_ref()),
-                            btfsm_core::sanitize::shown(&name)
-                        ),
-                        "name the parameter whose different values exclude each other",
-                    );
-                }
-                at
-            });
-            let args: Vec<String> = params.iter().map(|q| format!("{{{}}}", q.name)).collect();
-            let shown_fact = if args.is_empty() {
-                name.clone()
-            } else {
-                format!("{name} {}", args.join(" "))
-            };
-            let custom = format!("{}:{name}", d.name);
-            let skill = self.skill(p.skill.as_ref(), SkillKind::Condition, &params, custom);
-            d.predicates.push(Predicate {
-                name: name.clone(),
-                skill,
-                exclusive,
-                id: p.id.unwrap_or_else(|| default_id(&name, &params)),
-                label: p.label.unwrap_or_else(|| format!("{shown_fact}?")),
-                volatile: p.volatile,
-                achieved_id: p
-                    .achieved_id
-                    .unwrap_or_else(|| format!("ensure-{}", default_id(&name, &params))),
-                params,
-            });
+            let p = self.predicate(name, p.into_inner(), &d);
+            d.predicates.push(p);
         }
         for (name, a) in raw.actions.0 {
-            let span = a.span();
-            let a = a.into_inner();
-            let params = self.params(&a.params, &d);
-            if a.pre.len() > MAX_SIBLINGS {
-                self.err(
-                    span.clone(),
-                    format!(
-                        "action `{}` has {} preconditions, more than {MAX_SIBLINGS}",
-                        btfsm_core::sanitize::shown(&name),
-                        a.pre.len()
-                    ),
-                    "split the action",
-                );
-                continue;
+            if let Some(a) = self.action(name, a, &d) {
+                d.actions.push(a);
             }
-            let pre = self.patterns(&a.pre, &params, &d);
-            let add = self.patterns(&a.add, &params, &d);
-            let del = self.patterns(&a.del, &params, &d);
-            if a.add.is_empty() {
-                self.err(
-                    span.clone(),
-                    format!(
-                        "action `{}` adds no fact",
-                        btfsm_core::sanitize::shown(&name)
-                    ),
-                    "write `add = [\"Fact(param)\"]`: a planner uses an action for what it adds",
-                );
-            }
-            let args: Vec<String> = params.iter().map(|q| format!("{{{}}}", q.name)).collect();
-            let shown_call = if args.is_empty() {
-                name.clone()
-            } else {
-                format!("{name} {}", args.join(" "))
-            };
-            let id = a.id.unwrap_or_else(|| default_id(&name, &params));
-            d.actions.push(Action {
-                name: name.clone(),
-                pre,
-                add,
-                del,
-                cost: a.cost,
-                skill: self.skill(
-                    a.skill.as_ref(),
-                    SkillKind::Action,
-                    &params,
-                    format!("{}:{name}", d.name),
-                ),
-                label: a.label.unwrap_or_else(|| format!("{shown_call}!")),
-                sequence_id: a.sequence_id.unwrap_or_else(|| format!("do-{id}")),
-                id,
-                params,
-            });
         }
         d.goal = self.goal(&raw.goal, &d);
         for (name, t) in &raw.tasks.0 {
@@ -323,6 +221,130 @@ impl Validator {
             d.tasks.push((name.clone(), g));
         }
         d
+    }
+
+    /// The `[objects]` table, each name checked.
+    fn objects(&mut self, raw: &BTreeMap<Spanned<String>, RawObject>) -> BTreeMap<String, Object> {
+        let mut objects = BTreeMap::new();
+        for (name, o) in raw {
+            if !fact::is_name(name.get_ref()) {
+                self.err(
+                    name.span(),
+                    format!(
+                        "object `{}` is not a name",
+                        btfsm_core::sanitize::shown(name.get_ref())
+                    ),
+                    "letters, digits, `-` and `_`",
+                );
+            }
+            objects.insert(
+                name.get_ref().clone(),
+                Object {
+                    types: o.types.clone(),
+                    short: o.short.clone().unwrap_or_else(|| name.get_ref().clone()),
+                },
+            );
+        }
+        objects
+    }
+
+    /// Predicate `name` (`[predicates.NAME]`): parameters, `exclusive`,
+    /// skill, and the defaults of its ids and label.
+    fn predicate(&mut self, name: String, p: RawPredicate, d: &Domain) -> Predicate {
+        let params = self.params(&p.params, d);
+        let exclusive = p.exclusive.as_ref().and_then(|x| {
+            let at = params.iter().position(|q| &q.name == x.get_ref());
+            if at.is_none() {
+                self.err(
+                    x.span(),
+                    format!(
+                        "`exclusive` names `{}`, not a parameter of `{}`",
+                        btfsm_core::sanitize::shown(x.get_ref()),
+                        btfsm_core::sanitize::shown(&name)
+                    ),
+                    "name the parameter whose different values exclude each other",
+                );
+            }
+            at
+        });
+        let args: Vec<String> = params.iter().map(|q| format!("{{{}}}", q.name)).collect();
+        let shown_fact = if args.is_empty() {
+            name.clone()
+        } else {
+            format!("{name} {}", args.join(" "))
+        };
+        let custom = format!("{}:{name}", d.name);
+        let skill = self.skill(p.skill.as_ref(), SkillKind::Condition, &params, custom);
+        Predicate {
+            name: name.clone(),
+            skill,
+            exclusive,
+            id: p.id.unwrap_or_else(|| default_id(&name, &params)),
+            label: p.label.unwrap_or_else(|| format!("{shown_fact}?")),
+            volatile: p.volatile,
+            achieved_id: p
+                .achieved_id
+                .unwrap_or_else(|| format!("ensure-{}", default_id(&name, &params))),
+            params,
+        }
+    }
+
+    /// Action `name` (`[actions.NAME]`): parameters, facts, skill, and the
+    /// defaults of its ids and label; `None` when it has too many
+    /// preconditions to be checked.
+    fn action(&mut self, name: String, a: Spanned<RawAction>, d: &Domain) -> Option<Action> {
+        let span = a.span();
+        let a = a.into_inner();
+        let params = self.params(&a.params, d);
+        if a.pre.len() > MAX_SIBLINGS {
+            self.err(
+                span.clone(),
+                format!(
+                    "action `{}` has {} preconditions, more than {MAX_SIBLINGS}",
+                    btfsm_core::sanitize::shown(&name),
+                    a.pre.len()
+                ),
+                "split the action",
+            );
+            return None;
+        }
+        let pre = self.patterns(&a.pre, &params, d);
+        let add = self.patterns(&a.add, &params, d);
+        let del = self.patterns(&a.del, &params, d);
+        if a.add.is_empty() {
+            self.err(
+                span.clone(),
+                format!(
+                    "action `{}` adds no fact",
+                    btfsm_core::sanitize::shown(&name)
+                ),
+                "write `add = [\"Fact(param)\"]`: a planner uses an action for what it adds",
+            );
+        }
+        let args: Vec<String> = params.iter().map(|q| format!("{{{}}}", q.name)).collect();
+        let shown_call = if args.is_empty() {
+            name.clone()
+        } else {
+            format!("{name} {}", args.join(" "))
+        };
+        let id = a.id.unwrap_or_else(|| default_id(&name, &params));
+        Some(Action {
+            name: name.clone(),
+            pre,
+            add,
+            del,
+            cost: a.cost,
+            skill: self.skill(
+                a.skill.as_ref(),
+                SkillKind::Action,
+                &params,
+                format!("{}:{name}", d.name),
+            ),
+            label: a.label.unwrap_or_else(|| format!("{shown_call}!")),
+            sequence_id: a.sequence_id.unwrap_or_else(|| format!("do-{id}")),
+            id,
+            params,
+        })
     }
 
     /// A goal (`[goal]` or `[tasks.NAME]`): facts, `use`, names.

@@ -18,7 +18,7 @@
 
 use btfsm_model::Policy;
 use btfsm_model::bt::{Arity, Bt};
-use btfsm_model::{BtNodeKind, PolicyBody, StateBody, StateMachine, Target};
+use btfsm_model::{BtNodeKind, PolicyBody, Region, StateBody, StateMachine, Target};
 use std::fmt::Write;
 
 /// A label as Mermaid reads it between quotes (or after a transition's `:`).
@@ -101,31 +101,72 @@ fn bt_flowchart(name: &str, bt: &Bt) -> String {
     out
 }
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+/// The `stateDiagram-v2` text of an FSM or HFSM.
 fn state_diagram(name: &str, m: &StateMachine) -> String {
-    let mut out = String::new();
-    let _ = writeln!(out, "{}stateDiagram-v2", front_matter(name));
-    // Outcome states of a region: `o{k}` at the top, `o{c}_{k}` in container c.
-    let outcome_id = |owner: Option<usize>, k: usize| match owner {
+    let mut d = Diagram {
+        m,
+        out: String::new(),
+        decisions: Vec::new(),
+        stack: vec![Item::Region(None, 1)],
+    };
+    let _ = writeln!(d.out, "{}stateDiagram-v2", front_matter(name));
+    while let Some(item) = d.stack.pop() {
+        match item {
+            Item::Close(depth) => {
+                let _ = writeln!(d.out, "{}}}", "    ".repeat(depth - 1));
+            }
+            Item::Separator(depth) => {
+                let _ = writeln!(d.out, "{}--", "    ".repeat(depth));
+            }
+            Item::Orthogonal(s, depth) => d.orthogonal(s, depth),
+            Item::Region(owner, depth) => d.region(owner, depth),
+        }
+    }
+    for s in d.decisions {
+        let _ = writeln!(d.out, "    class s{s} decision");
+    }
+    let _ = writeln!(d.out, "    classDef decision fill:#fff3c4");
+    d.out
+}
+
+/// What is left to write of a state diagram. Regions go on an explicit
+/// stack: a container's block is opened, its region written (states,
+/// outcomes, transitions of its states), its nested containers written
+/// inside, then closed.
+enum Item {
+    Region(Option<usize>, usize),
+    Close(usize),
+    /// `--` between two regions of a parallel state (Mermaid's
+    /// concurrency separator).
+    Separator(usize),
+    /// A region of a parallel state at a depth: its start, and the
+    /// state itself (a block when it holds states).
+    Orthogonal(usize, usize),
+}
+
+/// The id of the outcome state `k` of a region: `o{k}` at the top,
+/// `o{c}_{k}` in container c.
+fn outcome_id(owner: Option<usize>, k: usize) -> String {
+    match owner {
         None => format!("o{k}"),
         Some(c) => format!("o{c}_{k}"),
-    };
-    // Regions with an explicit stack: a container's block is opened, its
-    // region written (states, outcomes, transitions of its states), its
-    // nested containers written inside, then closed.
-    enum Item {
-        Region(Option<usize>, usize),
-        Close(usize),
-        /// `--` between two regions of a parallel state (Mermaid's
-        /// concurrency separator).
-        Separator(usize),
-        /// A region of a parallel state at a depth: its start, and the
-        /// state itself (a block when it holds states).
-        Orthogonal(usize, usize),
     }
-    // The transitions of state `s`, whose region's outcomes are `outcomes`
-    // (an outcome of an enclosing region: that region's outcome state).
-    let transitions = |out: &mut String, pad: &str, s: usize, outcomes: &[String]| {
+}
+
+/// A state diagram being written: the text so far, the decision states met
+/// (styled at the end) and what is left to write.
+struct Diagram<'m> {
+    m: &'m StateMachine,
+    out: String,
+    decisions: Vec<usize>,
+    stack: Vec<Item>,
+}
+
+impl<'m> Diagram<'m> {
+    /// The transitions of state `s`, whose region's outcomes are `outcomes`
+    /// (an outcome of an enclosing region: that region's outcome state).
+    fn transitions(&mut self, pad: &str, s: usize, outcomes: &[String]) {
+        let m = self.m;
         for t in &m.states[s].transitions {
             let to = match &t.target {
                 Target::State(j) => format!("s{j}"),
@@ -149,55 +190,48 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
             };
             match label(&t.trigger.label()) {
                 l if l.trim().is_empty() => {
-                    let _ = writeln!(out, "{pad}s{s} --> {to}");
+                    let _ = writeln!(self.out, "{pad}s{s} --> {to}");
                 }
                 l => {
-                    let _ = writeln!(out, "{pad}s{s} --> {to} : {l}");
+                    let _ = writeln!(self.out, "{pad}s{s} --> {to} : {l}");
                 }
             }
         }
-    };
-    let mut decisions = Vec::new();
-    let mut stack = vec![Item::Region(None, 1)];
-    while let Some(item) = stack.pop() {
-        let (owner, depth) = match item {
-            Item::Close(depth) => {
-                let _ = writeln!(out, "{}}}", "    ".repeat(depth - 1));
-                continue;
+    }
+
+    /// One region of a parallel state: its start `s`, written as a state
+    /// unless it is a container (whose region is then written inside).
+    fn orthogonal(&mut self, s: usize, depth: usize) {
+        let pad = "    ".repeat(depth);
+        let st = &self.m.states[s];
+        let _ = writeln!(self.out, "{pad}[*] --> s{s}");
+        if !matches!(st.body, StateBody::Container(_)) {
+            if matches!(st.body, StateBody::Decision) {
+                self.decisions.push(s);
             }
-            Item::Separator(depth) => {
-                let _ = writeln!(out, "{}--", "    ".repeat(depth));
-                continue;
-            }
-            Item::Orthogonal(s, depth) => {
-                let pad = "    ".repeat(depth);
-                let st = &m.states[s];
-                let _ = writeln!(out, "{pad}[*] --> s{s}");
-                if !matches!(st.body, StateBody::Container(_)) {
-                    if matches!(st.body, StateBody::Decision) {
-                        decisions.push(s);
-                    }
-                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&st.label));
-                }
-                transitions(&mut out, &pad, s, &[]);
-                if matches!(st.body, StateBody::Container(_)) {
-                    stack.push(Item::Region(Some(s), depth + 1));
-                }
-                continue;
-            }
-            Item::Region(owner, depth) => (owner, depth),
-        };
+            let _ = writeln!(self.out, "{pad}state \"{}\" as s{s}", label(&st.label));
+        }
+        self.transitions(&pad, s, &[]);
+        if matches!(st.body, StateBody::Container(_)) {
+            self.stack.push(Item::Region(Some(s), depth + 1));
+        }
+    }
+
+    /// The region of container `owner` (the top region for `None`) at
+    /// `depth`, its container's block opened.
+    fn region(&mut self, owner: Option<usize>, depth: usize) {
+        let m = self.m;
         let pad = "    ".repeat(depth);
         let region = match owner {
             None => &m.top,
             Some(c) => {
                 let outer = "    ".repeat(depth - 1);
                 let _ = writeln!(
-                    out,
+                    self.out,
                     "{outer}state \"{}\" as s{c}",
                     label(&m.states[c].label)
                 );
-                let _ = writeln!(out, "{outer}state s{c} {{");
+                let _ = writeln!(self.out, "{outer}state s{c} {{");
                 match &m.states[c].body {
                     StateBody::Container(r) => r,
                     _ => unreachable!("only containers are pushed"),
@@ -205,38 +239,60 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
             }
         };
         if region.parallel {
-            // Each state is a region of its own, separated by `--`; history
-            // pseudo-states (no region) go in the first.
-            for &s in &region.states {
-                if m.states[s].pseudo.is_some() {
-                    decisions.push(s);
-                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&m.states[s].label));
-                    transitions(&mut out, &pad, s, &[]);
-                }
-            }
-            if owner.is_some() {
-                stack.push(Item::Close(depth));
-            }
-            let regions = region.entered(&m.states);
-            for (k, &c) in regions.iter().enumerate().rev() {
-                stack.push(Item::Orthogonal(c, depth));
-                if k > 0 {
-                    stack.push(Item::Separator(depth));
-                }
-            }
-            continue;
+            self.parallel_region(owner, region, depth, &pad);
+        } else {
+            self.sequential_region(owner, region, depth, &pad);
         }
+    }
+
+    /// A parallel region: each state is a region of its own, separated by
+    /// `--`; history pseudo-states (no region) go in the first.
+    fn parallel_region(&mut self, owner: Option<usize>, region: &Region, depth: usize, pad: &str) {
+        let m = self.m;
+        for &s in &region.states {
+            if m.states[s].pseudo.is_some() {
+                self.decisions.push(s);
+                let _ = writeln!(
+                    self.out,
+                    "{pad}state \"{}\" as s{s}",
+                    label(&m.states[s].label)
+                );
+                self.transitions(pad, s, &[]);
+            }
+        }
+        if owner.is_some() {
+            self.stack.push(Item::Close(depth));
+        }
+        let regions = region.entered(&m.states);
+        for (k, &c) in regions.iter().enumerate().rev() {
+            self.stack.push(Item::Orthogonal(c, depth));
+            if k > 0 {
+                self.stack.push(Item::Separator(depth));
+            }
+        }
+    }
+
+    /// A region that is not parallel: its start, its outcomes, its states,
+    /// their transitions, then its nested containers.
+    fn sequential_region(
+        &mut self,
+        owner: Option<usize>,
+        region: &Region,
+        depth: usize,
+        pad: &str,
+    ) {
+        let m = self.m;
         if let Some(i) = region.initial_state() {
-            let _ = writeln!(out, "{pad}[*] --> s{i}");
+            let _ = writeln!(self.out, "{pad}[*] --> s{i}");
         } else if let Target::Outcome(o) = &region.initial
             && let Some(k) = region.outcomes.iter().position(|x| x == o)
         {
-            let _ = writeln!(out, "{pad}[*] --> {}", outcome_id(owner, k));
+            let _ = writeln!(self.out, "{pad}[*] --> {}", outcome_id(owner, k));
         }
         for (k, o) in region.outcomes.iter().enumerate() {
             let id = outcome_id(owner, k);
-            let _ = writeln!(out, "{pad}state \"{}\" as {id}", label(o));
-            let _ = writeln!(out, "{pad}{id} --> [*]");
+            let _ = writeln!(self.out, "{pad}state \"{}\" as {id}", label(o));
+            let _ = writeln!(self.out, "{pad}{id} --> [*]");
         }
         let mut nested = Vec::new();
         for &s in &region.states {
@@ -244,29 +300,24 @@ fn state_diagram(name: &str, m: &StateMachine) -> String {
             match st.body {
                 StateBody::Container(_) => nested.push(s),
                 StateBody::Decision => {
-                    decisions.push(s);
-                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&st.label));
+                    self.decisions.push(s);
+                    let _ = writeln!(self.out, "{pad}state \"{}\" as s{s}", label(&st.label));
                 }
                 StateBody::Task(_) => {
-                    let _ = writeln!(out, "{pad}state \"{}\" as s{s}", label(&st.label));
+                    let _ = writeln!(self.out, "{pad}state \"{}\" as s{s}", label(&st.label));
                 }
             }
         }
         for &s in &region.states {
-            transitions(&mut out, &pad, s, &region.outcomes);
+            self.transitions(pad, s, &region.outcomes);
         }
         if owner.is_some() {
-            stack.push(Item::Close(depth));
+            self.stack.push(Item::Close(depth));
         }
         for &c in nested.iter().rev() {
-            stack.push(Item::Region(Some(c), depth + 1));
+            self.stack.push(Item::Region(Some(c), depth + 1));
         }
     }
-    for s in decisions {
-        let _ = writeln!(out, "    class s{s} decision");
-    }
-    let _ = writeln!(out, "    classDef decision fill:#fff3c4");
-    out
 }
 
 #[cfg(test)]

@@ -378,22 +378,100 @@ fn find_state(m: &StateMachine, s: &str) -> Result<usize, EditError> {
 
 /// Adds a state to an FSM, or to a region of an HFSM (see the module
 /// documentation).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditError> {
-    check_call(&spec.skill, SkillKind::Action)?;
-    for g in spec.guard.iter().chain(&spec.selector_guard) {
-        for t in &g.all {
-            check_call(&t.condition, SkillKind::Condition)?;
-        }
-    }
+    check_calls(spec)?;
     let after = spec
         .after
         .as_deref()
         .map(|a| find_state(m, a))
         .transpose()?;
     // The container whose region gets the state (`None`: the top level).
-    let container = match (&spec.within, after) {
-        (None, a) => a.and_then(|a| m.states[a].parent),
+    let container = container_of_new(m, spec, after)?;
+    let (top, outcomes) = region_of_new(m, container)?;
+    check_name_free(m, spec, &top, &outcomes)?;
+    let at = Placement {
+        after,
+        selector: top
+            .iter()
+            .copied()
+            .find(|&i| matches!(m.states[i].body, StateBody::Decision)),
+        n: m.states.len(),
+    };
+    let keys_before = m.hierarchical.then(|| m.keys());
+    let mut new = State {
+        name: spec.name.clone(),
+        label: spec.name.clone(),
+        parent: container,
+        body: StateBody::Task(Some(spec.skill.clone())),
+        transitions: Vec::new(),
+        pseudo: None,
+        span: None,
+    };
+    let mut touched = Touched {
+        added: 1,
+        ..Touched::default()
+    };
+    // The place of the new state in the file.
+    let pos = match (after, at.selector) {
+        (Some(p), _) => top
+            .iter()
+            .position(|&i| i == p)
+            .map_or(top.len(), |k| k + 1),
+        (None, Some(s)) => top.iter().position(|&i| i == s).unwrap_or(top.len()),
+        (None, None) => top.len(),
+    };
+    match spec.kind {
+        AddKind::Sequential | AddKind::Alternative => {
+            link_after(m, spec, &at, &mut new, &mut touched)?;
+        }
+        AddKind::Connected => link_connected(m, spec, &at, &top, &mut new, &mut touched)?,
+    }
+    m.states.push(new);
+    region_mut(m, container).states.insert(pos, at.n);
+    // A state named by its position among siblings keeps its identity only
+    // if the new state does not come before it: else it goes last.
+    if let Some(before) = keys_before
+        && m.keys()[..at.n] != before[..]
+    {
+        let r = region_mut(m, container);
+        r.states.retain(|&i| i != at.n);
+        r.states.push(at.n);
+    }
+    Ok(touched)
+}
+
+/// Where [`add_state`] puts the new state.
+struct Placement {
+    /// Its predecessor (`--after`).
+    after: Option<usize>,
+    /// The decision state of its region (the SELECTOR).
+    selector: Option<usize>,
+    /// Its index in the machine's states.
+    n: usize,
+}
+
+/// Checks the new state's skill, and the conditions of its guards, against
+/// the shared library.
+fn check_calls(spec: &AddState) -> Result<(), EditError> {
+    check_call(&spec.skill, SkillKind::Action)?;
+    for g in spec.guard.iter().chain(&spec.selector_guard) {
+        for t in &g.all {
+            check_call(&t.condition, SkillKind::Condition)?;
+        }
+    }
+    Ok(())
+}
+
+/// The container whose region gets the new state (`None`: the top level):
+/// `--in`'s, which must hold the predecessor `after` if there is one, else
+/// the predecessor's.
+fn container_of_new(
+    m: &StateMachine,
+    spec: &AddState,
+    after: Option<usize>,
+) -> Result<Option<usize>, EditError> {
+    match (&spec.within, after) {
+        (None, a) => Ok(a.and_then(|a| m.states[a].parent)),
         (Some(c), a) => {
             let c = find_state(m, c)?;
             if !matches!(m.states[c].body, StateBody::Container(_)) {
@@ -410,30 +488,46 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
                     Some("drop --in: the new state goes beside its predecessor".into()),
                 ));
             }
-            Some(c)
+            Ok(Some(c))
         }
+    }
+}
+
+/// The states and outcomes of the region of `container` (the top level for
+/// `None`), which must not be parallel.
+fn region_of_new(
+    m: &StateMachine,
+    container: Option<usize>,
+) -> Result<(Vec<usize>, Vec<String>), EditError> {
+    let r = match container {
+        None => &m.top,
+        Some(c) => match &m.states[c].body {
+            StateBody::Container(r) => r,
+            _ => unreachable!("checked above"),
+        },
     };
-    let (top, outcomes) = {
-        let r = match container {
-            None => &m.top,
-            Some(c) => match &m.states[c].body {
-                StateBody::Container(r) => r,
-                _ => unreachable!("checked above"),
-            },
-        };
-        if r.parallel {
-            // A state here would be a new region, run beside the others:
-            // none of the paper's edit operations.
-            return Err(err(
-                format!(
-                    "`{}` is a parallel state: a state added to it would be a region of its own",
-                    container.map_or_else(String::new, |c| m.path(c))
-                ),
-                Some("add the state inside one of its regions (--in REGION)".into()),
-            ));
-        }
-        (r.states.clone(), r.outcomes.clone())
-    };
+    if r.parallel {
+        // A state here would be a new region, run beside the others:
+        // none of the paper's edit operations.
+        return Err(err(
+            format!(
+                "`{}` is a parallel state: a state added to it would be a region of its own",
+                container.map_or_else(String::new, |c| m.path(c))
+            ),
+            Some("add the state inside one of its regions (--in REGION)".into()),
+        ));
+    }
+    Ok((r.states.clone(), r.outcomes.clone()))
+}
+
+/// Checks that the new state's name is not taken by a state (of its region
+/// `top`, or of the machine in an HFSM) or an outcome.
+fn check_name_free(
+    m: &StateMachine,
+    spec: &AddState,
+    top: &[usize],
+    outcomes: &[String],
+) -> Result<(), EditError> {
     // HFSM vertex identity is the name where it is unique in the machine, so
     // a new name must be unique there (else other states' identities move).
     let taken = if m.hierarchical {
@@ -447,181 +541,168 @@ pub fn add_state(m: &mut StateMachine, spec: &AddState) -> Result<Touched, EditE
             Some("choose an unused name".into()),
         ));
     }
-    let selector = top
-        .iter()
-        .copied()
-        .find(|&i| matches!(m.states[i].body, StateBody::Decision));
+    Ok(())
+}
+
+/// A transition on outcome `o`.
+fn outcome(o: &str, target: Target) -> Transition {
+    Transition {
+        trigger: Trigger::Outcome(o.to_string()),
+        target,
+        span: None,
+    }
+}
+
+/// Links a sequential or alternative state `new` after its predecessor:
+/// it takes the predecessor's `SUCCESS` (or `FAILURE`) arc, copies its
+/// `FAILURE` and `RUNNING` pattern and its guards to connected states, and
+/// a sequential state gets the SELECTOR's guard.
+fn link_after(
+    m: &mut StateMachine,
+    spec: &AddState,
+    at: &Placement,
+    new: &mut State,
+    touched: &mut Touched,
+) -> Result<(), EditError> {
+    let (selector, n) = (at.selector, at.n);
+    let Some(p) = at.after else {
+        return Err(err(
+            "a sequential or alternative state needs its predecessor",
+            Some("give --after STATE".into()),
+        ));
+    };
     let connected = btfsm_metrics::counts::fully_connected_states(m);
+    let pred = m.states[p].clone();
+    let next = outcome_target(&pred, "SUCCESS").cloned().ok_or_else(|| {
+        err(
+            format!("state `{}` has no SUCCESS transition to follow", pred.name),
+            None,
+        )
+    })?;
+    // Guards of the predecessor to connected states come along.
+    for t in &pred.transitions {
+        if let (Trigger::Guard(_), Target::State(j)) = (&t.trigger, &t.target)
+            && connected.contains(j)
+        {
+            new.transitions.push(t.clone());
+        }
+    }
+    if spec.kind == AddKind::Sequential
+        && let Some(s) = selector
+        && spec.selector_guard.is_none()
+    {
+        return Err(err(
+            format!(
+                "the SELECTOR `{}` needs a guard to resume the task at `{}`",
+                m.states[s].name, spec.name
+            ),
+            Some("give --selector-guard, e.g. 'In-Hand(object=cube2) & not Arm-Tucked'".into()),
+        ));
+    }
+    let fail = outcome_target(&pred, "FAILURE").cloned();
+    let running = outcome_target(&pred, "RUNNING").cloned();
+    if spec.kind == AddKind::Sequential {
+        set_outcome_target(&mut m.states[p], "SUCCESS", Target::State(n));
+        new.transitions.push(outcome("SUCCESS", next));
+        if let Some(f) = fail {
+            new.transitions.push(outcome("FAILURE", f));
+        }
+    } else {
+        let Some(f) = fail else {
+            return Err(err(
+                format!(
+                    "state `{}` has no FAILURE transition to take over",
+                    pred.name
+                ),
+                Some("an alternative state runs when its predecessor fails".into()),
+            ));
+        };
+        set_outcome_target(&mut m.states[p], "FAILURE", Target::State(n));
+        new.transitions.push(outcome("SUCCESS", next));
+        new.transitions.push(outcome("FAILURE", f));
+    }
+    match running {
+        Some(Target::State(r)) if r == p => {
+            new.transitions.push(outcome("RUNNING", Target::State(n)))
+        }
+        Some(t) => new.transitions.push(outcome("RUNNING", t)),
+        None => {}
+    }
+    touched.modified += 1;
+    touched.transitions_added += 1 + new.transitions.len();
+    touched.transitions_removed += 1;
+    if spec.kind == AddKind::Sequential
+        && let (Some(s), Some(g)) = (selector, &spec.selector_guard)
+    {
+        add_resume_guard(&mut m.states[s], spec.selector_guard_index, g, p, n);
+        touched.modified += 1;
+        touched.transitions_added += 1;
+    }
+    Ok(())
+}
+
+/// Gives the SELECTOR `sel` the guard `g` resuming the task at the new
+/// state `n`, at guard position `index` (default: right before its guard
+/// to the predecessor `p`).
+fn add_resume_guard(sel: &mut State, index: Option<usize>, g: &Guard, p: usize, n: usize) {
+    let k = index.unwrap_or_else(|| {
+        sel.transitions
+            .iter()
+            .position(|t| matches!(t.trigger, Trigger::Guard(_)) && t.target == Target::State(p))
+            .unwrap_or(usize::MAX)
+    });
+    insert_guard(sel, k, guard_transition(g, n));
+}
+
+/// Links a connected state `new` (Algorithm 1): a guarded arc from every
+/// action state of its region `top` and from the SELECTOR, `SUCCESS` ->
+/// SELECTOR and `RUNNING` -> itself.
+fn link_connected(
+    m: &mut StateMachine,
+    spec: &AddState,
+    at: &Placement,
+    top: &[usize],
+    new: &mut State,
+    touched: &mut Touched,
+) -> Result<(), EditError> {
+    let n = at.n;
+    let Some(s) = at.selector else {
+        return Err(err(
+            "a connected state returns to the SELECTOR, and this FSM has no decision state",
+            Some("make the FSM fault tolerant first (btfsm convert --to fault-tolerant)".into()),
+        ));
+    };
+    let Some(g) = &spec.guard else {
+        return Err(err(
+            "a connected state needs the guard every other state takes to it",
+            Some("give --guard, e.g. 'not Battery-Level(min=20)'".into()),
+        ));
+    };
     let is_action = |m: &StateMachine, i: usize| {
         matches!(
             btfsm_model::graph::build::state_vertex_type(&m.states[i].body),
             btfsm_model::graph::VertexType::State
         )
     };
-    let n = m.states.len();
-    let keys_before = m.hierarchical.then(|| m.keys());
-    let mut new = State {
-        name: spec.name.clone(),
-        label: spec.name.clone(),
-        parent: container,
-        body: StateBody::Task(Some(spec.skill.clone())),
-        transitions: Vec::new(),
-        pseudo: None,
-        span: None,
-    };
-    let mut touched = Touched {
-        added: 1,
-        ..Touched::default()
-    };
-    let outcome = |o: &str, target: Target| Transition {
-        trigger: Trigger::Outcome(o.to_string()),
-        target,
-        span: None,
-    };
-    // The place of the new state in the file.
-    let pos = match (after, selector) {
-        (Some(p), _) => top
-            .iter()
-            .position(|&i| i == p)
-            .map_or(top.len(), |k| k + 1),
-        (None, Some(s)) => top.iter().position(|&i| i == s).unwrap_or(top.len()),
-        (None, None) => top.len(),
-    };
-    match spec.kind {
-        AddKind::Sequential | AddKind::Alternative => {
-            let Some(p) = after else {
-                return Err(err(
-                    "a sequential or alternative state needs its predecessor",
-                    Some("give --after STATE".into()),
-                ));
-            };
-            let pred = m.states[p].clone();
-            let next = outcome_target(&pred, "SUCCESS").cloned().ok_or_else(|| {
-                err(
-                    format!("state `{}` has no SUCCESS transition to follow", pred.name),
-                    None,
-                )
-            })?;
-            // Guards of the predecessor to connected states come along.
-            for t in &pred.transitions {
-                if let (Trigger::Guard(_), Target::State(j)) = (&t.trigger, &t.target)
-                    && connected.contains(j)
-                {
-                    new.transitions.push(t.clone());
-                }
-            }
-            if spec.kind == AddKind::Sequential
-                && let Some(s) = selector
-                && spec.selector_guard.is_none()
-            {
-                return Err(err(
-                    format!(
-                        "the SELECTOR `{}` needs a guard to resume the task at `{}`",
-                        m.states[s].name, spec.name
-                    ),
-                    Some(
-                        "give --selector-guard, e.g. 'In-Hand(object=cube2) & not Arm-Tucked'"
-                            .into(),
-                    ),
-                ));
-            }
-            let fail = outcome_target(&pred, "FAILURE").cloned();
-            let running = outcome_target(&pred, "RUNNING").cloned();
-            if spec.kind == AddKind::Sequential {
-                set_outcome_target(&mut m.states[p], "SUCCESS", Target::State(n));
-                new.transitions.push(outcome("SUCCESS", next));
-                if let Some(f) = fail {
-                    new.transitions.push(outcome("FAILURE", f));
-                }
-            } else {
-                let Some(f) = fail else {
-                    return Err(err(
-                        format!(
-                            "state `{}` has no FAILURE transition to take over",
-                            pred.name
-                        ),
-                        Some("an alternative state runs when its predecessor fails".into()),
-                    ));
-                };
-                set_outcome_target(&mut m.states[p], "FAILURE", Target::State(n));
-                new.transitions.push(outcome("SUCCESS", next));
-                new.transitions.push(outcome("FAILURE", f));
-            }
-            match running {
-                Some(Target::State(r)) if r == p => {
-                    new.transitions.push(outcome("RUNNING", Target::State(n)))
-                }
-                Some(t) => new.transitions.push(outcome("RUNNING", t)),
-                None => {}
-            }
-            touched.modified += 1;
-            touched.transitions_added += 1 + new.transitions.len();
-            touched.transitions_removed += 1;
-            if spec.kind == AddKind::Sequential
-                && let (Some(s), Some(g)) = (selector, &spec.selector_guard)
-            {
-                let k = spec.selector_guard_index.unwrap_or_else(|| {
-                    m.states[s]
-                        .transitions
-                        .iter()
-                        .position(|t| {
-                            matches!(t.trigger, Trigger::Guard(_)) && t.target == Target::State(p)
-                        })
-                        .unwrap_or(usize::MAX)
-                });
-                insert_guard(&mut m.states[s], k, guard_transition(g, n));
-                touched.modified += 1;
-                touched.transitions_added += 1;
-            }
-        }
-        AddKind::Connected => {
-            let Some(s) = selector else {
-                return Err(err(
-                    "a connected state returns to the SELECTOR, and this FSM has no decision state",
-                    Some(
-                        "make the FSM fault tolerant first (btfsm convert --to fault-tolerant)"
-                            .into(),
-                    ),
-                ));
-            };
-            let Some(g) = &spec.guard else {
-                return Err(err(
-                    "a connected state needs the guard every other state takes to it",
-                    Some("give --guard, e.g. 'not Battery-Level(min=20)'".into()),
-                ));
-            };
-            for &i in &top {
-                if is_action(m, i) {
-                    insert_guard(&mut m.states[i], 0, guard_transition(g, n));
-                    touched.modified += 1;
-                    touched.transitions_added += 1;
-                }
-            }
-            let sg = spec.selector_guard.as_ref().unwrap_or(g);
-            insert_guard(
-                &mut m.states[s],
-                spec.selector_guard_index.unwrap_or(0),
-                guard_transition(sg, n),
-            );
+    for &i in top {
+        if is_action(m, i) {
+            insert_guard(&mut m.states[i], 0, guard_transition(g, n));
             touched.modified += 1;
             touched.transitions_added += 1;
-            new.transitions.push(outcome("SUCCESS", Target::State(s)));
-            new.transitions.push(outcome("RUNNING", Target::State(n)));
-            touched.transitions_added += 2;
         }
     }
-    m.states.push(new);
-    region_mut(m, container).states.insert(pos, n);
-    // A state named by its position among siblings keeps its identity only
-    // if the new state does not come before it: else it goes last.
-    if let Some(before) = keys_before
-        && m.keys()[..n] != before[..]
-    {
-        let r = region_mut(m, container);
-        r.states.retain(|&i| i != n);
-        r.states.push(n);
-    }
-    Ok(touched)
+    let sg = spec.selector_guard.as_ref().unwrap_or(g);
+    insert_guard(
+        &mut m.states[s],
+        spec.selector_guard_index.unwrap_or(0),
+        guard_transition(sg, n),
+    );
+    touched.modified += 1;
+    touched.transitions_added += 1;
+    new.transitions.push(outcome("SUCCESS", Target::State(s)));
+    new.transitions.push(outcome("RUNNING", Target::State(n)));
+    touched.transitions_added += 2;
+    Ok(())
 }
 
 fn region_mut(m: &mut StateMachine, container: Option<usize>) -> &mut btfsm_model::Region {

@@ -28,7 +28,7 @@
 //! it, else when its action's effect does not hold. Review the guards of a
 //! generated machine: the structure is the paper's.
 
-use btfsm_metrics::effort::detect;
+use btfsm_metrics::effort::{Detected, detect};
 use btfsm_model::{
     Guard, GuardTerm, Policy, PolicyBody, State, StateBody, StateMachine, Target, Transition,
     Trigger,
@@ -98,7 +98,6 @@ pub fn fault_tolerant_policy_with(
 }
 
 /// The fault-tolerant version of a flat FSM (see the module documentation).
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn fault_tolerant(
     m: &StateMachine,
     domain: &Domain,
@@ -109,23 +108,59 @@ pub fn fault_tolerant(
     let det = detect(m);
     let mut out = m.clone();
     let mut errors = Vec::new();
-    let step = |i: usize| -> Option<Step<'_>> {
-        match &m.states[i].body {
-            StateBody::Task(Some(call)) => domain.step_of(call),
-            _ => None,
-        }
+    let (chain, end) = task_chain(m, &det);
+    let sel = match det.selector {
+        Some(s) => s,
+        None => add_selector(&mut out),
     };
-    let no_action = |i: usize| FaultTolerantError::NoPostcondition {
+    complete_states(&mut out, &det, sel);
+    // The SELECTOR's arcs.
+    let front = connected_guards(m, domain, &det, &out.states[sel], &mut errors);
+    let back = resume_guards(m, domain, (&chain, &end), &out.states[sel], &mut errors);
+    if !errors.is_empty() {
+        errors.dedup();
+        return Err(errors);
+    }
+    let st = &mut out.states[sel];
+    let mut trs = front;
+    trs.append(&mut st.transitions);
+    trs.extend(back);
+    st.transitions = trs;
+    if !has_outcome(st, RUNNING) {
+        st.transitions
+            .push(Transition::on_outcome(RUNNING, Target::State(sel)));
+    }
+    for &i in det.sequential.iter().chain(&det.connected).chain([&sel]) {
+        guards_first(&mut out.states[i]);
+    }
+    Ok(out)
+}
+
+/// The domain's step that runs state `i`'s skill, if any.
+fn step_of<'d>(m: &StateMachine, domain: &'d Domain, i: usize) -> Option<Step<'d>> {
+    match &m.states[i].body {
+        StateBody::Task(Some(call)) => domain.step_of(call),
+        _ => None,
+    }
+}
+
+/// The error for state `i`, whose skill no action of `domain` runs.
+fn no_action(m: &StateMachine, domain: &Domain, i: usize) -> FaultTolerantError {
+    FaultTolerantError::NoPostcondition {
         state: m.states[i].name.clone(),
         skill: match &m.states[i].body {
             StateBody::Task(Some(call)) => call.skill.clone(),
             _ => "no skill".to_string(),
         },
         domain: domain.name.clone(),
-    };
+    }
+}
 
-    // The task's steps in execution order: the SUCCESS chain from the initial
-    // state, then sequential states off the chain in file order.
+/// The task's steps in execution order: the SUCCESS chain from the initial
+/// state, then sequential states off the chain in file order; and the
+/// outcome the task ends in (that of the chain, else the first top-level
+/// one).
+fn task_chain(m: &StateMachine, det: &Detected) -> (Vec<usize>, Option<String>) {
     let mut chain: Vec<usize> = Vec::new();
     let mut end: Option<String> = None;
     let mut cur = m.top.initial_state();
@@ -152,34 +187,36 @@ pub fn fault_tolerant(
         }
     }
     let end = end.or_else(|| m.top.outcomes.first().cloned());
+    (chain, end)
+}
 
-    // The SELECTOR: reused or added.
-    let sel = match det.selector {
-        Some(s) => s,
-        None => {
-            let mut name = "SELECTOR".to_string();
-            let mut k = 2;
-            while m.top.states.iter().any(|&i| m.states[i].name == name) {
-                name = format!("SELECTOR {k}");
-                k += 1;
-            }
-            out.states.push(State {
-                name: name.clone(),
-                label: name,
-                parent: None,
-                body: StateBody::Decision,
-                transitions: Vec::new(),
-                pseudo: None,
-                span: None,
-            });
-            let idx = out.states.len() - 1;
-            out.top.states.push(idx);
-            idx
-        }
-    };
+/// Adds a top-level decision state `SELECTOR` (numbered when the name is
+/// taken) and returns its index.
+fn add_selector(out: &mut StateMachine) -> usize {
+    let mut name = "SELECTOR".to_string();
+    let mut k = 2;
+    while out.top.states.iter().any(|&i| out.states[i].name == name) {
+        name = format!("SELECTOR {k}");
+        k += 1;
+    }
+    out.states.push(State {
+        name: name.clone(),
+        label: name,
+        parent: None,
+        body: StateBody::Decision,
+        transitions: Vec::new(),
+        pseudo: None,
+        span: None,
+    });
+    let idx = out.states.len() - 1;
+    out.top.states.push(idx);
+    idx
+}
 
-    // Connected states: drop their arcs to sequential states, add RUNNING and
-    // SUCCESS -> SELECTOR.
+/// Connected states drop their arcs to sequential states and get `RUNNING`
+/// -> itself and `SUCCESS` -> SELECTOR; sequential states get `RUNNING` ->
+/// itself and `FAILURE` -> SELECTOR (arcs already present are kept).
+fn complete_states(out: &mut StateMachine, det: &Detected, sel: usize) {
     for &c in &det.connected {
         let st = &mut out.states[c];
         st.transitions
@@ -193,7 +230,6 @@ pub fn fault_tolerant(
                 .push(Transition::on_outcome(RUNNING, Target::State(c)));
         }
     }
-    // Sequential states: RUNNING -> itself, FAILURE -> SELECTOR.
     for &s in &det.sequential {
         let st = &mut out.states[s];
         if !has_outcome(st, FAILURE) {
@@ -205,14 +241,23 @@ pub fn fault_tolerant(
                 .push(Transition::on_outcome(RUNNING, Target::State(s)));
         }
     }
+}
 
-    // The SELECTOR's arcs.
+/// The SELECTOR's guards to the connected states it does not reach yet
+/// (they go first: they have priority): the guard the other states use to
+/// enter one, else "its action's effect does not hold" (an error in
+/// `errors` when no domain action runs it).
+fn connected_guards(
+    m: &StateMachine,
+    domain: &Domain,
+    det: &Detected,
+    selector: &State,
+    errors: &mut Vec<FaultTolerantError>,
+) -> Vec<Transition> {
     let mut front: Vec<Transition> = Vec::new();
-    let mut back: Vec<Transition> = Vec::new();
-    let selector_has = |t: &Target| goes_to(&out.states[sel], t);
     for &c in &det.connected {
         let target = Target::State(c);
-        if selector_has(&target) {
+        if goes_to(selector, &target) {
             continue;
         }
         // The guard the other states use to enter c, else "c's work is not done".
@@ -224,7 +269,7 @@ pub fn fault_tolerant(
         });
         let guard = match used {
             Some(g) => g,
-            None => match step(c).and_then(|st| st.adds().into_iter().next()) {
+            None => match step_of(m, domain, c).and_then(|st| st.adds().into_iter().next()) {
                 Some(f) => {
                     let term = domain.fact_term(&f, true);
                     Guard {
@@ -233,7 +278,7 @@ pub fn fault_tolerant(
                     }
                 }
                 None => {
-                    errors.push(no_action(c));
+                    errors.push(no_action(m, domain, c));
                     continue;
                 }
             },
@@ -244,81 +289,81 @@ pub fn fault_tolerant(
             span: None,
         });
     }
+    front
+}
+
+/// The SELECTOR's guards after its own arcs: to the task's end outcome
+/// `end` when the goal holds, then to each step of `chain` (latest first)
+/// when its kernel holds, those it does not have yet. A step no domain
+/// action runs is an error in `errors` (and then there are none).
+fn resume_guards(
+    m: &StateMachine,
+    domain: &Domain,
+    (chain, end): (&[usize], &Option<String>),
+    selector: &State,
+    errors: &mut Vec<FaultTolerantError>,
+) -> Vec<Transition> {
+    let mut back: Vec<Transition> = Vec::new();
     let resume = |label: String, all: Vec<GuardTerm>, target: Target| Transition {
         trigger: Trigger::Guard(Guard { label, all }),
         target,
         span: None,
     };
     // The chain's steps in the domain, and their kernels.
-    let steps: Vec<Option<Step<'_>>> = chain.iter().map(|&s| step(s)).collect();
+    let steps: Vec<Option<Step<'_>>> = chain.iter().map(|&s| step_of(m, domain, s)).collect();
     for (k, st) in steps.iter().enumerate() {
         if st.is_none() {
-            errors.push(no_action(chain[k]));
+            errors.push(no_action(m, domain, chain[k]));
         }
     }
     let steps: Vec<Step<'_>> = steps.into_iter().flatten().collect();
-    if !chain.is_empty() && steps.len() == chain.len() {
-        let goal = steps.last().map(Step::adds).unwrap_or_default();
-        let kernels = btfsm_plan::fsm::kernels(&steps, &goal);
-        let terms = |fs: &[Fact], negate: bool| -> Vec<GuardTerm> {
-            fs.iter().map(|f| domain.fact_term(f, negate)).collect()
-        };
-        let text = |ts: &[GuardTerm]| {
-            ts.iter()
-                .map(ToString::to_string)
-                .collect::<Vec<_>>()
-                .join(" and ")
-        };
-        if let Some(o) = &end {
-            let target = Target::Outcome(o.clone());
-            if !selector_has(&target) {
-                let ts = terms(&goal, false);
-                back.push(resume(format!("done: {}", text(&ts)), ts, target));
-            }
+    if chain.is_empty() || steps.len() != chain.len() {
+        return back;
+    }
+    let goal = steps.last().map(Step::adds).unwrap_or_default();
+    let kernels = btfsm_plan::fsm::kernels(&steps, &goal);
+    let terms = |fs: &[Fact], negate: bool| -> Vec<GuardTerm> {
+        fs.iter().map(|f| domain.fact_term(f, negate)).collect()
+    };
+    let text = |ts: &[GuardTerm]| {
+        ts.iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(" and ")
+    };
+    if let Some(o) = end {
+        let target = Target::Outcome(o.clone());
+        if !goes_to(selector, &target) {
+            let ts = terms(&goal, false);
+            back.push(resume(format!("done: {}", text(&ts)), ts, target));
         }
-        for k in (0..chain.len()).rev() {
-            let s = chain[k];
-            let target = Target::State(s);
-            if selector_has(&target) {
-                continue;
-            }
-            // An empty kernel (the first step's, usually): "not the next
-            // kernel's first fact", which the SELECTOR knows here.
-            let made = if kernels[k].is_empty() {
-                kernels
-                    .get(k + 1)
-                    .and_then(|next| next.first())
-                    .map(|f| (true, terms(std::slice::from_ref(f), true)))
+    }
+    for k in (0..chain.len()).rev() {
+        let s = chain[k];
+        let target = Target::State(s);
+        if goes_to(selector, &target) {
+            continue;
+        }
+        // An empty kernel (the first step's, usually): "not the next
+        // kernel's first fact", which the SELECTOR knows here.
+        let made = if kernels[k].is_empty() {
+            kernels
+                .get(k + 1)
+                .and_then(|next| next.first())
+                .map(|f| (true, terms(std::slice::from_ref(f), true)))
+        } else {
+            Some((false, terms(&kernels[k], false)))
+        };
+        if let Some((restart, ts)) = made {
+            let label = if restart {
+                format!("restart: {}", text(&ts))
             } else {
-                Some((false, terms(&kernels[k], false)))
+                format!("resume at {}: {}", m.states[s].label, text(&ts))
             };
-            if let Some((restart, ts)) = made {
-                let label = if restart {
-                    format!("restart: {}", text(&ts))
-                } else {
-                    format!("resume at {}: {}", m.states[s].label, text(&ts))
-                };
-                back.push(resume(label, ts, target));
-            }
+            back.push(resume(label, ts, target));
         }
     }
-    if !errors.is_empty() {
-        errors.dedup();
-        return Err(errors);
-    }
-    let st = &mut out.states[sel];
-    let mut trs = front;
-    trs.append(&mut st.transitions);
-    trs.extend(back);
-    st.transitions = trs;
-    if !has_outcome(st, RUNNING) {
-        st.transitions
-            .push(Transition::on_outcome(RUNNING, Target::State(sel)));
-    }
-    for &i in det.sequential.iter().chain(&det.connected).chain([&sel]) {
-        guards_first(&mut out.states[i]);
-    }
-    Ok(out)
+    back
 }
 
 #[cfg(test)]

@@ -113,48 +113,98 @@ pub(crate) fn find(p: &Problem, deadline: Instant, budget: u64) -> Embedding {
     }
 }
 
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+/// Searches `sub` into `sup`: set-up, backtracking, then completion with the
+/// arc-less vertices.
 fn search(p: &Problem, sub: &Side, sup: &Side, deadline: Instant, budget: u64) -> Embedding {
+    let m = match Matcher::new(p, sub, sup, deadline) {
+        Ok(m) => m,
+        Err(settled) => return settled,
+    };
     let n = p.n();
-    // The set-up below is O((n + m) log m), milliseconds on 100k vertices:
-    // the clock is read between its steps, so that a spent budget stops it.
-    let late = || Instant::now() > deadline;
-    let ds = Degrees::of(sub);
-    let dp = Degrees::of(sup);
-    if late() {
-        return Embedding::Unknown;
+    let mut sigma = vec![NONE; n];
+    let mut used = vec![false; n];
+    if let Err(settled) = m.backtrack(&mut sigma, &mut used, deadline, budget) {
+        return settled;
     }
-    let ord = order(sub);
-    if late() {
-        return Embedding::Unknown;
-    }
-    // Quick necessary condition: per class, enough vertices with arcs.
-    for &(s, e) in &p.classes {
+    complete(p, sigma, &used)
+}
+
+/// Per class, whether `sup` has at least as many vertices with arcs as `sub`
+/// (a quick necessary condition for an embedding).
+fn classes_can_host(p: &Problem, sub: &Side, sup: &Side) -> bool {
+    p.classes.iter().all(|&(s, e)| {
         let need = (s..e).filter(|&u| sub.degree(u) > 0).count();
         let have = (s..e).filter(|&v| sup.degree(v) > 0).count();
-        if need > have {
-            return Embedding::Absent;
+        need <= have
+    })
+}
+
+/// The two sides of an embedding search with their degrees and the matching
+/// order of `sub`.
+struct Matcher<'a> {
+    p: &'a Problem,
+    sub: &'a Side,
+    sup: &'a Side,
+    ds: Degrees,
+    dp: Degrees,
+    ord: Vec<u32>,
+}
+
+impl<'a> Matcher<'a> {
+    /// Builds the degrees and the order, reading the clock between the steps;
+    /// `Err` holds the outcome when the set-up already settles the search.
+    fn new(
+        p: &'a Problem,
+        sub: &'a Side,
+        sup: &'a Side,
+        deadline: Instant,
+    ) -> Result<Self, Embedding> {
+        // The set-up below is O((n + m) log m), milliseconds on 100k vertices:
+        // the clock is read between its steps, so that a spent budget stops it.
+        let late = || Instant::now() > deadline;
+        let ds = Degrees::of(sub);
+        let dp = Degrees::of(sup);
+        if late() {
+            return Err(Embedding::Unknown);
         }
+        let ord = order(sub);
+        if late() {
+            return Err(Embedding::Unknown);
+        }
+        if !classes_can_host(p, sub, sup) {
+            return Err(Embedding::Absent);
+        }
+        if late() {
+            return Err(Embedding::Unknown);
+        }
+        Ok(Matcher {
+            p,
+            sub,
+            sup,
+            ds,
+            dp,
+            ord,
+        })
     }
-    if late() {
-        return Embedding::Unknown;
-    }
-    let fits = |u: usize, v: usize| {
-        p.class_of[u] == p.class_of[v]
-            && sup.loops[v] >= sub.loops[u]
+
+    /// Whether `v` of `sup` can host `u` of `sub` on its own: same class, and
+    /// at least as many loops, arcs and distinct neighbours each way.
+    #[inline]
+    fn fits(&self, u: usize, v: usize) -> bool {
+        let (ds, dp) = (&self.ds, &self.dp);
+        self.p.class_of[u] == self.p.class_of[v]
+            && self.sup.loops[v] >= self.sub.loops[u]
             && dp.out[v] >= ds.out[u]
             && dp.inn[v] >= ds.inn[u]
             && dp.out_distinct[v] >= ds.out_distinct[u]
             && dp.inn_distinct[v] >= ds.inn_distinct[u]
-    };
-    let mut sigma = vec![NONE; n];
-    let mut used = vec![false; n];
-    // Per depth: candidate list and next index.
-    let mut cands: Vec<Vec<u32>> = Vec::with_capacity(ord.len());
-    let mut next: Vec<usize> = Vec::with_capacity(ord.len());
-    let mut tries = 0u64;
-    let candidates = |d: usize, sigma: &[u32], used: &[bool]| -> Vec<u32> {
-        let u = ord[d] as usize;
+    }
+
+    /// The unused vertices of `sup` consistent with the matched neighbours of
+    /// the vertex at depth `d`, tightest (closest degrees) first.
+    fn candidates(&self, d: usize, sigma: &[u32], used: &[bool]) -> Vec<u32> {
+        let (p, sub, sup) = (self.p, self.sub, self.sup);
+        let u = self.ord[d] as usize;
         // Anchor: a matched neighbour, preferring the one with fewest options.
         let mut pool: Option<Vec<u32>> = None;
         for &(w, _) in &sub.inn[u] {
@@ -184,7 +234,7 @@ fn search(p: &Problem, sub: &Side, sup: &Side, deadline: Instant, budget: u64) -
             .into_iter()
             .filter(|&v| {
                 let vu = v as usize;
-                if used[vu] || !fits(u, vu) {
+                if used[vu] || !self.fits(u, vu) {
                     return false;
                 }
                 sub.out[u].iter().all(|&(w, a)| {
@@ -197,55 +247,75 @@ fn search(p: &Problem, sub: &Side, sup: &Side, deadline: Instant, budget: u64) -
             })
             .collect();
         // Tightest first: candidates whose degrees are closest to u's.
+        let (ds, dp) = (&self.ds, &self.dp);
         out.sort_by_key(|&v| {
             let v = v as usize;
             (dp.out[v] - ds.out[u] + dp.inn[v] - ds.inn[u], v)
         });
         out
-    };
-    if !ord.is_empty() {
-        cands.push(candidates(0, &sigma, &used));
-        next.push(0);
     }
-    loop {
-        let d = cands.len();
-        if d == 0 {
-            return Embedding::Absent;
+
+    /// Depth-first matching of the ordered vertices into `sigma` (and
+    /// `used`); `Ok` once all are matched, `Err` with the outcome otherwise.
+    fn backtrack(
+        &self,
+        sigma: &mut [u32],
+        used: &mut [bool],
+        deadline: Instant,
+        budget: u64,
+    ) -> Result<(), Embedding> {
+        let ord = &self.ord;
+        // Per depth: candidate list and next index.
+        let mut cands: Vec<Vec<u32>> = Vec::with_capacity(ord.len());
+        let mut next: Vec<usize> = Vec::with_capacity(ord.len());
+        let mut tries = 0u64;
+        if !ord.is_empty() {
+            cands.push(self.candidates(0, sigma, used));
+            next.push(0);
         }
-        if d > ord.len() {
-            break;
+        loop {
+            let d = cands.len();
+            if d == 0 {
+                return Err(Embedding::Absent);
+            }
+            if d > ord.len() {
+                return Ok(());
+            }
+            let top = d - 1;
+            let u = ord[top] as usize;
+            // Undo the previous choice at this depth.
+            if sigma[u] != NONE {
+                used[sigma[u] as usize] = false;
+                sigma[u] = NONE;
+            }
+            let i = next[top];
+            if i >= cands[top].len() {
+                cands.pop();
+                next.pop();
+                continue;
+            }
+            next[top] = i + 1;
+            tries += 1;
+            // The clock is read at every try: one try builds a candidate list,
+            // which on a large class costs far more than reading it.
+            if tries > budget || Instant::now() > deadline {
+                return Err(Embedding::Unknown);
+            }
+            let v = cands[top][i];
+            sigma[u] = v;
+            used[v as usize] = true;
+            if d == ord.len() {
+                return Ok(());
+            }
+            let c = self.candidates(d, sigma, used);
+            cands.push(c);
+            next.push(0);
         }
-        let top = d - 1;
-        let u = ord[top] as usize;
-        // Undo the previous choice at this depth.
-        if sigma[u] != NONE {
-            used[sigma[u] as usize] = false;
-            sigma[u] = NONE;
-        }
-        let i = next[top];
-        if i >= cands[top].len() {
-            cands.pop();
-            next.pop();
-            continue;
-        }
-        next[top] = i + 1;
-        tries += 1;
-        // The clock is read at every try: one try builds a candidate list,
-        // which on a large class costs far more than reading it.
-        if tries > budget || Instant::now() > deadline {
-            return Embedding::Unknown;
-        }
-        let v = cands[top][i];
-        sigma[u] = v;
-        used[v as usize] = true;
-        if d == ord.len() {
-            break;
-        }
-        let c = candidates(d, &sigma, &used);
-        cands.push(c);
-        next.push(0);
     }
-    // Complete with the arc-less vertices, class by class.
+}
+
+/// Completes `sigma` with the arc-less vertices, class by class.
+fn complete(p: &Problem, mut sigma: Vec<u32>, used: &[bool]) -> Embedding {
     for &(s, e) in &p.classes {
         let mut free = (s..e).filter(|&v| !used[v]);
         for slot in sigma[s..e].iter_mut() {

@@ -66,7 +66,6 @@ impl Lsap {
     /// costs, which makes the duals feasible; tentative pairs that are tight
     /// under them are kept; only the remaining rows are augmented. The
     /// result is optimal whatever the start.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn solve_warm(
         &mut self,
         n: usize,
@@ -89,21 +88,7 @@ impl Lsap {
             && v0.len() == n
             && cols0.len() == n
         {
-            a.v.copy_from_slice(v0);
-            for i in 0..n {
-                let row = &cost[i * n..(i + 1) * n];
-                a.u[i] = row
-                    .iter()
-                    .zip(&a.v)
-                    .map(|(&c, &vj)| c - vj)
-                    .min()
-                    .unwrap_or(0);
-                let j = cols0[i];
-                if j < n && self.row_of_col[j] == NIL && row[j] - a.u[i] - a.v[j] == 0 {
-                    self.row_of_col[j] = i;
-                    a.col_of_row[i] = j;
-                }
-            }
+            self.warm_start(n, cost, &mut a, v0, cols0);
         }
         let every = if n >= 256 { 1 } else { 8 };
         for cur in 0..n {
@@ -113,77 +98,136 @@ impl Lsap {
             if n >= 48 && cur % every == 0 && Instant::now() > deadline {
                 return None;
             }
-            self.spc.clear();
-            self.spc.resize(n, INF);
-            self.path.clear();
-            self.path.resize(n, NIL);
-            self.in_sr.clear();
-            self.in_sr.resize(n, false);
-            self.in_sc.clear();
-            self.in_sc.resize(n, false);
-            self.sr.clear();
-            let mut min_val = 0i64;
-            let mut i = cur;
-            let sink = loop {
-                self.in_sr[i] = true;
-                self.sr.push(i);
-                let row = &cost[i * n..(i + 1) * n];
-                let mut lowest = INF;
-                let mut best = NIL;
-                for (j, &cij) in row.iter().enumerate() {
-                    if self.in_sc[j] {
-                        continue;
-                    }
-                    let r = min_val + cij - a.u[i] - a.v[j];
-                    if r < self.spc[j] {
-                        self.spc[j] = r;
-                        self.path[j] = i;
-                    }
-                    let s = self.spc[j];
-                    if s < lowest || (s == lowest && best != NIL && self.row_of_col[j] == NIL) {
-                        lowest = s;
-                        best = j;
-                    }
-                }
-                if best == NIL {
-                    return None;
-                }
-                min_val = lowest;
-                self.in_sc[best] = true;
-                let r = self.row_of_col[best];
-                if r == NIL {
-                    break best;
-                }
-                i = r;
-            };
-            a.u[cur] += min_val;
-            for &r in &self.sr {
-                if r != cur {
-                    a.u[r] += min_val - self.spc[a.col_of_row[r]];
-                }
-            }
-            for j in 0..n {
-                if self.in_sc[j] {
-                    a.v[j] -= min_val - self.spc[j];
-                }
-            }
-            let mut j = sink;
-            loop {
-                let r = self.path[j];
-                if r == NIL {
-                    return None;
-                }
-                self.row_of_col[j] = r;
-                let prev = a.col_of_row[r];
-                a.col_of_row[r] = j;
-                if r == cur {
-                    break;
-                }
-                j = prev;
-            }
+            self.reset_row_buffers(n);
+            let (sink, min_val) = self.shortest_path(n, cost, &a, cur)?;
+            self.update_potentials(n, &mut a, cur, min_val);
+            self.augment(&mut a, cur, sink)?;
         }
         a.total = (0..n).map(|i| cost[i * n + a.col_of_row[i]]).sum();
         Some(a)
+    }
+
+    /// Takes the column potentials `v0`, sets each row potential to its row
+    /// minimum of reduced costs, and keeps the pairs of `cols0` that are tight.
+    fn warm_start(
+        &mut self,
+        n: usize,
+        cost: &[i64],
+        a: &mut Assignment,
+        v0: &[i64],
+        cols0: &[usize],
+    ) {
+        a.v.copy_from_slice(v0);
+        for i in 0..n {
+            let row = &cost[i * n..(i + 1) * n];
+            a.u[i] = row
+                .iter()
+                .zip(&a.v)
+                .map(|(&c, &vj)| c - vj)
+                .min()
+                .unwrap_or(0);
+            let j = cols0[i];
+            if j < n && self.row_of_col[j] == NIL && row[j] - a.u[i] - a.v[j] == 0 {
+                self.row_of_col[j] = i;
+                a.col_of_row[i] = j;
+            }
+        }
+    }
+
+    /// Clears the per-row search buffers for an `n × n` problem.
+    #[inline]
+    fn reset_row_buffers(&mut self, n: usize) {
+        self.spc.clear();
+        self.spc.resize(n, INF);
+        self.path.clear();
+        self.path.resize(n, NIL);
+        self.in_sr.clear();
+        self.in_sr.resize(n, false);
+        self.in_sc.clear();
+        self.in_sc.resize(n, false);
+        self.sr.clear();
+    }
+
+    /// Dijkstra search over reduced costs from the free row `cur` to a free
+    /// column: returns that column (the sink) and the path length.
+    #[inline]
+    fn shortest_path(
+        &mut self,
+        n: usize,
+        cost: &[i64],
+        a: &Assignment,
+        cur: usize,
+    ) -> Option<(usize, i64)> {
+        let mut min_val = 0i64;
+        let mut i = cur;
+        loop {
+            self.in_sr[i] = true;
+            self.sr.push(i);
+            let row = &cost[i * n..(i + 1) * n];
+            let mut lowest = INF;
+            let mut best = NIL;
+            for (j, &cij) in row.iter().enumerate() {
+                if self.in_sc[j] {
+                    continue;
+                }
+                let r = min_val + cij - a.u[i] - a.v[j];
+                if r < self.spc[j] {
+                    self.spc[j] = r;
+                    self.path[j] = i;
+                }
+                let s = self.spc[j];
+                if s < lowest || (s == lowest && best != NIL && self.row_of_col[j] == NIL) {
+                    lowest = s;
+                    best = j;
+                }
+            }
+            if best == NIL {
+                return None;
+            }
+            min_val = lowest;
+            self.in_sc[best] = true;
+            let r = self.row_of_col[best];
+            if r == NIL {
+                return Some((best, min_val));
+            }
+            i = r;
+        }
+    }
+
+    /// Updates the potentials after the search from row `cur` so that every
+    /// reduced cost stays non-negative and the new path is tight.
+    #[inline]
+    fn update_potentials(&self, n: usize, a: &mut Assignment, cur: usize, min_val: i64) {
+        a.u[cur] += min_val;
+        for &r in &self.sr {
+            if r != cur {
+                a.u[r] += min_val - self.spc[a.col_of_row[r]];
+            }
+        }
+        for j in 0..n {
+            if self.in_sc[j] {
+                a.v[j] -= min_val - self.spc[j];
+            }
+        }
+    }
+
+    /// Flips the augmenting path ending at column `sink` back to row `cur`.
+    #[inline]
+    fn augment(&mut self, a: &mut Assignment, cur: usize, sink: usize) -> Option<()> {
+        let mut j = sink;
+        loop {
+            let r = self.path[j];
+            if r == NIL {
+                return None;
+            }
+            self.row_of_col[j] = r;
+            let prev = a.col_of_row[r];
+            a.col_of_row[r] = j;
+            if r == cur {
+                return Some(());
+            }
+            j = prev;
+        }
     }
 }
 

@@ -129,30 +129,8 @@ impl TedResult {
 }
 
 /// The ordered tree edit distance of `a` and `b` with unit costs.
-#[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
 pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
-    // The orientation with fewer cells: same distance, mirrored mapping.
-    let (fa, fb) = (
-        OrderedTree::build(&a.children, &a.labels, a.root, false),
-        OrderedTree::build(&b.children, &b.labels, b.root, false),
-    );
-    let (ma, mb) = (
-        OrderedTree::build(&a.children, &a.labels, a.root, true),
-        OrderedTree::build(&b.children, &b.labels, b.root, true),
-    );
-    let weight = |x: &OrderedTree, y: &OrderedTree| {
-        u128::from(x.keyroot_weight()) * u128::from(y.keyroot_weight())
-    };
-    let mirrored = weight(&ma, &mb) < weight(&fa, &fb);
-    let (f, g) = if mirrored { (ma, mb) } else { (fa, fb) };
-    let to_arena = |pairs: Vec<(usize, usize)>| -> Vec<(usize, usize)> {
-        let mut m: Vec<(usize, usize)> = pairs
-            .into_iter()
-            .map(|(x, y)| (f.arena[x], g.arena[y]))
-            .collect();
-        m.sort_unstable();
-        m
-    };
+    let (f, g) = oriented(a, b);
     let (n1, n2) = (f.len(), g.len());
     if n1 == 0 || n2 == 0 {
         let d = (n1 + n2) as u64;
@@ -165,76 +143,162 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
             peak_cells: 0,
         };
     }
-    // No mapping costs more than n1 + n2: a band this wide prunes nothing.
-    let full = n1 + n2;
-    let mut lower = n1.abs_diff(n2) as u64;
-    // A mapping always available: the roots to each other; usually a far
-    // better one: the top-down alignment of `greedy.rs` (arena pairs).
-    let root_cost = (n1 + n2 - 2) as u64 + u64::from(f.label[n1 - 1] != g.label[n2 - 1]);
-    let (gm, gcost) = greedy::greedy_mapping(a, b);
-    let mut best: (u64, Vec<(usize, usize)>) = if gcost < root_cost {
-        (gcost, gm)
-    } else {
-        (root_cost, vec![(f.arena[n1 - 1], g.arena[n2 - 1])])
+    let mut pr = Progress {
+        lower: n1.abs_diff(n2) as u64,
+        best: first_mapping(a, b, &f, &g),
+        work: 0,
+        peak: 0,
     };
-    let mut work = 0u64;
-    let mut peak = 0u64;
     // The label sequences' bounds (`bounds.rs`): a lower bound that often
     // meets the upper one on a tree and its edited copy, and a mapping that
     // is often better than the greedy one; skipped when they do not fit
     // the budgets.
     if bounds::work(n1, n2) <= opts.max_work && bounds::cells(n1, n2) <= opts.max_cells {
-        let sb = bounds::sequence_bounds(&f, &g);
-        work += sb.work;
-        peak = peak.max(sb.peak);
-        lower = lower.max(sb.lower);
-        if sb.upper < best.0 {
-            best = (sb.upper, to_arena(sb.mapping));
-        }
-        if lower >= best.0 {
-            let (upper, mapping) = best;
-            return TedResult {
-                lower: upper,
-                upper,
-                mapping,
-                work,
-                band: 0,
-                peak_cells: peak,
-            };
+        pr.sequence_bounds(&f, &g);
+        if pr.lower >= pr.best.0 {
+            return pr.finish(0);
         }
     }
+    band_search(&f, &g, opts, pr)
+}
+
+/// Both trees in the orientation with fewer cells (as drawn or mirrored):
+/// same distance, mirrored mapping.
+fn oriented(a: &LabelledTree, b: &LabelledTree) -> (OrderedTree, OrderedTree) {
+    let (fa, fb) = (
+        OrderedTree::build(&a.children, &a.labels, a.root, false),
+        OrderedTree::build(&b.children, &b.labels, b.root, false),
+    );
+    let (ma, mb) = (
+        OrderedTree::build(&a.children, &a.labels, a.root, true),
+        OrderedTree::build(&b.children, &b.labels, b.root, true),
+    );
+    let weight = |x: &OrderedTree, y: &OrderedTree| {
+        u128::from(x.keyroot_weight()) * u128::from(y.keyroot_weight())
+    };
+    let mirrored = weight(&ma, &mb) < weight(&fa, &fb);
+    if mirrored { (ma, mb) } else { (fa, fb) }
+}
+
+/// Postorder pairs of `f` and `g` as sorted arena pairs.
+fn to_arena(f: &OrderedTree, g: &OrderedTree, pairs: Vec<(usize, usize)>) -> Vec<(usize, usize)> {
+    let mut m: Vec<(usize, usize)> = pairs
+        .into_iter()
+        .map(|(x, y)| (f.arena[x], g.arena[y]))
+        .collect();
+    m.sort_unstable();
+    m
+}
+
+/// The better of two mappings always available (non-empty trees): the
+/// roots to each other, and the top-down alignment of `greedy.rs`.
+fn first_mapping(
+    a: &LabelledTree,
+    b: &LabelledTree,
+    f: &OrderedTree,
+    g: &OrderedTree,
+) -> (u64, Vec<(usize, usize)>) {
+    let (n1, n2) = (f.len(), g.len());
+    let root_cost = (n1 + n2 - 2) as u64 + u64::from(f.label[n1 - 1] != g.label[n2 - 1]);
+    let (gm, gcost) = greedy::greedy_mapping(a, b);
+    if gcost < root_cost {
+        (gcost, gm)
+    } else {
+        (root_cost, vec![(f.arena[n1 - 1], g.arena[n2 - 1])])
+    }
+}
+
+/// What a computation has established so far.
+struct Progress {
+    /// Lower bound on the distance.
+    lower: u64,
+    /// The best mapping known (arena pairs) and its cost.
+    best: (u64, Vec<(usize, usize)>),
+    /// Table cells computed.
+    work: u64,
+    /// Most table cells held at once.
+    peak: u64,
+}
+
+impl Progress {
+    /// Takes in the label sequences' lower bound and mapping.
+    fn sequence_bounds(&mut self, f: &OrderedTree, g: &OrderedTree) {
+        let sb = bounds::sequence_bounds(f, g);
+        self.work += sb.work;
+        self.peak = self.peak.max(sb.peak);
+        self.lower = self.lower.max(sb.lower);
+        if sb.upper < self.best.0 {
+            self.best = (sb.upper, to_arena(f, g, sb.mapping));
+        }
+    }
+
+    /// The interval `[lower, best]` with the best mapping, `band` the width
+    /// of the last band that ran to completion.
+    fn finish(self, band: usize) -> TedResult {
+        let (upper, mapping) = self.best;
+        TedResult {
+            lower: self.lower.min(upper),
+            upper,
+            mapping,
+            work: self.work,
+            band,
+            peak_cells: self.peak,
+        }
+    }
+}
+
+/// The width of the next band from the planned `u`: the best mapping's cost
+/// once `u` comes close to it, and the full width `full` once the band would
+/// cost about as much as Zhang–Shasha's whole tables (`full_cells`), judged
+/// from the width and work of the last band run.
+fn band_width(
+    mut u: usize,
+    best: u64,
+    last: Option<(usize, u64)>,
+    full_cells: u128,
+    full: usize,
+) -> usize {
+    // A band as wide as a known mapping's cost holds that mapping, so
+    // its result is exact: jump there once the growth comes close.
+    let ub = usize::try_from(best).unwrap_or(usize::MAX);
+    if u.saturating_mul(3) >= ub.saturating_mul(2) {
+        u = ub;
+    }
+    // Once a band would cost about as much as Zhang–Shasha's whole
+    // tables (the product of the keyroot weights), run those instead.
+    if let Some((pu, pw)) = last {
+        let grow = (u as f64 / pu as f64).powi(3);
+        if pw as f64 * grow >= full_cells as f64 {
+            u = full;
+        }
+    }
+    u.min(full)
+}
+
+/// Zhang & Shasha in ever wider bands, from the lower bound, until a band's
+/// result is at most its width (exact) or a budget is spent (an interval).
+fn band_search(f: &OrderedTree, g: &OrderedTree, opts: &TedOptions, mut pr: Progress) -> TedResult {
+    let (n1, n2) = (f.len(), g.len());
+    // No mapping costs more than n1 + n2: a band this wide prunes nothing.
+    let full = n1 + n2;
     let mut done_band = 0;
     // A band narrower than the lower bound cannot prove the distance.
     let mut u = n1
         .abs_diff(n2)
         .max(2)
-        .max(usize::try_from(lower).unwrap_or(usize::MAX));
+        .max(usize::try_from(pr.lower).unwrap_or(usize::MAX));
     let full_cells = u128::from(f.keyroot_weight()) * u128::from(g.keyroot_weight());
     // The width and work of the last band run.
     let mut last: Option<(usize, u64)> = None;
     loop {
-        // A band as wide as a known mapping's cost holds that mapping, so
-        // its result is exact: jump there once the growth comes close.
-        let ub = usize::try_from(best.0).unwrap_or(usize::MAX);
-        if u.saturating_mul(3) >= ub.saturating_mul(2) {
-            u = ub;
-        }
-        // Once a band would cost about as much as Zhang–Shasha's whole
-        // tables (the product of the keyroot weights), run those instead.
-        if let Some((pu, pw)) = last {
-            let grow = (u as f64 / pu as f64).powi(3);
-            if pw as f64 * grow >= full_cells as f64 {
-                u = full;
-            }
-        }
-        u = u.min(full);
-        if Banded::memory_cells(&f, &g, u) > opts.max_cells {
+        u = band_width(u, pr.best.0, last, full_cells, full);
+        if Banded::memory_cells(f, g, u) > opts.max_cells {
             break;
         }
-        let mut band = Banded::new(&f, &g, u);
-        let ran = band.run(opts.max_work.saturating_sub(work));
-        work += band.work;
-        peak = peak.max(band.peak);
+        let mut band = Banded::new(f, g, u);
+        let ran = band.run(opts.max_work.saturating_sub(pr.work));
+        pr.work += band.work;
+        pr.peak = pr.peak.max(band.peak);
         last = Some((u.max(1), band.work.max(1)));
         if ran.is_err() {
             break;
@@ -244,36 +308,28 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
         if r <= u as u64 || u == full {
             band.work = 0;
             let m = mapping::mapping(&mut band);
-            work += band.work;
+            pr.work += band.work;
             return TedResult {
                 lower: r,
                 upper: r,
-                mapping: to_arena(m),
-                work,
+                mapping: to_arena(f, g, m),
+                work: pr.work,
                 band: u,
-                peak_cells: peak.max(band.peak),
+                peak_cells: pr.peak.max(band.peak),
             };
         }
         // The distance is above u; r, if finite, is a mapping's cost.
-        lower = lower.max(u as u64 + 1);
-        if r < best.0 {
+        pr.lower = pr.lower.max(u as u64 + 1);
+        if r < pr.best.0 {
             band.work = 0;
             let m = mapping::mapping(&mut band);
-            work += band.work;
-            peak = peak.max(band.peak);
-            best = (r, to_arena(m));
+            pr.work += band.work;
+            pr.peak = pr.peak.max(band.peak);
+            pr.best = (r, to_arena(f, g, m));
         }
         // Grow by half: the work grows as about u³, so overshooting the
         // distance by up to 1.5× costs less than doubling's 2×.
         u = u.saturating_add(u.div_ceil(2));
     }
-    let (upper, m) = best;
-    TedResult {
-        lower: lower.min(upper),
-        upper,
-        mapping: m,
-        work,
-        band: done_band,
-        peak_cells: peak,
-    }
+    pr.finish(done_band)
 }

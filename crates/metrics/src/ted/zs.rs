@@ -138,7 +138,6 @@ impl<'a> Banded<'a> {
     /// the last pair of subtrees on the two leftmost paths those diagonals
     /// allow; records the distance of every pair of subtrees that both start
     /// the table in `td`.
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
     pub(super) fn table(&mut self, k1: usize, k2: usize) {
         let (f, g, u) = (self.f, self.g, self.u);
         let (l1, l2) = (f.lml[k1], g.lml[k2]);
@@ -146,9 +145,23 @@ impl<'a> Banded<'a> {
             self.fd.reset((l1, l1), (l2, l2), (1, 0));
             return;
         };
-        // The last rows and columns needed: the highest path pairs (x, y)
-        // with y − x on an allowed diagonal (both paths ascend) whose four
-        // regions (`OrderedTree::regions`) differ by at most u in all.
+        let Some((rmax, cmax)) = self.last_pair(k1, k2, dlo, dhi) else {
+            self.fd.reset((l1, l1), (l2, l2), (1, 0));
+            return;
+        };
+        self.fd.reset((l1, rmax + 1), (l2, cmax + 1), (dlo, dhi));
+        self.peak = self
+            .peak
+            .max((self.td.data.len() + self.fd.data.len()) as u64);
+        self.work += fill(&mut self.fd, &mut self.td, f, g, (l1, l2), rmax);
+    }
+
+    /// The last row and column the table of `k1`, `k2` needs: the highest
+    /// path pairs (x, y) with y − x in `dlo..=dhi` (both paths ascend) whose
+    /// four regions (`OrderedTree::regions`) differ by at most u in all;
+    /// `None` when no pair qualifies.
+    fn last_pair(&mut self, k1: usize, k2: usize, dlo: i64, dhi: i64) -> Option<(usize, usize)> {
+        let (f, g, u) = (self.f, self.g, self.u);
         Self::path(f, k1, &mut self.path1);
         Self::path(g, k2, &mut self.path2);
         let (mut rmax, mut cmax) = (None::<usize>, None::<usize>);
@@ -170,90 +183,7 @@ impl<'a> Banded<'a> {
                 j += 1;
             }
         }
-        let (Some(rmax), Some(cmax)) = (rmax, cmax) else {
-            self.fd.reset((l1, l1), (l2, l2), (1, 0));
-            return;
-        };
-        self.fd.reset((l1, rmax + 1), (l2, cmax + 1), (dlo, dhi));
-        self.peak = self
-            .peak
-            .max((self.td.data.len() + self.fd.data.len()) as u64);
-        let fd = &mut self.fd;
-        let td = &mut self.td;
-        let mut work = 0u64;
-        for p in l1..=rmax + 1 {
-            let i = p - fd.row0;
-            let (lo, hi) = (fd.lo[i], fd.hi[i]);
-            if lo > hi {
-                continue;
-            }
-            work += (hi + 1 - lo) as u64;
-            let (before, rest) = fd.data.split_at_mut(fd.off[i]);
-            let cur = &mut rest[..hi + 1 - lo];
-            // The table above this row, read-only.
-            let above = At {
-                row0: fd.row0,
-                lo: &fd.lo[..i],
-                hi: &fd.hi[..i],
-                off: &fd.off[..i],
-                data: before,
-            };
-            if p == l1 {
-                for q in lo..=hi {
-                    cur[q - lo] = (q - l2) as u32;
-                }
-                continue;
-            }
-            let x = p - 1;
-            let x_starts = f.lml[x] == l1;
-            let (lx, labx) = (f.lml[x], f.label[x]);
-            // Row p − 1 (the deletion of x) and td's row x, as slices.
-            let (plo, phi) = (above.lo[i - 1], above.hi[i - 1]);
-            let prev: &[u32] = if plo <= phi {
-                &above.data[above.off[i - 1]..above.off[i - 1] + phi + 1 - plo]
-            } else {
-                &[]
-            };
-            let at_prev = |q: usize| -> u32 {
-                if q >= plo && q <= phi {
-                    prev[q - plo]
-                } else {
-                    INF
-                }
-            };
-            // td's row x: read and written in place.
-            let ti = x - td.row0;
-            let (tlo, thi, toff) = (td.lo[ti], td.hi[ti], td.off[ti]);
-            let mut left = INF;
-            for q in lo..=hi {
-                let del = at_prev(q) + 1;
-                let v = if q == l2 {
-                    del
-                } else {
-                    let y = q - 1;
-                    let ins = left + 1;
-                    let gy = g.lml[y];
-                    if x_starts && gy == l2 {
-                        let rename = u32::from(labx != g.label[y]);
-                        let v = del.min(ins).min(at_prev(q - 1) + rename).min(INF);
-                        if y >= tlo && y <= thi {
-                            td.data[toff + y - tlo] = v;
-                        }
-                        v
-                    } else {
-                        let t = if y >= tlo && y <= thi {
-                            td.data[toff + y - tlo]
-                        } else {
-                            INF
-                        };
-                        del.min(ins).min(above.get(lx, gy) + t)
-                    }
-                };
-                left = v.min(INF);
-                cur[q - lo] = left;
-            }
-        }
-        self.work += work;
+        Some((rmax?, cmax?))
     }
 
     /// The distance of the two whole trees under this band (infinite when
@@ -264,6 +194,94 @@ impl<'a> Banded<'a> {
             (n1, n2) => self.td.get(n1 - 1, n2 - 1),
         }
     }
+}
+
+/// Fills the forest table `fd` (already reset to rows `l1..=rmax + 1`) row
+/// by row, writing the distance of every pair of subtrees that both start
+/// the table into `td`; returns the number of cells computed.
+#[inline]
+fn fill(
+    fd: &mut Stair,
+    td: &mut Stair,
+    f: &OrderedTree,
+    g: &OrderedTree,
+    (l1, l2): (usize, usize),
+    rmax: usize,
+) -> u64 {
+    let mut work = 0u64;
+    for p in l1..=rmax + 1 {
+        let i = p - fd.row0;
+        let (lo, hi) = (fd.lo[i], fd.hi[i]);
+        if lo > hi {
+            continue;
+        }
+        work += (hi + 1 - lo) as u64;
+        let (before, rest) = fd.data.split_at_mut(fd.off[i]);
+        let cur = &mut rest[..hi + 1 - lo];
+        // The table above this row, read-only.
+        let above = At {
+            row0: fd.row0,
+            lo: &fd.lo[..i],
+            hi: &fd.hi[..i],
+            off: &fd.off[..i],
+            data: before,
+        };
+        if p == l1 {
+            for q in lo..=hi {
+                cur[q - lo] = (q - l2) as u32;
+            }
+            continue;
+        }
+        let x = p - 1;
+        let x_starts = f.lml[x] == l1;
+        let (lx, labx) = (f.lml[x], f.label[x]);
+        // Row p − 1 (the deletion of x) and td's row x, as slices.
+        let (plo, phi) = (above.lo[i - 1], above.hi[i - 1]);
+        let prev: &[u32] = if plo <= phi {
+            &above.data[above.off[i - 1]..above.off[i - 1] + phi + 1 - plo]
+        } else {
+            &[]
+        };
+        let at_prev = |q: usize| -> u32 {
+            if q >= plo && q <= phi {
+                prev[q - plo]
+            } else {
+                INF
+            }
+        };
+        // td's row x: read and written in place.
+        let ti = x - td.row0;
+        let (tlo, thi, toff) = (td.lo[ti], td.hi[ti], td.off[ti]);
+        let mut left = INF;
+        for q in lo..=hi {
+            let del = at_prev(q) + 1;
+            let v = if q == l2 {
+                del
+            } else {
+                let y = q - 1;
+                let ins = left + 1;
+                let gy = g.lml[y];
+                if x_starts && gy == l2 {
+                    let rename = u32::from(labx != g.label[y]);
+                    let v = del.min(ins).min(at_prev(q - 1) + rename).min(INF);
+                    if y >= tlo && y <= thi {
+                        td.data[toff + y - tlo] = v;
+                    }
+                    v
+                } else {
+                    let t = if y >= tlo && y <= thi {
+                        td.data[toff + y - tlo]
+                    } else {
+                        INF
+                    };
+                    del.min(ins).min(above.get(lx, gy) + t)
+                }
+            };
+            left = v.min(INF);
+            cur[q - lo] = left;
+        }
+    }
+    work
 }
 
 /// Read access to the rows of a [`Stair`] above the row being written.

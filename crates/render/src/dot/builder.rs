@@ -3,7 +3,7 @@
 //! the legend.
 
 use super::*;
-use btfsm_model::{Bt, StateBody, StateMachine, Target, Trigger};
+use btfsm_model::{Bt, Region, State, StateBody, StateMachine, Target, Transition, Trigger};
 use graphviz_rust::dot_structures::{Stmt, Subgraph};
 use std::collections::{HashMap, HashSet};
 
@@ -177,30 +177,36 @@ impl<'o> Builder<'o> {
 
     // --- FSMs and HFSMs -----------------------------------------------------
 
-    #[expect(clippy::too_many_lines, reason = "to be split: issue 28")]
+    /// An FSM or HFSM: vertex ids, state nodes, the top level's outcomes and
+    /// start, the clusters' plans, then the edges.
     pub(super) fn machine(&mut self, m: &StateMachine) {
         let n = m.states.len();
-        // Nesting levels, parents before children, without recursion.
-        let mut level = vec![0usize; n];
-        for c in m.parents_first() {
-            level[c] = m.states[c].parent.map_or(0, |p| level[p] + 1);
+        let ids = self.machine_ids(m);
+        self.state_stmt = vec![None; n];
+        self.header = vec![Vec::new(); n];
+        self.footer = vec![Vec::new(); n];
+        for i in 0..n {
+            self.state_node(&ids, i);
         }
+        self.top_level(&ids);
+        self.plan_clusters(&ids);
+        for i in 0..n {
+            self.state_edges(&ids, i);
+        }
+    }
+
+    /// Registers the machine's vertex ids: states, top outcomes, then the
+    /// extra outcome boxes of the containers, so that every vertex keeps its
+    /// key as its id.
+    fn machine_ids<'m>(&mut self, m: &'m StateMachine) -> MachineIds<'m> {
         // Vertices are identified by the graph's keys (SPEC §3 identity),
         // so that highlights and ghosts given by key find them.
         let key: Vec<String> = m.keys();
-        let region = |i: usize| match &m.states[i].body {
-            StateBody::Container(r) => Some(r),
-            _ => None,
-        };
-        let cluster_name = |i: usize| format!("cluster_{}", key[i]);
-
-        // Vertex ids first (states, top outcomes), then the extra outcome boxes
-        // of the containers, so that every vertex keeps its key as its id.
         let state_id: Vec<String> = key.iter().map(|p| self.vertex(p)).collect();
         let top_outcome_id: Vec<String> = m.top.outcomes.iter().map(|o| self.vertex(o)).collect();
         let mut outcome_box: HashMap<(usize, &str), String> = HashMap::new();
         for (i, p) in key.iter().enumerate() {
-            if let Some(r) = region(i) {
+            if let StateBody::Container(r) = &m.states[i].body {
                 self.container_of_key.insert(p.clone(), i);
                 for o in &r.outcomes {
                     let id = self.fresh(&format!("{p}/{o}"));
@@ -208,77 +214,44 @@ impl<'o> Builder<'o> {
                 }
             }
         }
-
-        // Nodes.
-        self.state_stmt = vec![None; n];
-        self.header = vec![Vec::new(); n];
-        self.footer = vec![Vec::new(); n];
-        for i in 0..n {
-            let s = &m.states[i];
-            let condition = match &s.body {
-                StateBody::Task(Some(c)) => {
-                    btfsm_model::skill::skill_kind(&c.skill)
-                        == Some(btfsm_model::SkillKind::Condition)
-                }
-                _ => false,
-            };
-            let mut a = Attrs::default();
-            match &s.body {
-                StateBody::Container(r) => {
-                    // A region of a parallel state: a dashed box, as UML
-                    // separates orthogonal regions with dashed lines.
-                    let orthogonal = s.parent.is_some_and(
-                        |p| matches!(&m.states[p].body, StateBody::Container(pr) if pr.parallel),
-                    );
-                    self.container_nodes(i, &s.label, &key[i], r, orthogonal, &outcome_box);
-                    continue;
-                }
-                // SCXML history pseudo-states as in UML: a small circle with H / H*.
-                StateBody::Decision if s.pseudo.is_some() => {
-                    let h = match s.pseudo {
-                        Some(btfsm_model::Pseudo::DeepHistory) => "H*",
-                        _ => "H",
-                    };
-                    a.set("label", h)
-                        .set("shape", "circle")
-                        .set("fillcolor", "white")
-                        .set("fontsize", "10")
-                        .set("width", "0.3")
-                        .set("tooltip", &key[i])
-                        .style("filled");
-                }
-                StateBody::Decision => {
-                    a.set("label", &s.label)
-                        .set("shape", "diamond")
-                        .set("fillcolor", DECISION_FILL)
-                        .set("fontsize", "10")
-                        .set("margin", "0.02,0.02")
-                        .set("tooltip", &key[i])
-                        .style("filled");
-                }
-                StateBody::Task(call) => {
-                    a.set("label", &s.label).set("shape", "ellipse");
-                    if condition {
-                        a.set("fillcolor", "white")
-                            .set("fontname", "Helvetica-Oblique");
-                    } else {
-                        a.set("fillcolor", ACTION_FILL);
-                    }
-                    let tip = match call {
-                        Some(c) => format!("{}: {c}", key[i]),
-                        None => key[i].clone(),
-                    };
-                    a.set("tooltip", &tip).style("filled");
-                }
-            }
-            if s.parent.is_none() && m.top.initial == Target::State(i) {
-                a.set("penwidth", "2.2");
-            }
-            a.node_highlight(self.vhl(&key[i]));
-            a.changed(self.opts.changed.get(&key[i]));
-            self.state_stmt[i] = Some(node_stmt(&state_id[i], a));
+        MachineIds {
+            m,
+            key,
+            state_id,
+            top_outcome_id,
+            outcome_box,
         }
-        for (o, id) in m.top.outcomes.iter().zip(&top_outcome_id) {
+    }
+
+    /// The node of state `i`, or for a container its cluster's header and
+    /// footer.
+    fn state_node(&mut self, ids: &MachineIds<'_>, i: usize) {
+        let (m, key) = (ids.m, &ids.key);
+        let s = &m.states[i];
+        if let StateBody::Container(r) = &s.body {
+            // A region of a parallel state: a dashed box, as UML
+            // separates orthogonal regions with dashed lines.
+            let orthogonal = s.parent.is_some_and(
+                |p| matches!(&m.states[p].body, StateBody::Container(pr) if pr.parallel),
+            );
+            self.container_nodes(i, &s.label, &key[i], r, orthogonal, &ids.outcome_box);
+            return;
+        }
+        let mut a = state_attrs(s, &key[i]);
+        if s.parent.is_none() && m.top.initial == Target::State(i) {
+            a.set("penwidth", "2.2");
+        }
+        a.node_highlight(self.vhl(&key[i]));
+        a.changed(self.opts.changed.get(&key[i]));
+        self.state_stmt[i] = Some(node_stmt(&ids.state_id[i], a));
+    }
+
+    /// The top level's outcome nodes and states, and its initial state as
+    /// UML marks it: a filled dot and an arrow (containers mark theirs with
+    /// their own dot, a vertex). Neither is a vertex nor an arc of the graph.
+    fn top_level(&mut self, ids: &MachineIds<'_>) {
+        let m = ids.m;
+        for (o, id) in m.top.outcomes.iter().zip(&ids.top_outcome_id) {
             let mut a = Attrs::default();
             a.set("label", o)
                 .set("shape", "doublecircle")
@@ -287,13 +260,10 @@ impl<'o> Builder<'o> {
             a.node_highlight(self.vhl(o));
             self.top_tail.push(node_stmt(id, a));
         }
-        if !top_outcome_id.is_empty() {
-            self.top_tail.push(rank_group("sink", &top_outcome_id));
+        if !ids.top_outcome_id.is_empty() {
+            self.top_tail.push(rank_group("sink", &ids.top_outcome_id));
         }
         self.top_states = m.top.states.clone();
-        // The top level's initial state, as UML marks it: a filled dot and
-        // an arrow (containers mark theirs with their own dot, a vertex).
-        // Neither is a vertex nor an arc of the graph.
         if let Target::State(j) = m.top.initial {
             let start = self.fresh(START);
             let mut a = Attrs::default();
@@ -302,16 +272,25 @@ impl<'o> Builder<'o> {
                 .set("tooltip", "initial state");
             self.top_tail.push(node_stmt(&start, a));
             let mut e = Attrs::default();
-            if region(j).is_some() {
-                e.set("lhead", &cluster_name(j));
+            if ids.region(j).is_some() {
+                e.set("lhead", &ids.cluster_name(j));
             }
             e.set("class", "start");
-            self.edges.push(edge_stmt(&start, &state_id[j], e));
+            self.edges.push(edge_stmt(&start, &ids.state_id[j], e));
         }
+    }
 
-        // Clusters, deepest first; below MAX_CLUSTER_NESTING a cluster goes
-        // beside its parent's instead of inside it.
-        let mut by_level: Vec<usize> = (0..n).filter(|&i| region(i).is_some()).collect();
+    /// The clusters' plans, deepest first; below `MAX_CLUSTER_NESTING` a
+    /// cluster goes beside its parent's instead of inside it.
+    fn plan_clusters(&mut self, ids: &MachineIds<'_>) {
+        let m = ids.m;
+        let n = m.states.len();
+        // Nesting levels, parents before children, without recursion.
+        let mut level = vec![0usize; n];
+        for c in m.parents_first() {
+            level[c] = m.states[c].parent.map_or(0, |p| level[p] + 1);
+        }
+        let mut by_level: Vec<usize> = (0..n).filter(|&i| ids.region(i).is_some()).collect();
         by_level.sort_by_key(|&i| (level[i], i));
         let mut slot: Vec<Option<usize>> = vec![None; n];
         for &i in &by_level {
@@ -323,93 +302,72 @@ impl<'o> Builder<'o> {
         for &i in by_level.iter().rev() {
             self.clusters.push(ClusterPlan {
                 container: i,
-                name: cluster_name(i),
-                children: region(i).map(|r| r.states.clone()).unwrap_or_default(),
+                name: ids.cluster_name(i),
+                children: ids.region(i).map(|r| r.states.clone()).unwrap_or_default(),
                 in_parent: slot[i] == m.states[i].parent,
                 slot: slot[i],
             });
         }
+    }
 
-        // Edges.
-        for i in 0..n {
-            let s = &m.states[i];
-            let reg = region(i);
-            if let Some(r) = reg {
-                for j in r.entered(&m.states) {
-                    let mut a = Attrs::default();
-                    if region(j).is_some() {
-                        a.set("lhead", &cluster_name(j));
-                    }
-                    a.edge_highlight(self.ahl(&key[i], &key[j], "initial"));
-                    self.edges.push(edge_stmt(&state_id[i], &state_id[j], a));
-                }
-            }
-            for t in &s.transitions {
+    /// The edges of state `i`: into a container's initial states, then one
+    /// per transition.
+    fn state_edges(&mut self, ids: &MachineIds<'_>, i: usize) {
+        let (m, key, state_id) = (ids.m, &ids.key, &ids.state_id);
+        if let Some(r) = ids.region(i) {
+            for j in r.entered(&m.states) {
                 let mut a = Attrs::default();
-                // Tail: a container's outcome transitions leave from its
-                // outcome box, anything else from the state's node.
-                let tail = match &t.trigger {
-                    Trigger::Outcome(o) => outcome_box.get(&(i, o.as_str())),
-                    Trigger::Guard(_) => None,
+                if ids.region(j).is_some() {
+                    a.set("lhead", &ids.cluster_name(j));
                 }
-                .unwrap_or(&state_id[i])
-                .clone();
-                let (head, to_key) = match &t.target {
-                    &Target::State(j) => {
-                        if region(j).is_some() && j != i {
-                            a.set("lhead", &cluster_name(j));
-                        }
-                        (state_id[j].clone(), key[j].clone())
-                    }
-                    Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => match match &t
-                        .target
-                    {
-                        Target::OuterOutcome { owner, .. } => *owner,
-                        _ => s.parent,
-                    } {
-                        Some(p) => {
-                            let head = outcome_box.get(&(p, o.as_str())).unwrap_or(&state_id[p]);
-                            (head.clone(), key[p].clone())
-                        }
-                        None => {
-                            let head = m
-                                .top
-                                .outcomes
-                                .iter()
-                                .position(|x| x == o)
-                                .map_or(o, |k| &top_outcome_id[k]);
-                            (head.clone(), o.clone())
-                        }
-                    },
-                };
-                if reg.is_some() && tail == state_id[i] && head != state_id[i] {
-                    a.set("ltail", &cluster_name(i));
-                }
-                if head == tail && matches!(s.body, StateBody::Decision) {
-                    // A decision state's arcs leave on every side; its
-                    // self-loop goes below it, clear of their labels.
-                    a.set("tailport", "s").set("headport", "s");
-                }
-                let color = match &t.trigger {
-                    Trigger::Outcome(o) => {
-                        Status::from_outcome(o).map_or("black", Status::line_color)
-                    }
-                    Trigger::Guard(_) => GUARD,
-                };
-                let label = t.trigger.label();
-                a.set("label", &label)
-                    .set("color", color)
-                    .set("fontcolor", color);
-                a.edge_highlight(self.ahl(&key[i], &to_key, &label));
-                let was = (key[i].clone(), to_key, label);
-                if let Some(old) = self.opts.changed_arcs.get(&was) {
-                    a.set("label", &format!("{}\n(was {old})", was.2))
-                        .set("color", CHANGED)
-                        .set("fontcolor", CHANGED);
-                }
-                self.edges.push(edge_stmt(&tail, &head, a));
+                a.edge_highlight(self.ahl(&key[i], &key[j], "initial"));
+                self.edges.push(edge_stmt(&state_id[i], &state_id[j], a));
             }
         }
+        for t in &m.states[i].transitions {
+            self.transition_edge(ids, i, t);
+        }
+    }
+
+    /// The edge of transition `t` of state `i`, coloured by its trigger,
+    /// highlighted, and showing the old label of a changed arc.
+    fn transition_edge(&mut self, ids: &MachineIds<'_>, i: usize, t: &Transition) {
+        let (m, key, state_id) = (ids.m, &ids.key, &ids.state_id);
+        let s = &m.states[i];
+        let mut a = Attrs::default();
+        // Tail: a container's outcome transitions leave from its
+        // outcome box, anything else from the state's node.
+        let tail = match &t.trigger {
+            Trigger::Outcome(o) => ids.outcome_box.get(&(i, o.as_str())),
+            Trigger::Guard(_) => None,
+        }
+        .unwrap_or(&state_id[i])
+        .clone();
+        let (head, to_key) = ids.head(i, t, &mut a);
+        if ids.region(i).is_some() && tail == state_id[i] && head != state_id[i] {
+            a.set("ltail", &ids.cluster_name(i));
+        }
+        if head == tail && matches!(s.body, StateBody::Decision) {
+            // A decision state's arcs leave on every side; its
+            // self-loop goes below it, clear of their labels.
+            a.set("tailport", "s").set("headport", "s");
+        }
+        let color = match &t.trigger {
+            Trigger::Outcome(o) => Status::from_outcome(o).map_or("black", Status::line_color),
+            Trigger::Guard(_) => GUARD,
+        };
+        let label = t.trigger.label();
+        a.set("label", &label)
+            .set("color", color)
+            .set("fontcolor", color);
+        a.edge_highlight(self.ahl(&key[i], &to_key, &label));
+        let was = (key[i].clone(), to_key, label);
+        if let Some(old) = self.opts.changed_arcs.get(&was) {
+            a.set("label", &format!("{}\n(was {old})", was.2))
+                .set("color", CHANGED)
+                .set("fontcolor", CHANGED);
+        }
+        self.edges.push(edge_stmt(&tail, &head, a));
     }
 
     /// A container's cluster header (attributes, its own vertex as a dot) and
@@ -598,4 +556,127 @@ impl<'o> Builder<'o> {
         key.rmatch_indices('/')
             .find_map(|(at, _)| self.container_of_key.get(&key[..at]).copied())
     }
+}
+
+/// The vertex ids of a machine being drawn, which `Builder::machine`'s
+/// phases share.
+struct MachineIds<'m> {
+    m: &'m StateMachine,
+    /// Each state's key (SPEC §3 identity).
+    key: Vec<String>,
+    /// Each state's DOT node id.
+    state_id: Vec<String>,
+    /// The DOT node id of each outcome of the top level.
+    top_outcome_id: Vec<String>,
+    /// `(container, outcome)` -> DOT node id of the container's outcome box.
+    outcome_box: HashMap<(usize, &'m str), String>,
+}
+
+impl<'m> MachineIds<'m> {
+    /// The region of state `i`, if it is a container.
+    fn region(&self, i: usize) -> Option<&'m Region> {
+        match &self.m.states[i].body {
+            StateBody::Container(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The DOT name of container `i`'s cluster.
+    fn cluster_name(&self, i: usize) -> String {
+        format!("cluster_{}", self.key[i])
+    }
+
+    /// The head of transition `t` of state `i` and the key it reaches (a
+    /// state, or an outcome: its container's outcome box, or the top
+    /// level's outcome node); sets `lhead` in `a` for a container.
+    fn head(&self, i: usize, t: &Transition, a: &mut Attrs) -> (String, String) {
+        let (m, key, state_id) = (self.m, &self.key, &self.state_id);
+        match &t.target {
+            &Target::State(j) => {
+                if self.region(j).is_some() && j != i {
+                    a.set("lhead", &self.cluster_name(j));
+                }
+                (state_id[j].clone(), key[j].clone())
+            }
+            Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
+                let owner = match &t.target {
+                    Target::OuterOutcome { owner, .. } => *owner,
+                    _ => m.states[i].parent,
+                };
+                match owner {
+                    Some(p) => {
+                        let head = self
+                            .outcome_box
+                            .get(&(p, o.as_str()))
+                            .unwrap_or(&state_id[p]);
+                        (head.clone(), key[p].clone())
+                    }
+                    None => {
+                        let head = m
+                            .top
+                            .outcomes
+                            .iter()
+                            .position(|x| x == o)
+                            .map_or(o, |k| &self.top_outcome_id[k]);
+                        (head.clone(), o.clone())
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The attributes of a state drawn as a node: a history pseudo-state as a
+/// small circle with H / H*, a decision as a diamond, a task as an ellipse
+/// (white and oblique for a condition skill). Containers are clusters
+/// (`Builder::container_nodes`) and get none.
+fn state_attrs(s: &State, key: &str) -> Attrs {
+    let condition = match &s.body {
+        StateBody::Task(Some(c)) => {
+            btfsm_model::skill::skill_kind(&c.skill) == Some(btfsm_model::SkillKind::Condition)
+        }
+        _ => false,
+    };
+    let mut a = Attrs::default();
+    match &s.body {
+        StateBody::Container(_) => {}
+        // SCXML history pseudo-states as in UML: a small circle with H / H*.
+        StateBody::Decision if s.pseudo.is_some() => {
+            let h = match s.pseudo {
+                Some(btfsm_model::Pseudo::DeepHistory) => "H*",
+                _ => "H",
+            };
+            a.set("label", h)
+                .set("shape", "circle")
+                .set("fillcolor", "white")
+                .set("fontsize", "10")
+                .set("width", "0.3")
+                .set("tooltip", key)
+                .style("filled");
+        }
+        StateBody::Decision => {
+            a.set("label", &s.label)
+                .set("shape", "diamond")
+                .set("fillcolor", DECISION_FILL)
+                .set("fontsize", "10")
+                .set("margin", "0.02,0.02")
+                .set("tooltip", key)
+                .style("filled");
+        }
+        StateBody::Task(call) => {
+            a.set("label", &s.label).set("shape", "ellipse");
+            if condition {
+                a.set("fillcolor", "white")
+                    .set("fontname", "Helvetica-Oblique");
+            } else {
+                a.set("fillcolor", ACTION_FILL);
+            }
+            let tip = match call {
+                Some(c) => format!("{key}: {c}"),
+                None => key.to_string(),
+            };
+            a.set("tooltip", &tip).style("filled");
+        }
+    }
+    a
 }
