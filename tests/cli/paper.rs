@@ -86,6 +86,17 @@ fn paper_check_names_the_cell_a_policy_edit_changes() {
     let (code, _, stderr) = btfsm(&["paper", "--check", "--policies", &copy_s]);
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("fig04-fsm.toml:"), "{stderr}");
+    // A missing file several tables need is said once, not once per table.
+    std::fs::remove_file(copy.join("fig07d-bt.toml")).expect("remove");
+    let (code, _, stderr) = btfsm(&["paper", "--check", "--policies", &copy_s]);
+    assert_eq!(code, 2, "{stderr}");
+    let said = stderr.matches("fig07d-bt.toml").count();
+    assert!(said >= 1, "{stderr}");
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("error:") && l.contains("fig07d-bt.toml"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
 

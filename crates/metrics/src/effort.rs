@@ -1,10 +1,14 @@
-//! Effort (paper sec. IV-B, Eq. 4/5; SPEC §3): the edits that make a
+//! The paper's effort formulas. Eq. 3 (sec. IV-A): what BT edits cost the
+//! HFSM built from the BT, from their named edit script ([`eq3`]).
+//! Effort (sec. IV-B, Eq. 4/5; SPEC §3): the edits that make a
 //! sequential FSM reactive, from the formula at the M_s sequential action
 //! states and M_fc fully connected states detected in the FSM. The measured
 //! effort (the named GED to the fault-tolerant FSM that
 //! `btfsm_transform::fault_tolerant` generates) is composed above this crate,
 //! in `btfsm_report::effort`.
 
+use crate::ged::EditScript;
+use btfsm_model::graph::{PolicyGraph, VertexType};
 use btfsm_model::{StateBody, StateMachine};
 
 /// The states Eq. 4 counts, by index, in file order.
@@ -60,6 +64,28 @@ pub fn effort_formula(m_s: u64, m_fc: u64) -> u64 {
     3 * (m_s + 1) + m_fc * ((m_s + m_fc - 1) + 3)
 }
 
+/// Eq. 3 (paper sec. IV-A): what adding and removing BT nodes costs the
+/// HFSM built from the BT, 3Δc + 4Δa + 5Δi over the nodes the named edit
+/// script of the two BTs' graphs adds or removes (c conditions, a actions,
+/// i control and decorator nodes: each added node's own vertex and arcs).
+pub fn eq3(a: &PolicyGraph, b: &PolicyGraph, script: &EditScript) -> i64 {
+    let ty =
+        |g: &PolicyGraph, key: &str| g.g.node_weights().find(|v| v.key == key).map(|v| v.vtype);
+    let weight = |t: Option<VertexType>| match t {
+        Some(VertexType::Condition) => 3,
+        Some(VertexType::Action) => 4,
+        Some(_) => 5,
+        None => 0,
+    };
+    let added: i64 = script.vertices_added.iter().map(|k| weight(ty(b, k))).sum();
+    let removed: i64 = script
+        .vertices_removed
+        .iter()
+        .map(|k| weight(ty(a, k)))
+        .sum();
+    added + removed
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -95,5 +121,29 @@ mod tests {
         let fig02 = machine("fig02-fsm");
         let d = detect(&fig02);
         assert_eq!((d.sequential.len(), d.connected.len()), (4, 0));
+    }
+
+    /// Table II's "HFSM Eq. 3" column: Tuck arm 12, Safe-Move-To 4, Dock
+    /// 17, Recharge 17 (Fig. 1 to Fig. 7a-d).
+    #[test]
+    fn eq3_gives_table_ii_hfsm_column() {
+        let graph = |name: &str| {
+            let p =
+                std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../policies/paper"))
+                    .join(format!("{name}.toml"));
+            btfsm_model::graph::policy_graph(&load(&p, &Limits::default()).unwrap().policy)
+        };
+        let fig01 = graph("fig01-bt");
+        for (to, want) in [
+            ("fig07a-bt", 12),
+            ("fig07b-bt", 4),
+            ("fig07c-bt", 17),
+            ("fig07d-bt", 17),
+        ] {
+            let b = graph(to);
+            let named =
+                crate::ged::ged(&fig01, &b, crate::ged::GedMode::Named, &Default::default());
+            assert_eq!(eq3(&fig01, &b, &named.edit_script), want, "{to}");
+        }
     }
 }

@@ -22,7 +22,7 @@ use btfsm_format::{Limits, load};
 use btfsm_metrics::complexity::{cyclomatic, essential};
 use btfsm_metrics::counts::{Counts, TableOne, counts, fully_connected_states, table_one};
 use btfsm_metrics::ged::{GedMode, GedOptions, GedResult, ged};
-use btfsm_model::graph::{PolicyGraph, VertexType, policy_graph};
+use btfsm_model::graph::{PolicyGraph, policy_graph};
 use btfsm_model::{Policy, PolicyBody, PolicyKind};
 use btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm;
 use std::collections::BTreeMap;
@@ -245,31 +245,37 @@ fn published(p: &Published, table: &str, row: &str, key: &str, side: Option<usiz
 struct Inputs {
     dir: PathBuf,
     limits: Limits,
-    cache: BTreeMap<String, Policy>,
+    /// Each file read once: its policy, or `None` when it failed (its
+    /// errors are in `errors` once, however many tables need it).
+    cache: BTreeMap<String, Option<Policy>>,
+    /// Each BT's HFSM, converted once, likewise.
+    hfsms: BTreeMap<String, Option<Policy>>,
     errors: Vec<Diagnostic>,
 }
 
 impl Inputs {
     fn policy(&mut self, stem: &str) -> Option<Policy> {
         if let Some(p) = self.cache.get(stem) {
-            return Some(p.clone());
+            return p.clone();
         }
-        match load(&self.dir.join(format!("{stem}.toml")), &self.limits) {
-            Ok(l) => {
-                self.cache.insert(stem.to_string(), l.policy.clone());
-                Some(l.policy)
-            }
+        let p = match load(&self.dir.join(format!("{stem}.toml")), &self.limits) {
+            Ok(l) => Some(l.policy),
             Err(d) => {
                 self.errors
                     .extend(d.into_iter().filter(Diagnostic::is_error));
                 None
             }
-        }
+        };
+        self.cache.insert(stem.to_string(), p.clone());
+        p
     }
 
     fn hfsm(&mut self, stem: &str) -> Option<Policy> {
+        if let Some(h) = self.hfsms.get(stem) {
+            return h.clone();
+        }
         let bt = self.policy(stem)?;
-        match bt_policy_to_hfsm(&bt) {
+        let h = match bt_policy_to_hfsm(&bt) {
             Ok(h) => Some(h),
             Err(e) => {
                 for u in e {
@@ -278,7 +284,9 @@ impl Inputs {
                 }
                 None
             }
-        }
+        };
+        self.hfsms.insert(stem.to_string(), h.clone());
+        h
     }
 }
 
@@ -291,27 +299,6 @@ fn m_fc(p: &Policy) -> usize {
         PolicyBody::Machine(m) => fully_connected_states(m).len(),
         PolicyBody::Bt(_) => 0,
     }
-}
-
-/// Eq. 3 on the named edit script of two BTs: 3Δc + 4Δa + 5Δi over the
-/// nodes added or removed (c conditions, a actions, i control and decorator
-/// nodes).
-fn eq3(a: &PolicyGraph, b: &PolicyGraph, script: &btfsm_metrics::ged::EditScript) -> i64 {
-    let ty =
-        |g: &PolicyGraph, key: &str| g.g.node_weights().find(|v| v.key == key).map(|v| v.vtype);
-    let weight = |t: Option<VertexType>| match t {
-        Some(VertexType::Condition) => 3,
-        Some(VertexType::Action) => 4,
-        Some(_) => 5,
-        None => 0,
-    };
-    let added: i64 = script.vertices_added.iter().map(|k| weight(ty(b, k))).sum();
-    let removed: i64 = script
-        .vertices_removed
-        .iter()
-        .map(|k| weight(ty(a, k)))
-        .sum();
-    added + removed
 }
 
 // --- the report ---------------------------------------------------------------
@@ -371,6 +358,7 @@ pub fn build(
             dir: dir.to_path_buf(),
             limits: limits.clone(),
             cache: BTreeMap::new(),
+            hfsms: BTreeMap::new(),
             errors: Vec::new(),
         },
         opts,
@@ -524,7 +512,11 @@ impl Build<'_> {
             name,
             "HFSM Eq. 3",
             pv("HFSM"),
-            int(eq3(&graph(a), &graph(b), &n.edit_script)),
+            int(btfsm_metrics::effort::eq3(
+                &graph(a),
+                &graph(b),
+                &n.edit_script,
+            )),
             NOTE_UNKNOWN,
         ));
     }
