@@ -5,7 +5,7 @@
 use super::io::{emit_text, fail, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
-use btfsm_core::output::Format;
+use btfsm_core::output::{Format, Report};
 use btfsm_sim::report::{McReport, SimReport, TraceWriter};
 use btfsm_sim::{monte_carlo, plot, run, scenario};
 use clap::Args;
@@ -128,14 +128,8 @@ fn monte_carlo_runs(
         ));
     }
     let seed = a.seed.unwrap_or(s.seed);
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let threads = match a.threads {
-        Some(0) => {
-            return fail(Diagnostic::error("--threads must be at least 1"));
-        }
-        // More threads than cores only wait; a few per core at most.
-        Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
-        None => cores,
+    let Some(threads) = threads(a, n) else {
+        return EXIT_BAD_INPUT;
     };
     let mc = monte_carlo::monte_carlo_within(s, n, seed, threads, deadline);
     let done = mc.runs;
@@ -144,7 +138,7 @@ fn monte_carlo_runs(
         seed,
         // What the figures cover.
         runs: done,
-        threads: threads.max(1).min(n.max(1) as usize),
+        threads,
         millis: t0.elapsed().as_millis(),
         policies: mc.policies,
         pairs: mc.pairs,
@@ -157,20 +151,24 @@ fn monte_carlo_runs(
     });
     let note =
         format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
-    let text = render(
-        &rep,
-        a.format,
-        McReport::json,
-        McReport::csv,
-        if a.format == Format::Markdown {
-            McReport::markdown
-        } else {
-            McReport::table
-        },
-        &budget,
-        &note,
-    );
+    let text = render(&rep, a.format, &budget, &note);
     emit_text(None, text)
+}
+
+/// The workers of `--runs n`: `--threads` (default the cores; more than
+/// [`MAX_THREADS_PER_CORE`] per core only wait and are lowered), at most
+/// one per episode; `None` after an error.
+fn threads(a: &SimArgs, n: u32) -> Option<usize> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let t = match a.threads {
+        Some(0) => {
+            fail(Diagnostic::error("--threads must be at least 1"));
+            return None;
+        }
+        Some(t) => t.min(MAX_THREADS_PER_CORE * cores),
+        None => cores,
+    };
+    Some(t.clamp(1, n.max(1) as usize))
 }
 
 /// `sim` without `--runs`: each policy once (or the episode of `--seed`),
@@ -253,15 +251,7 @@ fn one_run(
         return EXIT_BAD_INPUT;
     }
     let note = "the runs with outcome `timeout` stopped at the step shown in their reason, and the verdicts not computed are listed";
-    let text = render(
-        &rep,
-        a.format,
-        SimReport::json,
-        SimReport::csv,
-        SimReport::table,
-        &budget,
-        note,
-    );
+    let text = render(&rep, a.format, &budget, note);
     let code = emit_text(None, text);
     if code != EXIT_OK {
         return code;
@@ -302,41 +292,34 @@ struct Budget {
 }
 
 /// The report in `format`; with `--timeout-ms`, JSON gets the `budget`
-/// object, and the table `note` when the budget ran out.
-fn render<R: serde::Serialize>(
+/// object, and the table `note` when the budget ran out (on stderr for
+/// CSV, which stays one table).
+fn render<R: Report + serde::Serialize>(
     rep: &R,
     format: Format,
-    json: fn(&R) -> String,
-    csv: fn(&R) -> String,
-    table: fn(&R) -> String,
     budget: &Option<Budget>,
     note: &str,
 ) -> String {
-    match (format, budget) {
-        (Format::Json, None) => json(rep),
-        (Format::Json, Some(b)) => with_budget(rep, b),
-        // The note goes to stderr: the CSV stays one table.
-        (Format::Csv, b) => {
-            if let Some(b) = b.as_ref().filter(|b| b.exhausted) {
-                eprintln!(
-                    "note: the wall-clock budget of {} ms ran out: {note}",
-                    b.timeout_ms
-                );
-            }
-            csv(rep)
-        }
-        (_, None) => table(rep),
-        (_, Some(b)) => {
-            let mut t = table(rep);
-            if b.exhausted {
-                t.push_str(&format!(
-                    "note: the wall-clock budget of {} ms ran out: {note}\n",
-                    b.timeout_ms
-                ));
-            }
-            t
+    let format = R::supported(format);
+    let Some(b) = budget else {
+        return rep.write(format);
+    };
+    if format == Format::Json {
+        return with_budget(rep, b);
+    }
+    let mut t = rep.write(format);
+    if b.exhausted {
+        let note = format!(
+            "note: the wall-clock budget of {} ms ran out: {note}\n",
+            b.timeout_ms
+        );
+        if format == Format::Csv {
+            eprint!("{note}");
+        } else {
+            t.push_str(&note);
         }
     }
+    t
 }
 
 /// The JSON report with a `budget` object after its own fields.
@@ -499,14 +482,41 @@ fn symbolic(
             return EXIT_BAD_INPUT;
         }
     };
-    let json = a.format == Format::Json;
-    let text = match a.runs {
-        Some(n) => {
-            let seed = a.seed.unwrap_or(s.seed);
-            let (p, q) = run::monte_carlo(&s, n, seed);
-            report::render_mc(&s, n, seed, &p, &q, json)
-        }
-        None => report::render_runs(&s, &run::run_all(&s, a.seed.unwrap_or(s.seed)), json),
+    let t0 = std::time::Instant::now();
+    let deadline = a
+        .timeout_ms
+        .and_then(|ms| t0.checked_add(std::time::Duration::from_millis(ms)));
+    let Some(n) = a.runs else {
+        let runs = run::run_all(&s, a.seed, deadline);
+        let budget = a.timeout_ms.map(|ms| Budget {
+            timeout_ms: ms,
+            exhausted: runs.iter().any(|r| r.cut_short),
+            requested_runs: None,
+            millis: Some(t0.elapsed().as_millis()),
+        });
+        let note = "the runs with outcome `timeout` stopped at the step shown";
+        let rep = report::RunsReport::new(&s, &runs);
+        return emit_text(None, render(&rep, a.format, &budget, note));
     };
-    emit_text(None, text)
+    let Some(threads) = threads(a, n) else {
+        return EXIT_BAD_INPUT;
+    };
+    let budget = btfsm_sim::episodes::Budget {
+        runs: n,
+        seed: a.seed.unwrap_or(s.seed),
+        threads,
+        deadline,
+    };
+    let mc = run::monte_carlo(&s, &budget);
+    let done = mc.runs;
+    let b = a.timeout_ms.map(|ms| Budget {
+        timeout_ms: ms,
+        exhausted: done < n,
+        requested_runs: Some(n),
+        millis: Some(t0.elapsed().as_millis()),
+    });
+    let note =
+        format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
+    let rep = report::McReport::new(&s, budget.seed, &mc);
+    emit_text(None, render(&rep, a.format, &b, &note))
 }

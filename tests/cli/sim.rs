@@ -1051,3 +1051,53 @@ fn sim_csv_has_the_figures_of_the_json_report() {
         );
     }
 }
+
+/// The symbolic simulator keeps the one simulation contract of the planar
+/// one (`btfsm_sim::episodes`): `--timeout-ms` stops a million episodes at
+/// the deadline in bounded memory, and `--threads` changes no figure.
+#[test]
+fn symbolic_monte_carlo_honours_timeout_and_threads_in_bounded_memory() {
+    let domain = "policies/domains/moma-sim.toml";
+    let (code, stdout, stderr, _) = crate::common::btfsm_capped(
+        256,
+        &[
+            "sim",
+            domain,
+            "--runs",
+            "1000000",
+            "--timeout-ms",
+            "300",
+            "--format",
+            "json",
+        ],
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    assert_eq!(v["budget"]["exhausted"], true, "{v}");
+    assert_eq!(v["budget"]["requested_runs"], 1_000_000, "{v}");
+    let done = v["runs"].as_u64().expect("runs");
+    assert!(done < 1_000_000, "{v}");
+    for p in v["policies"].as_array().expect("policies") {
+        assert_eq!(p["runs"].as_u64(), Some(done), "{p}");
+        let sum: u64 = ["successes", "failures", "chattering", "timeouts"]
+            .iter()
+            .map(|k| p[k].as_u64().expect("count"))
+            .sum();
+        assert_eq!(sum, done, "{p}");
+    }
+    let json = |threads: &str| {
+        let (code, out, err) = btfsm(&[
+            "sim",
+            domain,
+            "--runs",
+            "120",
+            "--threads",
+            threads,
+            "--format",
+            "json",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        out
+    };
+    assert_eq!(json("1"), json("3"));
+}

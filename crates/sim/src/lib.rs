@@ -5,6 +5,7 @@
 //! Monte Carlo episodes.
 
 mod csv;
+pub mod episodes;
 pub mod exec;
 mod livelock;
 pub mod monte_carlo;

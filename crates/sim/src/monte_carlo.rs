@@ -2,13 +2,13 @@
 //! jittered disturbances, run in parallel over the cores and combined in
 //! episode order, so that the figures do not depend on the thread count.
 
+use super::episodes::{self, Budget, PairTally};
 use super::rng::SimRng;
 use super::robot::round3;
 use super::run::{Prepared, RunOptions, cut_short, prepare, run_policy};
 use super::scenario::{Disturbance, Scenario, mc};
 use super::trace::{Outcome, behavior_matches};
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Per-policy figures of `--runs N`.
@@ -79,16 +79,6 @@ pub fn wilson(k: u32, n: u32) -> [f64; 2] {
     [r4((centre - half).max(0.0)), r4((centre + half).min(1.0))]
 }
 
-/// Nearest-rank quantiles 10 %, 50 %, 90 % of `v` (sorted here).
-fn quantiles(v: &mut [f64]) -> Option<[f64; 3]> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let q = |p: f64| v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
-    Some([q(0.1), q(0.5), q(0.9)])
-}
-
 /// The seed of episode `i` of a Monte Carlo run with seed `seed`.
 pub fn episode_seed(seed: u64, i: u32) -> u64 {
     SimRng::named(seed, &format!("episode-{i}")).next_u64()
@@ -111,7 +101,9 @@ pub fn monte_carlo(s: &Scenario, runs: u32, seed: u64, threads: usize) -> McResu
 /// steps and dropped, no new one starts), and the figures cover the first
 /// k episodes, k the number returned (every episode before k completed for
 /// every policy; `runs` when the deadline never passed). The same k
-/// episodes give the same figures as `monte_carlo(s, k, seed, ..)`.
+/// episodes give the same figures as `monte_carlo(s, k, seed, ..)`. The
+/// episodes go through the one contract of [`crate::episodes`]: folded in
+/// order as they come, in memory bounded by the threads.
 pub fn monte_carlo_within(
     s: &Scenario,
     runs: u32,
@@ -120,229 +112,194 @@ pub fn monte_carlo_within(
     deadline: Option<Instant>,
 ) -> McResult {
     let prepared = prepare(s);
-    let np = prepared.len();
-    let pairs: Vec<(usize, usize)> = (0..np)
-        .flat_map(|a| (a + 1..np).map(move |b| (a, b)))
-        .collect();
-    let stop = AtomicBool::new(false);
-    let episodes = Episodes {
-        s,
-        prepared: &prepared,
-        pairs: &pairs,
+    let pairs = episodes::pairs(prepared.len());
+    let budget = Budget {
         runs,
         seed,
-        threads: threads.max(1).min(runs.max(1) as usize),
+        threads,
         deadline,
-        stop: &stop,
     };
-    let (all, agree, runs) = complete_prefix(episodes.run(), runs);
+    let mut policies: Vec<PolicyTally> = prepared.iter().map(|_| PolicyTally::default()).collect();
+    let mut agree = vec![PairTally::default(); pairs.len()];
+    let done = episodes::stream(
+        &budget,
+        |_, ep_seed| one_episode(s, &prepared, &pairs, ep_seed, deadline),
+        |i, ep_seed, (figures, same): Episode| {
+            for (t, r) in policies.iter_mut().zip(figures) {
+                t.fold(r);
+            }
+            for (t, m) in agree.iter_mut().zip(same) {
+                t.fold(i, ep_seed, m);
+            }
+        },
+    );
     McResult {
-        policies: policy_stats(&prepared, &all, runs),
-        pairs: pair_stats(&prepared, &pairs, &agree, runs),
-        runs,
+        policies: (prepared.iter().zip(&policies))
+            .map(|(p, t)| t.stats(&p.name, done))
+            .collect(),
+        pairs: (pairs.iter().zip(&agree))
+            .map(|(&(a, b), t)| pair_stats(&prepared[a].name, &prepared[b].name, t, done))
+            .collect(),
+        runs: done,
     }
 }
 
 /// One policy's figures of an episode: its outcome, whether the goal was
 /// met, its completion time and its recharge latencies.
 type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
-/// Per episode: its index, its seed and, per pair, whether the behavior
+/// An episode: per policy its figures, per pair whether the behavior
 /// matched.
-type Agree = (u32, u64, Vec<bool>);
-/// What a worker made: (episode, policy, figures), and its episodes'
-/// agreements.
-type Results = (Vec<(u32, usize, Res)>, Vec<Agree>);
+type Episode = (Vec<Res>, Vec<bool>);
 
-/// The episodes of a Monte Carlo run, shared by its worker threads.
-struct Episodes<'a> {
-    s: &'a Scenario,
-    prepared: &'a [Prepared],
-    pairs: &'a [(usize, usize)],
-    runs: u32,
-    seed: u64,
-    threads: usize,
-    deadline: Option<Instant>,
-    /// Set by the first worker whose episode the deadline cut short.
-    stop: &'a AtomicBool,
-}
-
-impl Episodes<'_> {
-    /// Runs the episodes on `threads` threads; per thread what it made.
-    fn run(&self) -> Vec<Results> {
-        let mut per_thread: Vec<Results> = Vec::new();
-        std::thread::scope(|sc| {
-            let mut handles = Vec::new();
-            for t in 0..self.threads {
-                // A thread the system refuses (a limit on processes) does its
-                // share on this one instead: the same episodes, the same figures.
-                match std::thread::Builder::new().spawn_scoped(sc, move || self.work(t)) {
-                    Ok(h) => handles.push(h),
-                    Err(_) => per_thread.push(self.work(t)),
-                }
-            }
-            for h in handles {
-                per_thread.push(h.join().expect("episode thread"));
-            }
-        });
-        per_thread
-    }
-
-    /// One worker's episodes: t, t + threads, ... until the deadline cuts
-    /// one short (dropped, and every worker stops).
-    fn work(&self, t: usize) -> Results {
-        let s = self.s;
-        let mut out = Vec::new();
-        let mut agree = Vec::new();
-        let mut i = t as u32;
-        'episodes: while i < self.runs {
-            if self.stop.load(Ordering::Relaxed) {
-                break;
-            }
-            let ep_seed = episode_seed(self.seed, i);
-            let (ds, rates) = episode(s, ep_seed);
-            let first = out.len();
-            let mut ep_runs = Vec::with_capacity(self.prepared.len());
-            for (k, p) in self.prepared.iter().enumerate() {
-                let r = run_policy(
-                    s,
-                    p,
-                    s.world.clone(),
-                    &ds,
-                    rates.clone(),
-                    ep_seed,
-                    RunOptions {
-                        log: false,
-                        trace: false,
-                        deadline: self.deadline,
-                    },
-                );
-                if cut_short(s, &r) {
-                    self.stop.store(true, Ordering::Relaxed);
-                    out.truncate(first);
-                    break 'episodes;
-                }
-                out.push((
-                    i,
-                    k,
-                    (
-                        r.outcome,
-                        r.goal_met,
-                        r.completion_s,
-                        r.recharge_latency_s.clone(),
-                    ),
-                ));
-                ep_runs.push(r);
-            }
-            let same = (self.pairs.iter())
-                .map(|&(a, b)| behavior_matches(&ep_runs[a], &ep_runs[b]))
-                .collect();
-            agree.push((i, ep_seed, same));
-            i += self.threads as u32;
-        }
-        (out, agree)
-    }
-}
-
-/// The workers' results merged: the episodes that came whole (all
-/// policies), up to the first that did not, ordered by policy then
-/// episode, the agreements by episode; and how many episodes that is.
-fn complete_prefix(
-    per_thread: Vec<Results>,
-    runs: u32,
-) -> (Vec<(u32, usize, Res)>, Vec<Agree>, u32) {
-    let mut all: Vec<(u32, usize, Res)> = Vec::new();
-    let mut agree: Vec<Agree> = Vec::new();
-    for (o, a) in per_thread {
-        all.extend(o);
-        agree.extend(a);
-    }
-    // Episodes come whole (all policies) or not at all: keep the prefix of
-    // consecutive completed ones.
-    let mut complete = vec![false; runs as usize];
-    for (i, _, _) in &all {
-        complete[*i as usize] = true;
-    }
-    let runs = complete.iter().position(|c| !c).unwrap_or(complete.len()) as u32;
-    all.retain(|(i, _, _)| *i < runs);
-    all.sort_by_key(|(i, k, _)| (*k, *i));
-    agree.retain(|(i, _, _)| *i < runs);
-    agree.sort_by_key(|(i, _, _)| *i);
-    (all, agree, runs)
-}
-
-/// Per pair of policies: how often their behavior matched, and the first
-/// episode where it did not.
-fn pair_stats(
+/// Every policy's run of the episode with seed `ep_seed`; `None` when the
+/// deadline cut one short.
+fn one_episode(
+    s: &Scenario,
     prepared: &[Prepared],
     pairs: &[(usize, usize)],
-    agree: &[Agree],
-    runs: u32,
-) -> Vec<PairStats> {
-    (pairs.iter().enumerate())
-        .map(|(x, &(a, b))| {
-            let matches = agree.iter().filter(|e| e.2[x]).count() as u32;
-            PairStats {
-                a: prepared[a].name.clone(),
-                b: prepared[b].name.clone(),
-                runs,
-                matches,
-                match_rate: if runs == 0 {
-                    0.0
-                } else {
-                    round3(matches as f64 / runs as f64)
-                },
-                match_ci95: wilson(matches, runs),
-                first_divergence: (agree.iter().find(|e| !e.2[x])).map(|e| Diverged {
-                    episode: e.0,
-                    seed: e.1,
-                }),
-            }
-        })
-        .collect()
+    ep_seed: u64,
+    deadline: Option<Instant>,
+) -> Option<Episode> {
+    let (ds, rates) = episode(s, ep_seed);
+    let mut runs = Vec::with_capacity(prepared.len());
+    for p in prepared {
+        let options = RunOptions {
+            log: false,
+            trace: false,
+            deadline,
+        };
+        let r = run_policy(s, p, s.world.clone(), &ds, rates.clone(), ep_seed, options);
+        if cut_short(s, &r) {
+            return None;
+        }
+        runs.push(r);
+    }
+    let same = (pairs.iter())
+        .map(|&(a, b)| behavior_matches(&runs[a], &runs[b]))
+        .collect();
+    let figures = (runs.into_iter())
+        .map(|r| (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s))
+        .collect();
+    Some((figures, same))
 }
 
-/// Per policy: its figures over the episodes (`all`, ordered by policy).
-fn policy_stats(prepared: &[Prepared], all: &[(u32, usize, Res)], runs: u32) -> Vec<McStats> {
-    prepared
-        .iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let mine: Vec<&Res> = all
-                .iter()
-                .filter(|(_, kk, _)| *kk == k)
-                .map(|(_, _, r)| r)
-                .collect();
-            let ok: Vec<&&Res> = mine
-                .iter()
-                .filter(|r| r.0 == Outcome::Success && r.1 != Some(false))
-                .collect();
-            let mut comp: Vec<f64> = ok.iter().filter_map(|r| r.2).collect();
-            let lat: Vec<f64> = mine.iter().flat_map(|r| r.3.iter().copied()).collect();
-            let mean =
-                |v: &[f64]| (!v.is_empty()).then(|| round3(v.iter().sum::<f64>() / v.len() as f64));
-            let count = |o: Outcome| mine.iter().filter(|r| r.0 == o).count() as u32;
-            McStats {
-                policy: p.name.clone(),
-                runs,
-                successes: ok.len() as u32,
-                success_rate: if runs == 0 {
-                    0.0
-                } else {
-                    round3(ok.len() as f64 / runs as f64)
-                },
-                chattering: count(Outcome::Chattering),
-                timeouts: count(Outcome::Timeout),
-                failures: runs
-                    - ok.len() as u32
-                    - count(Outcome::Chattering)
-                    - count(Outcome::Timeout),
-                success_ci95: wilson(ok.len() as u32, runs),
-                // The mean before the quantiles, which sort `comp`.
-                mean_completion_s: mean(&comp),
-                completion_quantiles_s: quantiles(&mut comp),
-                mean_recharge_latency_s: mean(&lat),
-                recharges: lat.len() as u32,
+/// A policy's figures folded over the episodes, in episode order: counts,
+/// sums, and the completion times as a histogram of their (rounded)
+/// values, which are at most a scenario's steps apart, so that the
+/// quantiles are exact in memory independent of the episodes.
+#[derive(Debug, Default)]
+struct PolicyTally {
+    successes: u32,
+    chattering: u32,
+    timeouts: u32,
+    completion_sum: f64,
+    completions: BTreeMap<TotalF64, u32>,
+    latency_sum: f64,
+    latencies: u32,
+}
+
+/// An `f64` ordered by `total_cmp`, as a map key.
+#[derive(Debug, Clone, Copy)]
+struct TotalF64(f64);
+
+impl PartialEq for TotalF64 {
+    fn eq(&self, o: &Self) -> bool {
+        self.0.total_cmp(&o.0).is_eq()
+    }
+}
+impl Eq for TotalF64 {}
+impl PartialOrd for TotalF64 {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for TotalF64 {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
+
+impl PolicyTally {
+    fn fold(&mut self, (outcome, goal_met, completion, latencies): Res) {
+        match outcome {
+            Outcome::Success if goal_met != Some(false) => {
+                self.successes += 1;
+                if let Some(c) = completion {
+                    self.completion_sum += c;
+                    *self.completions.entry(TotalF64(c)).or_insert(0) += 1;
+                }
             }
-        })
-        .collect()
+            Outcome::Chattering => self.chattering += 1,
+            Outcome::Timeout => self.timeouts += 1,
+            _ => {}
+        }
+        for l in latencies {
+            self.latency_sum += l;
+            self.latencies += 1;
+        }
+    }
+
+    /// Nearest-rank quantiles 10 %, 50 %, 90 % of the completion times.
+    fn quantiles(&self) -> Option<[f64; 3]> {
+        let n: u32 = self.completions.values().sum();
+        if n == 0 {
+            return None;
+        }
+        let q = |p: f64| {
+            let rank = ((p * f64::from(n)).ceil() as u32).clamp(1, n);
+            let mut below = 0;
+            for (v, k) in &self.completions {
+                below += k;
+                if below >= rank {
+                    return v.0;
+                }
+            }
+            unreachable!("the ranks are at most the count")
+        };
+        Some([q(0.1), q(0.5), q(0.9)])
+    }
+
+    fn stats(&self, policy: &str, runs: u32) -> McStats {
+        let n_comp: u32 = self.completions.values().sum();
+        let mean = |sum: f64, n: u32| (n > 0).then(|| round3(sum / f64::from(n)));
+        McStats {
+            policy: policy.to_string(),
+            runs,
+            successes: self.successes,
+            success_rate: rate(self.successes, runs),
+            chattering: self.chattering,
+            timeouts: self.timeouts,
+            failures: runs - self.successes - self.chattering - self.timeouts,
+            success_ci95: wilson(self.successes, runs),
+            mean_completion_s: mean(self.completion_sum, n_comp),
+            completion_quantiles_s: self.quantiles(),
+            mean_recharge_latency_s: mean(self.latency_sum, self.latencies),
+            recharges: self.latencies,
+        }
+    }
+}
+
+/// `k / n` to 3 decimals (0 when `n` is 0).
+fn rate(k: u32, n: u32) -> f64 {
+    if n == 0 {
+        0.0
+    } else {
+        round3(f64::from(k) / f64::from(n))
+    }
+}
+
+/// A pair's figures: how often their behavior matched, and the first
+/// episode where it did not.
+fn pair_stats(a: &str, b: &str, t: &PairTally, runs: u32) -> PairStats {
+    PairStats {
+        a: a.to_string(),
+        b: b.to_string(),
+        runs,
+        matches: t.matches,
+        match_rate: rate(t.matches, runs),
+        match_ci95: wilson(t.matches, runs),
+        first_divergence: t
+            .first_divergence
+            .map(|(episode, seed)| Diverged { episode, seed }),
+    }
 }

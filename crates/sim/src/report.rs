@@ -6,6 +6,7 @@
 use super::monte_carlo::{McStats, PairStats};
 use super::scenario::expect::{ExpectResult, Status};
 use super::trace::{FRECHET_POINTS, Run, Verdict, verdicts_within};
+use btfsm_core::output::{Format, Report};
 use btfsm_core::table::Table;
 use serde::Serialize;
 
@@ -388,6 +389,32 @@ impl McReport {
             out.push_str(&table(md, &head, rows));
         }
         out
+    }
+}
+
+impl Report for SimReport {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json, Format::Csv];
+
+    fn write(&self, format: Format) -> String {
+        match Self::supported(format) {
+            Format::Json => self.json(),
+            Format::Csv => self.csv(),
+            _ => self.table(),
+        }
+    }
+}
+
+impl Report for McReport {
+    const FORMATS: &'static [Format] =
+        &[Format::Table, Format::Json, Format::Markdown, Format::Csv];
+
+    fn write(&self, format: Format) -> String {
+        match Self::supported(format) {
+            Format::Json => self.json(),
+            Format::Csv => self.csv(),
+            Format::Markdown => self.markdown(),
+            _ => self.table(),
+        }
     }
 }
 

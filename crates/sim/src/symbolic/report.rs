@@ -1,178 +1,200 @@
 //! The table and JSON of a symbolic `sim` (one run per policy, or Monte
 //! Carlo), with the pairwise verdicts.
 
-use super::run::{McPair, McPolicy, SymRun, first_difference};
+use super::run::{McPair, McPolicy, McResult, SymRun, first_difference};
 use super::scenario::SymScenario;
+use btfsm_core::output::{Format, Report};
 use btfsm_core::sanitize::shown;
 use btfsm_core::table::Table;
 
-/// One run per policy: outcomes, steps, actions, and per pair whether the
-/// runs match (else the first differing action).
-pub fn render_runs(s: &SymScenario, runs: &[SymRun], json: bool) -> String {
-    let pairs: Vec<(usize, usize, Option<usize>)> = (0..runs.len())
-        .flat_map(|a| (a + 1..runs.len()).map(move |b| (a, b)))
-        .map(|(a, b)| (a, b, first_difference(&runs[a], &runs[b])))
-        .collect();
-    if json {
-        #[derive(serde::Serialize)]
-        struct Pair<'a> {
-            a: &'a str,
-            b: &'a str,
-            matches: bool,
-            first_difference: Option<usize>,
-        }
-        #[derive(serde::Serialize)]
-        struct Out<'a> {
-            scenario: &'a str,
-            domain: &'a str,
-            goal: Vec<String>,
-            runs: &'a [SymRun],
-            pairs: Vec<Pair<'a>>,
-        }
-        let out = Out {
-            scenario: &s.name,
-            domain: &s.domain.name,
-            goal: s.goal.iter().map(ToString::to_string).collect(),
-            runs,
-            pairs: pairs
-                .iter()
-                .map(|&(a, b, d)| Pair {
+/// A pair's verdict of one run per policy.
+#[derive(Debug, serde::Serialize)]
+pub struct PairVerdict<'a> {
+    pub a: &'a str,
+    pub b: &'a str,
+    pub matches: bool,
+    /// The index of the first action that differs.
+    pub first_difference: Option<usize>,
+}
+
+/// What a symbolic `sim` prints for one run per policy: outcomes, steps,
+/// actions, and per pair whether the runs match (else the first differing
+/// action).
+#[derive(Debug, serde::Serialize)]
+pub struct RunsReport<'a> {
+    pub scenario: &'a str,
+    pub domain: &'a str,
+    pub goal: Vec<String>,
+    pub runs: &'a [SymRun],
+    pub pairs: Vec<PairVerdict<'a>>,
+}
+
+impl<'a> RunsReport<'a> {
+    pub fn new(s: &'a SymScenario, runs: &'a [SymRun]) -> Self {
+        let pairs = (0..runs.len())
+            .flat_map(|a| (a + 1..runs.len()).map(move |b| (a, b)))
+            .map(|(a, b)| {
+                let d = first_difference(&runs[a], &runs[b]);
+                PairVerdict {
                     a: &runs[a].policy,
                     b: &runs[b].policy,
                     matches: d.is_none(),
                     first_difference: d,
-                })
-                .collect(),
-        };
-        let mut t =
-            btfsm_core::sanitize::json(serde_json::to_string_pretty(&out).expect("serializable"));
-        t.push('\n');
-        return t;
+                }
+            })
+            .collect();
+        RunsReport {
+            scenario: &s.name,
+            domain: &s.domain.name,
+            goal: s.goal.iter().map(ToString::to_string).collect(),
+            runs,
+            pairs,
+        }
     }
-    let mut out = format!(
-        "scenario `{}` (symbolic, domain `{}`): goal {}\n\n",
-        shown(&s.name),
-        shown(&s.domain.name),
-        shown(
-            &s.goal
-                .iter()
-                .map(ToString::to_string)
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    );
-    let mut t = Table::new(&["policy", "outcome", "steps", "actions (succeeded / failed)"]);
-    for r in runs {
-        let ok = r.actions.iter().filter(|a| a.2).count();
-        t.row(vec![
-            shown(&r.policy).into_owned(),
-            r.outcome.as_str().to_string(),
-            r.steps.to_string(),
-            format!("{ok} / {}", r.actions.len() - ok),
-        ]);
-    }
-    out.push_str(&t.render());
-    for r in runs {
-        out.push_str(&format!(
-            "\n{}: {}\n",
-            shown(&r.policy),
-            shown(&r.effective().join(", "))
-        ));
-    }
-    if !pairs.is_empty() {
-        out.push('\n');
-        let mut t = Table::new(&["pair", "verdict"]);
-        for (a, b, d) in pairs {
-            let v = match d {
-                None => "match".to_string(),
-                Some(i) => format!("differ from action {}", i + 1),
-            };
+
+    fn table(&self) -> String {
+        let mut out = format!(
+            "scenario `{}` (symbolic, domain `{}`): goal {}\n\n",
+            shown(self.scenario),
+            shown(self.domain),
+            shown(&self.goal.join(", "))
+        );
+        let mut t = Table::new(&["policy", "outcome", "steps", "actions (succeeded / failed)"]);
+        for r in self.runs {
+            let ok = r.actions.iter().filter(|a| a.2).count();
             t.row(vec![
-                format!("{} vs {}", shown(&runs[a].policy), shown(&runs[b].policy)),
-                v,
+                shown(&r.policy).into_owned(),
+                r.outcome.as_str().to_string(),
+                r.steps.to_string(),
+                format!("{ok} / {}", r.actions.len() - ok),
             ]);
         }
         out.push_str(&t.render());
+        for r in self.runs {
+            out.push_str(&format!(
+                "\n{}: {}\n",
+                shown(&r.policy),
+                shown(&r.effective().join(", "))
+            ));
+        }
+        if !self.pairs.is_empty() {
+            out.push('\n');
+            let mut t = Table::new(&["pair", "verdict"]);
+            for p in &self.pairs {
+                let v = match p.first_difference {
+                    None => "match".to_string(),
+                    Some(i) => format!("differ from action {}", i + 1),
+                };
+                t.row(vec![format!("{} vs {}", shown(p.a), shown(p.b)), v]);
+            }
+            out.push_str(&t.render());
+        }
+        out
     }
-    out
 }
 
-/// Monte Carlo figures per policy and pair.
-pub fn render_mc(
-    s: &SymScenario,
-    runs: u32,
-    seed: u64,
-    policies: &[McPolicy],
-    pairs: &[McPair],
-    json: bool,
-) -> String {
-    if json {
-        #[derive(serde::Serialize)]
-        struct Out<'a> {
-            scenario: &'a str,
-            domain: &'a str,
-            seed: u64,
-            runs: u32,
-            policies: &'a [McPolicy],
-            pairs: &'a [McPair],
+impl Report for RunsReport<'_> {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json];
+
+    fn write(&self, format: Format) -> String {
+        match Self::supported(format) {
+            Format::Json => json(self),
+            _ => self.table(),
         }
-        let out = Out {
+    }
+}
+
+/// What a symbolic `sim --runs N` prints: Monte Carlo figures per policy
+/// and pair.
+#[derive(Debug, serde::Serialize)]
+pub struct McReport<'a> {
+    pub scenario: &'a str,
+    pub domain: &'a str,
+    pub seed: u64,
+    /// Episodes the figures cover.
+    pub runs: u32,
+    pub policies: &'a [McPolicy],
+    pub pairs: &'a [McPair],
+}
+
+impl<'a> McReport<'a> {
+    pub fn new(s: &'a SymScenario, seed: u64, mc: &'a McResult) -> Self {
+        McReport {
             scenario: &s.name,
             domain: &s.domain.name,
             seed,
-            runs,
-            policies,
-            pairs,
-        };
-        let mut t =
-            btfsm_core::sanitize::json(serde_json::to_string_pretty(&out).expect("serializable"));
-        t.push('\n');
-        return t;
+            runs: mc.runs,
+            policies: &mc.policies,
+            pairs: &mc.pairs,
+        }
     }
-    let mut out = format!(
-        "scenario `{}` (symbolic, domain `{}`): {runs} episodes (seed {seed})\n\n",
-        shown(&s.name),
-        shown(&s.domain.name)
-    );
-    let mut t = Table::new(&[
-        "policy",
-        "success rate",
-        "95% CI",
-        "failures",
-        "chattering",
-        "timeouts",
-    ]);
-    for p in policies {
-        t.row(vec![
-            shown(&p.policy).into_owned(),
-            format!("{:.3}", p.success_rate),
-            format!("[{:.4}, {:.4}]", p.success_ci95[0], p.success_ci95[1]),
-            p.failures.to_string(),
-            p.chattering.to_string(),
-            p.timeouts.to_string(),
-        ]);
-    }
-    out.push_str(&t.render());
-    if !pairs.is_empty() {
-        out.push('\n');
+
+    fn table(&self) -> String {
+        let mut out = format!(
+            "scenario `{}` (symbolic, domain `{}`): {} episodes (seed {})\n\n",
+            shown(self.scenario),
+            shown(self.domain),
+            self.runs,
+            self.seed
+        );
         let mut t = Table::new(&[
-            "pair",
-            "behavior match rate",
+            "policy",
+            "success rate",
             "95% CI",
-            "first diverging episode (seed)",
+            "failures",
+            "chattering",
+            "timeouts",
         ]);
-        for p in pairs {
+        for p in self.policies {
             t.row(vec![
-                format!("{} vs {}", shown(&p.a), shown(&p.b)),
-                format!("{:.3}", p.match_rate),
-                format!("[{:.4}, {:.4}]", p.match_ci95[0], p.match_ci95[1]),
-                match p.first_diverging {
-                    Some((e, sd)) => format!("{e} (--seed {sd})"),
-                    None => "-".into(),
-                },
+                shown(&p.policy).into_owned(),
+                format!("{:.3}", p.success_rate),
+                format!("[{:.4}, {:.4}]", p.success_ci95[0], p.success_ci95[1]),
+                p.failures.to_string(),
+                p.chattering.to_string(),
+                p.timeouts.to_string(),
             ]);
         }
         out.push_str(&t.render());
+        if !self.pairs.is_empty() {
+            out.push('\n');
+            let mut t = Table::new(&[
+                "pair",
+                "behavior match rate",
+                "95% CI",
+                "first diverging episode (seed)",
+            ]);
+            for p in self.pairs {
+                t.row(vec![
+                    format!("{} vs {}", shown(&p.a), shown(&p.b)),
+                    format!("{:.3}", p.match_rate),
+                    format!("[{:.4}, {:.4}]", p.match_ci95[0], p.match_ci95[1]),
+                    match p.first_diverging {
+                        Some((e, sd)) => format!("{e} (--seed {sd})"),
+                        None => "-".into(),
+                    },
+                ]);
+            }
+            out.push_str(&t.render());
+        }
+        out
     }
-    out
+}
+
+impl Report for McReport<'_> {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json];
+
+    fn write(&self, format: Format) -> String {
+        match Self::supported(format) {
+            Format::Json => json(self),
+            _ => self.table(),
+        }
+    }
+}
+
+/// Pretty JSON, sanitised, with a final newline.
+fn json<T: serde::Serialize>(v: &T) -> String {
+    let mut t = btfsm_core::sanitize::json(serde_json::to_string_pretty(v).expect("serializable"));
+    t.push('\n');
+    t
 }

@@ -8,21 +8,28 @@
 //! without a new goal fact; `chattering` when a state of the world (facts
 //! and running actions) recurs `livelock_repeats` times without a new goal
 //! fact (a disturbance or a failed action starts the count again: a retry
-//! is not a livelock); `timeout` at `max_steps`. A BT that fails is ticked again at the
+//! is not a livelock; the one detector of `crate::livelock`, as in the
+//! planar simulator, which remembers at most 4096 states between two
+//! progresses); `timeout` at `max_steps` or when `--timeout-ms` runs out
+//! (the run is then `cut_short`). A BT that fails is ticked again at the
 //! next step (a task retried), as the planar simulator does by default.
+//! Monte Carlo runs its episodes through `crate::episodes`, the contract
+//! both simulators share (threads, deadline, order, bounded memory).
 //!
 //! Two runs *match* when their outcomes and their sequences of actions that
 //! succeeded (what the robot did to the world) are the same.
 
 use super::scenario::{Disturbance, SymScenario};
 use super::world::World;
+use crate::episodes::{self, Budget, PairTally};
 use crate::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
-use crate::monte_carlo::{episode_seed, wilson};
+use crate::livelock::Livelock;
+use crate::monte_carlo::wilson;
 use crate::rng::SimRng;
 use crate::skills::Status;
 use btfsm_model::PolicyBody;
-use std::collections::HashMap;
 use std::sync::Arc;
+use std::time::Instant;
 
 pub use crate::trace::Outcome;
 
@@ -34,6 +41,10 @@ pub struct SymRun {
     pub steps: u64,
     /// Actions finished: `Name(args)` and whether it succeeded, by step.
     pub actions: Vec<(u64, String, bool)>,
+    /// Whether the wall-clock deadline cut the run short (its outcome is
+    /// then `timeout` at the step reached).
+    #[serde(skip)]
+    pub cut_short: bool,
 }
 
 impl SymRun {
@@ -59,25 +70,36 @@ pub fn first_difference(a: &SymRun, b: &SymRun) -> Option<usize> {
     }
 }
 
-/// The facts that hold and the running actions (leaf, steps left).
-type WorldState = (Vec<btfsm_plan::fact::Fact>, Vec<(usize, u32)>);
-
 enum Exec {
     Bt(BtExec),
     Machine(MachineExec),
 }
 
-/// Runs policy `i` of the scenario with these disturbances and rates.
-pub fn run_policy(
-    s: &SymScenario,
-    i: usize,
-    disturbances: &[Disturbance],
-    rates: &std::collections::BTreeMap<String, f64>,
-    seed: u64,
-) -> SymRun {
-    let (_, policy) = &s.policies[i];
-    let mut w = World::new(&s.domain, &s.facts, &s.durations, rates.clone(), seed);
-    let mut exec = match &policy.body {
+/// The state of the world livelock detection compares, hashed: the facts
+/// that hold and the running actions (leaf, steps left).
+fn world_state(w: &World) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::hash::DefaultHasher::new();
+    for f in &w.facts {
+        f.hash(&mut h);
+    }
+    w.running_keys().hash(&mut h);
+    h.finish()
+}
+
+/// Steps between two clock readings under a deadline: about every 64k
+/// node ticks, at most [`crate::run::CLOCK_EVERY`].
+fn clock_every(policy: &btfsm_model::Policy) -> u64 {
+    let work = match &policy.body {
+        PolicyBody::Bt(bt) => bt.nodes.len(),
+        PolicyBody::Machine(m) => m.states.len(),
+    };
+    (65_536 / work.max(1) as u64).clamp(1, crate::run::CLOCK_EVERY)
+}
+
+/// The executor of policy `i` of the scenario, its leaves bound in `w`.
+fn executor(s: &SymScenario, i: usize, w: &mut World) -> Exec {
+    match &s.policies[i].1.body {
         PolicyBody::Bt(bt) => {
             let calls = bt
                 .nodes
@@ -91,20 +113,42 @@ pub fn run_policy(
                 .expect("infallible: every binding checked when the scenario was read");
             Exec::Machine(MachineExec::new(Arc::new(cm), false))
         }
-    };
+    }
+}
+
+/// Runs policy `i` of the scenario with these disturbances and rates,
+/// until its verdict, `max_steps`, or the deadline (read every
+/// [`clock_every`] steps; the run is then `timeout` and `cut_short`).
+pub fn run_policy(
+    s: &SymScenario,
+    i: usize,
+    disturbances: &[Disturbance],
+    rates: &std::collections::BTreeMap<String, f64>,
+    seed: u64,
+    deadline: Option<Instant>,
+) -> SymRun {
+    let (_, policy) = &s.policies[i];
+    let mut w = World::new(&s.domain, &s.facts, &s.durations, rates.clone(), seed);
+    let mut exec = executor(s, i, &mut w);
+    let every = clock_every(policy);
     let goal_held = |w: &World| s.goal.iter().filter(|f| w.facts.contains(f)).count();
     let mut best = goal_held(&w);
-    let mut seen: HashMap<WorldState, u32> = HashMap::new();
-    let mut failures = 0u32;
-    let mut finished = 0usize;
-    let mut outcome = Outcome::Timeout;
-    let mut steps = 0;
+    // The one livelock detector of both simulators: every step's state is
+    // counted (`fresh`), and progress is a new most goal facts held.
+    let mut livelock = Livelock::new(s.livelock_repeats);
+    let (mut failures, mut finished) = (0u32, 0usize);
+    let (mut outcome, mut steps, mut cut_short) = (Outcome::Timeout, 0, false);
     while steps < s.max_steps {
+        if deadline.is_some_and(|d| steps % every == 0 && Instant::now() >= d) {
+            cut_short = true;
+            break;
+        }
         w.step = steps;
+        // The world changed from outside: states seen before are no
+        // evidence of a livelock.
+        let mut disturbed = false;
         for d in disturbances.iter().filter(|d| d.at == steps) {
-            // The world changed from outside: states seen before are no
-            // evidence of a livelock.
-            seen.clear();
+            disturbed = true;
             for f in &d.unset {
                 w.facts.remove(f);
             }
@@ -120,14 +164,11 @@ pub fn run_policy(
         let held = goal_held(&w);
         if held > best {
             best = held;
-            seen.clear();
             failures = 0;
         }
         // A failed action is a retry, not a recurring state.
         if w.done.len() > finished {
-            if w.done[finished..].iter().any(|a| !a.2) {
-                seen.clear();
-            }
+            disturbed |= w.done[finished..].iter().any(|a| !a.2);
             finished = w.done.len();
         }
         match status {
@@ -148,10 +189,10 @@ pub fn run_policy(
             }
             Status::Running => failures = 0,
         }
-        let key = (w.facts.iter().cloned().collect(), w.running_keys());
-        let n = seen.entry(key).or_insert(0);
-        *n += 1;
-        if *n >= s.livelock_repeats {
+        if livelock
+            .step(world_state(&w), true, best, disturbed)
+            .is_some()
+        {
             outcome = Outcome::Chattering;
             break;
         }
@@ -161,15 +202,52 @@ pub fn run_policy(
         outcome,
         steps,
         actions: w.done,
+        cut_short,
     }
 }
 
 /// Every policy once, with the scenario's disturbances and rates (action
-/// failures drawn with `seed`).
-pub fn run_all(s: &SymScenario, seed: u64) -> Vec<SymRun> {
+/// failures drawn with the scenario's seed); with `seed`, the episode of
+/// that seed as `--runs` draws it ([`episode`]), so that the seed a Monte
+/// Carlo report names replays its episode.
+pub fn run_all(s: &SymScenario, seed: Option<u64>, deadline: Option<Instant>) -> Vec<SymRun> {
+    let (ds, rates, seed) = match seed {
+        Some(seed) => {
+            let (ds, rates) = episode(s, seed);
+            (ds, rates, seed)
+        }
+        None => (s.disturbances.clone(), s.rates.clone(), s.seed),
+    };
     (0..s.policies.len())
-        .map(|i| run_policy(s, i, &s.disturbances, &s.rates, seed))
+        .map(|i| run_policy(s, i, &ds, &rates, seed, deadline))
         .collect()
+}
+
+/// The disturbances and failure rates of the episode with seed `ep_seed`:
+/// the scenario's disturbances, plus (with the `[monte_carlo]` table's
+/// probability) one of its facts made false at a step drawn in its range;
+/// the scenario's rates with the table's on top.
+pub fn episode(
+    s: &SymScenario,
+    ep_seed: u64,
+) -> (Vec<Disturbance>, std::collections::BTreeMap<String, f64>) {
+    let mut rates = s.rates.clone();
+    rates.extend(s.mc.rates.clone());
+    let mut rng = SimRng::named(ep_seed, "symbolic-disturbances");
+    let mut dist = s.disturbances.clone();
+    if let Some((p, facts, [lo, hi])) = &s.mc.unset
+        && !facts.is_empty()
+        && rng.chance(*p)
+    {
+        let at = lo + rng.next_u64() % (hi - lo + 1);
+        let f = facts[(rng.next_u64() % facts.len() as u64) as usize].clone();
+        dist.push(Disturbance {
+            at,
+            set: Vec::new(),
+            unset: vec![f],
+        });
+    }
+    (dist, rates)
 }
 
 /// One policy's Monte Carlo figures.
@@ -196,77 +274,86 @@ pub struct McPair {
     pub first_diverging: Option<(u32, u64)>,
 }
 
-/// Monte Carlo: `runs` episodes; in each, every policy meets the same
-/// disturbances (the scenario's, plus the sampled fact made false) and the
-/// same failure rates, with the same seed.
-pub fn monte_carlo(s: &SymScenario, runs: u32, seed: u64) -> (Vec<McPolicy>, Vec<McPair>) {
+/// What `--runs N` of a symbolic scenario computes.
+#[derive(Debug, Clone)]
+pub struct McResult {
+    pub policies: Vec<McPolicy>,
+    pub pairs: Vec<McPair>,
+    /// Episodes the figures cover (all asked for, unless the deadline
+    /// passed: then the first that completed).
+    pub runs: u32,
+}
+
+/// Monte Carlo: the episodes of `budget`; in each, every policy meets the
+/// same disturbances (the scenario's, plus the sampled fact made false) and
+/// the same failure rates, with the same seed. Episodes go through the one
+/// contract of [`crate::episodes`] (threads, deadline, in-order folding in
+/// memory bounded by the threads), as the planar simulator's do.
+pub fn monte_carlo(s: &SymScenario, budget: &Budget) -> McResult {
     let n = s.policies.len();
-    let mut out: Vec<Vec<SymRun>> = vec![Vec::new(); n];
-    let mut seeds = Vec::new();
-    let mut rates = s.rates.clone();
-    rates.extend(s.mc.rates.clone());
-    for e in 0..runs {
-        let es = episode_seed(seed, e);
-        seeds.push(es);
-        let mut rng = SimRng::named(es, "symbolic-disturbances");
-        let mut dist = s.disturbances.clone();
-        if let Some((p, facts, [lo, hi])) = &s.mc.unset
-            && !facts.is_empty()
-            && rng.chance(*p)
-        {
-            let at = lo + rng.next_u64() % (hi - lo + 1);
-            let f = facts[(rng.next_u64() % facts.len() as u64) as usize].clone();
-            dist.push(Disturbance {
-                at,
-                set: Vec::new(),
-                unset: vec![f],
-            });
+    let pairs = episodes::pairs(n);
+    let mut counts = vec![[0u32; 4]; n];
+    let mut agree = vec![PairTally::default(); pairs.len()];
+    let done = episodes::stream(
+        budget,
+        |_, es| {
+            let (dist, rates) = episode(s, es);
+            let mut runs = Vec::with_capacity(n);
+            for i in 0..n {
+                let r = run_policy(s, i, &dist, &rates, es, budget.deadline);
+                if r.cut_short {
+                    return None;
+                }
+                runs.push(r);
+            }
+            let same: Vec<bool> = (pairs.iter())
+                .map(|&(a, b)| first_difference(&runs[a], &runs[b]).is_none())
+                .collect();
+            Some((runs.iter().map(|r| r.outcome).collect::<Vec<_>>(), same))
+        },
+        |e, es, (outcomes, same)| {
+            for (c, o) in counts.iter_mut().zip(outcomes) {
+                c[o as usize] += 1;
+            }
+            for (t, m) in agree.iter_mut().zip(same) {
+                t.fold(e, es, m);
+            }
+        },
+    );
+    let rate = |k: u32| {
+        if done == 0 {
+            0.0
+        } else {
+            f64::from(k) / f64::from(done)
         }
-        for (i, runs_i) in out.iter_mut().enumerate() {
-            runs_i.push(run_policy(s, i, &dist, &rates, es));
-        }
-    }
-    let policies = out
-        .iter()
-        .enumerate()
-        .map(|(i, rs)| {
-            let count = |o: Outcome| rs.iter().filter(|r| r.outcome == o).count() as u32;
-            let k = count(Outcome::Success);
+    };
+    let policies = (s.policies.iter().zip(&counts))
+        .map(|((_, p), c)| {
+            let k = c[Outcome::Success as usize];
             McPolicy {
-                policy: s.policies[i].1.name.clone(),
-                runs,
+                policy: p.name.clone(),
+                runs: done,
                 successes: k,
-                success_rate: if runs == 0 {
-                    0.0
-                } else {
-                    f64::from(k) / f64::from(runs)
-                },
-                success_ci95: wilson(k, runs),
-                failures: count(Outcome::Failure),
-                chattering: count(Outcome::Chattering),
-                timeouts: count(Outcome::Timeout),
+                success_rate: rate(k),
+                success_ci95: wilson(k, done),
+                failures: c[Outcome::Failure as usize],
+                chattering: c[Outcome::Chattering as usize],
+                timeouts: c[Outcome::Timeout as usize],
             }
         })
         .collect();
-    let mut pairs = Vec::new();
-    for a in 0..n {
-        for b in a + 1..n {
-            let same: Vec<bool> = (0..runs as usize)
-                .map(|e| first_difference(&out[a][e], &out[b][e]).is_none())
-                .collect();
-            let k = same.iter().filter(|x| **x).count() as u32;
-            pairs.push(McPair {
-                a: s.policies[a].1.name.clone(),
-                b: s.policies[b].1.name.clone(),
-                match_rate: if runs == 0 {
-                    0.0
-                } else {
-                    f64::from(k) / f64::from(runs)
-                },
-                match_ci95: wilson(k, runs),
-                first_diverging: same.iter().position(|x| !x).map(|e| (e as u32, seeds[e])),
-            });
-        }
+    let pairs = (pairs.iter().zip(&agree))
+        .map(|(&(a, b), t)| McPair {
+            a: s.policies[a].1.name.clone(),
+            b: s.policies[b].1.name.clone(),
+            match_rate: rate(t.matches),
+            match_ci95: wilson(t.matches, done),
+            first_diverging: t.first_divergence,
+        })
+        .collect();
+    McResult {
+        policies,
+        pairs,
+        runs: done,
     }
-    (policies, pairs)
 }

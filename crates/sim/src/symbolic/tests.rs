@@ -2,6 +2,7 @@
 
 use super::run::{self, Outcome};
 use super::scenario::parse;
+use crate::episodes::Budget;
 use btfsm_core::diagnostic::SourceFile;
 use std::path::Path;
 
@@ -32,7 +33,7 @@ fn fig_1_and_fig_4_deliver_and_fig_3_chatters() {
         "{HEAD}{}",
         policies(&["fig01-bt", "fig04-fsm", "fig03-bt"])
     ));
-    let runs = run::run_all(&s, 0);
+    let runs = run::run_all(&s, None, None);
     let outcomes: Vec<Outcome> = runs.iter().map(|r| r.outcome).collect();
     assert_eq!(
         outcomes,
@@ -62,7 +63,7 @@ fn a_dropped_cube_is_recovered_by_the_reactive_policies_only() {
         "{HEAD}{}[[disturbances]]\nat = 4\nunset = [\"In-Hand(cube2)\"]\n",
         policies(&["fig01-bt", "fig04-fsm", "fig02-fsm"])
     ));
-    let runs = run::run_all(&s, 0);
+    let runs = run::run_all(&s, None, None);
     let outcomes: Vec<Outcome> = runs.iter().map(|r| r.outcome).collect();
     assert_eq!(
         outcomes,
@@ -76,20 +77,76 @@ fn a_dropped_cube_is_recovered_by_the_reactive_policies_only() {
     );
 }
 
+fn budget(runs: u32, seed: u64, threads: usize) -> Budget {
+    Budget {
+        runs,
+        seed,
+        threads,
+        deadline: None,
+    }
+}
+
+const MC: &str = "[monte_carlo]\nrates = { Pick = 0.3 }\nunset = { probability = 0.5, facts = [\"In-Hand(cube2)\"], window = [1, 12] }\n";
+
 #[test]
 fn monte_carlo_is_reproducible_and_counts_every_episode() {
     let s = scenario(&format!(
-        "{HEAD}{}[monte_carlo]\nrates = {{ Pick = 0.3 }}\nunset = {{ probability = 0.5, facts = [\"In-Hand(cube2)\"], window = [1, 12] }}\n",
+        "{HEAD}{}{MC}",
         policies(&["fig01-bt", "fig02-fsm"])
     ));
-    let (a, pa) = run::monte_carlo(&s, 200, 9);
-    let (b, pb) = run::monte_carlo(&s, 200, 9);
-    assert_eq!(format!("{a:?}{pa:?}"), format!("{b:?}{pb:?}"));
-    for p in &a {
+    let a = run::monte_carlo(&s, &budget(200, 9, 1));
+    let b = run::monte_carlo(&s, &budget(200, 9, 3));
+    assert_eq!(format!("{a:?}"), format!("{b:?}"), "1 thread and 3 alike");
+    assert_eq!(a.runs, 200);
+    for p in &a.policies {
         assert_eq!(p.successes + p.failures + p.chattering + p.timeouts, 200);
     }
-    assert_eq!(a[0].success_rate, 1.0, "the BT retries and recovers");
-    assert!(a[1].success_rate < 0.8, "the sequential FSM cannot: {a:?}");
+    assert_eq!(
+        a.policies[0].success_rate, 1.0,
+        "the BT retries and recovers"
+    );
+    assert!(
+        a.policies[1].success_rate < 0.8,
+        "the sequential FSM cannot: {a:?}"
+    );
+}
+
+#[test]
+fn the_seed_of_a_diverging_episode_replays_it() {
+    let s = scenario(&format!(
+        "{HEAD}{}{MC}",
+        policies(&["fig01-bt", "fig02-fsm"])
+    ));
+    let mc = run::monte_carlo(&s, &budget(50, 9, 2));
+    let (_, seed) = mc.pairs[0]
+        .first_diverging
+        .expect("the FSM fails somewhere");
+    let runs = run::run_all(&s, Some(seed), None);
+    assert!(
+        run::first_difference(&runs[0], &runs[1]).is_some(),
+        "episode seed {seed} replayed alike: {runs:?}"
+    );
+}
+
+#[test]
+fn a_deadline_stops_monte_carlo_at_the_episodes_completed() {
+    let s = scenario(&format!(
+        "{HEAD}{}{MC}",
+        policies(&["fig01-bt", "fig02-fsm"])
+    ));
+    let past = Budget {
+        deadline: Some(std::time::Instant::now()),
+        ..budget(1_000_000, 9, 2)
+    };
+    let mc = run::monte_carlo(&s, &past);
+    assert_eq!(mc.runs, 0);
+    assert!(mc.policies.iter().all(|p| p.runs == 0 && p.successes == 0));
+    // A run cut short by the deadline says so, as `timeout`.
+    let cut = run::run_all(&s, None, Some(std::time::Instant::now()));
+    assert!(
+        cut.iter()
+            .all(|r| r.cut_short && r.outcome == Outcome::Timeout && r.steps == 0)
+    );
 }
 
 #[test]
