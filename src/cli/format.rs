@@ -26,9 +26,6 @@ pub(crate) fn parser(
     .map(|name| Format::from_name(&name).unwrap_or(Format::Table))
 }
 
-/// Figures: `plan`.
-pub(crate) const FIGURES: &[Format] = &[Format::Table, Format::Json, Format::Csv];
-
 /// Comparisons: `compare` and `log compare`.
 pub(crate) const COMPARISON: &[Format] = &[Format::Table, Format::Json, Format::Markdown];
 

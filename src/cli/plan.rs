@@ -7,7 +7,7 @@
 use super::io::{emit_text, fail, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
-use btfsm_core::output::Format;
+use btfsm_core::output::{Format, Report};
 use btfsm_format::{Limits, Loaded};
 use btfsm_model::{Policy, PolicyBody};
 use btfsm_plan::{self as plan, Options};
@@ -54,7 +54,7 @@ pub(crate) struct PlanArgs {
     pub max_plan_depth: u16,
     /// Output format of the report: table, json, or csv (the metrics rows,
     /// as `analyze` writes them; the conflicts are in table and json)
-    #[arg(long, value_parser = super::format::parser(super::format::FIGURES, &[]), default_value = "table")]
+    #[arg(long, value_parser = super::format::parser(PlanReport::FORMATS, &[]), default_value = "table")]
     pub format: Format,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
@@ -164,7 +164,7 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
             })
         })
         .collect();
-    let text = plan_report(&domain, &planned, &rows, a.format);
+    let text = PlanReport::new(&domain, &planned, &rows).write(a.format);
     let code = emit_text(None, text);
     let left = planned.conflicts.iter().any(|c| {
         matches!(
@@ -181,64 +181,66 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
 
 /// What `plan` prints: the goal, the conflicts and the planned policies'
 /// figures (the `analyze` rows), as a table, JSON or CSV.
-fn plan_report(
-    domain: &plan::Domain,
-    planned: &plan::Planned,
-    rows: &[report::PolicyReport],
-    format: Format,
-) -> String {
-    match format {
-        Format::Csv => report::render_analysis(rows, Format::Csv),
-        Format::Json => {
-            #[derive(serde::Serialize)]
-            struct Out<'a> {
-                domain: &'a str,
-                goal: Vec<String>,
-                conflicts: &'a [plan::conflicts::Conflict],
-                policies: &'a [report::PolicyReport],
-            }
-            let out = Out {
-                domain: &domain.name,
-                goal: domain.goal.facts.iter().map(ToString::to_string).collect(),
-                conflicts: &planned.conflicts,
-                policies: rows,
-            };
-            let mut s = btfsm_core::sanitize::json(
-                serde_json::to_string_pretty(&out).expect("serializable"),
-            );
-            s.push('\n');
-            s
+#[derive(serde::Serialize)]
+struct PlanReport<'a> {
+    domain: &'a str,
+    goal: Vec<String>,
+    conflicts: &'a [plan::conflicts::Conflict],
+    policies: &'a [report::PolicyReport],
+}
+
+impl<'a> PlanReport<'a> {
+    fn new(
+        domain: &'a plan::Domain,
+        planned: &'a plan::Planned,
+        rows: &'a [report::PolicyReport],
+    ) -> Self {
+        PlanReport {
+            domain: &domain.name,
+            goal: domain.goal.facts.iter().map(ToString::to_string).collect(),
+            conflicts: &planned.conflicts,
+            policies: rows,
         }
-        _ => {
-            let mut s = format!(
-                "domain `{}`, goal: {}\n",
-                btfsm_core::sanitize::shown(&domain.name),
-                btfsm_core::sanitize::shown(
-                    &domain
-                        .goal
-                        .facts
-                        .iter()
-                        .map(ToString::to_string)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            );
-            let shown_conflicts: Vec<&plan::conflicts::Conflict> = planned
-                .conflicts
-                .iter()
-                .filter(|c| c.outcome != plan::conflicts::Outcome::InOrder)
-                .collect();
-            if shown_conflicts.is_empty() {
-                s.push_str("conflicts: none\n");
-            } else {
-                s.push_str("conflicts:\n");
-                for c in shown_conflicts {
-                    s.push_str(&format!("  {c}\n"));
-                }
+    }
+
+    fn table(&self) -> String {
+        use btfsm_core::sanitize::shown;
+        let mut s = format!(
+            "domain `{}`, goal: {}\n",
+            shown(self.domain),
+            shown(&self.goal.join(", "))
+        );
+        let shown_conflicts: Vec<&plan::conflicts::Conflict> = (self.conflicts.iter())
+            .filter(|c| c.outcome != plan::conflicts::Outcome::InOrder)
+            .collect();
+        if shown_conflicts.is_empty() {
+            s.push_str("conflicts: none\n");
+        } else {
+            s.push_str("conflicts:\n");
+            for c in shown_conflicts {
+                s.push_str(&format!("  {c}\n"));
             }
-            s.push('\n');
-            s.push_str(&report::render_analysis(rows, Format::Table));
-            s
+        }
+        s.push('\n');
+        s.push_str(&report::render_analysis(self.policies, Format::Table));
+        s
+    }
+}
+
+impl Report for PlanReport<'_> {
+    const FORMATS: &'static [Format] = &[Format::Table, Format::Json, Format::Csv];
+
+    fn write(&self, format: Format) -> String {
+        match Self::supported(format) {
+            Format::Csv => report::render_analysis(self.policies, Format::Csv),
+            Format::Json => {
+                let mut s = btfsm_core::sanitize::json(
+                    serde_json::to_string_pretty(self).expect("serializable"),
+                );
+                s.push('\n');
+                s
+            }
+            _ => self.table(),
         }
     }
 }

@@ -6,8 +6,7 @@
 use super::EXIT_BAD_INPUT;
 use super::io::{emit_text, fail, print_diagnostics};
 use btfsm_core::diagnostic::Diagnostic;
-use btfsm_core::output::Format;
-use btfsm_core::sanitize::shown;
+use btfsm_core::output::{Format, Report};
 use btfsm_format as format;
 use btfsm_model::PolicyBody;
 use btfsm_tick as tick;
@@ -23,7 +22,7 @@ pub(crate) struct TickArgs {
     #[arg(long = "script", required = true, value_name = "S.toml")]
     pub scripts: Vec<PathBuf>,
     /// Output format
-    #[arg(long, value_parser = super::format::parser(&[Format::Table, Format::Json], &[]), default_value = "table")]
+    #[arg(long, value_parser = super::format::parser(tick::TickReport::FORMATS, &[]), default_value = "table")]
     pub format: Format,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
@@ -113,10 +112,13 @@ fn one(
     let sc = tick::script::parse(&sfile, bt)?;
     let run = tick::run(bt, &sc);
     let (tn, sn) = (tree.display().to_string(), script.display().to_string());
-    Ok(match fmt {
-        Format::Json => run.json(bt, &tn, &sn),
-        _ => run.table(bt, &shown(&tn), &shown(&sn)),
-    })
+    let rep = tick::TickReport {
+        run: &run,
+        bt,
+        tree: &tn,
+        script: &sn,
+    };
+    Ok(rep.write(fmt))
 }
 
 /// Whether a node's span is in the file given on the command line (not in

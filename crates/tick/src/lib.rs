@@ -226,6 +226,30 @@ impl TickRun {
     }
 }
 
+/// What `btfsm tick` prints: a run of a tree against a script, in the
+/// table or the JSON contract of docs/bt-semantics.md.
+pub struct TickReport<'a> {
+    pub run: &'a TickRun,
+    pub bt: &'a Bt,
+    /// The tree's and the script's file names, as given.
+    pub tree: &'a str,
+    pub script: &'a str,
+}
+
+impl btfsm_core::output::Report for TickReport<'_> {
+    const FORMATS: &'static [btfsm_core::output::Format] = &[
+        btfsm_core::output::Format::Table,
+        btfsm_core::output::Format::Json,
+    ];
+
+    fn write(&self, format: btfsm_core::output::Format) -> String {
+        match Self::supported(format) {
+            btfsm_core::output::Format::Json => self.run.json(self.bt, self.tree, self.script),
+            _ => self.run.table(self.bt, self.tree, self.script),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
