@@ -145,11 +145,12 @@ pub fn from_scenario(s: &Scenario, file: &str) -> Result<Replay, ViewError> {
             marks: Vec::new(),
         });
     }
-    let pos = |name: &str| runs.iter().position(|r| r.policy == name);
+    // Without a deadline every pair has its verdict, in pair order: the
+    // panels are found by place, not by name (two policies may share one).
     let mut divs = Vec::new();
     let mut index = Vec::new();
-    for v in &verdicts {
-        if let (Some(d), Some(a), Some(b)) = (&v.first_divergence, pos(&v.a), pos(&v.b)) {
+    for (v, (a, b)) in verdicts.iter().zip(btfsm_sim::episodes::pairs(runs.len())) {
+        if let Some(d) = &v.first_divergence {
             divs.push(Divergence {
                 a,
                 b,
@@ -369,5 +370,41 @@ mod tests {
         }
         let html = super::super::html::page(&ok, std::time::Duration::from_secs(60)).unwrap();
         assert!(html.contains("btfsm-data"));
+    }
+
+    /// Two policies of one name: each divergence is marked on the panels
+    /// of its own pair, found by place.
+    #[test]
+    fn divergences_go_to_their_own_panels_when_names_repeat() {
+        let text = r#"name = "dup"
+goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+robot = "start"
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+[[disturbances]]
+at = 0.0
+fail = "Pick"
+times = 1
+"#;
+        let base = std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../policies/scenarios"
+        ));
+        let file = std::sync::Arc::new(btfsm_core::diagnostic::SourceFile::new("dup.toml", text));
+        let s = btfsm_sim::scenario::parse(&file, base, &Limits::default()).expect("scenario");
+        let r = from_scenario(&s, "dup.toml").expect("replay");
+        let pairs: Vec<(usize, usize)> = r.divergences.iter().map(|d| (d.a, d.b)).collect();
+        // The two sequential FSMs match; each differs from the BT.
+        assert_eq!(pairs, [(0, 1), (1, 2)]);
+        assert!(
+            r.panels.iter().all(|p| !p.marks.is_empty()),
+            "every panel marked"
+        );
     }
 }

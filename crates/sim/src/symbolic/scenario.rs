@@ -32,9 +32,9 @@ struct Raw {
     #[serde(default)]
     seed: u64,
     #[serde(default = "default_steps")]
-    max_steps: u64,
+    max_steps: Spanned<u64>,
     #[serde(default = "default_repeats")]
-    livelock_repeats: u32,
+    livelock_repeats: Spanned<u32>,
     #[serde(default = "default_failures")]
     max_failures: u32,
     #[serde(default)]
@@ -50,11 +50,11 @@ struct Raw {
     monte_carlo: Option<RawMc>,
 }
 
-fn default_steps() -> u64 {
-    1000
+fn default_steps() -> Spanned<u64> {
+    Spanned::new(0..0, 1000)
 }
-fn default_repeats() -> u32 {
-    3
+fn default_repeats() -> Spanned<u32> {
+    Spanned::new(0..0, 3)
 }
 fn default_failures() -> u32 {
     10
@@ -188,8 +188,8 @@ pub fn parse(
         goal: domain.goal.facts.clone(),
         domain: Arc::new(domain),
         seed: raw.seed,
-        max_steps: raw.max_steps,
-        livelock_repeats: raw.livelock_repeats,
+        max_steps: *raw.max_steps.get_ref(),
+        livelock_repeats: *raw.livelock_repeats.get_ref(),
         max_failures: raw.max_failures,
         facts: initial,
         durations,
@@ -403,19 +403,17 @@ fn read_durations(
 
 /// Checks `max_steps` and `livelock_repeats`.
 fn check_bounds(raw: &Raw, pb: &mut Problems<'_>) {
-    if raw.max_steps == 0 || raw.max_steps > MAX_STEPS {
+    let steps = *raw.max_steps.get_ref();
+    if steps == 0 || steps > MAX_STEPS {
         pb.err(
-            0..0,
-            format!(
-                "`max_steps` must be 1 to {MAX_STEPS}, found {}",
-                raw.max_steps
-            ),
+            raw.max_steps.span(),
+            format!("`max_steps` must be 1 to {MAX_STEPS}, found {steps}"),
             "write e.g. `max_steps = 1000`".into(),
         );
     }
-    if raw.livelock_repeats < 2 {
+    if *raw.livelock_repeats.get_ref() < 2 {
         pb.err(
-            0..0,
+            raw.livelock_repeats.span(),
             "`livelock_repeats` must be at least 2".into(),
             "the default is 3".into(),
         );

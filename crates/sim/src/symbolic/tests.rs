@@ -177,3 +177,28 @@ fn scenario_errors_are_reported_together() {
     );
     assert!(e.iter().all(|d| d.span.is_some()));
 }
+
+#[test]
+fn step_and_livelock_bounds_point_at_their_values() {
+    let text = format!(
+        "{HEAD}max_steps = 0\nlivelock_repeats = 1\n{}",
+        policies(&["fig01-bt"])
+    );
+    let e = parse(
+        &SourceFile::new("t.toml", text.clone()),
+        Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../policies/domains"
+        )),
+        &Default::default(),
+    )
+    .err()
+    .unwrap_or_else(|| panic!("accepted: {text}"));
+    for (key, value) in [("max_steps", "0"), ("livelock_repeats", "1")] {
+        let d = (e.iter())
+            .find(|d| d.message.contains(key))
+            .unwrap_or_else(|| panic!("no message about {key}: {e:?}"));
+        let span = d.span.clone().expect("positioned");
+        assert_eq!(&text[span], value, "{key}");
+    }
+}
