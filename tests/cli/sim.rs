@@ -250,7 +250,7 @@ fn sim_exits_1_naming_the_expectations_that_fail() {
         ),
         "{stdout}"
     );
-    assert!(stdout.contains("  FAIL Fig. 1 BT baseline matches Fig. 2 FSM sequential (they differ: at 9.7 s, skill 3"), "{stdout}");
+    assert!(stdout.contains("  FAIL Fig. 1 BT baseline matches Fig. 2 FSM sequential (they differ: at 9.4 s, skill 3"), "{stdout}");
     assert!(stderr.contains("2 of 3 expectations of the scenario failed: Fig. 2 FSM sequential reaches the goal; Fig. 1 BT baseline matches Fig. 2 FSM sequential"), "{stderr}");
     let (code, stdout, _) = btfsm(&["sim", f, "--format", "json"]);
     assert_eq!(code, 1);

@@ -18,14 +18,19 @@ use super::world::{Place, World};
 use std::collections::BTreeMap;
 
 /// Injected faults: "fail the next N times" and failure rates.
+///
+/// Common random numbers (issue 31): whether a start of a skill is doomed,
+/// and where it aborts, is drawn from a stream of its own, keyed by the
+/// episode's seed, the call (skill and arguments) and how many times that
+/// call started before in the run: two policies that make the same calls
+/// meet the same faults, whatever else they do in between.
 #[derive(Debug, Clone)]
 pub(super) struct Faults {
     pub(super) next: BTreeMap<String, u32>,
     pub(super) rates: BTreeMap<String, f64>,
-    pub(super) rng: SimRng,
-    /// Where in its execution a doomed action aborts (its own stream, so
-    /// that which starts are doomed does not depend on it).
-    pub(super) points: SimRng,
+    seed: u64,
+    /// Starts so far per call (at most `MAX_SKILL_RECORDS` entries).
+    starts: std::collections::HashMap<String, u32>,
 }
 
 impl Faults {
@@ -33,14 +38,25 @@ impl Faults {
         Faults {
             next: BTreeMap::new(),
             rates,
-            rng: SimRng::named(seed, "skill-faults"),
-            points: SimRng::named(seed, "fault-points"),
+            seed,
+            starts: std::collections::HashMap::new(),
         }
     }
 
-    /// `Some(f)`: this start of `skill` aborts at the fraction `f` (drawn
-    /// uniformly from [0.05, 0.95]) of its execution.
-    fn doomed(&mut self, skill: &str) -> Option<f64> {
+    /// `Some(f)`: this start of `skill` with these arguments aborts at the
+    /// fraction `f` (drawn uniformly from [0.05, 0.95]) of its execution.
+    fn doomed(&mut self, skill: &str, args: &BTreeMap<String, String>) -> Option<f64> {
+        let mut call = String::from(skill);
+        for (k, v) in args {
+            call.push_str(&format!("\u{1f}{k}={v}"));
+        }
+        let n = self.starts.entry(call.clone()).or_insert(0);
+        let ordinal = *n;
+        *n += 1;
+        let mut rng = SimRng::named(
+            self.seed,
+            &format!("skill-fault\u{1f}{call}\u{1f}{ordinal}"),
+        );
         let doomed = if let Some(n) = self.next.get_mut(skill)
             && *n > 0
         {
@@ -48,11 +64,11 @@ impl Faults {
             true
         } else {
             match self.rates.get(skill) {
-                Some(&p) => self.rng.chance(p),
+                Some(&p) => rng.chance(p),
                 None => false,
             }
         };
-        doomed.then(|| self.points.range(0.05, 0.95))
+        doomed.then(|| rng.range(0.05, 0.95))
     }
 }
 
@@ -325,7 +341,8 @@ impl Leaves for Robot {
                 self.started.push(key);
             }
             self.failed_key = None;
-            let fault_at = self.faults.doomed(call.name());
+            let args = call_args(call, &self.world);
+            let fault_at = self.faults.doomed(call.name(), &args);
             if *call == Call::Recharge
                 && let Some(t) = self.low_at.take()
             {
@@ -333,7 +350,7 @@ impl Leaves for Robot {
             }
             self.records.push(SkillRecord {
                 skill: call.name().into(),
-                args: call_args(call, &self.world),
+                args,
                 outcome: "running".into(),
                 start: round3(self.world.time),
                 end: None,
@@ -408,4 +425,48 @@ pub(super) fn apply(d: &Disturbance, r: &mut Robot) {
     }
     r.world.progress += 1;
     r.event("disturbance", d.text.clone());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn args(object: &str) -> BTreeMap<String, String> {
+        BTreeMap::from([("object".to_string(), object.to_string())])
+    }
+
+    proptest! {
+        /// Common random numbers: a policy that makes extra calls between
+        /// the same calls meets the same faults on those calls, at the same
+        /// points.
+        #[test]
+        fn the_same_calls_meet_the_same_faults_whatever_comes_between(
+            seed in any::<u64>(),
+            rate in 0.05f64..0.95,
+            calls in proptest::collection::vec(0usize..3, 1..40),
+            extra in proptest::collection::vec((0usize..40, 0usize..4), 0..20),
+        ) {
+            let objects = ["cube1", "cube2", "cube3", "cube4"];
+            let rates = BTreeMap::from([
+                ("Pick".to_string(), rate),
+                ("Place".to_string(), rate),
+            ]);
+            let mut a = Faults::new(seed, rates.clone());
+            let mut b = Faults::new(seed, rates);
+            let mut inserted: Vec<Vec<usize>> = vec![Vec::new(); calls.len()];
+            for (at, o) in extra {
+                inserted[at % calls.len()].push(o);
+            }
+            for (k, &c) in calls.iter().enumerate() {
+                for &o in &inserted[k] {
+                    // Another skill, or the same one on another object.
+                    let _ = b.doomed(if o % 2 == 0 { "Place" } else { "Move-To" }, &args(objects[o]));
+                }
+                let da = a.doomed("Pick", &args(objects[c]));
+                let db = b.doomed("Pick", &args(objects[c]));
+                prop_assert_eq!(da, db);
+            }
+        }
+    }
 }

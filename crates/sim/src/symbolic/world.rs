@@ -55,7 +55,12 @@ pub struct World<'d> {
     running: HashMap<usize, Instance>,
     durations: &'d BTreeMap<String, u32>,
     rates: BTreeMap<String, f64>,
-    rng: SimRng,
+    /// The episode's seed: each start's failure is drawn from a stream of
+    /// its own, keyed by the call and its ordinal (common random numbers:
+    /// policies that start the same actions meet the same failures).
+    seed: u64,
+    /// Starts so far per action instance (`Name(args)`).
+    starts: HashMap<String, u32>,
     pub step: u64,
     /// Actions finished: (step, `Name(args)`, succeeded).
     pub done: Vec<(u64, String, bool)>,
@@ -76,7 +81,8 @@ impl<'d> World<'d> {
             running: HashMap::new(),
             durations,
             rates,
-            rng: SimRng::named(seed, "symbolic-action-failures"),
+            seed,
+            starts: HashMap::new(),
             step: 0,
             done: Vec::new(),
         }
@@ -114,17 +120,20 @@ impl<'d> World<'d> {
         k
     }
 
+    /// The random stream of this start of `step`'s action instance.
+    fn fault_draw(&mut self, step: &Step<'_>) -> SimRng {
+        let call = instance(step);
+        let n = self.starts.entry(call.clone()).or_insert(0);
+        let ordinal = *n;
+        *n += 1;
+        SimRng::named(
+            self.seed,
+            &format!("symbolic-fault\u{1f}{call}\u{1f}{ordinal}"),
+        )
+    }
+
     fn finish(&mut self, step: &Step<'_>, ok: bool) {
-        let name = format!(
-            "{}({})",
-            step.action.name,
-            step.action
-                .params
-                .iter()
-                .map(|p| step.bind[&p.name].as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+        let name = instance(step);
         self.done.push((self.step, name, ok));
         if !ok {
             return;
@@ -149,6 +158,20 @@ impl<'d> World<'d> {
             self.facts.insert(f);
         }
     }
+}
+
+/// An action instance as the runs report it: `Name(arg, ...)`.
+fn instance(step: &Step<'_>) -> String {
+    format!(
+        "{}({})",
+        step.action.name,
+        step.action
+            .params
+            .iter()
+            .map(|p| step.bind[&p.name].as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
 }
 
 impl Leaves for World<'_> {
@@ -185,7 +208,7 @@ impl Leaves for World<'_> {
             return Status::Failure;
         }
         let rate = self.rates.get(&action.name).copied().unwrap_or(0.0);
-        let fails = rate > 0.0 && self.rng.chance(rate);
+        let fails = rate > 0.0 && self.fault_draw(&step).chance(rate);
         let d = self.durations.get(&action.name).copied().unwrap_or(1);
         if d <= 1 {
             self.finish(&step, !fails);
