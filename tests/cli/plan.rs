@@ -323,6 +323,48 @@ unset = { probability = 0.6, facts = ["Door-Open(door)", "Holding(cup)"], window
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// One failure budget for every representation in the symbolic world: the
+/// planned BT, fault-tolerant FSM and HFSM of one plan, with grasps failing
+/// 40 % of the time, succeed at the same rate and match (the HFSM, ticked
+/// again after a failure as its BT is, got one failed grasp before: 0.587).
+#[test]
+fn planned_bt_fsm_and_hfsm_share_one_failure_budget_in_the_symbolic_world() {
+    let d = scratch("plan-budget");
+    let dir = d.to_str().expect("utf-8");
+    std::fs::copy("policies/domains/moma.toml", d.join("moma.toml")).expect("copy");
+    let (code, _, err) = btfsm(&["plan", "policies/domains/moma.toml", "-o", dir]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(
+        d.join("sim.toml"),
+        r#"name = "budget"
+domain = "moma.toml"
+max_steps = 200
+durations = { Move-To = 3, Pick = 2, Place = 2 }
+rates = { Pick = 0.4 }
+[[policies]]
+file = "moma-bt.toml"
+[[policies]]
+file = "moma-fsm.toml"
+[[policies]]
+file = "moma-hfsm.toml"
+"#,
+    )
+    .expect("write");
+    let sim = format!("{dir}/sim.toml");
+    let (code, out, err) = btfsm(&["sim", &sim, "--runs", "200", "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    let rates: Vec<f64> = (v["policies"].as_array().expect("policies").iter())
+        .map(|p| p["success_rate"].as_f64().expect("rate"))
+        .collect();
+    assert_eq!(rates.len(), 3, "{out}");
+    assert!(rates.iter().all(|r| *r == rates[0]), "{rates:?}");
+    for p in v["pairs"].as_array().expect("pairs") {
+        assert_eq!(p["match_rate"], 1.0, "{p}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 #[test]
 fn validate_checks_action_domains_and_symbolic_scenarios() {
     let (code, _, err) = btfsm(&["validate", "policies/domains"]);

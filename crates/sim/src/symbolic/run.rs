@@ -4,8 +4,9 @@
 //! with BehaviorTree.CPP 4 semantics (`sim::exec`, docs/bt-semantics.md).
 //! It ends: `success` when the policy reports SUCCESS and the goal's facts
 //! hold; `failure` when it reports SUCCESS without them, when a machine
-//! reaches another outcome, or after `max_failures` failed ticks in a row
-//! without a new goal fact; `chattering` when a state of the world (facts
+//! stops at another outcome, or after `max_failures` failed ticks in a row
+//! without a new goal fact (BTs and tick-driven machines alike: both are
+//! ticked again after a failure); `chattering` when a state of the world (facts
 //! and running actions) recurs `livelock_repeats` times without a new goal
 //! fact (a disturbance or a failed action starts the count again: a retry
 //! is not a livelock; the one detector of `crate::livelock`, as in the
@@ -182,7 +183,12 @@ pub fn run_policy(
             }
             Status::Failure => {
                 failures += 1;
-                if matches!(exec, Exec::Machine(_)) || failures >= s.max_failures {
+                // One failure budget for every representation: a policy
+                // ticked again after a failure (a BT, a tick-driven machine
+                // such as the HFSM of a BT) has `max_failures`; a machine
+                // that stopped at its outcome has ended.
+                let stopped = matches!(&exec, Exec::Machine(e) if e.finished.is_some());
+                if stopped || failures >= s.max_failures {
                     outcome = Outcome::Failure;
                     break;
                 }
