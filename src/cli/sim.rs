@@ -256,24 +256,31 @@ fn one_run(
     if code != EXIT_OK {
         return code;
     }
-    if rep.expectations_failed > 0 {
-        eprint!(
-            "{}",
-            Diagnostic::error(format!(
-                "{} of {} expectations of the scenario failed: {}",
-                rep.expectations_failed,
-                rep.expectations.len(),
-                (rep.expectations.iter())
-                    .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
-                    .map(|e| btfsm_core::sanitize::shown(&e.name).into_owned())
-                    .take(10)
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            ))
-        );
-        return EXIT_CHECK_FAILED;
+    let failed: Vec<&str> = (rep.expectations.iter())
+        .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
+        .map(|e| e.name.as_str())
+        .collect();
+    expectations_failed(&failed, rep.expectations.len())
+}
+
+/// Exit 1 naming the expectations that failed (the first 10), if any.
+fn expectations_failed(failed: &[&str], of: usize) -> u8 {
+    if failed.is_empty() {
+        return EXIT_OK;
     }
-    EXIT_OK
+    eprint!(
+        "{}",
+        Diagnostic::error(format!(
+            "{} of {of} expectations of the scenario failed: {}",
+            failed.len(),
+            (failed.iter())
+                .map(|e| btfsm_core::sanitize::shown(e).into_owned())
+                .take(10)
+                .collect::<Vec<_>>()
+                .join("; ")
+        ))
+    );
+    EXIT_CHECK_FAILED
 }
 
 /// What `--timeout-ms` adds to a JSON report.
@@ -496,7 +503,15 @@ fn symbolic(
         });
         let note = "the runs with outcome `timeout` stopped at the step shown";
         let rep = report::RunsReport::new(&s, &runs);
-        return emit_text(None, render(&rep, a.format, &budget, note));
+        let code = emit_text(None, render(&rep, a.format, &budget, note));
+        if code != EXIT_OK {
+            return code;
+        }
+        let failed: Vec<&str> = (rep.expectations.iter())
+            .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
+            .map(|e| e.name.as_str())
+            .collect();
+        return expectations_failed(&failed, rep.expectations.len());
     };
     let Some(threads) = threads(a, n) else {
         return EXIT_BAD_INPUT;

@@ -239,22 +239,28 @@ impl SimReport {
 
     /// The expectations checked: how many hold, and each one's status.
     fn expectations_text(&self, out: &mut String) {
-        if self.expectations.is_empty() {
-            return;
-        }
-        out.push_str(&format!(
-            "\nexpectations: {} of {} hold\n",
-            self.expectations.len() - self.expectations_failed,
-            self.expectations.len()
-        ));
-        for e in &self.expectations {
-            let st = match e.status {
-                Status::Pass => "ok  ",
-                Status::Fail => "FAIL",
-                Status::Undecided => "UNDECIDED",
-            };
-            out.push_str(&format!("  {st} {} ({})\n", e.name, e.found));
-        }
+        expectations_text(out, &self.expectations, self.expectations_failed);
+    }
+}
+
+/// The expectations checked (planar or symbolic): how many hold, and each
+/// one's status.
+pub(crate) fn expectations_text(out: &mut String, expectations: &[ExpectResult], failed: usize) {
+    if expectations.is_empty() {
+        return;
+    }
+    out.push_str(&format!(
+        "\nexpectations: {} of {} hold\n",
+        expectations.len() - failed,
+        expectations.len()
+    ));
+    for e in expectations {
+        let st = match e.status {
+            Status::Pass => "ok  ",
+            Status::Fail => "FAIL",
+            Status::Undecided => "UNDECIDED",
+        };
+        out.push_str(&format!("  {st} {} ({})\n", e.name, e.found));
     }
 }
 

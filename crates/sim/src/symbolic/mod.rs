@@ -6,6 +6,7 @@
 //! their verdicts and Monte Carlo. The planar world stays the paper's
 //! experiments' world.
 
+pub mod expect;
 pub mod report;
 pub mod run;
 pub mod scenario;

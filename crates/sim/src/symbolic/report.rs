@@ -3,6 +3,7 @@
 
 use super::run::{McPair, McPolicy, McResult, SymRun, first_difference};
 use super::scenario::SymScenario;
+use crate::scenario::expect::{ExpectResult, Status};
 use btfsm_core::output::{Format, Report};
 use btfsm_core::sanitize::shown;
 use btfsm_core::table::Table;
@@ -27,6 +28,17 @@ pub struct RunsReport<'a> {
     pub goal: Vec<String>,
     pub runs: &'a [SymRun],
     pub pairs: Vec<PairVerdict<'a>>,
+    /// The scenario's `[expect]`, checked (empty when it has none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub expectations: Vec<ExpectResult>,
+    /// How many expectations failed or could not be decided (`sim` exits 1
+    /// when this is not 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub expectations_failed: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl<'a> RunsReport<'a> {
@@ -43,12 +55,18 @@ impl<'a> RunsReport<'a> {
                 }
             })
             .collect();
+        let expectations = super::expect::check(&s.expect, runs);
+        let expectations_failed = (expectations.iter())
+            .filter(|e| e.status != Status::Pass)
+            .count();
         RunsReport {
             scenario: &s.name,
             domain: &s.domain.name,
             goal: s.goal.iter().map(ToString::to_string).collect(),
             runs,
             pairs,
+            expectations,
+            expectations_failed,
         }
     }
 
@@ -89,6 +107,7 @@ impl<'a> RunsReport<'a> {
             }
             out.push_str(&t.render());
         }
+        crate::report::expectations_text(&mut out, &self.expectations, self.expectations_failed);
         out
     }
 }

@@ -48,6 +48,8 @@ struct Raw {
     disturbances: Vec<RawDisturbance>,
     #[serde(default)]
     monte_carlo: Option<RawMc>,
+    #[serde(default)]
+    expect: Option<super::expect::RawExpect>,
 }
 
 fn default_steps() -> Spanned<u64> {
@@ -64,6 +66,9 @@ fn default_failures() -> u32 {
 #[serde(deny_unknown_fields)]
 struct RawPolicy {
     file: Spanned<String>,
+    /// The name reports and `[expect]` give it (default: the policy's own).
+    #[serde(default)]
+    name: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -128,6 +133,8 @@ pub struct SymScenario {
     pub policies: Vec<(PathBuf, Policy)>,
     pub disturbances: Vec<Disturbance>,
     pub mc: Mc,
+    /// The scenario's `[expect]`, checked against one run per policy.
+    pub expect: Vec<crate::scenario::expect::Expectation>,
 }
 
 /// Does a TOML text set `domain` before its first table (a symbolic
@@ -179,6 +186,13 @@ pub fn parse(
     let durations = read_durations(&domain, &raw.durations, &mut pb);
     check_bounds(&raw, &mut pb);
     let policies = load_policies(&domain, &raw.policies, &files, &mut pb);
+    let expect = match &raw.expect {
+        Some(e) if pb.diags.is_empty() => {
+            let names: Vec<String> = policies.iter().map(|(_, p)| p.name.clone()).collect();
+            super::expect::read(e, &names, file, &mut pb.diags)
+        }
+        _ => Vec::new(),
+    };
     if !pb.diags.is_empty() {
         return Err(pb.diags);
     }
@@ -197,6 +211,7 @@ pub fn parse(
         policies,
         disturbances,
         mc,
+        expect,
     })
 }
 
@@ -448,8 +463,13 @@ fn load_policies(
             }
         };
         match format::load(&path, files.limits) {
-            Ok(l) => match unbound(domain, &l.policy) {
-                None => policies.push((path, l.policy)),
+            Ok(mut l) => match unbound(domain, &l.policy) {
+                None => {
+                    if let Some(n) = &p.name {
+                        l.policy.name = n.clone();
+                    }
+                    policies.push((path, l.policy));
+                }
                 Some(why) => pb.err(
                     p.file.span(),
                     format!("policy `{}`: {why}", btfsm_core::sanitize::shown(rel)),

@@ -3,6 +3,7 @@
 use super::run::{self, Outcome};
 use super::scenario::parse;
 use crate::episodes::Budget;
+use crate::scenario::expect::Status;
 use btfsm_core::diagnostic::SourceFile;
 use std::path::Path;
 
@@ -201,4 +202,42 @@ fn step_and_livelock_bounds_point_at_their_values() {
         let span = d.span.clone().expect("positioned");
         assert_eq!(&text[span], value, "{key}");
     }
+}
+
+#[test]
+fn named_policies_and_expectations_are_checked_against_the_runs() {
+    let text = format!(
+        "{HEAD}[[policies]]\nfile = \"../paper/fig01-bt.toml\"\nname = \"bt\"\n[[policies]]\nfile = \"../paper/fig02-fsm.toml\"\nname = \"seq\"\n[[disturbances]]\nat = 4\nunset = [\"In-Hand(cube2)\"]\n[expect]\nreach_goal = [\"bt\", \"seq\"]\nmatch = [[\"bt\", \"seq\"]]\noutcome = {{ seq = \"failure\" }}\n"
+    );
+    let s = scenario(&text);
+    let runs = run::run_all(&s, None, None);
+    assert_eq!(runs[0].policy, "bt");
+    let got: Vec<(String, Status)> = super::expect::check(&s.expect, &runs)
+        .into_iter()
+        .map(|e| (e.name, e.status))
+        .collect();
+    assert_eq!(
+        got,
+        [
+            ("bt reaches the goal".to_string(), Status::Pass),
+            ("seq reaches the goal".to_string(), Status::Fail),
+            ("seq ends failure".to_string(), Status::Pass),
+            ("bt matches seq".to_string(), Status::Fail),
+        ]
+    );
+    // A name no policy has is a positioned error with a suggestion.
+    let bad = text.replace("reach_goal = [\"bt\"", "reach_goal = [\"bq\"");
+    let e = parse(
+        &SourceFile::new("t.toml", bad.clone()),
+        Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../policies/domains"
+        )),
+        &Default::default(),
+    )
+    .err()
+    .unwrap_or_else(|| panic!("accepted: {bad}"));
+    let span = e[0].span.clone().expect("positioned");
+    assert_eq!(&bad[span], "\"bq\"");
+    assert!(e[0].to_string().contains("did you mean `bt`?"), "{}", e[0]);
 }
