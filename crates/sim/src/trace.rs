@@ -35,14 +35,21 @@ impl SkillRecord {
         format!("{}({}) -> {}", self.skill, args.join(", "), self.outcome)
     }
 
-    /// The same skill, arguments and outcome; `cancelled` and `aborted` are
-    /// the same outcome here: the action ended because the policy started
-    /// another, and which came first, the halt or the new goal, is the
-    /// executor's order (BehaviorTree.CPP starts the new action before it
-    /// halts the old one; an FSM leaves its state first), not behavior.
+    /// The same skill, arguments and what the world did: it completed
+    /// (`success`), it did not (`failure`, `cancelled`, `aborted`: the
+    /// same here), or it was still running. How a skill that did not
+    /// complete ended is the executor's bookkeeping, not behavior: a BT
+    /// halts a Pick whose object moved away (`cancelled`) where an FSM's
+    /// Pick runs into it (`failure`), and BehaviorTree.CPP starts the new
+    /// action before it halts the old one (`aborted`) where an FSM leaves
+    /// its state first. When the two ended at different times, the next
+    /// start (or the trajectories) tells.
     fn same(&self, o: &SkillRecord) -> bool {
         fn class(x: &str) -> &str {
-            if x == "aborted" { "cancelled" } else { x }
+            match x {
+                "aborted" | "cancelled" | "failure" => "not completed",
+                x => x,
+            }
         }
         self.skill == o.skill && self.args == o.args && class(&self.outcome) == class(&o.outcome)
     }
