@@ -189,7 +189,10 @@ impl SimReport {
         if self.verdicts.is_empty() {
             return;
         }
-        out.push_str("\nbehavior match (same executed skills with arguments, outcomes and start times within a step, same goal outcome, same final world):\n");
+        let (tol_s, tol_m) = (self.verdicts.iter()).fold((0.0f64, 0.0f64), |(s, m), v| {
+            (s.max(v.tolerance_s), m.max(v.pose_tolerance_m))
+        });
+        out.push_str(&format!("\nbehavior match (same executed skills with arguments and results, started within {tol_s} s; robots within {tol_m} m at equal times; same goal outcome; same final world):\n"));
         for v in &self.verdicts {
             let what = if v.matches {
                 "MATCH".to_string()
@@ -203,6 +206,9 @@ impl SimReport {
                 }
                 if !v.same_final_world {
                     why.push("final worlds differ");
+                }
+                if !v.same_motion {
+                    why.push("motion differs");
                 }
                 format!("DIFFER ({})", why.join(", "))
             };

@@ -552,6 +552,8 @@ impl<'a> Episode<'a> {
             goal_met,
             steps: self.steps,
             dt: s.dt,
+            pose_tolerance_m: s.pose_tolerance_m,
+            start_tolerance_s: s.start_tolerance_s,
             after_success: p.after_success.as_str(),
             after_failure: p.after_failure.as_str(),
             completion_s: self.completion.map(round3),

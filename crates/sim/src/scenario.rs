@@ -109,6 +109,11 @@ pub struct Scenario {
     pub livelock_repeats: u32,
     /// Action failures without progress after which a run gives up.
     pub max_failures: u32,
+    /// The verdicts' tolerances: the largest distance between two robots
+    /// at the same step, m, and between two starts of the same skill, s,
+    /// for their behavior to match (defaults 0.2 m and one step).
+    pub pose_tolerance_m: f64,
+    pub start_tolerance_s: f64,
     pub world: World,
     pub policies: Vec<PolicyEntry>,
     pub rates: BTreeMap<String, f64>,
@@ -262,6 +267,8 @@ const TOP_KEYS: &[&str] = &[
     "chatter_switches",
     "livelock_repeats",
     "max_failures",
+    "pose_tolerance_m",
+    "start_tolerance_s",
     "expect",
     "goal",
     "world",

@@ -207,9 +207,15 @@ pub struct Run {
     /// Whether the scenario's goal holds at the end (`None`: no goal given).
     pub goal_met: Option<bool>,
     pub steps: u64,
-    /// Step length, s (the verdicts' default start-time tolerance).
+    /// Step length, s.
     #[serde(skip)]
     pub dt: f64,
+    /// The scenario's verdict tolerances (`pose_tolerance_m`,
+    /// `start_tolerance_s`).
+    #[serde(skip)]
+    pub pose_tolerance_m: f64,
+    #[serde(skip)]
+    pub start_tolerance_s: f64,
     /// What the policy did after SUCCESS (`stop` or `keep-ticking`).
     pub after_success: &'static str,
     /// What the policy did after FAILURE (`stop` or `keep-ticking`).
@@ -284,7 +290,11 @@ pub struct Verdict {
     /// The same run outcome and the same goal result.
     pub same_outcome: bool,
     pub same_final_world: bool,
+    /// The two robots were never more than `pose_tolerance_m` apart at the
+    /// same step (`trajectory_distance_m`).
+    pub same_motion: bool,
     pub tolerance_s: f64,
+    pub pose_tolerance_m: f64,
     pub first_divergence: Option<Divergence>,
     /// The largest distance between the two robots at the same time, m
     /// (after its run ended, a robot stands where it stopped).
@@ -350,7 +360,8 @@ pub fn behavior_matches(a: &Run, b: &Run) -> bool {
 }
 
 fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
-    let tol = a.dt.max(b.dt) + 1e-6;
+    let tol = a.start_tolerance_s.max(b.start_tolerance_s) + 1e-6;
+    let pose_tol = a.pose_tolerance_m.max(b.pose_tolerance_m);
     let mut sa = SkillSlice::new(&a.skills, a.duration_s);
     let mut sb = SkillSlice::new(&b.skills, b.duration_s);
     let first = match first_divergence(&mut sa, &mut sb, tol) {
@@ -359,16 +370,20 @@ fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
     };
     let same_world = a.final_world.same_state(&b.final_world);
     let same_outcome = a.outcome == b.outcome && a.goal_met == b.goal_met;
+    let apart = (aligned_distance(&a.track, &b.track) * 1000.0).round() / 1000.0;
+    let same_motion = apart <= pose_tol + 1e-9;
     Verdict {
         a: a.policy.clone(),
         b: b.policy.clone(),
-        matches: first.is_none() && same_world && same_outcome,
+        matches: first.is_none() && same_world && same_outcome && same_motion,
         same_skills: first.is_none(),
         same_outcome,
         same_final_world: same_world,
+        same_motion,
         tolerance_s: (tol * 1000.0).round() / 1000.0,
+        pose_tolerance_m: pose_tol,
         first_divergence: first,
-        trajectory_distance_m: (aligned_distance(&a.track, &b.track) * 1000.0).round() / 1000.0,
+        trajectory_distance_m: apart,
         path_distance_m: (frechet_thinned(ta, tb) * 1000.0).round() / 1000.0,
     }
 }

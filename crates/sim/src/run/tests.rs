@@ -455,3 +455,26 @@ block = { name = "fence3", rect = [1.4, 1.4, 1.5, 2.99] }
         assert!(r.reason.starts_with("gave up"), "{}", r.reason);
     }
 }
+
+/// The same skills at the same times do not make a match when the robots
+/// were apart: the verdict compares motion too, within the scenario's
+/// `pose_tolerance_m` (default 0.2 m), and names it (`same_motion`).
+#[test]
+fn runs_apart_by_more_than_the_pose_tolerance_differ() {
+    let s = scenario(&fig1_fig4(""));
+    let mut runs = run_scenario(&s, false);
+    let v = &crate::trace::verdicts(&runs, 300)[0];
+    assert!(v.matches && v.same_motion, "{v:?}");
+    assert_eq!(v.pose_tolerance_m, 0.2);
+    // The FSM's robot 0.5 m off its path for one step in the middle.
+    let k = runs[1].track.len() / 2;
+    runs[1].track[k].1.0 += 0.5;
+    let v = &crate::trace::verdicts(&runs, 300)[0];
+    assert!(v.same_skills && !v.same_motion && !v.matches, "{v:?}");
+    assert!(v.trajectory_distance_m >= 0.5, "{v:?}");
+    // A scenario that allows 1 m calls it the same motion.
+    let loose = scenario(&format!("pose_tolerance_m = 1.0\n{}", fig1_fig4("")));
+    let mut runs2 = run_scenario(&loose, false);
+    runs2[1].track[k].1.0 += 0.5;
+    assert!(crate::trace::verdicts(&runs2, 300)[0].matches);
+}

@@ -60,6 +60,8 @@ impl Reader {
             max_steps: run.max_steps,
             livelock_repeats: run.livelock_repeats,
             max_failures: run.max_failures,
+            pose_tolerance_m: run.pose_tolerance_m,
+            start_tolerance_s: run.start_tolerance_s,
             world,
             policies,
             rates,
@@ -104,12 +106,25 @@ impl Reader {
             .get("max_failures")
             .and_then(|v| self.integer(v, "`max_failures`", 1, 1_000_000))
             .unwrap_or(50) as u32;
+        // The verdicts' tolerances (docs/simulator-verdicts.md): how far
+        // apart two robots may be at the same time, and two starts of the
+        // same skill, for their behavior to match.
+        let pose_tolerance_m = t
+            .get("pose_tolerance_m")
+            .and_then(|v| self.number(v, "`pose_tolerance_m`", 0.0, 100.0))
+            .unwrap_or(POSE_TOLERANCE_M);
+        let start_tolerance_s = t
+            .get("start_tolerance_s")
+            .and_then(|v| self.number(v, "`start_tolerance_s`", 0.0, 3600.0))
+            .unwrap_or(dt);
         Settings {
             seed,
             dt,
             max_steps,
             livelock_repeats,
             max_failures,
+            pose_tolerance_m,
+            start_tolerance_s,
         }
     }
 
@@ -411,4 +426,11 @@ struct Settings {
     max_steps: u64,
     livelock_repeats: u32,
     max_failures: u32,
+    pose_tolerance_m: f64,
+    start_tolerance_s: f64,
 }
+
+/// The default of `pose_tolerance_m`: two robots within 0.2 m of each
+/// other at every step move alike (a tenth of the room's smallest
+/// clearance, twice a step's travel at top speed).
+pub(super) const POSE_TOLERANCE_M: f64 = 0.2;
