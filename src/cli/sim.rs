@@ -133,6 +133,15 @@ fn monte_carlo_runs(
     };
     let mc = monte_carlo::monte_carlo_within(s, n, seed, threads, deadline);
     let done = mc.runs;
+    let expectations = btfsm_sim::scenario::expect::check_monte_carlo(&s.expect, &mc);
+    let single = s.expect.len() - expectations.len();
+    if single > 0 {
+        eprintln!(
+            "note: the scenario's {single} expectation{} about single runs {} checked without --runs",
+            if single == 1 { "" } else { "s" },
+            if single == 1 { "is" } else { "are" }
+        );
+    }
     let rep = McReport {
         scenario: s.name.clone(),
         seed,
@@ -142,6 +151,10 @@ fn monte_carlo_runs(
         millis: t0.elapsed().as_millis(),
         policies: mc.policies,
         pairs: mc.pairs,
+        expectations_failed: (expectations.iter())
+            .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
+            .count(),
+        expectations,
     };
     let budget = a.timeout_ms.map(|ms| Budget {
         timeout_ms: ms,
@@ -152,7 +165,15 @@ fn monte_carlo_runs(
     let note =
         format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
     let text = render(&rep, a.format, &budget, &note);
-    emit_text(None, text)
+    let code = emit_text(None, text);
+    if code != EXIT_OK {
+        return code;
+    }
+    let failed: Vec<&str> = (rep.expectations.iter())
+        .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
+        .map(|e| e.name.as_str())
+        .collect();
+    expectations_failed(&failed, rep.expectations.len())
 }
 
 /// The workers of `--runs n`: `--threads` (default the cores; more than

@@ -1105,3 +1105,47 @@ fn symbolic_monte_carlo_honours_timeout_and_threads_in_bounded_memory() {
     };
     assert_eq!(json("1"), json("3"));
 }
+
+/// `[expect]` on Monte Carlo rates is checked under `--runs` by the 95 %
+/// interval: inside the range passes, outside fails, across a bound is
+/// undecided (exit 1, more episodes decide it); the expectations about
+/// single runs are named as not checked, not skipped silently.
+#[test]
+fn sim_runs_checks_expected_rates_by_their_intervals() {
+    let f = "tests/fixtures/sim/rates-expect.toml";
+    let (code, out, err) = btfsm(&["sim", f, "--runs", "40", "--format", "json"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(
+            "note: the scenario's 1 expectation about single runs is checked without --runs"
+        ),
+        "{err}"
+    );
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    let status: Vec<&str> = (v["expectations"].as_array().expect("expectations").iter())
+        .map(|e| e["status"].as_str().expect("status"))
+        .collect();
+    assert_eq!(status, ["pass", "fail", "undecided"], "{v}");
+    assert_eq!(v["expectations_failed"], 2);
+    // One run per policy: the rates are not expectations of a single run.
+    let (code, out, err) = btfsm(&["sim", f, "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    assert_eq!(v["expectations"].as_array().map(Vec::len), Some(1), "{v}");
+    // A rate out of [0, 1] is a positioned error.
+    let d = crate::common::scratch("rates-bad");
+    let text = std::fs::read_to_string(f)
+        .expect("fixture")
+        .replace("[0.75, 1.0]", "[0.75, 1.5]")
+        .replace(
+            "../../../policies/",
+            &format!("{}/policies/", env!("CARGO_MANIFEST_DIR")),
+        );
+    let bad = d.join("bad.toml");
+    std::fs::write(&bad, text).expect("write");
+    let bad = bad.to_str().expect("utf-8");
+    let (code, _, err) = btfsm(&["sim", bad, "--runs", "2", "--allow-outside-root"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("a success rate must be a range"), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -249,6 +249,30 @@ impl SimReport {
     }
 }
 
+/// The expectations checked, as a markdown list (names escaped).
+fn markdown_expectations(out: &mut String, expectations: &[ExpectResult], failed: usize) {
+    if expectations.is_empty() {
+        return;
+    }
+    out.push_str(&format!(
+        "\nexpectations: {} of {} hold\n\n",
+        expectations.len() - failed,
+        expectations.len()
+    ));
+    for e in expectations {
+        let st = match e.status {
+            Status::Pass => "ok",
+            Status::Fail => "**FAIL**",
+            Status::Undecided => "**UNDECIDED**",
+        };
+        out.push_str(&format!(
+            "- {st} {} ({})\n",
+            btfsm_core::sanitize::markdown_cell(&e.name),
+            btfsm_core::sanitize::markdown_cell(&e.found)
+        ));
+    }
+}
+
 /// The expectations checked (planar or symbolic): how many hold, and each
 /// one's status.
 pub(crate) fn expectations_text(out: &mut String, expectations: &[ExpectResult], failed: usize) {
@@ -323,6 +347,17 @@ pub struct McReport {
     pub policies: Vec<McStats>,
     /// Per pair of policies, the rate of episodes whose behavior matched.
     pub pairs: Vec<PairStats>,
+    /// The scenario's `[expect]` on rates (`success_rate`, `match_rate`),
+    /// checked on these figures (absent when it has none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub expectations: Vec<ExpectResult>,
+    /// How many of them failed or are undecided (`sim` exits 1 when not 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub expectations_failed: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl McReport {
@@ -399,6 +434,11 @@ impl McReport {
                 })
                 .collect();
             out.push_str(&table(md, &head, rows));
+        }
+        if md {
+            markdown_expectations(&mut out, &self.expectations, self.expectations_failed);
+        } else {
+            expectations_text(&mut out, &self.expectations, self.expectations_failed);
         }
         out
     }

@@ -38,6 +38,21 @@ pub enum Check {
     /// The policy completes (reports SUCCESS for the last time) within
     /// `[low, high]` seconds.
     Completion(usize, f64, f64),
+    /// With `--runs`: the policy's success rate is within `[low, high]`
+    /// (its 95 % interval inside: pass; outside: fail; across a bound:
+    /// undecided, more episodes needed).
+    SuccessRate(usize, f64, f64),
+    /// With `--runs`: the pair's behavior match rate is within
+    /// `[low, high]`, judged by its 95 % interval likewise.
+    MatchRate(usize, usize, f64, f64),
+}
+
+impl Check {
+    /// Whether it is checked on Monte Carlo figures (`--runs`), not on one
+    /// run per policy.
+    pub fn is_monte_carlo(&self) -> bool {
+        matches!(self, Check::SuccessRate(..) | Check::MatchRate(..))
+    }
 }
 
 /// One expectation, with the name reports give it.
@@ -74,6 +89,8 @@ const KEYS: &[&str] = &[
     "match",
     "differ",
     "completion_s",
+    "success_rate",
+    "match_rate",
 ];
 
 /// Expectations a scenario holds at most (a fixed limit, like its other
@@ -178,6 +195,12 @@ impl Reader {
         self.expect_verdicts(t, names, &mut out);
         if let Some(x) = t.get("completion_s") {
             self.expect_completions(x, names, &mut out);
+        }
+        if let Some(x) = t.get("success_rate") {
+            self.expect_success_rates(x, names, &mut out);
+        }
+        if let Some(x) = t.get("match_rate") {
+            self.expect_match_rates(x, names, &mut out);
         }
         if out.len() > MAX_EXPECTATIONS {
             self.err(
@@ -310,6 +333,143 @@ impl Reader {
     }
 }
 
+impl Reader {
+    /// `success_rate`: a table of policies and the range of their Monte
+    /// Carlo success rate.
+    fn expect_success_rates(&mut self, x: &Val<'_>, names: &[String], out: &mut Vec<Expectation>) {
+        let Some(t) = self.table(x, "`success_rate`") else {
+            return;
+        };
+        for (k, v) in t.iter() {
+            let Some(i) = self.expect_policy(k.span(), k.get_ref(), names) else {
+                continue;
+            };
+            if let Some((lo, hi)) = self.range(v, "a success rate", 0.0, 1.0) {
+                out.push(Expectation {
+                    check: Check::SuccessRate(i, lo, hi),
+                    name: format!("{} succeeds at a rate within [{lo}, {hi}]", names[i]),
+                });
+            }
+        }
+    }
+
+    /// A pair of two different policies `[A, B]`.
+    fn expect_pair(&mut self, p: &Val<'_>, names: &[String]) -> Option<(usize, usize)> {
+        let Some([x, y]) = p
+            .get_ref()
+            .as_array()
+            .and_then(|a| <&[_; 2]>::try_from(&a[..]).ok())
+        else {
+            self.err(
+                p.span(),
+                "`pair` must be a pair of policy names",
+                "write `[\"Fig. 1 BT baseline\", \"Fig. 4 FSM fault tolerant\"]`",
+            );
+            return None;
+        };
+        let a =
+            (self.string(x, "a policy name")).and_then(|n| self.expect_policy(x.span(), &n, names));
+        let b =
+            (self.string(y, "a policy name")).and_then(|n| self.expect_policy(y.span(), &n, names));
+        match (a, b) {
+            (Some(a), Some(b)) if a != b => Some((a, b)),
+            (Some(_), Some(_)) => {
+                self.err(
+                    p.span(),
+                    "a pair names the same policy twice",
+                    "name two different policies",
+                );
+                None
+            }
+            _ => None,
+        }
+    }
+
+    /// `match_rate`: a list of `{ pair = [A, B], within = [low, high] }`.
+    fn expect_match_rates(&mut self, x: &Val<'_>, names: &[String], out: &mut Vec<Expectation>) {
+        let Some(a) = self.array(x, "`match_rate`") else {
+            return;
+        };
+        for e in a {
+            let Some(t) = self.table(e, "an entry of `match_rate`") else {
+                continue;
+            };
+            self.keys(t, &["pair", "within"], "field of a `match_rate` entry");
+            let (Some(p), Some(w)) = (t.get("pair"), t.get("within")) else {
+                self.err(
+                    e.span(),
+                    "a `match_rate` entry needs `pair` and `within`",
+                    "write `{ pair = [\"Fig. 1 BT baseline\", \"Fig. 4 FSM fault tolerant\"], within = [0.9, 1.0] }`",
+                );
+                continue;
+            };
+            let pair = self.expect_pair(p, names);
+            let range = self.range(w, "a match rate", 0.0, 1.0);
+            if let (Some((a, b)), Some((lo, hi))) = (pair, range) {
+                out.push(Expectation {
+                    check: Check::MatchRate(a, b, lo, hi),
+                    name: format!(
+                        "{} matches {} at a rate within [{lo}, {hi}]",
+                        names[a], names[b]
+                    ),
+                });
+            }
+        }
+    }
+}
+
+/// Checks the Monte Carlo expectations against the figures of `--runs`
+/// (policies and pairs in the scenario's order): a rate whose 95 % Wilson
+/// interval lies inside the expected range passes, one whose interval lies
+/// outside it fails, and one whose interval crosses a bound is undecided
+/// (counted as failed: more episodes decide it). Expectations about single
+/// runs are not checked here.
+pub fn check_monte_carlo(
+    expect: &[Expectation],
+    mc: &crate::monte_carlo::McResult,
+) -> Vec<ExpectResult> {
+    let judge = |ci: [f64; 2], rate: f64, lo: f64, hi: f64| {
+        let status = if lo <= ci[0] && ci[1] <= hi {
+            Status::Pass
+        } else if ci[1] < lo || ci[0] > hi {
+            Status::Fail
+        } else {
+            Status::Undecided
+        };
+        let mut found = format!("{rate:.3}, 95% interval [{:.4}, {:.4}]", ci[0], ci[1]);
+        if status == Status::Undecided {
+            found.push_str(": the interval crosses a bound, more episodes decide it");
+        }
+        (status, found)
+    };
+    let n = mc.policies.len();
+    let pair_index = |a: usize, b: usize| {
+        let (a, b) = (a.min(b), a.max(b));
+        // Pairs (a < b) in order: those of the policies before a, then b.
+        a * n - a * (a + 1) / 2 + (b - a - 1)
+    };
+    (expect.iter())
+        .filter_map(|e| {
+            let (status, found) = match e.check {
+                Check::SuccessRate(i, lo, hi) => {
+                    let p = &mc.policies[i];
+                    judge(p.success_ci95, p.success_rate, lo, hi)
+                }
+                Check::MatchRate(a, b, lo, hi) => {
+                    let p = &mc.pairs[pair_index(a, b)];
+                    judge(p.match_ci95, p.match_rate, lo, hi)
+                }
+                _ => return None,
+            };
+            Some(ExpectResult {
+                name: e.name.clone(),
+                status,
+                found,
+            })
+        })
+        .collect()
+}
+
 fn goal_text(r: &Run) -> String {
     let goal = match r.goal_met {
         Some(true) => "goal met",
@@ -337,6 +497,7 @@ pub fn check(
     };
     expect
         .iter()
+        .filter(|e| !e.check.is_monte_carlo())
         .map(|e| {
             let (status, found) = match e.check {
                 Check::ReachGoal(i) | Check::MissGoal(i) | Check::Outcome(i, _)
@@ -356,6 +517,9 @@ pub fn check(
                 Check::Outcome(i, o) => {
                     let r = &runs[i];
                     (pass(r.outcome == o, cut[i]), goal_text(r))
+                }
+                Check::SuccessRate(..) | Check::MatchRate(..) => {
+                    (Status::Undecided, "checked with --runs".into())
                 }
                 Check::Completion(i, lo, hi) => match runs.get(i) {
                     None => (Status::Undecided, "not run".into()),

@@ -180,7 +180,9 @@ pub fn check(expect: &[Expectation], runs: &[SymRun]) -> Vec<ExpectResult> {
                     let cut = runs[a].cut_short || runs[b].cut_short;
                     (decided(d.is_none() == want, cut), text)
                 }
-                Check::Completion(..) => (Status::Undecided, "not in a symbolic run".into()),
+                Check::Completion(..) | Check::SuccessRate(..) | Check::MatchRate(..) => {
+                    (Status::Undecided, "not in a symbolic run".into())
+                }
             };
             ExpectResult {
                 name: e.name.clone(),
