@@ -380,7 +380,7 @@ fn a_dropped_cube_is_not_delivered() {
             env!("CARGO_MANIFEST_DIR"),
             "/../../policies/scenarios"
         )),
-        "goal = [{ if = \"Object-At\", args = { object = \"cube2\", at = \"delivery\" } }]\n[world]\nrobot = [0.5, 1.83]\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"../paper/fig02-fsm.toml\"\n[[disturbances]]\nwhen = [{ if = \"Robot-At\", args = { target = \"delivery\" } }, { if = \"In-Hand\", args = { object = \"cube2\" } }]\ndrop = \"cube2\"\n",
+        "goal = [{ if = \"Object-At\", args = { object = \"cube2\", at = \"delivery\" } }]\n[world]\nrobot = [0.5, 1.83]\nobjects = { cube2 = { at = \"east-table\" } }\n[[policies]]\nfile = \"../paper/fig02-fsm.toml\"\nafter_failure = \"stop\"\n[[disturbances]]\nwhen = [{ if = \"Robot-At\", args = { target = \"delivery\" } }, { if = \"In-Hand\", args = { object = \"cube2\" } }]\ndrop = \"cube2\"\n",
     );
     let r = &run_scenario(&s, false)[0];
     assert_eq!(r.goal_met, Some(false));

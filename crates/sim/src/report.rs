@@ -297,10 +297,12 @@ pub(crate) fn expectations_text(out: &mut String, expectations: &[ExpectResult],
 /// A run's outcome and reason, its executed skills, and its final world.
 fn run_details(out: &mut String, r: &Run) {
     out.push_str(&format!(
-        "\n{} — {}: {}\n",
+        "\n{} — {}: {}\n  (after SUCCESS: {}; after FAILURE: {})\n",
         r.policy,
         r.outcome.as_str(),
-        r.reason
+        r.reason,
+        r.after_success,
+        r.after_failure
     ));
     for (i, s) in r.skills.iter().enumerate() {
         out.push_str(&format!(

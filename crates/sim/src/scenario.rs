@@ -30,11 +30,12 @@ type Val<'i> = Spanned<DeValue<'i>>;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Afterwards {
-    /// No longer ticked: the robot stands idle (SMACH's final state; the
-    /// default for FSMs and HFSMs).
+    /// No longer ticked: the robot stands idle (SMACH's final state; after
+    /// SUCCESS, the default for FSMs and HFSMs).
     Stop,
     /// Ticked again every step: a BT from its root, a machine re-entered at
-    /// its initial state (the default for BTs, as the paper describes).
+    /// its initial state (after SUCCESS, the default for BTs, as the paper
+    /// describes; after FAILURE, the default for every policy).
     KeepTicking,
 }
 
@@ -146,6 +147,7 @@ pub fn parse(
         file: file.clone(),
         diags: Vec::new(),
         terms: 0,
+        after: (None, None),
     };
     // The policies and their includes stay inside the scenario's root.
     let root = format::source::root_for(limits, base);
@@ -217,6 +219,9 @@ struct Reader {
     diags: Vec<Diagnostic>,
     /// Condition terms read so far (at most [`MAX_TERMS`]).
     terms: usize,
+    /// The scenario's own `after_success` / `after_failure`, for every
+    /// policy entry that does not state its own.
+    after: (Option<Afterwards>, Option<Afterwards>),
 }
 
 /// A number as messages show it: short (`1e300`, not 301 digits).
@@ -267,6 +272,8 @@ const TOP_KEYS: &[&str] = &[
     "chatter_switches",
     "livelock_repeats",
     "max_failures",
+    "after_success",
+    "after_failure",
     "pose_tolerance_m",
     "start_tolerance_s",
     "expect",

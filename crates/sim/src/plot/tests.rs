@@ -133,6 +133,7 @@ objects = { cube2 = { at = "east-table" } }
 file = "../paper/fig01-bt.toml"
 [[policies]]
 file = "../paper/fig02-fsm.toml"
+after_failure = "stop"
 [[disturbances]]
 at = 4.0
 move = "cube2"

@@ -165,6 +165,7 @@ name = "FSM reset"
 after_failure = "keep-ticking"
 [[policies]]
 file = "../paper/fig02-fsm.toml"
+after_failure = "stop"
 [[policies]]
 file = "../paper/fig01-bt.toml"
 name = "BT stop"
@@ -383,6 +384,7 @@ fn a_sequential_policy_without_a_failure_arc_fails() {
 objects = { cube2 = { at = "east-table" } }
 [[policies]]
 file = "../paper/fig02-fsm.toml"
+after_failure = "stop"
 [[disturbances]]
 at = 0.0
 fail = "Move-To"
@@ -477,4 +479,51 @@ fn runs_apart_by_more_than_the_pose_tolerance_differ() {
     let mut runs2 = run_scenario(&loose, false);
     runs2[1].track[k].1.0 += 0.5;
     assert!(crate::trace::verdicts(&runs2, 300)[0].matches);
+}
+
+/// What a policy does after FAILURE is one setting for every
+/// representation: by default a BT and a machine alike are ticked (or
+/// started) again; the scenario's own `after_failure` applies to all its
+/// policies, and an entry may still state its own.
+#[test]
+fn after_failure_is_one_setting_for_every_representation() {
+    let body = r#"[[policies]]
+file = "../paper/fig02-fsm.toml"
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[disturbances]]
+at = 0.0
+fail = "Pick"
+"#;
+    // `top` goes before the tables.
+    let outcomes = |top: &str, text: &str| -> Vec<(Outcome, &'static str)> {
+        let s = scenario(&format!("{top}{}", deliver(text)));
+        (run_scenario(&s, false).iter())
+            .map(|r| (r.outcome, r.after_failure))
+            .collect()
+    };
+    assert_eq!(
+        outcomes("", body),
+        [
+            (Outcome::Success, "keep-ticking"),
+            (Outcome::Success, "keep-ticking")
+        ]
+    );
+    // The scenario's setting: both stop at their first FAILURE.
+    assert_eq!(
+        outcomes("after_failure = \"stop\"\n", body),
+        [(Outcome::Failure, "stop"), (Outcome::Failure, "stop")]
+    );
+    // An entry's own setting wins over the scenario's.
+    let own = body.replace(
+        "fig01-bt.toml\"\n",
+        "fig01-bt.toml\"\nafter_failure = \"keep-ticking\"\n",
+    );
+    assert_eq!(
+        outcomes("after_failure = \"stop\"\n", &own),
+        [
+            (Outcome::Failure, "stop"),
+            (Outcome::Success, "keep-ticking")
+        ]
+    );
 }

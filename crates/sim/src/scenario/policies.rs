@@ -25,6 +25,13 @@ impl Reader {
             None => None,
         };
         let run = self.settings(t);
+        // The scenario's own settings for every policy (an entry may state
+        // its own): read before the policies.
+        let keep = |s: &mut Self, key: &str| match t.get(key) {
+            Some(v) => s.afterwards(Some(v), key, false),
+            None => None,
+        };
+        self.after = (keep(self, "after_success"), keep(self, "after_failure"));
         let world = self.world(t.get("world"))?;
         let rates = match t.get("rates") {
             Some(r) => self.rates(r)?,
@@ -265,17 +272,20 @@ impl Reader {
         if let Some(n) = t.get("name") {
             policy.name = self.string(n, "`name`")?;
         }
-        // Defaults: a BT keeps ticking after both (its root is ticked every
-        // step); a machine stops, unless its top-level outcomes include
-        // RUNNING (the Fig. 6 construction says it is ticked), which keeps
-        // ticking after FAILURE.
-        let (bt, tick_driven) = match &policy.body {
-            PolicyBody::Bt(_) => (true, true),
-            PolicyBody::Machine(m) => (false, m.top.outcomes.iter().any(|o| o == "RUNNING")),
+        // Defaults, unless the scenario states its own for every policy:
+        // after FAILURE every policy is ticked (a BT) or started (a
+        // machine) again, whatever its representation; after SUCCESS a BT
+        // keeps ticking (its root is ticked every step) and a machine stops
+        // (SMACH's final state). Reports print each run's settings.
+        let bt = matches!(policy.body, PolicyBody::Bt(_));
+        let after_success = match (t.get("after_success"), self.after.0) {
+            (None, Some(a)) => a,
+            (v, _) => self.afterwards(v, "after_success", bt)?,
         };
-        let after_success = self.afterwards(t.get("after_success"), "after_success", bt)?;
-        let after_failure =
-            self.afterwards(t.get("after_failure"), "after_failure", tick_driven)?;
+        let after_failure = match (t.get("after_failure"), self.after.1) {
+            (None, Some(a)) => a,
+            (v, _) => self.afterwards(v, "after_failure", true)?,
+        };
         Some(PolicyEntry {
             file: path,
             convert,
