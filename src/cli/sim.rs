@@ -543,6 +543,14 @@ fn symbolic(
         threads,
         deadline,
     };
+    if !s.expect.is_empty() {
+        eprintln!(
+            "note: the scenario's {} expectation{} about single runs {} checked without --runs",
+            s.expect.len(),
+            if s.expect.len() == 1 { "" } else { "s" },
+            if s.expect.len() == 1 { "is" } else { "are" }
+        );
+    }
     let mc = run::monte_carlo(&s, &budget);
     let done = mc.runs;
     let b = a.timeout_ms.map(|ms| Budget {
