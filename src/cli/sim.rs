@@ -134,14 +134,7 @@ fn monte_carlo_runs(
     let mc = monte_carlo::monte_carlo_within(s, n, seed, threads, deadline);
     let done = mc.runs;
     let expectations = btfsm_sim::scenario::expect::check_monte_carlo(&s.expect, &mc);
-    let single = s.expect.len() - expectations.len();
-    if single > 0 {
-        eprintln!(
-            "note: the scenario's {single} expectation{} about single runs {} checked without --runs",
-            if single == 1 { "" } else { "s" },
-            if single == 1 { "is" } else { "are" }
-        );
-    }
+    note_single_run_expectations(s.expect.len() - expectations.len());
     let rep = McReport {
         scenario: s.name.clone(),
         seed,
@@ -282,6 +275,18 @@ fn one_run(
         .map(|e| e.name.as_str())
         .collect();
     expectations_failed(&failed, rep.expectations.len())
+}
+
+/// With `--runs`, says how many expectations about single runs are not
+/// checked (never skipped silently).
+fn note_single_run_expectations(n: usize) {
+    if n > 0 {
+        eprintln!(
+            "note: the scenario's {n} expectation{} about single runs {} checked without --runs",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "is" } else { "are" }
+        );
+    }
 }
 
 /// Exit 1 naming the expectations that failed (the first 10), if any.
@@ -543,14 +548,7 @@ fn symbolic(
         threads,
         deadline,
     };
-    if !s.expect.is_empty() {
-        eprintln!(
-            "note: the scenario's {} expectation{} about single runs {} checked without --runs",
-            s.expect.len(),
-            if s.expect.len() == 1 { "" } else { "s" },
-            if s.expect.len() == 1 { "is" } else { "are" }
-        );
-    }
+    note_single_run_expectations(s.expect.len());
     let mc = run::monte_carlo(&s, &budget);
     let done = mc.runs;
     let b = a.timeout_ms.map(|ms| Budget {
