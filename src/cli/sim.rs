@@ -157,16 +157,7 @@ fn monte_carlo_runs(
     });
     let note =
         format!("{done} of {n} episodes completed; the figures cover those (the first {done})");
-    let text = render(&rep, a.format, &budget, &note);
-    let code = emit_text(None, text);
-    if code != EXIT_OK {
-        return code;
-    }
-    let failed: Vec<&str> = (rep.expectations.iter())
-        .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
-        .map(|e| e.name.as_str())
-        .collect();
-    expectations_failed(&failed, rep.expectations.len())
+    finish(render(&rep, a.format, &budget, &note), &rep.expectations)
 }
 
 /// The workers of `--runs n`: `--threads` (default the cores; more than
@@ -265,16 +256,7 @@ fn one_run(
         return EXIT_BAD_INPUT;
     }
     let note = "the runs with outcome `timeout` stopped at the step shown in their reason, and the verdicts not computed are listed";
-    let text = render(&rep, a.format, &budget, note);
-    let code = emit_text(None, text);
-    if code != EXIT_OK {
-        return code;
-    }
-    let failed: Vec<&str> = (rep.expectations.iter())
-        .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
-        .map(|e| e.name.as_str())
-        .collect();
-    expectations_failed(&failed, rep.expectations.len())
+    finish(render(&rep, a.format, &budget, note), &rep.expectations)
 }
 
 /// With `--runs`, says how many expectations about single runs are not
@@ -289,21 +271,27 @@ fn note_single_run_expectations(n: usize) {
     }
 }
 
-/// Exit 1 naming the expectations that failed (the first 10), if any.
-fn expectations_failed(failed: &[&str], of: usize) -> u8 {
+/// Prints the report; then exit 1 naming the expectations that failed
+/// (the first 10), if any.
+fn finish(text: String, expectations: &[btfsm_sim::scenario::expect::ExpectResult]) -> u8 {
+    let code = emit_text(None, text);
+    if code != EXIT_OK {
+        return code;
+    }
+    let failed: Vec<String> = (expectations.iter())
+        .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
+        .map(|e| btfsm_core::sanitize::shown(&e.name).into_owned())
+        .collect();
     if failed.is_empty() {
         return EXIT_OK;
     }
     eprint!(
         "{}",
         Diagnostic::error(format!(
-            "{} of {of} expectations of the scenario failed: {}",
+            "{} of {} expectations of the scenario failed: {}",
             failed.len(),
-            (failed.iter())
-                .map(|e| btfsm_core::sanitize::shown(e).into_owned())
-                .take(10)
-                .collect::<Vec<_>>()
-                .join("; ")
+            expectations.len(),
+            failed[..failed.len().min(10)].join("; ")
         ))
     );
     EXIT_CHECK_FAILED
@@ -529,15 +517,7 @@ fn symbolic(
         });
         let note = "the runs with outcome `timeout` stopped at the step shown";
         let rep = report::RunsReport::new(&s, &runs);
-        let code = emit_text(None, render(&rep, a.format, &budget, note));
-        if code != EXIT_OK {
-            return code;
-        }
-        let failed: Vec<&str> = (rep.expectations.iter())
-            .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
-            .map(|e| e.name.as_str())
-            .collect();
-        return expectations_failed(&failed, rep.expectations.len());
+        return finish(render(&rep, a.format, &budget, note), &rep.expectations);
     };
     let Some(threads) = threads(a, n) else {
         return EXIT_BAD_INPUT;

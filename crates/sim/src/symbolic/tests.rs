@@ -16,6 +16,17 @@ fn scenario(text: &str) -> super::SymScenario {
         .unwrap_or_else(|e| panic!("{e:?}"))
 }
 
+/// The problems of a scenario that must be refused.
+fn refused(text: &str) -> Vec<btfsm_core::diagnostic::Diagnostic> {
+    let base = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../policies/domains"
+    ));
+    parse(&SourceFile::new("t.toml", text), base, &Default::default())
+        .err()
+        .unwrap_or_else(|| panic!("accepted: {text}"))
+}
+
 const HEAD: &str = r#"name = "t"
 domain = "moma.toml"
 durations = { Move-To = 3, Pick = 2, Place = 2 }
@@ -156,16 +167,7 @@ fn scenario_errors_are_reported_together() {
         "name = \"t\"\ndomain = \"moma.toml\"\nfacts = [\"Robot-Art(cube2)\", \"Robot-At(20)\"]\ndurations = {{ Pik = 2 }}\n{}",
         policies(&["fig01-bt"])
     );
-    let e = parse(
-        &SourceFile::new("t.toml", text.clone()),
-        Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../policies/domains"
-        )),
-        &Default::default(),
-    )
-    .err()
-    .unwrap_or_else(|| panic!("accepted: {text}"));
+    let e = refused(&text);
     let msgs: Vec<&str> = e.iter().map(|d| d.message.as_str()).collect();
     assert!(
         msgs.iter()
@@ -185,16 +187,7 @@ fn step_and_livelock_bounds_point_at_their_values() {
         "{HEAD}max_steps = 0\nlivelock_repeats = 1\n{}",
         policies(&["fig01-bt"])
     );
-    let e = parse(
-        &SourceFile::new("t.toml", text.clone()),
-        Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../policies/domains"
-        )),
-        &Default::default(),
-    )
-    .err()
-    .unwrap_or_else(|| panic!("accepted: {text}"));
+    let e = refused(&text);
     for (key, value) in [("max_steps", "0"), ("livelock_repeats", "1")] {
         let d = (e.iter())
             .find(|d| d.message.contains(key))
@@ -227,16 +220,7 @@ fn named_policies_and_expectations_are_checked_against_the_runs() {
     );
     // A name no policy has is a positioned error with a suggestion.
     let bad = text.replace("reach_goal = [\"bt\"", "reach_goal = [\"bq\"");
-    let e = parse(
-        &SourceFile::new("t.toml", bad.clone()),
-        Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../policies/domains"
-        )),
-        &Default::default(),
-    )
-    .err()
-    .unwrap_or_else(|| panic!("accepted: {bad}"));
+    let e = refused(&bad);
     let span = e[0].span.clone().expect("positioned");
     assert_eq!(&bad[span], "\"bq\"");
     assert!(e[0].to_string().contains("did you mean `bt`?"), "{}", e[0]);
