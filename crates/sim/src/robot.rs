@@ -401,8 +401,13 @@ pub(super) fn apply(d: &Disturbance, r: &mut Robot) {
         Effect::Move { object, to } => w.objects[*object].place = w.rest_at(*to),
         Effect::Drop { object } => {
             if w.objects[*object].place == Place::Held {
-                // It lies on the floor where it fell.
+                // It lies on the floor where it fell, and (`drop_sensed`)
+                // the robot that held it knows where.
                 w.objects[*object].place = Place::Floor(w.robot);
+                if w.params.drop_sensed {
+                    w.objects[*object].belief = w.robot;
+                    w.objects[*object].found = true;
+                }
             }
         }
         Effect::Fail { skill, times } => *r.faults.next.entry(skill.clone()).or_insert(0) += times,

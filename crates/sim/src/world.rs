@@ -184,6 +184,13 @@ pub struct Params {
     /// the goal is the believed pose when the action started, as a
     /// navigation action server's goal.
     pub follow_belief: bool,
+    /// The robot knows where an object it held fell: its believed pose is
+    /// set there at once (default `true`). With `false` it stays where the
+    /// object was last seen until the camera sees it, and a policy that
+    /// reacts to the drop in the same step (a BT's In-Hand condition)
+    /// drives back to that stale pose: a modelling choice that favoured
+    /// the policy reacting later (issue 31).
+    pub drop_sensed: bool,
     /// Duration of Pick (grasp and tuck) and Place, s.
     pub manipulation_s: f64,
     /// Duration of Tuck-Arm and Shut-Down, s.
@@ -208,6 +215,7 @@ impl Default for Params {
             reach: 0.1,
             stall_s: 10.0,
             follow_belief: false,
+            drop_sensed: true,
             manipulation_s: 1.5,
             arm_s: 0.5,
             grid: 0.1,

@@ -152,18 +152,23 @@ impl Reader {
         self.keys(
             pt,
             &(PARAMS.iter().map(|p| p.0))
-                .chain(["follow_belief"])
+                .chain(["follow_belief", "drop_sensed"])
                 .collect::<Vec<_>>(),
             "world parameter",
         );
         for (k, v) in pt.iter() {
-            if k.get_ref().as_ref() == "follow_belief" {
+            let flag = match k.get_ref().as_ref() {
+                "follow_belief" => Some(&mut params.follow_belief),
+                "drop_sensed" => Some(&mut params.drop_sensed),
+                _ => None,
+            };
+            if let Some(flag) = flag {
                 match v.get_ref() {
-                    DeValue::Boolean(b) => params.follow_belief = *b,
+                    DeValue::Boolean(b) => *flag = *b,
                     _ => self.err(
                         v.span(),
-                        "`follow_belief` must be true or false",
-                        "write `follow_belief = true`",
+                        format!("`{}` must be true or false", k.get_ref()),
+                        format!("write `{} = true`", k.get_ref()),
                     ),
                 }
                 continue;
