@@ -58,6 +58,51 @@ impl Livelock {
     }
 }
 
+/// Progress of navigation (issue 31): the closest the robot has come to
+/// each navigation goal in the run (goals to the centimetre, at most
+/// [`LIVELOCK_STATES`] of them). A step that brings the robot more than
+/// [`NAV_PROGRESS_M`] closer to a running navigation's goal than ever
+/// before is progress: an alternation of skills that advances the robot
+/// toward the same goal (a Timeout and a Safe-Move-To) is not a livelock,
+/// while going back and forth between two goals already reached is.
+#[derive(Default)]
+pub(super) struct NavProgress {
+    best: std::collections::HashMap<(i64, i64), f64>,
+}
+
+/// How much closer than ever to a navigation goal counts as progress, m.
+pub(super) const NAV_PROGRESS_M: f64 = 0.05;
+
+impl NavProgress {
+    /// Whether the robot at `at` came closer to any of `goals` than ever
+    /// by more than [`NAV_PROGRESS_M`] (the best distances updated).
+    pub(super) fn advanced(
+        &mut self,
+        at: (f64, f64),
+        goals: impl Iterator<Item = (f64, f64)>,
+    ) -> bool {
+        let mut advanced = false;
+        for g in goals {
+            if self.best.len() >= LIVELOCK_STATES {
+                self.best.clear();
+            }
+            let key = ((g.0 * 100.0).round() as i64, (g.1 * 100.0).round() as i64);
+            let d = ((at.0 - g.0).powi(2) + (at.1 - g.1).powi(2)).sqrt();
+            match self.best.get_mut(&key) {
+                Some(b) if d < *b - NAV_PROGRESS_M => {
+                    *b = d;
+                    advanced = true;
+                }
+                Some(_) => {}
+                None => {
+                    self.best.insert(key, d);
+                }
+            }
+        }
+        advanced
+    }
+}
+
 /// The abstract state of the robot, hashed: where each object is (held, or
 /// its place on a surface or the floor to the centimetre), whether it was
 /// seen and where it is believed to be, the arm, shut-down,

@@ -9,7 +9,7 @@
 //! the first k whole episodes.
 
 use super::exec::{BtExec, CompiledBt, CompiledMachine, MachineExec};
-use super::livelock::{Livelock, abstract_state};
+use super::livelock::{Livelock, NavProgress, abstract_state};
 use super::robot::{Faults, MAX_EVENTS, MAX_SKILL_RECORDS, Robot, apply, round3};
 use super::scenario::{Afterwards, Disturbance, PolicyEntry, Scenario, When};
 use super::skills::{self, Call, Status};
@@ -221,6 +221,7 @@ struct Episode<'a> {
     /// reported SUCCESS (a machine ends at its outcome by itself).
     stopped: bool,
     livelock: Livelock,
+    nav: NavProgress,
     goal_terms: &'a [(Call, bool)],
     track: Vec<(u64, P2)>,
     fired: Vec<bool>,
@@ -263,6 +264,7 @@ impl<'a> Episode<'a> {
             keep_ticking: p.after_success == Afterwards::KeepTicking,
             stopped: false,
             livelock: Livelock::new(s.livelock_repeats),
+            nav: NavProgress::default(),
             goal_terms: s.goal.as_deref().unwrap_or(&[]),
             track,
             fired: vec![false; disturbances.len()],
@@ -480,7 +482,13 @@ impl<'a> Episode<'a> {
         let fresh = !robot.started.is_empty();
         let state = abstract_state(robot);
         robot.started.clear();
-        if let Some(n) = self.livelock.step(state, fresh, measure, disturbed) {
+        let goals = (robot.touched.iter())
+            .filter_map(|&k| robot.live[k].as_ref().and_then(|r| r.nav_goal()));
+        let advanced = self.nav.advanced(robot.world.robot, goals);
+        // No livelock while a scheduled disturbance is still to come (an
+        // all-clear may end the waiting), nor while the robot advances.
+        let reset = disturbed || pending || advanced;
+        if let Some(n) = self.livelock.step(state, fresh, measure, reset) {
             let text = format!(
                 "livelock: an abstract state (world facts, running skills) entered {n} times without progress toward the goal"
             );

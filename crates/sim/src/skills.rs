@@ -330,6 +330,11 @@ pub struct Running {
 }
 
 impl Running {
+    /// The navigation goal, when it is a navigation that has started.
+    pub(crate) fn nav_goal(&self) -> Option<P2> {
+        self.goal
+    }
+
     pub fn new(call: Call, fault_at: Option<f64>, record: usize) -> Self {
         Running {
             call,
@@ -492,7 +497,7 @@ impl Running {
                 w.arm_tucked = false;
             }
             Call::TuckArm => w.arm_tucked = true,
-            _ => w.shut_down = true,
+            _ => w.shut_down = w.emergency || w.params.shut_down_latches,
         }
         w.progress += 1;
         Status::Success

@@ -191,6 +191,15 @@ pub struct Params {
     /// drives back to that stale pose: a modelling choice that favoured
     /// the policy reacting later (issue 31).
     pub drop_sensed: bool,
+    /// A Shut-Down that completes when no emergency is in force (it was
+    /// cleared while the arm folded) leaves the robot down for the rest of
+    /// the run (`true`), or has no lasting effect, the shut-down lasting as
+    /// long as the emergency it answered (`false`, the default): then how
+    /// the robot resumes follows each policy's structure (a BT re-checks
+    /// its condition, the FSM of Fig. 9b leaves its Shut Down state), where
+    /// a latched shut-down failed every policy whose Shut-Down outlasted
+    /// the emergency (issue 31).
+    pub shut_down_latches: bool,
     /// Duration of Pick (grasp and tuck) and Place, s.
     pub manipulation_s: f64,
     /// Duration of Tuck-Arm and Shut-Down, s.
@@ -216,6 +225,7 @@ impl Default for Params {
             stall_s: 10.0,
             follow_belief: false,
             drop_sensed: true,
+            shut_down_latches: false,
             manipulation_s: 1.5,
             arm_s: 0.5,
             grid: 0.1,

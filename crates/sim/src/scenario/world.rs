@@ -152,7 +152,7 @@ impl Reader {
         self.keys(
             pt,
             &(PARAMS.iter().map(|p| p.0))
-                .chain(["follow_belief", "drop_sensed"])
+                .chain(["follow_belief", "drop_sensed", "shut_down_latches"])
                 .collect::<Vec<_>>(),
             "world parameter",
         );
@@ -160,6 +160,7 @@ impl Reader {
             let flag = match k.get_ref().as_ref() {
                 "follow_belief" => Some(&mut params.follow_belief),
                 "drop_sensed" => Some(&mut params.drop_sensed),
+                "shut_down_latches" => Some(&mut params.shut_down_latches),
                 _ => None,
             };
             if let Some(flag) = flag {
