@@ -201,14 +201,9 @@ fn one_run(
     // The trace goes to its (temporary) file as the runs make it.
     let (runs, cut, trace_out) = match &a.trace {
         Some(p) => {
-            let f = match btfsm_report::output::OutputFile::create(p) {
+            let f = match super::io::create_output_file(p) {
                 Ok(f) => f,
-                Err(e) => {
-                    return fail(Diagnostic::error(format!(
-                        "cannot write `{}`: {e}",
-                        btfsm_core::sanitize::shown(&p.display().to_string())
-                    )));
-                }
+                Err(code) => return code,
             };
             let mut w = TraceWriter::new(f, &s.name, &file, s.seed, s.dt);
             let (runs, cut) = run::run_scenario_traced(&s, runs_deadline, &mut w);
@@ -242,10 +237,7 @@ fn one_run(
     if let Some((p, w)) = trace_out
         && let Err(e) = w.finish(&rep).and_then(|f| f.commit())
     {
-        return fail(Diagnostic::error(format!(
-            "cannot write `{}`: {e}",
-            btfsm_core::sanitize::shown(&p.display().to_string())
-        )));
+        return super::io::cannot_write(Some(p), e);
     }
     if let Some(p) = &a.plot
         && emit_text(Some(p), plot::svg(&s, &rep.policies)) != EXIT_OK
