@@ -143,11 +143,8 @@ fn open_within(
         )));
     };
     let tree = super::tree::parse(&xml).map_err(|e| Db3Error(format!("session {session}: {e}")))?;
-    let q = format!(
-        "SELECT timestamp FROM Transitions NOT INDEXED WHERE session_id = ?1 ORDER BY {rowid} LIMIT 1"
-    );
     let t0: Option<i64> = conn
-        .query_row(&q, [session], |r| r.get(0))
+        .query_row(&first_query(rowid), [session], |r| r.get(0))
         .optional()
         .map_err(sql)?;
     let t0 = t0.unwrap_or(0);
@@ -312,6 +309,13 @@ fn list_sessions(conn: &Connection, rowid: &str) -> Result<(Vec<Session>, bool),
         });
     }
     Ok((sessions, more_sessions))
+}
+
+/// The time of a session's first transition.
+fn first_query(rowid: &str) -> String {
+    format!(
+        "SELECT timestamp FROM Transitions NOT INDEXED WHERE session_id = ?1 ORDER BY {rowid} LIMIT 1"
+    )
 }
 
 /// One page of a session's transitions after a row id: a seek in the
@@ -523,16 +527,22 @@ mod tests {
         .unwrap();
         c.execute("INSERT INTO Definitions VALUES (1, 'd', ?1)", [XML])
             .unwrap();
-        for plan_of in [page_query("rowid", "uid")] {
+        for (plan_of, seek) in [
+            (page_query("rowid", "uid"), true),
+            (first_query("rowid"), false),
+        ] {
             let mut st = c.prepare(&format!("EXPLAIN QUERY PLAN {plan_of}")).unwrap();
             let plan: Vec<String> = st
-                .query_map(params![1, 0], |r| r.get::<_, String>(3))
+                .query_map(
+                    rusqlite::params_from_iter(if seek { vec![1, 0] } else { vec![1] }),
+                    |r| r.get::<_, String>(3),
+                )
                 .unwrap()
                 .map(Result::unwrap)
                 .collect();
             let plan = plan.join("; ");
             assert!(!plan.contains("INDEX") && !plan.contains("TEMP"), "{plan}");
-            assert!(plan.contains("rowid>?"), "{plan}");
+            assert!(!seek || plan.contains("rowid>?"), "{plan}");
         }
         for (ts, st) in [(10, 1), (20, 2), (15, 1)] {
             c.execute(
