@@ -59,6 +59,11 @@ impl Drop for Dir {
 /// Runs btfsm with `args` in `cwd`, the secret in its environment, under
 /// the caps; stderr goes to `stderr_to` when given (e.g. `/dev/full`).
 fn run_in(cwd: &Path, args: &[&str], stderr_to: Option<&str>) -> Run {
+    run_capped(cwd, args, stderr_to, AS_LIMIT)
+}
+
+/// [`run_in`] under an address-space cap of `as_limit` bytes.
+fn run_capped(cwd: &Path, args: &[&str], stderr_to: Option<&str>, as_limit: u64) -> Run {
     // BTFSM_UNDER_TEST runs the suite against another build (e.g. the one
     // before issue 12, to see every case fail).
     let bin =
@@ -84,10 +89,10 @@ fn run_in(cwd: &Path, args: &[&str], stderr_to: Option<&str>) -> Run {
     }
     // SAFETY: setrlimit is async-signal-safe; nothing else runs in the child.
     unsafe {
-        cmd.pre_exec(|| {
+        cmd.pre_exec(move || {
             let lim = libc::rlimit {
-                rlim_cur: AS_LIMIT,
-                rlim_max: AS_LIMIT,
+                rlim_cur: as_limit,
+                rlim_max: as_limit,
             };
             if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
                 return Err(std::io::Error::last_os_error());
@@ -424,6 +429,59 @@ fn memory_stays_bounded_by_the_input() {
     let r = run_in(&d.0, &["compare", &e14, &e14, "--mode", "named"], None);
     check(&r, &d.0, &[2], "expansion across policies");
     assert!(r.stderr.contains("copied by this command"), "{}", r.stderr);
+}
+
+/// Every TOML input (policy, scenario, domain, tick script, btfsm.toml) is
+/// counted before it is parsed (issue 33: 60 MB of `=` lines peaked at
+/// 4.45 GB, past a 2 GiB CI job's memory, before the first error): under
+/// a 2 GiB cap at the default limits, 8 MB of one-byte tokens is refused by
+/// the count, and the costliest document the count lets through (3 MB of
+/// dots, 112 bytes of parser memory per token) stays within 64 x the bytes
+/// read + 200 MB.
+#[test]
+fn every_toml_input_is_counted_before_it_is_parsed() {
+    const CAP: u64 = 2 << 30;
+    let d = Dir::new("toml-tokens");
+    let policy = d.write("leaf.toml", LEAF);
+    let readers = |f: &str| -> Vec<(Vec<String>, &'static str)> {
+        let v = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        vec![
+            (v(&["analyze", f]), "policy"),
+            (v(&["sim", f]), "scenario"),
+            (v(&["plan", f]), "domain"),
+            (v(&["tick", &policy, "--script", f]), "tick script"),
+        ]
+    };
+    for (name, text, counted) in [
+        ("eq.toml", "=\n".repeat(4_000_000), true),
+        (
+            "dots.toml",
+            format!("a = 1\n{}", ".".repeat(2_990_000)),
+            false,
+        ),
+    ] {
+        let f = d.write(name, &text);
+        drop(text);
+        for (args, what) in readers(&f) {
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let r = run_capped(&d.0, &args, None, CAP);
+            check(&r, &d.0, &[2], &format!("{what} {name}"));
+            assert_eq!(
+                r.stderr.contains("TOML tokens"),
+                counted,
+                "{what} {name}: {}",
+                &r.stderr[..r.stderr.len().min(2000)]
+            );
+        }
+        std::fs::remove_file(&f).expect("rm");
+    }
+    // btfsm.toml, found from the current directory.
+    let conf = Dir::new("toml-tokens-conf");
+    conf.write("btfsm.toml", "=\n".repeat(4_000_000));
+    let leaf = conf.write("leaf.toml", LEAF);
+    let r = run_capped(&conf.0, &["lint", &leaf], None, CAP);
+    check(&r, &conf.0, &[2], "btfsm.toml");
+    assert!(r.stderr.contains("TOML tokens"), "{}", r.stderr);
 }
 
 /// A FIFO with no writer, as a policy, node model or baseline: an answer

@@ -87,6 +87,17 @@ pub const DEFAULT_MAX_DEPTH: usize = 1_000;
 /// Default of [`Limits::max_name_bytes`].
 pub const DEFAULT_MAX_NAME_BYTES: usize = 4096;
 
+impl Limits {
+    /// The TOML tokens a policy may hold before it is parsed
+    /// (`core::toml_budget`): 50 per node of `--max-nodes`, at least a
+    /// million.
+    pub fn max_toml_tokens(&self) -> u64 {
+        (self.max_nodes as u64)
+            .saturating_mul(btfsm_core::toml_budget::TOKENS_PER_NODE)
+            .max(1 << 20)
+    }
+}
+
 impl Default for Limits {
     fn default() -> Self {
         Limits {

@@ -385,6 +385,15 @@ impl Loader {
         &mut self,
         file: &'i Arc<SourceFile>,
     ) -> Option<Spanned<DeTable<'i>>> {
+        // Counted before the parser allocates 70-112 bytes per token.
+        if let Err(d) = btfsm_core::toml_budget::check(
+            file,
+            self.limits.max_toml_tokens(),
+            "a policy of --max-nodes nodes needs fewer: raise --max-nodes",
+        ) {
+            self.diags.push(d);
+            return None;
+        }
         // The parser keeps the first error only (the recoverable parser
         // keeps every one: millions for a large bad file).
         let errors = match DeTable::parse(&file.text) {

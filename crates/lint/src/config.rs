@@ -85,6 +85,12 @@ pub fn find(dir: &Path) -> Option<PathBuf> {
 /// Reads the `[lint]` table of a `btfsm.toml`; every unknown code is
 /// reported with its position.
 pub fn read(file: &Arc<SourceFile>) -> Result<Config, Vec<Diagnostic>> {
+    btfsm_core::toml_budget::check(
+        file,
+        btfsm_core::toml_budget::DEFAULT_MAX_TOKENS,
+        "btfsm.toml lists rule codes: a few hundred tokens",
+    )
+    .map_err(|d| vec![d])?;
     let raw: RawFile = toml::from_str(&file.text).map_err(|e| {
         let d = Diagnostic::error(format!("invalid btfsm.toml: {}", e.message().trim()))
             .hint("btfsm.toml holds `[lint]` with `deny`, `warn` and `allow` lists of rule codes");

@@ -232,6 +232,12 @@ impl Files<'_> {
 /// The scenario's TOML as written (a syntax or type error is the one
 /// diagnostic).
 fn read_raw(file: &Arc<SourceFile>) -> Result<Raw, Vec<Diagnostic>> {
+    btfsm_core::toml_budget::check(
+        file,
+        btfsm_core::toml_budget::DEFAULT_MAX_TOKENS,
+        "a scenario's counts are capped (docs/guide/sim.md)",
+    )
+    .map_err(|d| vec![d])?;
     toml::from_str(&file.text).map_err(|e| {
         let d = Diagnostic::error(format!("invalid symbolic scenario: {}", e.message().trim()))
             .hint("see docs/guide/sim.md (\"Symbolic simulation\") for the format");
