@@ -359,6 +359,70 @@ fn control_characters_never_reach_an_output() {
     assert!(!outside.contains("<img"), "{}", r.stdout);
 }
 
+/// A file inside the root that is not a policy (a `.env` a CI step wrote,
+/// a `secrets.toml`, a key), named as a subtree, a BehaviorTree.CPP or
+/// yasmin include, a scenario's policy or a symbolic scenario's domain, is
+/// refused before it is parsed, and nothing of it is quoted (issue 33: its
+/// first line was the snippet of the parse error).
+#[test]
+fn a_named_file_that_is_not_a_policy_is_never_quoted() {
+    let d = Dir::new("not-policy");
+    d.write("repo/.git/HEAD", "ref: refs/heads/main\n");
+    d.write(".env", format!("GITHUB_TOKEN={SECRET}\n"));
+    d.write("repo/.env", format!("GITHUB_TOKEN={SECRET}\n"));
+    d.write("repo/secrets.toml", format!("token = \"{SECRET}\"\n"));
+    d.write("repo/key.xml", format!("{SECRET}\n<root/>\n"));
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "subtree.toml",
+            "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \".env\" }\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "subtree2.toml",
+            "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"secrets.toml\" }\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "inc.xml",
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"M\">\n<include path=\"key.xml\"/>\n<BehaviorTree ID=\"M\"><AlwaysSuccess/></BehaviorTree></root>\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "sm.xml",
+            "<StateMachine outcomes=\"end\">\n<StateMachine name=\"I\" file_path=\".env\"><Transition from=\"x\" to=\"end\"/></StateMachine>\n</StateMachine>\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "scen.toml",
+            "name = \"s\"\n[world]\n[[policies]]\nfile = \"secrets.toml\"\n".into(),
+            vec!["sim"],
+        ),
+        (
+            "symbolic.toml",
+            "name = \"s\"\ndomain = \".env\"\n[[policies]]\nfile = \"secrets.toml\"\n".into(),
+            vec!["sim"],
+        ),
+    ];
+    for (name, text, cmd) in cases {
+        let f = d.write(&format!("repo/{name}"), text);
+        let mut args = cmd.clone();
+        args.push(&f);
+        let r = run_in(&d.0, &args, None);
+        check(&r, &d.0, &[2], name);
+        assert!(
+            r.stderr.contains("nothing of it is shown"),
+            "{name}: {}",
+            r.stderr
+        );
+        assert!(
+            !r.stderr.contains("GITHUB_TOKEN") && !r.stderr.contains("token ="),
+            "{name}: {}",
+            r.stderr
+        );
+    }
+}
+
 /// Parameters doubled level by level, a file of a million TOML errors, the
 /// same big file given many times, a big include: bounded memory, exit 2.
 #[test]

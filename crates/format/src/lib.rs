@@ -277,6 +277,27 @@ pub(crate) fn head(text: &str) -> &str {
     &text[..end]
 }
 
+/// Reads a policy that another file names (a scenario's `file`, a trace's
+/// policy), once [`source::resolve`] has placed it inside the root: a
+/// regular file that is a policy by its name and first bytes
+/// ([`source::check_named`]), else refused quoting none of it.
+pub fn load_named(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    let file = source::read(path, &shown, limits, true)?;
+    source::check_named(path, &file.text, source::Named::AnyPolicy).map_err(|r| {
+        vec![
+            Diagnostic::error(format!(
+                "`{}`: {}",
+                btfsm_core::sanitize::shown(&shown),
+                r.message
+            ))
+            .hint(r.hint),
+        ]
+    })?;
+    let format = detect(path, &file.text);
+    load_read(file, path, format, limits)
+}
+
 /// Reads a policy from any supported format (see [`detect`]).
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();

@@ -133,13 +133,27 @@ pub fn read_source(
 }
 
 /// Reads a file another file names, once [`super::source::resolve`] has
-/// placed it inside the root: it must be a regular file.
+/// placed it inside the root: it must be a regular file and what `expect`
+/// says ([`super::source::check_named`]), else it is refused with a message
+/// that quotes none of it.
 pub(crate) fn read_included(
     path: &Path,
     shown: &str,
     limits: &Limits,
+    expect: super::source::Named,
 ) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
-    super::source::read(path, shown, limits, true)
+    let file = super::source::read(path, shown, limits, true)?;
+    super::source::check_named(path, &file.text, expect).map_err(|r| {
+        vec![
+            Diagnostic::error(format!(
+                "`{}`: {}",
+                btfsm_core::sanitize::shown(shown),
+                r.message
+            ))
+            .hint(r.hint),
+        ]
+    })?;
+    Ok(file)
 }
 
 /// An included file (canonical path) with its `with` values.

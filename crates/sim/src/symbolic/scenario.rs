@@ -259,6 +259,20 @@ fn load_domain(
         Ok(p) => {
             let shown = p.display().to_string();
             let f = format::source::read(&p, &shown, files.limits, true)?;
+            // Checked before it is parsed: a file that is not a domain is
+            // refused quoting none of it (issue 33).
+            let is_toml = p
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+            if !is_toml || !format::discover::looks_like_domain(&f.text) {
+                return Err(vec![
+                    Diagnostic::error(format!(
+                        "domain `{}`: not an action domain: it is not read, and nothing of it is shown",
+                        btfsm_core::sanitize::shown(&shown)
+                    ))
+                    .hint("a domain is a `.toml` file with `[actions.NAME]` or `[predicates]` tables (docs/guide/plan.md)"),
+                ]);
+            }
             btfsm_plan::load(&f).map(Some)
         }
         Err(r) => {
@@ -455,7 +469,7 @@ fn load_policies(
                 continue;
             }
         };
-        match format::load(&path, files.limits) {
+        match format::load_named(&path, files.limits) {
             Ok(l) => match unbound(domain, &l.policy) {
                 None => policies.push((path, l.policy)),
                 Some(why) => pb.err(
