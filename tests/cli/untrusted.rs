@@ -423,6 +423,63 @@ fn a_named_file_that_is_not_a_policy_is_never_quoted() {
     }
 }
 
+/// A pull request's `btfsm.toml` is bounded (one message per kind of
+/// error: 300,000 unknown codes give two messages, not 300,000), and cannot
+/// turn lint off where the CI reads the base branch's (`--config`) or none
+/// (`--no-config`), as docs/guide/ci.md's recipe does.
+#[test]
+fn a_pull_requests_btfsm_toml_is_bounded_and_can_be_ignored() {
+    let d = Dir::new("config");
+    d.write(".git/HEAD", "ref: refs/heads/main\n");
+    let fig03 = d.write(
+        "fig03-bt.toml",
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper/fig03-bt.toml"))
+            .expect("fig03"),
+    );
+    // fig03 has an error-level finding (exit 1) by default.
+    let r = run_in(&d.0, &["lint", &fig03], None);
+    check(&r, &d.0, &[1], "no btfsm.toml");
+    let codes: Vec<String> = (0..300_000)
+        .map(|i| format!("\"no-such-rule-{i}\""))
+        .collect();
+    d.write(
+        "btfsm.toml",
+        format!("[lint]\nallow = [{}]\n", codes.join(", ")),
+    );
+    let r = run_in(&d.0, &["lint", &fig03], None);
+    check(&r, &d.0, &[2], "300,000 unknown codes");
+    assert!(
+        r.stderr.len() < 4000,
+        "{}",
+        &r.stderr[..r.stderr.len().min(3000)]
+    );
+    assert!(
+        r.stderr.contains("299999 more unknown lint codes"),
+        "{}",
+        r.stderr
+    );
+    // A btfsm.toml allowing every rule: lint is off for the pull request...
+    let list = run_in(&d.0, &["lint", "--list"], None);
+    let all: Vec<String> = (list.stdout.lines().skip(1))
+        .filter_map(|l| l.split_whitespace().next())
+        .map(|c| format!("\"{c}\""))
+        .collect();
+    assert!(all.len() > 10, "{}", list.stdout);
+    d.write(
+        "btfsm.toml",
+        format!("[lint]\nallow = [{}]\n", all.join(", ")),
+    );
+    let r = run_in(&d.0, &["lint", &fig03], None);
+    check(&r, &d.0, &[0], "every rule allowed");
+    // ...unless the CI ignores it, or reads the base branch's.
+    let r = run_in(&d.0, &["lint", &fig03, "--no-config"], None);
+    check(&r, &d.0, &[1], "--no-config");
+    let base = Dir::new("config-base");
+    let conf = base.write("btfsm.toml", "[lint]\nwarn = [\"not-fault-tolerant\"]\n");
+    let r = run_in(&d.0, &["lint", &fig03, "--config", &conf], None);
+    check(&r, &d.0, &[1], "--config");
+}
+
 /// Parameters doubled level by level, a file of a million TOML errors, the
 /// same big file given many times, a big include: bounded memory, exit 2.
 #[test]
