@@ -182,6 +182,11 @@ pub(crate) struct LimitArgs {
     /// baselines, traces and repeated arguments each count)
     #[arg(long, default_value_t = btfsm_format::source::DEFAULT_MAX_TOTAL_BYTES, hide_short_help = true)]
     pub max_total_bytes: u64,
+    /// Most BT nodes and FSM states the command reads in all its policies
+    /// (a directory's files, a scenario's policies); past it no other
+    /// policy is parsed
+    #[arg(long, default_value_t = btfsm_format::DEFAULT_MAX_TOTAL_NODES, hide_short_help = true)]
+    pub max_total_nodes: u64,
     /// Directory that files named by a policy or scenario (subtrees,
     /// includes, scenario policies) must stay inside, and that outputs
     /// typed inside it may not leave through a symbolic link [default: the
@@ -257,6 +262,7 @@ impl LimitArgs {
             },
             read_budget: btfsm_format::source::Budget::new(self.max_total_bytes),
             expansion_budget: btfsm_format::source::Budget::new(self.max_nodes as u64),
+            total_nodes: btfsm_format::source::Budget::new(self.max_total_nodes),
             tree: self.tree.clone(),
             ..Default::default()
         }

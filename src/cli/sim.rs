@@ -29,6 +29,10 @@ const SIM_HELP: super::format::Help = &[
 /// `--threads` above this many per core are lowered to it.
 pub(crate) const MAX_THREADS_PER_CORE: usize = 4;
 
+/// Most `--runs` (issue 33: `--runs 4294967295` allocated 4 GiB of
+/// per-episode flags before its figures).
+pub(crate) const MAX_RUNS: u32 = 10_000_000;
+
 #[derive(Debug, Args)]
 pub(crate) struct SimArgs {
     /// Scenario file (TOML)
@@ -43,7 +47,9 @@ pub(crate) struct SimArgs {
     #[arg(long, value_name = "OUT.svg")]
     pub plot: Option<PathBuf>,
     /// Run N seeded episodes with randomized disturbances and failure rates
-    #[arg(long, value_name = "N")]
+    /// (at most 10,000,000: more would take days, and the figures keep a
+    /// flag per episode asked for)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(0..=i64::from(MAX_RUNS)))]
     pub runs: Option<u32>,
     /// With --runs, the seed of the episodes (default: the scenario's
     /// seed); without, run the one episode with seed S (the scenario's

@@ -1051,3 +1051,30 @@ fn sim_csv_has_the_figures_of_the_json_report() {
         );
     }
 }
+
+/// `--runs` is at most 10,000,000 (issue 33: `--runs 4294967295` allocated
+/// 4 GiB of per-episode flags); the most allowed, with a budget, stays
+/// small: 10 MB of flags.
+#[test]
+fn sim_hostile_runs_are_capped() {
+    let s = "policies/scenarios/exp1-nominal.toml";
+    let (code, _, err, _) = common::btfsm_capped(512, &["sim", s, "--runs", "4294967295"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("0..=10000000"), "{err}");
+    let (code, out, err, t) = common::btfsm_capped(
+        512,
+        &[
+            "sim",
+            s,
+            "--runs",
+            "10000000",
+            "--timeout-ms",
+            "300",
+            "--format",
+            "json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\"requested_runs\": 10000000"), "{out}");
+    assert!(t.as_secs() < 20, "{t:?}");
+}

@@ -480,6 +480,33 @@ fn a_pull_requests_btfsm_toml_is_bounded_and_can_be_ignored() {
     check(&r, &d.0, &[1], "--config");
 }
 
+/// `validate DIR` has a total budget (issue 33: a directory of large
+/// policies took 101 s of CPU within the byte budget): past
+/// `--max-total-nodes` in all, no other policy is parsed, and the files
+/// left are one message.
+#[test]
+fn validate_of_a_directory_stops_at_the_total_node_budget() {
+    let d = Dir::new("total-nodes");
+    let kids: Vec<String> = (0..1000).map(|i| format!("\"l{i}\"")).collect();
+    let mut text = format!(
+        "kind = \"bt\"\nroot = \"r\"\n[nodes]\nr = {{ sequence = [{}] }}\n",
+        kids.join(", ")
+    );
+    for i in 0..1000 {
+        text.push_str(&format!("l{i} = {{ action = \"A\", skill = \"Dock\" }}\n"));
+    }
+    for i in 0..30 {
+        d.write(&format!("p/f{i:02}.toml"), &text);
+    }
+    let dir = d.path("p");
+    let r = run_in(&d.0, &["validate", &dir, "--max-total-nodes", "5000"], None);
+    check(&r, &d.0, &[2], "validate DIR");
+    assert_eq!(r.stderr.matches(": ok (").count(), 4, "{}", r.stderr);
+    assert!(r.stderr.contains("25 files not validated"), "{}", r.stderr);
+    let r = run_in(&d.0, &["validate", &dir], None);
+    check(&r, &d.0, &[0], "validate DIR, default budget");
+}
+
 /// Parameters doubled level by level, a file of a million TOML errors, the
 /// same big file given many times, a big include: bounded memory, exit 2.
 #[test]

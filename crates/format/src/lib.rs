@@ -61,6 +61,11 @@ pub struct Limits {
     /// `max_nodes` in all, so that a few kilobytes of files including each
     /// other twice per level cannot build millions of nodes per policy.
     pub expansion_budget: Arc<source::Budget>,
+    /// The nodes and states of all the policies the command reads
+    /// (`--max-total-nodes`, issue 33: `validate DIR` of many large files
+    /// took 101 s of CPU within the byte budget): once spent, no other
+    /// policy is parsed.
+    pub total_nodes: Arc<source::Budget>,
     /// The BehaviorTree.CPP tree to read (`--tree ID`), as a program names
     /// it to the factory; over `main_tree_to_execute`. Other formats
     /// ignore it.
@@ -82,6 +87,9 @@ pub enum AssumeLeaf {
 pub const DEFAULT_MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 /// Default of [`Limits::max_nodes`].
 pub const DEFAULT_MAX_NODES: usize = 150_000;
+/// Default of `--max-total-nodes` ([`Limits::total_nodes`]): ten policies
+/// at `--max-nodes`.
+pub const DEFAULT_MAX_TOTAL_NODES: u64 = 10 * DEFAULT_MAX_NODES as u64;
 /// Default of [`Limits::max_depth`].
 pub const DEFAULT_MAX_DEPTH: usize = 1_000;
 /// Default of [`Limits::max_name_bytes`].
@@ -111,6 +119,7 @@ impl Default for Limits {
             confinement: source::Confinement::Auto,
             read_budget: source::Budget::new(source::DEFAULT_MAX_TOTAL_BYTES),
             expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
+            total_nodes: source::Budget::new(DEFAULT_MAX_TOTAL_NODES),
             tree: None,
             companions: None,
         }
@@ -313,6 +322,20 @@ pub fn load_read(
     format: FileFormat,
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
+    let total = &limits.total_nodes;
+    let spent = || {
+        vec![
+            Diagnostic::error(format!(
+                "{}: not read: this command has read more than {} nodes and states in all its policies",
+                btfsm_core::sanitize::shown(&path.display().to_string()),
+                total.limit()
+            ))
+            .hint("raise the limit with --max-total-nodes, or name fewer files"),
+        ]
+    };
+    if total.remaining() == 0 {
+        return Err(spent());
+    }
     let loaded = match format {
         FileFormat::Toml => toml::load_read(&file, path, limits),
         FileFormat::BtcppXml => btcpp_xml::load_read(file, path, limits),
@@ -325,6 +348,14 @@ pub fn load_read(
         d.message = format!("{}: {}", loaded.path, d.message);
         d.span = None;
         return Err(vec![d]);
+    }
+    let size = match &loaded.policy.body {
+        btfsm_model::PolicyBody::Bt(bt) => bt.nodes.len(),
+        btfsm_model::PolicyBody::Machine(m) => m.states.len(),
+    };
+    if !total.charge(size as u64) {
+        total.exhaust();
+        return Err(spent());
     }
     Ok(loaded)
 }

@@ -54,6 +54,11 @@ impl Budget {
         self.limit.saturating_sub(self.used.load(Ordering::Relaxed))
     }
 
+    /// Spends what remains.
+    pub fn exhaust(&self) {
+        self.used.store(self.limit, Ordering::Relaxed);
+    }
+
     /// Charges `n` bytes; `false` (nothing charged) when they do not fit.
     pub fn charge(&self, n: u64) -> bool {
         self.used
