@@ -179,6 +179,34 @@ fn monte_carlo_runs(
     emit_text(None, text)
 }
 
+/// The `--trace` file within `--max-file-bytes`, the most btfsm reads back
+/// (`view`, `log compare`, `dot --trace`): past it writing fails, the
+/// temporary is removed and the run exits 2 (issue 33: a 1 KB scenario
+/// wrote a 4.2 GB trace).
+struct Capped<W> {
+    w: W,
+    left: u64,
+    cap: u64,
+}
+
+impl<W: std::io::Write> std::io::Write for Capped<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if buf.len() as u64 > self.left {
+            return Err(std::io::Error::other(format!(
+                "the trace would be larger than {} bytes, the most btfsm reads back (--max-file-bytes); lower the scenario's max_steps, or raise --max-file-bytes",
+                self.cap
+            )));
+        }
+        let n = self.w.write(buf)?;
+        self.left -= n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.w.flush()
+    }
+}
+
 /// `sim` without `--runs`: each policy once (or the episode of `--seed`),
 /// the verdicts, the expectations, the trace and the plot.
 fn one_run(
@@ -211,6 +239,11 @@ fn one_run(
                 Ok(f) => f,
                 Err(code) => return code,
             };
+            let f = Capped {
+                w: f,
+                left: a.limits.max_file_bytes,
+                cap: a.limits.max_file_bytes,
+            };
             let mut w = TraceWriter::new(f, &s.name, &file, s.seed, s.dt);
             let (runs, cut) = run::run_scenario_traced(&s, runs_deadline, &mut w);
             (runs, cut, Some((p, w)))
@@ -241,7 +274,7 @@ fn one_run(
         millis: Some(millis),
     });
     if let Some((p, w)) = trace_out
-        && let Err(e) = w.finish(&rep).and_then(|f| f.commit())
+        && let Err(e) = w.finish(&rep).and_then(|f| f.w.commit())
     {
         return super::io::cannot_write(Some(p), e);
     }

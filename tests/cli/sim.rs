@@ -830,6 +830,49 @@ mod hostile {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A trace is at most `--max-file-bytes`, what btfsm reads back
+    /// (issue 33: a 1 KB scenario wrote a 4.2 GB trace): past it the run
+    /// exits 2 and leaves no file.
+    #[test]
+    fn sim_hostile_trace_is_bounded_by_max_file_bytes() {
+        let dir = scratch("capped-trace");
+        let f = dir.join("long.toml");
+        std::fs::write(
+            &f,
+            format!(
+                "max_steps = 200000\n{CUBE}{}[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n",
+                policies(1)
+            ),
+        )
+        .unwrap();
+        let trace = dir.join("trace.json");
+        let (code, _, err, took) = btfsm_within(
+            80,
+            &[
+                "sim",
+                f.to_str().unwrap(),
+                "--trace",
+                trace.to_str().unwrap(),
+                "--max-file-bytes",
+                "5000000",
+            ],
+        );
+        assert_eq!(code, 2, "{err}");
+        assert!(took < HANG_GUARD, "{took:?}");
+        assert!(err.contains("larger than 5000000 bytes"), "{err}");
+        let mut names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            ["fig01-bt.toml", "long.toml"],
+            "a trace or a temporary left"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     /// 64 policies picking and placing a cube every step for 10^6 steps
     /// (a 400-byte scenario) recorded 2 million skills each: 3.3 GB per
     /// policy. A run now records at most 1024 skills and 4096 events (every
