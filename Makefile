@@ -78,7 +78,11 @@ test: prerequisites
 # random trees (dataflow_btcpp.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
 # compared by `log compare` as its Python leaves saw them (btlog_compare.py),
-# and as SqliteLogger .db3 sessions counted by SQL (btlog_db3.py); and
+# and as SqliteLogger .db3 sessions counted by SQL (btlog_db3.py); every
+# markdown output (compare, sim --runs, log report, log compare) of seeded
+# random hostile names rendered by cmark-gfm (PyPI `cmarkgfm`, GitHub's
+# fork) with no element, link, mention or heading from input
+# (markdown_gfm.py); and
 # every corpus SCXML file read by btfsm and by an independent SCXML engine
 # (PyPI `scjson`) alike (tests/differential/scxml_engine.py); and
 # `compare --mode tree`'s distance against the `apted` and `zss` packages on
@@ -110,6 +114,7 @@ differential: $(VENV)/.installed
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/btlog_compare.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/btlog_compare.txt
 	$(VENV)/bin/python tests/differential/btlog_db3.py --btfsm $(TARGET_DIR)/debug/btfsm
+	$(VENV)/bin/python tests/differential/markdown_gfm.py --btfsm $(TARGET_DIR)/debug/btfsm --cases 150 --seed $(PROPTEST_SEED)
 	$(VENV)/bin/python tests/differential/scxml_engine.py $(TARGET_DIR)/debug/btfsm $$(find tests/fixtures/corpus/scxml -name '*.scxml' | sort)
 	GED_DUMP=$(abspath $(TARGET_DIR))/paper-graphs.jsonl GED_DUMP_FILES=$(GED_PAPER_FILES) \
 	  $(CARGO) test --quiet --locked -p btfsm-metrics --lib dump_policy_graphs -- --ignored > /dev/null

@@ -68,6 +68,37 @@ pub(crate) enum Command {
     Man(super::man::ManArgs),
 }
 
+impl Command {
+    /// The command's input limits, whose `--root` and
+    /// `--allow-outside-root` also say where its outputs may go.
+    pub(crate) fn limit_args(&self) -> Option<&LimitArgs> {
+        use super::log::LogCommand;
+        Some(match self {
+            Command::Analyze(a) => &a.limits,
+            Command::Validate(a) => &a.limits,
+            Command::Dot(a) => &a.limits,
+            Command::Compare(a) => &a.limits,
+            Command::Convert(a) => &a.limits,
+            Command::Effort(a) => &a.limits,
+            Command::Paper(a) => &a.limits,
+            Command::Edit(a) => &a.limits,
+            Command::Sim(a) => &a.limits,
+            Command::Tick(a) => &a.limits,
+            Command::Plan(a) => &a.limits,
+            Command::Lint(a) => &a.limits,
+            Command::Log(a) => match &a.command {
+                LogCommand::Report(a) => &a.limits,
+                LogCommand::Dot(a) => &a.limits,
+                LogCommand::Compare(a) => &a.limits,
+                LogCommand::Timeline(a) => &a.limits,
+            },
+            Command::View(a) => &a.limits,
+            Command::TedPairs(a) => &a.limits,
+            Command::Completions(_) | Command::Man(_) => return None,
+        })
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub(crate) enum CompareMode {
     Structural,
@@ -151,13 +182,21 @@ pub(crate) struct LimitArgs {
     /// baselines, traces and repeated arguments each count)
     #[arg(long, default_value_t = btfsm_format::source::DEFAULT_MAX_TOTAL_BYTES, hide_short_help = true)]
     pub max_total_bytes: u64,
+    /// Most BT nodes and FSM states the command reads in all its policies
+    /// (a directory's files, a scenario's policies); past it no other
+    /// policy is parsed
+    #[arg(long, default_value_t = btfsm_format::DEFAULT_MAX_TOTAL_NODES, hide_short_help = true)]
+    pub max_total_nodes: u64,
     /// Directory that files named by a policy or scenario (subtrees,
-    /// includes, scenario policies) must stay inside [default: the git work
-    /// tree of the file given, else its directory]
+    /// includes, scenario policies) must stay inside, and that outputs
+    /// typed inside it may not leave through a symbolic link [default: the
+    /// git work tree of the file given (for outputs: of the current
+    /// directory), else its directory]
     #[arg(long, value_name = "DIR", conflicts_with = "allow_outside_root")]
     pub root: Option<PathBuf>,
     /// Let policies and scenarios name files anywhere (absolute paths, `..`
-    /// out of the root): for trusted local files only
+    /// out of the root), and outputs be written through symbolic links out
+    /// of the root or into `.git`: for trusted local use only
     #[arg(long)]
     pub allow_outside_root: bool,
 }
@@ -223,6 +262,7 @@ impl LimitArgs {
             },
             read_budget: btfsm_format::source::Budget::new(self.max_total_bytes),
             expansion_budget: btfsm_format::source::Budget::new(self.max_nodes as u64),
+            total_nodes: btfsm_format::source::Budget::new(self.max_total_nodes),
             tree: self.tree.clone(),
             ..Default::default()
         }

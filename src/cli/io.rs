@@ -228,12 +228,34 @@ pub(super) fn emit_text(path: Option<&Path>, text: impl AsRef<str>) -> u8 {
     emit(path, super::out::text(text.as_ref()).as_bytes())
 }
 
+/// Where this command's outputs may go (`report::output::OutputRoot`), set
+/// once from its `--root` and `--allow-outside-root` before it runs.
+static OUTPUT_ROOT: std::sync::OnceLock<btfsm_report::output::OutputRoot> =
+    std::sync::OnceLock::new();
+
+/// Sets where the command's outputs may go (the first call wins).
+pub(super) fn set_output_root(limits: Option<&super::args::LimitArgs>) {
+    let root = match limits {
+        Some(l) => btfsm_report::output::OutputRoot::new(l.allow_outside_root, l.root.as_deref()),
+        None => btfsm_report::output::OutputRoot::new(false, None),
+    };
+    let _ = OUTPUT_ROOT.set(root);
+}
+
+/// Where outputs may go: what [`set_output_root`] set, else the default
+/// (the git work tree of the current directory, never `.git`).
+pub(super) fn output_root() -> &'static btfsm_report::output::OutputRoot {
+    OUTPUT_ROOT.get_or_init(|| btfsm_report::output::OutputRoot::new(false, None))
+}
+
 /// Writes output to a file (see `report::output`: atomically, through
-/// symlinks, into devices and FIFOs) or to stdout (no path, `-`, or a path
-/// that is stdout).
+/// symlinks that stay inside the root, into devices and FIFOs, never into
+/// `.git`) or to stdout (no path, `-`, or a path that is stdout). Every
+/// file a command writes goes through here (or, streamed, through
+/// [`create_output_file`]).
 pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
     use btfsm_report::output::Destination;
-    let dest = match path.map(Destination::resolve) {
+    let dest = match path.map(|p| Destination::resolve_within(p, output_root())) {
         None => Destination::Stdout,
         Some(Ok(d)) => d,
         Some(Err(e)) => return cannot_write(path, e),
@@ -254,13 +276,34 @@ pub(super) fn emit(path: Option<&Path>, bytes: &[u8]) -> u8 {
     }
 }
 
-fn cannot_write(path: Option<&Path>, e: std::io::Error) -> u8 {
+/// A streamed output file (`sim --trace`) under the rules of [`emit`]; an
+/// error is printed (exit 2).
+pub(super) fn create_output_file(path: &Path) -> Result<btfsm_report::output::OutputFile, u8> {
+    btfsm_report::output::OutputFile::create(path, output_root())
+        .map_err(|e| cannot_write(Some(path), e))
+}
+
+/// Creates a directory outputs go under (`plan -o DIR`) under the rules of
+/// [`emit`]; an error is printed (exit 2).
+pub(super) fn create_output_dir(path: &Path) -> Result<(), u8> {
+    btfsm_report::output::create_dir_within(path, output_root())
+        .map_err(|e| cannot_write(Some(path), e))
+}
+
+/// The error of an output that cannot be written, with the confinement's
+/// hint when that is why.
+pub(super) fn cannot_write(path: Option<&Path>, e: std::io::Error) -> u8 {
     let path = path.map_or_else(|| "-".into(), |p| p.display().to_string());
-    fail(Diagnostic::error(format!(
+    let d = Diagnostic::error(format!(
         "cannot write `{}`: {}",
         shown(&path),
         btfsm_core::sanitize::shown_max(&e.to_string(), 2000)
-    )))
+    ));
+    fail(if btfsm_report::output::is_confined(&e) {
+        d.hint(btfsm_report::output::CONFINED_HINT)
+    } else {
+        d
+    })
 }
 
 /// Refuses, before anything is computed or written, outputs of one command
@@ -271,6 +314,15 @@ pub(super) fn outputs_distinct(outputs: &[(&str, Option<&Path>)], report_on_stdo
         .iter()
         .filter_map(|&(flag, p)| Some((flag, p?)))
         .collect();
+    // Confined before anything is computed (`emit` checks again).
+    for &(_, p) in &given {
+        if let Err(e) = btfsm_report::output::Destination::resolve_within(p, output_root())
+            && btfsm_report::output::is_confined(&e)
+        {
+            cannot_write(Some(p), e);
+            return false;
+        }
+    }
     match btfsm_report::output::check_distinct(&given, report_on_stdout) {
         Ok(()) => true,
         Err(e) => {

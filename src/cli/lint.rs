@@ -40,9 +40,15 @@ pub(crate) struct LintArgs {
     #[arg(long, value_name = "CODE")]
     pub allow: Vec<String>,
     /// Do not read btfsm.toml (by default: the one in the current folder or
-    /// above it, up to the repository root)
+    /// above it, up to the repository root): for a pull request, whose
+    /// btfsm.toml could allow every rule
     #[arg(long)]
     pub no_config: bool,
+    /// Read the rule levels from this btfsm.toml instead of looking for one
+    /// (for a pull request: the base branch's, which the pull request
+    /// cannot change)
+    #[arg(long, value_name = "FILE", conflicts_with = "no_config")]
+    pub config: Option<PathBuf>,
     /// List the rules with their default level and summary, and exit
     #[arg(long, exclusive = true)]
     pub list: bool,
@@ -109,13 +115,20 @@ fn rule_table() -> String {
 /// then the flags; `None` after printing why they are invalid.
 fn levels(a: &LintArgs, err: &mut impl Write) -> Option<config::Config> {
     let mut cfg = config::Config::default();
-    if !a.no_config
-        && let Ok(cwd) = std::env::current_dir()
-        && let Some(path) = config::find(&cwd)
-    {
+    // `--config FILE` is read as a command-line file; one found is named.
+    let found = || {
+        let cwd = std::env::current_dir().ok()?;
+        config::find(&cwd)
+    };
+    let path = match &a.config {
+        Some(p) => Some((p.clone(), false)),
+        None if a.no_config => None,
+        None => found().map(|p| (p, true)),
+    };
+    if let Some((path, named)) = path {
         let limits = a.limits.limits();
         let shown = path.display().to_string();
-        match format::source::read(&path, &shown, &limits, true).map(|f| config::read(&f)) {
+        match format::source::read(&path, &shown, &limits, named).map(|f| config::read(&f)) {
             Ok(Ok(c)) => cfg = c,
             Ok(Err(d)) | Err(d) => {
                 print_diagnostics(err, &d);

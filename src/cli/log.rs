@@ -155,7 +155,9 @@ pub(super) fn execute(a: LogArgs) -> u8 {
     }
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
-    let opened = match btfsm_log::open(&a.log, a.session, limits.max_file_bytes) {
+    // One deadline for every query of the command (issue 33).
+    let deadline = std::time::Instant::now() + btfsm_log::DEADLINE;
+    let opened = match btfsm_log::open(&a.log, a.session, &limits, deadline) {
         Ok(o) => o,
         Err(e) => return bad_log(&shown, &e),
     };
@@ -213,7 +215,9 @@ fn dot(a: DotArgs) -> u8 {
     };
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
-    let file = match btfsm_log::open(&a.log, a.session, limits.max_file_bytes) {
+    // One deadline for every query of the command (issue 33).
+    let deadline = std::time::Instant::now() + btfsm_log::DEADLINE;
+    let file = match btfsm_log::open(&a.log, a.session, &limits, deadline) {
         Ok(o) => o.reader,
         Err(e) => return bad_log(&shown, &e),
     };
@@ -279,10 +283,12 @@ fn compare(a: CompareArgs) -> u8 {
         ));
     }
     let limits = a.limits.limits();
+    // One deadline for every query of the command (issue 33).
+    let deadline = std::time::Instant::now() + btfsm_log::DEADLINE;
     let mut sides = Vec::new();
     for (p, session) in [(&a.a, a.session_a), (&a.b, a.session_b)] {
         let shown = p.display().to_string();
-        let r = match btfsm_log::open(p, session, limits.max_file_bytes) {
+        let r = match btfsm_log::open(p, session, &limits, deadline) {
             Ok(o) => o.reader,
             Err(e) => return bad_log(&shown, &e),
         };
@@ -334,8 +340,10 @@ fn timeline(a: TimelineArgs) -> u8 {
     }
     let shown = a.log.display().to_string();
     let limits = a.limits.limits();
+    // One deadline for every query of the command (issue 33).
+    let deadline = std::time::Instant::now() + btfsm_log::DEADLINE;
     let open = || {
-        btfsm_log::open(&a.log, a.session, limits.max_file_bytes)
+        btfsm_log::open(&a.log, a.session, &limits, deadline)
             .map(|o| o.reader)
             .map_err(std::io::Error::other)
     };

@@ -80,6 +80,7 @@ where
 /// Runs one command: each is one function in its own file.
 fn execute(command: args::Command) -> u8 {
     use args::Command;
+    io::set_output_root(command.limit_args());
     match command {
         Command::Analyze(a) => analyze::run(a),
         Command::Validate(a) => validate::run(a),

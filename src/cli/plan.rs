@@ -133,11 +133,8 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
         written.push((format!("{}-{tag}.toml", domain.name), p));
     }
     if let Some(dir) = &a.output {
-        if let Err(e) = std::fs::create_dir_all(dir) {
-            return fail(Diagnostic::error(format!(
-                "cannot create {}: {e}",
-                btfsm_core::sanitize::shown(&dir.display().to_string())
-            )));
+        if let Err(code) = super::io::create_output_dir(dir) {
+            return code;
         }
         for (name, p) in &written {
             let code = emit_text(

@@ -29,6 +29,10 @@ const SIM_HELP: super::format::Help = &[
 /// `--threads` above this many per core are lowered to it.
 pub(crate) const MAX_THREADS_PER_CORE: usize = 4;
 
+/// Most `--runs` (issue 33: `--runs 4294967295` allocated 4 GiB of
+/// per-episode flags before its figures).
+pub(crate) const MAX_RUNS: u32 = 10_000_000;
+
 #[derive(Debug, Args)]
 pub(crate) struct SimArgs {
     /// Scenario file (TOML)
@@ -43,7 +47,9 @@ pub(crate) struct SimArgs {
     #[arg(long, value_name = "OUT.svg")]
     pub plot: Option<PathBuf>,
     /// Run N seeded episodes with randomized disturbances and failure rates
-    #[arg(long, value_name = "N")]
+    /// (at most 10,000,000: more would take days, and the figures keep a
+    /// flag per episode asked for)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(0..=i64::from(MAX_RUNS)))]
     pub runs: Option<u32>,
     /// With --runs, the seed of the episodes (default: the scenario's
     /// seed); without, run the one episode with seed S (the scenario's
@@ -176,6 +182,34 @@ fn threads(a: &SimArgs, n: u32) -> Option<usize> {
     Some(t.clamp(1, n.max(1) as usize))
 }
 
+/// The `--trace` file within `--max-file-bytes`, the most btfsm reads back
+/// (`view`, `log compare`, `dot --trace`): past it writing fails, the
+/// temporary is removed and the run exits 2 (issue 33: a 1 KB scenario
+/// wrote a 4.2 GB trace).
+struct Capped<W> {
+    w: W,
+    left: u64,
+    cap: u64,
+}
+
+impl<W: std::io::Write> std::io::Write for Capped<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if buf.len() as u64 > self.left {
+            return Err(std::io::Error::other(format!(
+                "the trace would be larger than {} bytes, the most btfsm reads back (--max-file-bytes); lower the scenario's max_steps, or raise --max-file-bytes",
+                self.cap
+            )));
+        }
+        let n = self.w.write(buf)?;
+        self.left -= n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.w.flush()
+    }
+}
+
 /// `sim` without `--runs`: each policy once (or the episode of `--seed`),
 /// the verdicts, the expectations, the trace and the plot.
 fn one_run(
@@ -204,14 +238,14 @@ fn one_run(
     // The trace goes to its (temporary) file as the runs make it.
     let (runs, cut, trace_out) = match &a.trace {
         Some(p) => {
-            let f = match btfsm_report::output::OutputFile::create(p) {
+            let f = match super::io::create_output_file(p) {
                 Ok(f) => f,
-                Err(e) => {
-                    return fail(Diagnostic::error(format!(
-                        "cannot write `{}`: {e}",
-                        btfsm_core::sanitize::shown(&p.display().to_string())
-                    )));
-                }
+                Err(code) => return code,
+            };
+            let f = Capped {
+                w: f,
+                left: a.limits.max_file_bytes,
+                cap: a.limits.max_file_bytes,
             };
             let mut w = TraceWriter::new(f, &s.name, &file, s.seed, s.dt);
             let (runs, cut) = run::run_scenario_traced(&s, runs_deadline, &mut w);
@@ -243,12 +277,9 @@ fn one_run(
         millis: Some(millis),
     });
     if let Some((p, w)) = trace_out
-        && let Err(e) = w.finish(&rep).and_then(|f| f.commit())
+        && let Err(e) = w.finish(&rep).and_then(|f| f.w.commit())
     {
-        return fail(Diagnostic::error(format!(
-            "cannot write `{}`: {e}",
-            btfsm_core::sanitize::shown(&p.display().to_string())
-        )));
+        return super::io::cannot_write(Some(p), e);
     }
     if let Some(p) = &a.plot
         && emit_text(Some(p), plot::svg(&s, &rep.policies)) != EXIT_OK

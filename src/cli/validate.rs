@@ -35,7 +35,22 @@ pub(super) fn run(a: ValidateArgs) -> u8 {
         }
     };
     let (mut failed, mut skipped) = (false, 0usize);
-    for input in &inputs {
+    for (i, input) in inputs.iter().enumerate() {
+        // Past the command's node budget, one message for the rest.
+        if limits.total_nodes.remaining() == 0 {
+            let _ = write!(
+                err,
+                "{}",
+                Diagnostic::error(format!(
+                    "{} files not validated: this command has read more than {} nodes and states in all",
+                    inputs.len() - i,
+                    limits.total_nodes.limit()
+                ))
+                .hint("raise the limit with --max-total-nodes, or name fewer files")
+            );
+            failed = true;
+            break;
+        }
         // Read once; a scenario is validated as `sim` reads it (its
         // policies included), without running it.
         match format::discover::read(input, &limits) {

@@ -67,7 +67,12 @@ fn view_failed(e: ViewError) -> Option<Replay> {
 
 /// One input's replay; `None` after printing why not. Every input is read
 /// once through `format::source` (bounded, never blocking on a FIFO).
-fn replay_of(path: &Path, a: &ViewArgs, limits: &btfsm_format::Limits) -> Option<Replay> {
+fn replay_of(
+    path: &Path,
+    a: &ViewArgs,
+    limits: &btfsm_format::Limits,
+    deadline: std::time::Instant,
+) -> Option<Replay> {
     let shown = path.display().to_string();
     let diags = |d: Vec<btfsm_core::diagnostic::Diagnostic>| {
         print_diagnostics(&mut std::io::stderr().lock(), &d);
@@ -96,7 +101,7 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &btfsm_format::Limits) -> Option
         Kind::Log => {
             btfsm_view::log::from_log(&bytes[..], &shown, limits).map_or_else(view_failed, Some)
         }
-        Kind::Db3 => match btfsm_log::open(path, None, limits.max_file_bytes) {
+        Kind::Db3 => match btfsm_log::open(path, None, limits, deadline) {
             Ok(o) => {
                 btfsm_view::log::from_log(o.reader, &shown, limits).map_or_else(view_failed, Some)
             }
@@ -146,9 +151,11 @@ fn replay_of(path: &Path, a: &ViewArgs, limits: &btfsm_format::Limits) -> Option
 
 pub(super) fn execute(a: ViewArgs) -> u8 {
     let limits = a.limits.limits();
+    // One deadline for every `.db3` query of the command (issue 33).
+    let deadline = std::time::Instant::now() + btfsm_log::DEADLINE;
     let mut all: Option<Replay> = None;
     for path in &a.inputs {
-        let Some(r) = replay_of(path, &a, &limits) else {
+        let Some(r) = replay_of(path, &a, &limits, deadline) else {
             return EXIT_BAD_INPUT;
         };
         all = Some(match all {

@@ -77,3 +77,19 @@ pub(crate) fn btfsm_without_graphviz(args: &[&str]) -> (i32, String, String) {
         .args(args)
         .env("PATH", &empty))
 }
+
+/// Runs the built `btfsm` with `dir` as its current directory: (exit code,
+/// stdout, stderr).
+pub(crate) fn btfsm_in(dir: &std::path::Path, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_btfsm"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("run btfsm");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}

@@ -13,6 +13,7 @@ mod common;
 mod compare;
 mod compare_report;
 mod compare_tree;
+mod confine;
 mod conventions;
 mod dot;
 mod formats;

@@ -834,6 +834,49 @@ mod hostile {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A trace is at most `--max-file-bytes`, what btfsm reads back
+    /// (issue 33: a 1 KB scenario wrote a 4.2 GB trace): past it the run
+    /// exits 2 and leaves no file.
+    #[test]
+    fn sim_hostile_trace_is_bounded_by_max_file_bytes() {
+        let dir = scratch("capped-trace");
+        let f = dir.join("long.toml");
+        std::fs::write(
+            &f,
+            format!(
+                "max_steps = 200000\n{CUBE}{}[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n",
+                policies(1)
+            ),
+        )
+        .unwrap();
+        let trace = dir.join("trace.json");
+        let (code, _, err, took) = btfsm_within(
+            80,
+            &[
+                "sim",
+                f.to_str().unwrap(),
+                "--trace",
+                trace.to_str().unwrap(),
+                "--max-file-bytes",
+                "5000000",
+            ],
+        );
+        assert_eq!(code, 2, "{err}");
+        assert!(took < HANG_GUARD, "{took:?}");
+        assert!(err.contains("larger than 5000000 bytes"), "{err}");
+        let mut names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            ["fig01-bt.toml", "long.toml"],
+            "a trace or a temporary left"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     /// 64 policies picking and placing a cube every step for 10^6 steps
     /// (a 400-byte scenario) recorded 2 million skills each: 3.3 GB per
     /// policy. A run now records at most 1024 skills and 4096 events (every
@@ -1054,6 +1097,32 @@ fn sim_csv_has_the_figures_of_the_json_report() {
             p["success_rate"].as_f64().unwrap()
         );
     }
+}
+
+/// `--runs` is at most 10,000,000 (issue 33: `--runs 4294967295` allocated
+/// 4 GiB of per-episode flags); the most allowed, with a budget, stays
+/// small: 10 MB of flags.
+#[test]
+fn sim_hostile_runs_are_capped() {
+    let s = "policies/scenarios/exp1-nominal.toml";
+    let (code, _, err, _) = common::btfsm_capped(512, &["sim", s, "--runs", "4294967295"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("0..=10000000"), "{err}");
+    let (code, out, err, _) = common::btfsm_capped(
+        512,
+        &[
+            "sim",
+            s,
+            "--runs",
+            "10000000",
+            "--timeout-ms",
+            "300",
+            "--format",
+            "json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\"requested_runs\": 10000000"), "{out}");
 }
 
 /// The symbolic simulator keeps the one simulation contract of the planar

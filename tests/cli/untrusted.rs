@@ -59,6 +59,11 @@ impl Drop for Dir {
 /// Runs btfsm with `args` in `cwd`, the secret in its environment, under
 /// the caps; stderr goes to `stderr_to` when given (e.g. `/dev/full`).
 fn run_in(cwd: &Path, args: &[&str], stderr_to: Option<&str>) -> Run {
+    run_capped(cwd, args, stderr_to, AS_LIMIT)
+}
+
+/// [`run_in`] under an address-space cap of `as_limit` bytes.
+fn run_capped(cwd: &Path, args: &[&str], stderr_to: Option<&str>, as_limit: u64) -> Run {
     // BTFSM_UNDER_TEST runs the suite against another build (e.g. the one
     // before issue 12, to see every case fail).
     let bin =
@@ -84,10 +89,10 @@ fn run_in(cwd: &Path, args: &[&str], stderr_to: Option<&str>) -> Run {
     }
     // SAFETY: setrlimit is async-signal-safe; nothing else runs in the child.
     unsafe {
-        cmd.pre_exec(|| {
+        cmd.pre_exec(move || {
             let lim = libc::rlimit {
-                rlim_cur: AS_LIMIT,
-                rlim_max: AS_LIMIT,
+                rlim_cur: as_limit,
+                rlim_max: as_limit,
             };
             if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
                 return Err(std::io::Error::last_os_error());
@@ -354,6 +359,154 @@ fn control_characters_never_reach_an_output() {
     assert!(!outside.contains("<img"), "{}", r.stdout);
 }
 
+/// A file inside the root that is not a policy (a `.env` a CI step wrote,
+/// a `secrets.toml`, a key), named as a subtree, a BehaviorTree.CPP or
+/// yasmin include, a scenario's policy or a symbolic scenario's domain, is
+/// refused before it is parsed, and nothing of it is quoted (issue 33: its
+/// first line was the snippet of the parse error).
+#[test]
+fn a_named_file_that_is_not_a_policy_is_never_quoted() {
+    let d = Dir::new("not-policy");
+    d.write("repo/.git/HEAD", "ref: refs/heads/main\n");
+    d.write(".env", format!("GITHUB_TOKEN={SECRET}\n"));
+    d.write("repo/.env", format!("GITHUB_TOKEN={SECRET}\n"));
+    d.write("repo/secrets.toml", format!("token = \"{SECRET}\"\n"));
+    d.write("repo/key.xml", format!("{SECRET}\n<root/>\n"));
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "subtree.toml",
+            "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \".env\" }\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "subtree2.toml",
+            "kind = \"bt\"\nroot = \"s\"\n[nodes]\ns = { subtree = \"secrets.toml\" }\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "inc.xml",
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"M\">\n<include path=\"key.xml\"/>\n<BehaviorTree ID=\"M\"><AlwaysSuccess/></BehaviorTree></root>\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "sm.xml",
+            "<StateMachine outcomes=\"end\">\n<StateMachine name=\"I\" file_path=\".env\"><Transition from=\"x\" to=\"end\"/></StateMachine>\n</StateMachine>\n".into(),
+            vec!["analyze"],
+        ),
+        (
+            "scen.toml",
+            "name = \"s\"\n[world]\n[[policies]]\nfile = \"secrets.toml\"\n".into(),
+            vec!["sim"],
+        ),
+        (
+            "symbolic.toml",
+            "name = \"s\"\ndomain = \".env\"\n[[policies]]\nfile = \"secrets.toml\"\n".into(),
+            vec!["sim"],
+        ),
+    ];
+    for (name, text, cmd) in cases {
+        let f = d.write(&format!("repo/{name}"), text);
+        let mut args = cmd.clone();
+        args.push(&f);
+        let r = run_in(&d.0, &args, None);
+        check(&r, &d.0, &[2], name);
+        assert!(
+            r.stderr.contains("nothing of it is shown"),
+            "{name}: {}",
+            r.stderr
+        );
+        assert!(
+            !r.stderr.contains("GITHUB_TOKEN") && !r.stderr.contains("token ="),
+            "{name}: {}",
+            r.stderr
+        );
+    }
+}
+
+/// A pull request's `btfsm.toml` is bounded (one message per kind of
+/// error: 300,000 unknown codes give two messages, not 300,000), and cannot
+/// turn lint off where the CI reads the base branch's (`--config`) or none
+/// (`--no-config`), as docs/guide/ci.md's recipe does.
+#[test]
+fn a_pull_requests_btfsm_toml_is_bounded_and_can_be_ignored() {
+    let d = Dir::new("config");
+    d.write(".git/HEAD", "ref: refs/heads/main\n");
+    let fig03 = d.write(
+        "fig03-bt.toml",
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("policies/paper/fig03-bt.toml"))
+            .expect("fig03"),
+    );
+    // fig03 has an error-level finding (exit 1) by default.
+    let r = run_in(&d.0, &["lint", &fig03], None);
+    check(&r, &d.0, &[1], "no btfsm.toml");
+    let codes: Vec<String> = (0..300_000)
+        .map(|i| format!("\"no-such-rule-{i}\""))
+        .collect();
+    d.write(
+        "btfsm.toml",
+        format!("[lint]\nallow = [{}]\n", codes.join(", ")),
+    );
+    let r = run_in(&d.0, &["lint", &fig03], None);
+    check(&r, &d.0, &[2], "300,000 unknown codes");
+    assert!(
+        r.stderr.len() < 4000,
+        "{}",
+        &r.stderr[..r.stderr.len().min(3000)]
+    );
+    assert!(
+        r.stderr.contains("299999 more unknown lint codes"),
+        "{}",
+        r.stderr
+    );
+    // A btfsm.toml allowing every rule: lint is off for the pull request...
+    let list = run_in(&d.0, &["lint", "--list"], None);
+    let all: Vec<String> = (list.stdout.lines().skip(1))
+        .filter_map(|l| l.split_whitespace().next())
+        .map(|c| format!("\"{c}\""))
+        .collect();
+    assert!(all.len() > 10, "{}", list.stdout);
+    d.write(
+        "btfsm.toml",
+        format!("[lint]\nallow = [{}]\n", all.join(", ")),
+    );
+    let r = run_in(&d.0, &["lint", &fig03], None);
+    check(&r, &d.0, &[0], "every rule allowed");
+    // ...unless the CI ignores it, or reads the base branch's.
+    let r = run_in(&d.0, &["lint", &fig03, "--no-config"], None);
+    check(&r, &d.0, &[1], "--no-config");
+    let base = Dir::new("config-base");
+    let conf = base.write("btfsm.toml", "[lint]\nwarn = [\"not-fault-tolerant\"]\n");
+    let r = run_in(&d.0, &["lint", &fig03, "--config", &conf], None);
+    check(&r, &d.0, &[1], "--config");
+}
+
+/// `validate DIR` has a total budget (issue 33: a directory of large
+/// policies took 101 s of CPU within the byte budget): past
+/// `--max-total-nodes` in all, no other policy is parsed, and the files
+/// left are one message.
+#[test]
+fn validate_of_a_directory_stops_at_the_total_node_budget() {
+    let d = Dir::new("total-nodes");
+    let kids: Vec<String> = (0..1000).map(|i| format!("\"l{i}\"")).collect();
+    let mut text = format!(
+        "kind = \"bt\"\nroot = \"r\"\n[nodes]\nr = {{ sequence = [{}] }}\n",
+        kids.join(", ")
+    );
+    for i in 0..1000 {
+        text.push_str(&format!("l{i} = {{ action = \"A\", skill = \"Dock\" }}\n"));
+    }
+    for i in 0..30 {
+        d.write(&format!("p/f{i:02}.toml"), &text);
+    }
+    let dir = d.path("p");
+    let r = run_in(&d.0, &["validate", &dir, "--max-total-nodes", "5000"], None);
+    check(&r, &d.0, &[2], "validate DIR");
+    assert_eq!(r.stderr.matches(": ok (").count(), 4, "{}", r.stderr);
+    assert!(r.stderr.contains("25 files not validated"), "{}", r.stderr);
+    let r = run_in(&d.0, &["validate", &dir], None);
+    check(&r, &d.0, &[0], "validate DIR, default budget");
+}
+
 /// Parameters doubled level by level, a file of a million TOML errors, the
 /// same big file given many times, a big include: bounded memory, exit 2.
 #[test]
@@ -424,6 +577,59 @@ fn memory_stays_bounded_by_the_input() {
     let r = run_in(&d.0, &["compare", &e14, &e14, "--mode", "named"], None);
     check(&r, &d.0, &[2], "expansion across policies");
     assert!(r.stderr.contains("copied by this command"), "{}", r.stderr);
+}
+
+/// Every TOML input (policy, scenario, domain, tick script, btfsm.toml) is
+/// counted before it is parsed (issue 33: 60 MB of `=` lines peaked at
+/// 4.45 GB, past a 2 GiB CI job's memory, before the first error): under
+/// a 2 GiB cap at the default limits, 8 MB of one-byte tokens is refused by
+/// the count, and the costliest document the count lets through (3 MB of
+/// dots, 112 bytes of parser memory per token) stays within 64 x the bytes
+/// read + 200 MB.
+#[test]
+fn every_toml_input_is_counted_before_it_is_parsed() {
+    const CAP: u64 = 2 << 30;
+    let d = Dir::new("toml-tokens");
+    let policy = d.write("leaf.toml", LEAF);
+    let readers = |f: &str| -> Vec<(Vec<String>, &'static str)> {
+        let v = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        vec![
+            (v(&["analyze", f]), "policy"),
+            (v(&["sim", f]), "scenario"),
+            (v(&["plan", f]), "domain"),
+            (v(&["tick", &policy, "--script", f]), "tick script"),
+        ]
+    };
+    for (name, text, counted) in [
+        ("eq.toml", "=\n".repeat(4_000_000), true),
+        (
+            "dots.toml",
+            format!("a = 1\n{}", ".".repeat(2_990_000)),
+            false,
+        ),
+    ] {
+        let f = d.write(name, &text);
+        drop(text);
+        for (args, what) in readers(&f) {
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let r = run_capped(&d.0, &args, None, CAP);
+            check(&r, &d.0, &[2], &format!("{what} {name}"));
+            assert_eq!(
+                r.stderr.contains("TOML tokens"),
+                counted,
+                "{what} {name}: {}",
+                &r.stderr[..r.stderr.len().min(2000)]
+            );
+        }
+        std::fs::remove_file(&f).expect("rm");
+    }
+    // btfsm.toml, found from the current directory.
+    let conf = Dir::new("toml-tokens-conf");
+    conf.write("btfsm.toml", "=\n".repeat(4_000_000));
+    let leaf = conf.write("leaf.toml", LEAF);
+    let r = run_capped(&conf.0, &["lint", &leaf], None, CAP);
+    check(&r, &conf.0, &[2], "btfsm.toml");
+    assert!(r.stderr.contains("TOML tokens"), "{}", r.stderr);
 }
 
 /// A FIFO with no writer, as a policy, node model or baseline: an answer

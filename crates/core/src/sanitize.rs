@@ -27,7 +27,12 @@ pub const SHOWN_CHARS: usize = 120;
 /// Whether `c` must not reach an output raw: C0 controls (tab and, where
 /// `keep_newline`, newline excepted), DEL, C1, the Unicode bidirectional
 /// overrides, embeddings, isolates and marks ("Trojan Source",
-/// CVE-2021-42574), and the line and paragraph separators.
+/// CVE-2021-42574), the line and paragraph separators, and the characters
+/// that show nothing but change what a reader sees or a program compares
+/// (issue 33): zero-width spaces and joiners, the word joiner and invisible
+/// operators, the byte-order mark, the soft hyphen, the combining grapheme
+/// joiner, the Hangul fillers, variation selectors, interlinear
+/// annotations and the tag characters (which can spell hidden text).
 pub fn is_unsafe(c: char, keep_newline: bool) -> bool {
     match c {
         '\t' => false,
@@ -37,6 +42,20 @@ pub fn is_unsafe(c: char, keep_newline: bool) -> bool {
             true
         }
         '\u{2028}' | '\u{2029}' => true,
+        '\u{ad}'
+        | '\u{34f}'
+        | '\u{115f}'
+        | '\u{1160}'
+        | '\u{17b4}'
+        | '\u{17b5}'
+        | '\u{180b}'..='\u{180f}' => true,
+        '\u{200b}'..='\u{200d}'
+        | '\u{2060}'..='\u{2064}'
+        | '\u{3164}'
+        | '\u{feff}'
+        | '\u{ffa0}' => true,
+        '\u{fe00}'..='\u{fe0f}' | '\u{fff9}'..='\u{fffb}' => true,
+        '\u{e0000}'..='\u{e007f}' | '\u{e0100}'..='\u{e01ef}' => true,
         _ => false,
     }
 }
@@ -114,19 +133,45 @@ pub fn json(s: String) -> String {
     out
 }
 
-/// A user string in a markdown table cell or paragraph: [`shown`], then
-/// HTML (`<`, `>`, `&`) as entities and markdown's active characters
-/// (`|`, `` ` ``, `*`, `_`, `[`, `]`, `\`) escaped, so that it can neither
-/// open a tag, a link or a code span nor end the table cell.
+/// A user string in a markdown table cell, list item or paragraph, inert
+/// on GitHub (issue 33): [`shown`] (one line, no control or invisible
+/// character), then
+///
+/// - a string holding `@` (a mention, a team, an e-mail address) or a link
+///   GitHub would make of bare text (`://`, `www.`, `mailto:`, `xmpp:`) is
+///   the code span of [`markdown_code`], where GitHub links and mentions
+///   nothing;
+/// - otherwise HTML (`<`, `>`, `&`) as entities, markdown's inline
+///   characters (`|`, `` ` ``, `*`, `_`, `[`, `]`, `\`, `#`, `~`) escaped,
+///   leading blanks as entities, and a first `-`, `+`, `=` or the `.`/`)`
+///   after leading digits escaped,
+///   so that it can open no tag, link, code span, emphasis, heading, list or
+///   rule, nor end the table cell.
 pub fn markdown_cell(s: &str) -> String {
+    if would_link(s) {
+        return markdown_code(s);
+    }
     let s = shown(s);
+    let lead = s.len() - s.trim_start().len();
+    let digits = s[lead..].bytes().take_while(u8::is_ascii_digit).count();
     let mut out = String::with_capacity(s.len() + 8);
-    for c in s.chars() {
+    for (i, c) in s.char_indices() {
         match c {
+            // Leading blanks would indent a code block or a list.
+            ' ' if i < lead => out.push_str("&#32;"),
+            '\t' if i < lead => out.push_str("&#9;"),
             '<' => out.push_str("&lt;"),
             '>' => out.push_str("&gt;"),
             '&' => out.push_str("&amp;"),
             '|' | '`' | '*' | '_' | '[' | ']' | '\\' | '#' | '~' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '-' | '+' | '=' if i == lead => {
+                out.push('\\');
+                out.push(c);
+            }
+            '.' | ')' if digits > 0 && i == lead + digits => {
                 out.push('\\');
                 out.push(c);
             }
@@ -136,15 +181,27 @@ pub fn markdown_cell(s: &str) -> String {
     out
 }
 
-/// A user string as an inline code span in a markdown table: [`shown`],
-/// `|` escaped (GitHub reads `\|` inside a code span in a table as `|`),
-/// and delimited by one more backtick than its longest run (CommonMark
-/// 0.31, 6.1), so it can neither end the span nor the cell. A code span
-/// shows HTML as text.
+/// Whether GitHub would make a mention or a link of some of `s`'s bare text.
+fn would_link(s: &str) -> bool {
+    if s.contains('@') {
+        return true;
+    }
+    let lower = s.to_ascii_lowercase();
+    ["://", "www.", "mailto:", "xmpp:"]
+        .iter()
+        .any(|p| lower.contains(p))
+}
+
+/// A user string as an inline code span, the one form in which GitHub shows
+/// any text inert (no HTML, link, autolink, mention nor emoji): [`shown`]
+/// (one line, no control or invisible character), `|` escaped (GitHub
+/// reads `\|` inside a code span in a table as `|`), and delimited by one
+/// more backtick than its longest run (CommonMark 0.31, 6.1), so it can
+/// neither end the span nor the cell.
 pub fn markdown_code(s: &str) -> String {
     let s = shown(s).replace('|', "\\|");
     let fence = "`".repeat(longest_backtick_run(&s) + 1);
-    let pad = if s.starts_with('`') || s.ends_with('`') {
+    let pad = if s.starts_with('`') || s.ends_with('`') || s.is_empty() {
         " "
     } else {
         ""
@@ -268,6 +325,45 @@ mod tests {
         assert_eq!(markdown_code("a|b"), "`a\\|b`");
         assert_eq!(markdown_code("x``y"), "```x``y```");
         assert_eq!(markdown_code("`x"), "`` `x ``");
+    }
+
+    #[test]
+    fn invisible_characters_are_escaped() {
+        for c in [
+            '\u{200b}',
+            '\u{200d}',
+            '\u{2060}',
+            '\u{feff}',
+            '\u{ad}',
+            '\u{115f}',
+            '\u{1160}',
+            '\u{3164}',
+            '\u{ffa0}',
+            '\u{fe0f}',
+            '\u{e0041}',
+            '\u{e0100}',
+            '\u{180e}',
+        ] {
+            let s = format!("a{c}b");
+            assert_eq!(shown(&s), format!("a\\u{{{:x}}}b", c as u32));
+            assert!(has_raw_control(&s), "{:x}", c as u32);
+        }
+        assert_eq!(shown("plain é ü ✓"), "plain é ü ✓");
+    }
+
+    #[test]
+    fn markdown_cells_make_no_link_mention_list_or_heading() {
+        assert_eq!(markdown_cell("@octocat"), "`@octocat`");
+        assert_eq!(markdown_cell("see https://x.io"), "`see https://x.io`");
+        assert_eq!(markdown_cell("WWW.x.io"), "`WWW.x.io`");
+        assert_eq!(markdown_cell("a@b.co"), "`a@b.co`");
+        assert_eq!(markdown_cell("- item"), "\\- item");
+        assert_eq!(markdown_cell("==="), "\\===");
+        assert_eq!(markdown_cell("  + x"), "&#32;&#32;\\+ x");
+        assert_eq!(markdown_cell("12. x"), "12\\. x");
+        assert_eq!(markdown_cell("3) x"), "3\\) x");
+        assert_eq!(markdown_cell("a-b 1.5"), "a-b 1.5");
+        assert_eq!(markdown_code(""), "`  `");
     }
 
     #[test]

@@ -127,7 +127,7 @@ pub fn read(
 }
 
 /// Does a TOML text set `kind` before its first table header?
-fn has_top_level_kind(text: &str) -> bool {
+pub(crate) fn has_top_level_kind(text: &str) -> bool {
     for line in text.lines() {
         let l = line.trim();
         if l.starts_with('[') {

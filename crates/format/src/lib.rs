@@ -61,6 +61,11 @@ pub struct Limits {
     /// `max_nodes` in all, so that a few kilobytes of files including each
     /// other twice per level cannot build millions of nodes per policy.
     pub expansion_budget: Arc<source::Budget>,
+    /// The nodes and states of all the policies the command reads
+    /// (`--max-total-nodes`, issue 33: `validate DIR` of many large files
+    /// took 101 s of CPU within the byte budget): once spent, no other
+    /// policy is parsed.
+    pub total_nodes: Arc<source::Budget>,
     /// The BehaviorTree.CPP tree to read (`--tree ID`), as a program names
     /// it to the factory; over `main_tree_to_execute`. Other formats
     /// ignore it.
@@ -82,10 +87,24 @@ pub enum AssumeLeaf {
 pub const DEFAULT_MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
 /// Default of [`Limits::max_nodes`].
 pub const DEFAULT_MAX_NODES: usize = 150_000;
+/// Default of `--max-total-nodes` ([`Limits::total_nodes`]): ten policies
+/// at `--max-nodes`.
+pub const DEFAULT_MAX_TOTAL_NODES: u64 = 10 * DEFAULT_MAX_NODES as u64;
 /// Default of [`Limits::max_depth`].
 pub const DEFAULT_MAX_DEPTH: usize = 1_000;
 /// Default of [`Limits::max_name_bytes`].
 pub const DEFAULT_MAX_NAME_BYTES: usize = 4096;
+
+impl Limits {
+    /// The TOML tokens a policy may hold before it is parsed
+    /// (`core::toml_budget`): 50 per node of `--max-nodes`, at least a
+    /// million.
+    pub fn max_toml_tokens(&self) -> u64 {
+        (self.max_nodes as u64)
+            .saturating_mul(btfsm_core::toml_budget::TOKENS_PER_NODE)
+            .max(1 << 20)
+    }
+}
 
 impl Default for Limits {
     fn default() -> Self {
@@ -100,6 +119,7 @@ impl Default for Limits {
             confinement: source::Confinement::Auto,
             read_budget: source::Budget::new(source::DEFAULT_MAX_TOTAL_BYTES),
             expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
+            total_nodes: source::Budget::new(DEFAULT_MAX_TOTAL_NODES),
             tree: None,
             companions: None,
         }
@@ -266,6 +286,27 @@ pub(crate) fn head(text: &str) -> &str {
     &text[..end]
 }
 
+/// Reads a policy that another file names (a scenario's `file`, a trace's
+/// policy), once [`source::resolve`] has placed it inside the root: a
+/// regular file that is a policy by its name and first bytes
+/// ([`source::check_named`]), else refused quoting none of it.
+pub fn load_named(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
+    let shown = path.display().to_string();
+    let file = source::read(path, &shown, limits, true)?;
+    source::check_named(path, &file.text, source::Named::AnyPolicy).map_err(|r| {
+        vec![
+            Diagnostic::error(format!(
+                "`{}`: {}",
+                btfsm_core::sanitize::shown(&shown),
+                r.message
+            ))
+            .hint(r.hint),
+        ]
+    })?;
+    let format = detect(path, &file.text);
+    load_read(file, path, format, limits)
+}
+
 /// Reads a policy from any supported format (see [`detect`]).
 pub fn load(path: &Path, limits: &Limits) -> Result<Loaded, Vec<Diagnostic>> {
     let shown = path.display().to_string();
@@ -281,6 +322,20 @@ pub fn load_read(
     format: FileFormat,
     limits: &Limits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
+    let total = &limits.total_nodes;
+    let spent = || {
+        vec![
+            Diagnostic::error(format!(
+                "{}: not read: this command has read more than {} nodes and states in all its policies",
+                btfsm_core::sanitize::shown(&path.display().to_string()),
+                total.limit()
+            ))
+            .hint("raise the limit with --max-total-nodes, or name fewer files"),
+        ]
+    };
+    if total.remaining() == 0 {
+        return Err(spent());
+    }
     let loaded = match format {
         FileFormat::Toml => toml::load_read(&file, path, limits),
         FileFormat::BtcppXml => btcpp_xml::load_read(file, path, limits),
@@ -293,6 +348,14 @@ pub fn load_read(
         d.message = format!("{}: {}", loaded.path, d.message);
         d.span = None;
         return Err(vec![d]);
+    }
+    let size = match &loaded.policy.body {
+        btfsm_model::PolicyBody::Bt(bt) => bt.nodes.len(),
+        btfsm_model::PolicyBody::Machine(m) => m.states.len(),
+    };
+    if !total.charge(size as u64) {
+        total.exhaust();
+        return Err(spent());
     }
     Ok(loaded)
 }

@@ -54,6 +54,11 @@ impl Budget {
         self.limit.saturating_sub(self.used.load(Ordering::Relaxed))
     }
 
+    /// Spends what remains.
+    pub fn exhaust(&self) {
+        self.used.store(self.limit, Ordering::Relaxed);
+    }
+
     /// Charges `n` bytes; `false` (nothing charged) when they do not fit.
     pub fn charge(&self, n: u64) -> bool {
         self.used
@@ -206,6 +211,93 @@ fn normalise(p: &Path) -> PathBuf {
         }
     }
     out
+}
+
+/// What a file named by another file must be (issue 33): its name and its
+/// first bytes are checked before it is parsed, so that a file that is not
+/// a policy (a `.env` a CI step wrote, a key) is refused without any of its
+/// content being quoted in a message.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Named {
+    /// A TOML policy (`subtree`): a `.toml` file that sets `kind` before its
+    /// first table.
+    TomlPolicy,
+    /// An XML file (`.xml`) whose document element is this
+    /// (BehaviorTree.CPP `<include>`: `root`; yasmin `file_path`:
+    /// `StateMachine`).
+    Xml(&'static str),
+    /// A policy of any format (a scenario's `file`, a trace's policy): a
+    /// TOML policy, or a `.xml`, `.scxml` or `.btproj` file whose document
+    /// element is `root`, `BehaviorTree`, `StateMachine` or `scxml`.
+    AnyPolicy,
+}
+
+impl Named {
+    fn what(self) -> &'static str {
+        match self {
+            Named::TomlPolicy => {
+                "a TOML policy (a `.toml` file that sets `kind` before its first table)"
+            }
+            Named::Xml("root") => "a BehaviorTree.CPP XML file (`.xml`, document element `<root>`)",
+            Named::Xml(_) => "a yasmin XML file (`.xml`, document element `<StateMachine>`)",
+            Named::AnyPolicy => {
+                "a policy file (a TOML policy that sets `kind`, or BehaviorTree.CPP, yasmin or SCXML XML)"
+            }
+        }
+    }
+}
+
+/// Refuses `text`, read from `path` (named by another file), unless it is
+/// what `expect` says; the message quotes nothing of the file.
+pub fn check_named(path: &Path, text: &str, expect: Named) -> Result<(), Refusal> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let toml = || ext == "toml" && crate::discover::has_top_level_kind(text);
+    let element = || document_element(text);
+    let ok = match expect {
+        Named::TomlPolicy => toml(),
+        Named::Xml(root) => ext == "xml" && element() == Some(root),
+        Named::AnyPolicy => {
+            toml()
+                || (["xml", "scxml", "btproj"].contains(&ext.as_str())
+                    && element().is_some_and(|e| {
+                        ["root", "BehaviorTree", "StateMachine", "scxml"].contains(&e)
+                    }))
+        }
+    };
+    if ok {
+        return Ok(());
+    }
+    Err(Refusal {
+        message: "not a policy file: it is not read, and nothing of it is shown".into(),
+        hint: format!("a file named here must be {}", expect.what()),
+    })
+}
+
+/// The name of an XML text's document element, skipping a byte-order mark,
+/// the XML declaration, processing instructions, comments and a DOCTYPE;
+/// `None` when the text does not start as XML does.
+pub fn document_element(text: &str) -> Option<&str> {
+    let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
+    loop {
+        rest = rest.trim_start();
+        if let Some(r) = rest.strip_prefix("<?") {
+            rest = &r[r.find("?>")? + 2..];
+        } else if let Some(r) = rest.strip_prefix("<!--") {
+            rest = &r[r.find("-->")? + 3..];
+        } else if let Some(r) = rest.strip_prefix("<!") {
+            rest = &r[r.find('>')? + 1..];
+        } else {
+            let r = rest.strip_prefix('<')?;
+            let end = r
+                .find(|c: char| c.is_whitespace() || c == '/' || c == '>')
+                .unwrap_or(r.len());
+            return (end > 0).then(|| &r[..end]);
+        }
+    }
 }
 
 pub(crate) fn io_msg(e: &std::io::Error) -> String {

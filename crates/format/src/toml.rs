@@ -133,13 +133,27 @@ pub fn read_source(
 }
 
 /// Reads a file another file names, once [`super::source::resolve`] has
-/// placed it inside the root: it must be a regular file.
+/// placed it inside the root: it must be a regular file and what `expect`
+/// says ([`super::source::check_named`]), else it is refused with a message
+/// that quotes none of it.
 pub(crate) fn read_included(
     path: &Path,
     shown: &str,
     limits: &Limits,
+    expect: super::source::Named,
 ) -> Result<Arc<SourceFile>, Vec<Diagnostic>> {
-    super::source::read(path, shown, limits, true)
+    let file = super::source::read(path, shown, limits, true)?;
+    super::source::check_named(path, &file.text, expect).map_err(|r| {
+        vec![
+            Diagnostic::error(format!(
+                "`{}`: {}",
+                btfsm_core::sanitize::shown(shown),
+                r.message
+            ))
+            .hint(r.hint),
+        ]
+    })?;
+    Ok(file)
 }
 
 /// An included file (canonical path) with its `with` values.
@@ -385,6 +399,15 @@ impl Loader {
         &mut self,
         file: &'i Arc<SourceFile>,
     ) -> Option<Spanned<DeTable<'i>>> {
+        // Counted before the parser allocates 70-112 bytes per token.
+        if let Err(d) = btfsm_core::toml_budget::check(
+            file,
+            self.limits.max_toml_tokens(),
+            "a policy of --max-nodes nodes needs fewer: raise --max-nodes",
+        ) {
+            self.diags.push(d);
+            return None;
+        }
         // The parser keeps the first error only (the recoverable parser
         // keeps every one: millions for a large bad file).
         let errors = match DeTable::parse(&file.text) {

@@ -570,16 +570,15 @@ impl Reader<'_> {
             return None;
         }
         let shown_path = full.display().to_string();
-        let file = match super::toml::read_included(&full, &shown_path, self.limits) {
+        let named = super::source::Named::Xml("StateMachine");
+        let file = match super::toml::read_included(&full, &shown_path, self.limits, named) {
             Ok(f) => f,
             Err(mut ds) => {
-                let msg = ds.remove(0).message;
-                self.err(
-                    doc,
-                    fp.span.clone(),
-                    msg,
-                    "`file_path` is relative to the including file",
-                );
+                let x = ds.remove(0);
+                let hint = x
+                    .hint
+                    .unwrap_or_else(|| "`file_path` is relative to the including file".into());
+                self.err(doc, fp.span.clone(), x.message, &hint);
                 return None;
             }
         };

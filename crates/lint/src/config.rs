@@ -82,9 +82,18 @@ pub fn find(dir: &Path) -> Option<PathBuf> {
     None
 }
 
-/// Reads the `[lint]` table of a `btfsm.toml`; every unknown code is
-/// reported with its position.
+/// Reads the `[lint]` table of a `btfsm.toml`. A file from a pull request
+/// is bounded (issue 33): its tokens are counted before it is parsed, and
+/// each kind of error is one message: the first unknown code, with its
+/// position and the closest code, then how many more there are (3 million
+/// unknown codes wrote 1.1 GB of messages).
 pub fn read(file: &Arc<SourceFile>) -> Result<Config, Vec<Diagnostic>> {
+    btfsm_core::toml_budget::check(
+        file,
+        btfsm_core::toml_budget::DEFAULT_MAX_TOKENS,
+        "btfsm.toml lists rule codes: a few hundred tokens",
+    )
+    .map_err(|d| vec![d])?;
     let raw: RawFile = toml::from_str(&file.text).map_err(|e| {
         let d = Diagnostic::error(format!("invalid btfsm.toml: {}", e.message().trim()))
             .hint("btfsm.toml holds `[lint]` with `deny`, `warn` and `allow` lists of rule codes");
@@ -98,16 +107,33 @@ pub fn read(file: &Arc<SourceFile>) -> Result<Config, Vec<Diagnostic>> {
         ..Config::default()
     };
     let mut errs = Vec::new();
+    let mut unknown = 0usize;
     for (list, level) in [
         (&raw.lint.allow, Level::Allow),
         (&raw.lint.warn, Level::Warning),
         (&raw.lint.deny, Level::Error),
     ] {
         for code in list {
+            if rule(code.get_ref()).is_none() {
+                unknown += 1;
+                if unknown > 1 {
+                    continue;
+                }
+            }
             if let Err(e) = cfg.set(code.get_ref(), level) {
                 errs.push(Diagnostic::error(e).at(file, code.span()));
             }
         }
+    }
+    if unknown > 1 {
+        errs.push(
+            Diagnostic::error(format!(
+                "{} more unknown lint codes in this btfsm.toml",
+                unknown - 1
+            ))
+            .in_file(file)
+            .hint("`btfsm lint --list` lists the codes"),
+        );
     }
     if errs.is_empty() { Ok(cfg) } else { Err(errs) }
 }

@@ -20,10 +20,12 @@ fn level(l: Level) -> &'static str {
 }
 
 /// A path as a relative URI reference: `/` separators, every byte outside
-/// the unreserved set and `/` percent-encoded.
+/// the unreserved set and `/` percent-encoded. A backslash is part of a
+/// file's name on the systems btfsm runs on, so it is encoded too (`%5C`):
+/// read as a separator, `a\b.toml` from a pull request pointed code
+/// scanning at another file, `a/b.toml` (issue 33).
 pub fn uri(path: &str) -> String {
-    let p = path.replace('\\', "/");
-    let p = p.strip_prefix("./").unwrap_or(&p);
+    let p = path.strip_prefix("./").unwrap_or(path);
     let mut out = String::with_capacity(p.len());
     for b in p.bytes() {
         if b.is_ascii_alphanumeric() || matches!(b, b'-' | b'.' | b'_' | b'~' | b'/') {
@@ -100,6 +102,6 @@ mod tests {
             uri("./policies/paper/fig 03.toml"),
             "policies/paper/fig%2003.toml"
         );
-        assert_eq!(uri("a\\b#c"), "a/b%23c");
+        assert_eq!(uri("a\\b#c"), "a%5Cb%23c");
     }
 }

@@ -12,7 +12,9 @@
 //!   the status (61-63).
 //!
 //! Every record is accounted for: a record cut short at the end, a status
-//! out of range, an XML length past the file's, all are errors with the byte
+//! out of range, an XML length past the file's, a time earlier than the
+//! record before (the logger writes them in order; figures computed over
+//! time going backwards would be wrong), all are errors with the byte
 //! offset. Memory holds the header and one record, whatever the log's size.
 
 use std::io::Read;
@@ -176,6 +178,8 @@ pub struct Records<R> {
     layout: Layout,
     at: u64,
     done: bool,
+    /// The time of the record before.
+    last_t: u64,
 }
 
 impl<R: Read> Records<R> {
@@ -185,6 +189,7 @@ impl<R: Read> Records<R> {
             layout: h.layout,
             at: h.records_at,
             done: false,
+            last_t: 0,
         }
     }
 
@@ -251,6 +256,17 @@ impl<R: Read> Iterator for Records<R> {
         };
         let at = self.at;
         self.at += size as u64;
+        if t_usec < self.last_t {
+            self.done = true;
+            return Some(Err(LogError::Bad {
+                offset: at,
+                what: format!(
+                    "time goes backwards: node {uid} at {t_usec} µs after a record at {} µs (FileLogger2 writes its records in time order)",
+                    self.last_t
+                ),
+            }));
+        }
+        self.last_t = t_usec;
         match Status::from_u8(raw) {
             Some(status) => Some(Ok(Record {
                 t_usec,
@@ -350,5 +366,21 @@ mod tests {
             read_header(&mut &v1("<root/>", &[])[..], 3),
             Err(LogError::Bad { offset: 19, .. })
         ));
+    }
+
+    #[test]
+    fn time_going_backwards_is_an_error_at_its_record() {
+        let b = v1("<root/>", &[(5, 1, 1), (5, 1, 2), (9, 1, 1), (4, 1, 2)]);
+        let mut r = &b[..];
+        let h = read_header(&mut r, 1 << 20).unwrap();
+        let recs: Vec<_> = Records::new(r, &h).collect();
+        assert_eq!(recs.len(), 4);
+        assert!(recs[..3].iter().all(Result::is_ok));
+        match &recs[3] {
+            Err(LogError::Bad { offset: 65, what }) => {
+                assert!(what.contains("time goes backwards"), "{what}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -37,18 +37,43 @@ pub struct OpenedLog {
     pub session: Option<i64>,
 }
 
+/// The longest a log command may spend in SQLite queries in all (issue 33:
+/// the deadline was per query, so a `.db3` made to be slow took minutes).
+pub const DEADLINE: std::time::Duration = std::time::Duration::from_secs(60);
+
 /// Opens a log: a `.btlog` (either layout), or a `.db3` (told by SQLite's
-/// magic) at `session` (default: its last). `-` is stdin (a `.btlog` only).
-pub fn open(path: &Path, session: Option<i64>, max_bytes: u64) -> Result<OpenedLog, String> {
+/// magic) at `session` (default: its last). `-` is stdin (a `.btlog`
+/// only), read as it comes. A regular file is streamed; anything else (a
+/// FIFO, a device) is read as `btfsm view` reads it, through
+/// `format::source`: never blocking on a FIFO without writer, within
+/// `--max-file-bytes`, a pipe silent for 10 s an error. A `.db3`'s queries
+/// all stop at `deadline`, one instant for the whole command.
+pub fn open(
+    path: &Path,
+    session: Option<i64>,
+    limits: &btfsm_format::Limits,
+    deadline: std::time::Instant,
+) -> Result<OpenedLog, String> {
     let stdin = path.as_os_str() == "-";
     let r: Box<dyn Read> = if stdin {
         Box::new(std::io::stdin())
     } else {
-        let f = std::fs::File::open(path).map_err(|e| format!("cannot read this file: {e}"))?;
-        if f.metadata().is_ok_and(|m| m.is_dir()) {
+        let meta = std::fs::metadata(path).map_err(|e| format!("cannot read this file: {e}"))?;
+        if meta.is_dir() {
             return Err("cannot read this file: it is a directory".into());
         }
-        Box::new(f)
+        if meta.is_file() {
+            let f = std::fs::File::open(path).map_err(|e| format!("cannot read this file: {e}"))?;
+            Box::new(f)
+        } else {
+            let shown = path.display().to_string();
+            let bytes = btfsm_format::source::read_bytes(path, &shown, limits, false)
+                .map_err(|d| d.first().map(|d| d.message.clone()).unwrap_or_default())?;
+            if bytes.starts_with(b"SQLite format 3\0") {
+                return Err("a .db3 log must be a regular file (SQLite reads it in place)".into());
+            }
+            Box::new(std::io::Cursor::new(bytes))
+        }
     };
     let mut r = BufReader::with_capacity(1 << 16, r);
     let head = r.fill_buf().map_err(|e| format!("cannot read: {e}"))?;
@@ -68,12 +93,17 @@ pub fn open(path: &Path, session: Option<i64>, max_bytes: u64) -> Result<OpenedL
     if stdin {
         return Err("a .db3 log must be a file, not stdin".into());
     }
-    open_db3(path, session, max_bytes)
+    open_db3(path, session, limits, deadline)
 }
 
 #[cfg(feature = "sqlite")]
-fn open_db3(path: &Path, session: Option<i64>, max_bytes: u64) -> Result<OpenedLog, String> {
-    let o = db3::open(path, session, max_bytes).map_err(|e| e.0)?;
+fn open_db3(
+    path: &Path,
+    session: Option<i64>,
+    limits: &btfsm_format::Limits,
+    deadline: std::time::Instant,
+) -> Result<OpenedLog, String> {
+    let o = db3::open(path, session, limits, deadline).map_err(|e| e.0)?;
     Ok(OpenedLog {
         reader: Box::new(o.stream),
         sessions: o.sessions,
@@ -83,7 +113,12 @@ fn open_db3(path: &Path, session: Option<i64>, max_bytes: u64) -> Result<OpenedL
 }
 
 #[cfg(not(feature = "sqlite"))]
-fn open_db3(_: &Path, _: Option<i64>, _: u64) -> Result<OpenedLog, String> {
+fn open_db3(
+    _: &Path,
+    _: Option<i64>,
+    _: &btfsm_format::Limits,
+    _: std::time::Instant,
+) -> Result<OpenedLog, String> {
     Err("a .db3 (SqliteLogger) log, and this btfsm was built without the `sqlite` feature".into())
 }
 

@@ -137,6 +137,12 @@ struct RawGoal {
 
 /// Reads and validates a domain from its text.
 pub(super) fn load(file: &Arc<SourceFile>) -> Result<Domain, Vec<Diagnostic>> {
+    btfsm_core::toml_budget::check(
+        file,
+        btfsm_core::toml_budget::DEFAULT_MAX_TOKENS,
+        "a domain's counts are capped (docs/guide/plan.md)",
+    )
+    .map_err(|d| vec![d])?;
     let raw: RawDomain = toml::from_str(&file.text).map_err(|e| {
         let d = Diagnostic::error(format!("invalid domain: {}", e.message().trim()))
             .hint("see docs/guide/plan.md (\"The domain file\") for the format");

@@ -12,7 +12,9 @@
 //! - `-`, or a path that is this process's stdout, is stdout;
 //! - temporary names stay within NAME_MAX (255 bytes) whatever the name.
 //!
-//! [`check_distinct`] refuses one file named by two outputs of a command.
+//! [`check_distinct`] refuses one file named by two outputs of a command;
+//! [`OutputRoot`] (`confine.rs`) keeps outputs inside the root and out of
+//! `.git` (issue 33), and a replaced file never keeps an executable bit.
 
 use std::ffi::{OsStr, OsString};
 use std::fs::{File, Metadata, OpenOptions};
@@ -20,6 +22,9 @@ use std::io::{self, Write};
 use std::os::unix::ffi::{OsStrExt, OsStringExt};
 use std::os::unix::fs::{FileTypeExt, MetadataExt, OpenOptionsExt, PermissionsExt};
 use std::path::{Path, PathBuf};
+
+mod confine;
+pub use confine::{CONFINED_HINT, Confined, OutputRoot, is_confined};
 
 /// Longest file name on the file systems btfsm writes to (Linux's NAME_MAX).
 pub const NAME_MAX: usize = 255;
@@ -122,6 +127,18 @@ impl Destination {
         )))
     }
 
+    /// [`Destination::resolve`], then refused unless `root` allows what
+    /// the path resolved to.
+    pub fn resolve_within(path: &Path, root: &OutputRoot) -> io::Result<Destination> {
+        let d = Destination::resolve(path)?;
+        match &d {
+            Destination::Stdout => {}
+            Destination::File { dir, name, .. } => root.check(path, &dir.join(name))?,
+            Destination::Direct { path: target } => root.check(path, target)?,
+        }
+        Ok(d)
+    }
+
     /// Writes `bytes` whole: stdout, in place, or by atomic replacement.
     pub fn write(&self, bytes: &[u8]) -> io::Result<()> {
         match self {
@@ -173,6 +190,15 @@ impl Destination {
 /// place, `-` to stdout.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     Destination::resolve(path)?.write(bytes)
+}
+
+/// Creates the directory `path` and its parents for outputs written under
+/// it (`plan -o DIR`), once `root` allows where it resolves; each file
+/// written under it is checked again as it is written.
+pub fn create_dir_within(path: &Path, root: &OutputRoot) -> io::Result<()> {
+    root.check_dir(path)?;
+    std::fs::create_dir_all(path)?;
+    root.check_dir(path)
 }
 
 /// One output of a command that names the same file as another: which
@@ -341,7 +367,9 @@ fn replace(dir: &Path, name: &OsStr, existing: Option<&Metadata>, bytes: &[u8]) 
 /// (a planted file or symlink of that name is never followed), given the
 /// existing file's owner and mode (a new file gets the default mode, 0666
 /// less the umask); [`Replacement::commit`] syncs it and renames it over
-/// the target. Dropped uncommitted, it is removed.
+/// the target. Dropped uncommitted, it is removed. The existing file's
+/// mode loses its executable, set-id and sticky bits: an output is data, so
+/// replacing a hook or a script leaves a file that does not run.
 struct Replacement {
     file: File,
     tmp: PathBuf,
@@ -384,7 +412,7 @@ impl Replacement {
                 let _ = std::os::unix::fs::fchown(&r.file, Some(m.uid()), Some(m.gid()));
             }
             r.file
-                .set_permissions(std::fs::Permissions::from_mode(m.mode() & 0o7777))?;
+                .set_permissions(std::fs::Permissions::from_mode(m.mode() & 0o666))?;
         }
         Ok(r)
     }
@@ -421,8 +449,8 @@ pub struct OutputFile {
 }
 
 impl OutputFile {
-    pub fn create(path: &Path) -> io::Result<OutputFile> {
-        match Destination::resolve(path)? {
+    pub fn create(path: &Path, root: &OutputRoot) -> io::Result<OutputFile> {
+        match Destination::resolve_within(path, root)? {
             Destination::Stdout => Err(io::Error::other(
                 "this output cannot go to standard output; name a file",
             )),
@@ -616,14 +644,16 @@ mod tests {
     }
 
     #[test]
-    fn an_existing_files_mode_is_kept_and_new_files_get_the_default() {
+    fn an_existing_files_mode_is_kept_but_never_executable_and_new_files_get_the_default() {
         let d = Dir::new("mode");
         let p = d.0.join("secret");
-        for m in [0o600, 0o640, 0o755] {
+        for m in [0o600, 0o640, 0o755, 0o4775] {
             std::fs::write(&p, "old").unwrap();
             std::fs::set_permissions(&p, std::fs::Permissions::from_mode(m)).unwrap();
             write_atomically(&p, b"new").unwrap();
-            assert_eq!(mode(&p), m);
+            // Read and write bits kept; never executable (a hook replaced
+            // by an output no longer runs), never set-id.
+            assert_eq!(mode(&p), m & 0o666);
             assert_eq!(std::fs::read(&p).unwrap(), b"new");
         }
         std::fs::write(d.0.join("reference"), "").unwrap();

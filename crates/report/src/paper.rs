@@ -188,6 +188,11 @@ fn read_toml_file(path: &Path) -> Result<(std::sync::Arc<SourceFile>, toml::Tabl
                 .unwrap_or_else(|| Diagnostic::error(format!("cannot read `{shown}`")))
                 .hint("give the directory of the paper's policies with --policies")
         })?;
+    btfsm_core::toml_budget::check(
+        &file,
+        btfsm_core::toml_budget::DEFAULT_MAX_TOKENS,
+        "the paper's tables are a few thousand tokens",
+    )?;
     match file.text.parse::<toml::Table>() {
         Ok(t) => Ok((file, t)),
         Err(e) => {

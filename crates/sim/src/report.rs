@@ -381,9 +381,16 @@ impl McReport {
     }
 
     fn render(&self, md: bool) -> String {
+        // The scenario's name is the input's: a code span (inert on
+        // GitHub: issue 33) in markdown, one escaped line in the table.
+        let name = if md {
+            btfsm_core::sanitize::markdown_code(&self.scenario)
+        } else {
+            format!("`{}`", btfsm_core::sanitize::shown(&self.scenario))
+        };
         let mut out = format!(
-            "scenario `{}`: {} episodes (seed {}) on {} threads in {} ms\n\n",
-            self.scenario, self.runs, self.seed, self.threads, self.millis
+            "scenario {name}: {} episodes (seed {}) on {} threads in {} ms\n\n",
+            self.runs, self.seed, self.threads, self.millis
         );
         let head = [
             "policy",

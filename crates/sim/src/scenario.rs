@@ -157,6 +157,13 @@ pub fn parse(
         }),
         ..limits.clone()
     };
+    // Counted before the parser allocates 70-112 bytes per token.
+    btfsm_core::toml_budget::check(
+        file,
+        limits.max_toml_tokens(),
+        "a scenario's counts are capped (docs/guide/sim.md); raise --max-nodes",
+    )
+    .map_err(|d| vec![d])?;
     // The first TOML error only: the recoverable parser keeps them all.
     let doc = match DeTable::parse(&file.text) {
         Ok(doc) => doc,

@@ -116,6 +116,12 @@ impl Reader {
 
 /// Parses and validates a script for `bt`.
 pub fn parse(file: &Arc<SourceFile>, bt: &Bt) -> Result<Script, Vec<Diagnostic>> {
+    btfsm_core::toml_budget::check(
+        file,
+        btfsm_core::toml_budget::DEFAULT_MAX_TOKENS,
+        "a script's counts are capped (docs/guide/tick.md)",
+    )
+    .map_err(|d| vec![d])?;
     let doc = match DeTable::parse(&file.text) {
         Ok(doc) => doc,
         Err(e) => {

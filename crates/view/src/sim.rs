@@ -238,7 +238,7 @@ fn trace_panel(
             .hint(r.hint),
         ])
     })?;
-    let loaded = btfsm_format::load(&path, limits).map_err(ViewError::Diagnostics)?;
+    let loaded = btfsm_format::load_named(&path, limits).map_err(ViewError::Diagnostics)?;
     let mut policy = if run["convert"] == "hfsm" {
         btfsm_transform::bt_to_hfsm::bt_policy_to_hfsm(&loaded.policy)
             .map_err(|e| ViewError::Input(format!("{file}: {}", e[0])))?

@@ -289,12 +289,15 @@ impl Loader<'_> {
         shown: &str,
         pspan: Range<usize>,
     ) -> Option<XDoc> {
-        let file = match crate::toml::read_included(full, shown, self.limits) {
+        let named = crate::source::Named::Xml("root");
+        let file = match crate::toml::read_included(full, shown, self.limits, named) {
             Ok(f) => f,
             Err(mut ds) => {
-                let msg = ds.remove(0).message;
-                self.err(d, pspan, msg).hint =
-                    Some("`path` is relative to the including file".into());
+                let x = ds.remove(0);
+                self.err(d, pspan, x.message).hint = Some(
+                    x.hint
+                        .unwrap_or_else(|| "`path` is relative to the including file".into()),
+                );
                 return None;
             }
         };

@@ -162,6 +162,27 @@ fn builtin_rule(
             })
         }
         "Parallel" => {
+            // Its ports are `int`: BehaviorTree.CPP 4 refuses a literal out
+            // of its range when it creates the tree ("can not be
+            // converted"), where i64::MIN was read as a threshold of 1.
+            let out_of_range = ["success_count", "failure_count"]
+                .into_iter()
+                .find_map(|a| {
+                    let v = el.attr(a)?.trim();
+                    let digits = v.strip_prefix(['-', '+']).unwrap_or(v);
+                    let literal = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
+                    (literal && v.parse::<i32>().is_err()).then_some((a, v))
+                });
+            if let Some((a, v)) = out_of_range {
+                return Some((
+                    format!(
+                        "`Parallel` {a}={} is out of the range of a 32-bit `int`, which BehaviorTree.CPP 4 refuses",
+                        btfsm_core::sanitize::shown_max(v, 40)
+                    ),
+                    "a number of children, or a negative count from the end (-1: all)",
+                    None,
+                ));
+            }
             let over = |k: i64| k > 0 && k as usize > n;
             match (int("success_count"), int("failure_count")) {
                 (Some(k), _) if over(k) => Some((

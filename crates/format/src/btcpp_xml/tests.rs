@@ -35,6 +35,14 @@ fn behaviortree_cpp_child_count_and_port_rules_are_errors() {
             "success_count=4 with 3 children can never succeed",
         ),
         (
+            format!("<Parallel success_count=\"-9223372036854775808\">{s}{s}</Parallel>"),
+            "success_count=-9223372036854775808 is out of the range of a 32-bit `int`",
+        ),
+        (
+            format!("<Parallel failure_count=\"2147483648\">{s}{s}</Parallel>"),
+            "failure_count=2147483648 is out of the range",
+        ),
+        (
             format!("<RetryUntilSuccessful>{s}</RetryUntilSuccessful>"),
             "needs `num_attempts`",
         ),
@@ -46,6 +54,7 @@ fn behaviortree_cpp_child_count_and_port_rules_are_errors() {
         format!("<IfThenElse>{s}{s}</IfThenElse>"),
         format!("<Switch2 variable=\"x\" case_1=\"a\" case_2=\"b\">{s}{s}{s}</Switch2>"),
         format!("<Parallel success_count=\"-1\">{s}{s}</Parallel>"),
+        format!("<Parallel success_count=\"-2147483648\">{s}{s}</Parallel>"),
     ] {
         assert!(parse(&tree(&body)).is_ok(), "{body}");
     }

@@ -170,11 +170,17 @@ impl Loader {
         path: &Path,
     ) -> Option<Arc<SourceFile>> {
         let shown = path.display().to_string();
-        let file = match read_included(path, &shown, &self.limits) {
+        let file = match read_included(path, &shown, &self.limits, crate::source::Named::TomlPolicy)
+        {
             Ok(f) => f,
             Err(mut ds) => {
-                let msg = ds.remove(0).message;
-                self.err(cx, tval.span(), format!("subtree of node `{id}`: {msg}"));
+                let d = ds.remove(0);
+                self.err(
+                    cx,
+                    tval.span(),
+                    format!("subtree of node `{id}`: {}", d.message),
+                )
+                .hint = d.hint;
                 return None;
             }
         };

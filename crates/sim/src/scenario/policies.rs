@@ -253,7 +253,7 @@ impl Reader {
         let rel = self.string(f, "`file`")?;
         let path = self.policy_path(f, &rel, base, limits)?;
         let convert = self.convert(t)?;
-        let loaded = match format::load(&path, limits) {
+        let loaded = match format::load_named(&path, limits) {
             Ok(l) => l,
             Err(d) => {
                 self.diags.extend(d);

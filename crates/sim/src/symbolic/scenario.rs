@@ -247,6 +247,12 @@ impl Files<'_> {
 /// The scenario's TOML as written (a syntax or type error is the one
 /// diagnostic).
 fn read_raw(file: &Arc<SourceFile>) -> Result<Raw, Vec<Diagnostic>> {
+    btfsm_core::toml_budget::check(
+        file,
+        btfsm_core::toml_budget::DEFAULT_MAX_TOKENS,
+        "a scenario's counts are capped (docs/guide/sim.md)",
+    )
+    .map_err(|d| vec![d])?;
     toml::from_str(&file.text).map_err(|e| {
         let d = Diagnostic::error(format!("invalid symbolic scenario: {}", e.message().trim()))
             .hint("see docs/guide/sim.md (\"Symbolic simulation\") for the format");
@@ -268,6 +274,20 @@ fn load_domain(
         Ok(p) => {
             let shown = p.display().to_string();
             let f = format::source::read(&p, &shown, files.limits, true)?;
+            // Checked before it is parsed: a file that is not a domain is
+            // refused quoting none of it (issue 33).
+            let is_toml = p
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+            if !is_toml || !format::discover::looks_like_domain(&f.text) {
+                return Err(vec![
+                    Diagnostic::error(format!(
+                        "domain `{}`: not an action domain: it is not read, and nothing of it is shown",
+                        btfsm_core::sanitize::shown(&shown)
+                    ))
+                    .hint("a domain is a `.toml` file with `[actions.NAME]` or `[predicates]` tables (docs/guide/plan.md)"),
+                ]);
+            }
             btfsm_plan::load(&f).map(Some)
         }
         Err(r) => {
@@ -462,7 +482,7 @@ fn load_policies(
                 continue;
             }
         };
-        match format::load(&path, files.limits) {
+        match format::load_named(&path, files.limits) {
             Ok(mut l) => match unbound(domain, &l.policy) {
                 None => {
                     if let Some(n) = &p.name {
