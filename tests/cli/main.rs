@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 mod common;
 mod compare;
+mod compare_field;
 mod compare_report;
 mod compare_tree;
 mod conventions;

@@ -98,6 +98,7 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
     let (_, explicit) = btcpp_xml::derive_ids(&children, bt.root, name, &names, |i, derived| {
         (bt.nodes[i].id != derived).then(|| bt.nodes[i].id.clone())
     });
+    let explicit: Vec<bool> = explicit.iter().map(|s| !s.is_derived()).collect();
     let need_ns = explicit.iter().any(|&e| e);
 
     let mut out = String::new();

@@ -90,6 +90,8 @@ impl Loader<'_> {
             type_name: type_kept.then(|| v4_name(&ty).to_string()),
             ports,
             subtree: None,
+            // Set with the id, once the whole tree is read (`expand.rs`).
+            id_source: btfsm_model::IdSource::Position,
             span: Some(el.span.clone()),
         })
     }

@@ -303,8 +303,21 @@ proptest::proptest! {
 fn repeated_names_fall_back_to_positions() {
     let children = vec![vec![1, 2], vec![], vec![]];
     let names = vec![None, Some("x".to_string()), Some("x".to_string())];
-    let (ids, _) = derive_ids(&children, 0, "T", &names, |_, _| None);
+    let (ids, sources) = derive_ids(&children, 0, "T", &names, |_, _| None);
     assert_eq!(ids, ["T", "T/0", "T/1"]);
+    assert!(
+        sources
+            .iter()
+            .all(|&s| s == btfsm_model::IdSource::Position)
+    );
+    // A unique name is the id, derived from the name; btfsm:id is given.
+    let names = vec![None, Some("x".to_string()), Some("y".to_string())];
+    let (ids, sources) = derive_ids(&children, 0, "T", &names, |i, _| {
+        (i == 2).then(|| "kept".to_string())
+    });
+    assert_eq!(ids, ["T", "x", "kept"]);
+    use btfsm_model::IdSource::{Given, Name, Position};
+    assert_eq!(sources, [Position, Name, Given]);
 }
 
 #[test]
