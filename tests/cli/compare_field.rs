@@ -8,7 +8,8 @@
 
 use super::*;
 
-const NAV2: &str = "tests/fixtures/corpus/bt-xml/nav2";
+const NAV2: &str = "tests/fixtures/field/bt-xml/nav2";
+const NAV2_MODEL: &str = "tests/fixtures/corpus/bt-xml/nav2/nav2_tree_nodes.xml";
 const NAMES_BEFORE: &str = "tests/fixtures/compare/names-before.xml";
 const NAMES_AFTER: &str = "tests/fixtures/compare/names-after.xml";
 const TYPE_CHANGED: &str = "tests/fixtures/compare/names-type-changed.xml";
@@ -16,8 +17,8 @@ const TYPE_CHANGED: &str = "tests/fixtures/compare/names-type-changed.xml";
 fn nav2_pair() -> (String, String, String) {
     (
         format!("{NAV2}/humble/navigate_to_pose_w_replanning_and_recovery.xml"),
-        format!("{NAV2}/navigate_to_pose_w_replanning_and_recovery.xml"),
-        format!("{NAV2}/nav2_tree_nodes.xml"),
+        format!("{NAV2}/main/navigate_to_pose_w_replanning_and_recovery.xml"),
+        NAV2_MODEL.to_string(),
     )
 }
 

@@ -310,7 +310,11 @@ impl Loader<'_> {
             it.name_override
                 .or_else(|| el.attr("name").map(str::to_string)),
         );
-        w.explicit.push(el.btfsm_attr("id").map(str::to_string));
+        w.explicit.push(
+            el.btfsm_attr("id")
+                .map(str::to_string)
+                .or_else(|| el.id_comment.clone()),
+        );
         w.nodes.push(node);
         for &c in el.children.iter().rev() {
             w.stack.push(Item {
