@@ -234,19 +234,48 @@ fn generic_controls_keep_their_type_and_ports() {
     assert_eq!(b.nodes[3].ports["delay_msec"], "5");
 }
 
+/// BehaviorTree.CPP reads no category from a model: two that disagree
+/// are a warning naming both places, and the first one read is kept.
 #[test]
-fn conflicting_model_declarations_are_errors() {
-    let e = parse(
+fn conflicting_model_declarations_are_a_warning_naming_both() {
+    let l = parse(
         r#"<root><BehaviorTree ID="T"><Foo/></BehaviorTree>
 <TreeNodesModel><Action ID="Foo"/><Condition ID="Foo"/></TreeNodesModel></root>"#,
     )
-    .unwrap_err();
+    .unwrap();
+    let w = &l.warnings[0];
     assert!(
-        e[0].message
-            .contains("declared both as `Action` and as `Condition`"),
+        w.message.contains(
+            "`Foo` is declared as `Condition` here and as `Action` at t.xml:2:17; read as `Action`"
+        ),
         "{}",
-        e[0].message
+        w.message
     );
+    assert_eq!(bt(&l).nodes[0].kind, BtNodeKind::Action);
+}
+
+/// MoveIt Studio keeps `<MetadataFields>` in its models, inside an entry
+/// or beside them; BehaviorTree.CPP ignores what it does not read, so an
+/// unknown entry is a warning.
+#[test]
+fn metadata_in_a_model_is_read_past() {
+    let l = parse(
+        r#"<root BTCPP_format="4"><BehaviorTree ID="T"><Foo/></BehaviorTree>
+<TreeNodesModel>
+  <SubTree ID="T"><MetadataFields><Metadata runnable="true"/></MetadataFields></SubTree>
+  <MetadataFields><Metadata subcategory="Perception"/></MetadataFields>
+  <Action ID="Foo"><MetadataFields><Metadata subcategory="x"/></MetadataFields></Action>
+  <Acton ID="Bar"/>
+</TreeNodesModel></root>"#,
+    )
+    .unwrap();
+    assert_eq!(l.warnings.len(), 1, "{:?}", l.warnings);
+    assert!(
+        l.warnings[0].message.contains("unknown entry `<Acton>`"),
+        "{}",
+        l.warnings[0].message
+    );
+    assert_eq!(bt(&l).nodes[0].kind, BtNodeKind::Action);
 }
 
 #[test]
