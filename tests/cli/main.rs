@@ -16,6 +16,7 @@ mod compare_report;
 mod compare_tree;
 mod conventions;
 mod dot;
+mod fault_tolerant;
 mod field_formats;
 mod formats;
 mod gate;

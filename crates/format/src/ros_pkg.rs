@@ -30,6 +30,9 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
+/// Package name -> the directories of the `package.xml`s naming it.
+type PackageIndex = BTreeMap<String, Vec<PathBuf>>;
+
 /// Most directory entries one repository search (or one search for a
 /// yasmin `file_name` in a package) visits.
 pub const MAX_WALK: usize = 200_000;
@@ -45,7 +48,7 @@ pub struct RosPackages {
     /// The prefixes of `AMENT_PREFIX_PATH`, in order.
     pub ament_prefixes: Vec<PathBuf>,
     /// Per root searched: package name -> directories of its `package.xml`.
-    found: Mutex<HashMap<PathBuf, Arc<BTreeMap<String, Vec<PathBuf>>>>>,
+    found: Mutex<HashMap<PathBuf, Arc<PackageIndex>>>,
 }
 
 impl RosPackages {
@@ -96,7 +99,7 @@ impl RosPackages {
     }
 
     /// The packages below `top`, searched once.
-    fn index(&self, top: &Path) -> Arc<BTreeMap<String, Vec<PathBuf>>> {
+    fn index(&self, top: &Path) -> Arc<PackageIndex> {
         let key = super::source::canonical(top);
         let mut found = self.found.lock().unwrap_or_else(|e| e.into_inner());
         found
@@ -166,9 +169,9 @@ fn walk(top: &Path, mut visit: impl FnMut(&Path) -> bool) {
     }
 }
 
-/// Package name -> the directories of the `package.xml`s naming it.
-fn packages_below(top: &Path) -> BTreeMap<String, Vec<PathBuf>> {
-    let mut out: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
+/// The packages below `top`.
+fn packages_below(top: &Path) -> PackageIndex {
+    let mut out = PackageIndex::new();
     walk(top, |p| {
         if p.file_name().is_some_and(|n| n == "package.xml")
             && let Some(name) = package_name(p)

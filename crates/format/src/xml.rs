@@ -16,7 +16,7 @@ pub const BTFSM_NS: &str = "urn:btfsm";
 
 /// What opens the comment that gives the next element its node id in an
 /// export (`<!-- btfsm:id deliver -->`): BehaviorTree.CPP 4 refuses the
-/// attribute `btfsm:id` ("a port with name [btfsm:id] is found in the XML
+/// attribute `btfsm:id` ("a port with name \[btfsm:id\] is found in the XML
 /// but not in the providedPorts()") and skips comments.
 pub const ID_COMMENT: &str = "btfsm:id ";
 

@@ -6,6 +6,8 @@
 
 mod csv;
 pub mod exec;
+#[cfg(test)]
+mod fault_tolerant_tests;
 mod livelock;
 pub mod monte_carlo;
 #[cfg(test)]
