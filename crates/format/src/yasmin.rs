@@ -917,4 +917,38 @@ mod tests {
         assert!(!looks_like_yasmin("<root BTCPP_format=\"4\">"));
         assert!(!looks_like_yasmin("<StateMachineX/>"));
     }
+
+    /// yasmin's `<JoinState>` (a barrier in an orthogonal region, one
+    /// outcome) is a state; a `<Concurrence>` is a parallel state whose
+    /// children all run at once, and an empty one (yasmin_editor's test
+    /// file) a state ending in its default outcome.
+    #[test]
+    fn join_states_and_concurrences_are_read() {
+        let m = machine(
+            r#"<StateMachine name="M" outcomes="ok" start_state="par">
+  <OrthogonalState name="par" outcomes="done" default_outcome="done">
+    <Region name="A" outcomes="end" start_state="w">
+      <State name="w"><Transition from="ready" to="j"/></State>
+      <JoinState name="j" sync_id="s" outcome="joined"><Transition from="joined" to="end"/></JoinState>
+    </Region>
+    <Transition from="done" to="cc"/>
+  </OrthogonalState>
+  <Concurrence name="cc" outcomes="both" default_outcome="both">
+    <State name="x"/>
+    <State name="y"/>
+    <Transition from="both" to="empty"/>
+  </Concurrence>
+  <Concurrence name="empty" outcomes="fin" default_outcome="fin">
+    <Transition from="fin" to="ok"/>
+  </Concurrence>
+</StateMachine>"#,
+        );
+        let by = |n: &str| m.states.iter().find(|s| s.name == n).unwrap_or_else(|| panic!("{n}"));
+        assert!(matches!(by("j").body, StateBody::Task(None)));
+        match &by("cc").body {
+            StateBody::Container(r) => assert!(r.parallel && r.states.len() == 2),
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(by("empty").body, StateBody::Task(None)));
+    }
 }
