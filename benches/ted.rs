@@ -47,6 +47,7 @@ fn node(id: String, kind: BtNodeKind, label: String, skill: Option<SkillCall>) -
         type_name: None,
         ports: BTreeMap::new(),
         subtree: None,
+        id_source: btfsm_model::IdSource::Given,
         span: None,
     }
 }

@@ -199,6 +199,35 @@ pub(crate) struct LimitArgs {
     /// of the root or into `.git`: for trusted local use only
     #[arg(long)]
     pub allow_outside_root: bool,
+    /// Where ROS package NAME is, for BehaviorTree.CPP's `<include
+    /// ros_pkg="NAME">` and yasmin's `package="NAME"` (repeatable; else
+    /// AMENT_PREFIX_PATH's share/NAME/, else the package.xml named NAME in
+    /// the repository; files stay inside the root)
+    #[arg(long = "ros-pkg", value_name = "NAME=DIR", value_parser = parse_ros_pkg)]
+    pub ros_pkg: Vec<(String, PathBuf)>,
+}
+
+/// `NAME=DIR` of `--ros-pkg`.
+fn parse_ros_pkg(s: &str) -> Result<(String, PathBuf), String> {
+    match s.split_once('=') {
+        Some((n, d)) if !n.is_empty() && !d.is_empty() => Ok((n.to_string(), PathBuf::from(d))),
+        _ => Err(
+            "expected NAME=DIR, e.g. --ros-pkg nav2_bt_navigator=src/navigation2/nav2_bt_navigator"
+                .into(),
+        ),
+    }
+}
+
+/// The prefixes of `AMENT_PREFIX_PATH` (what a sourced ROS 2 workspace
+/// sets), in order.
+fn ament_prefixes() -> Vec<PathBuf> {
+    std::env::var_os("AMENT_PREFIX_PATH")
+        .map(|v| {
+            std::env::split_paths(&v)
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// How `dot` draws a Behavior Tree: ports, folded subtrees, direction.
@@ -264,6 +293,7 @@ impl LimitArgs {
             expansion_budget: btfsm_format::source::Budget::new(self.max_nodes as u64),
             total_nodes: btfsm_format::source::Budget::new(self.max_total_nodes),
             tree: self.tree.clone(),
+            ros: btfsm_format::ros_pkg::RosPackages::new(self.ros_pkg.clone(), ament_prefixes()),
             ..Default::default()
         }
     }

@@ -89,11 +89,11 @@ pub(super) fn run(args: CompareArgs) -> u8 {
     let [la, lb] = loaded.as_slice() else {
         return EXIT_BAD_INPUT;
     };
-    let bts = match (&la.policy.body, &lb.policy.body) {
-        (PolicyBody::Bt(a), PolicyBody::Bt(b)) => Some((a, b)),
-        _ => None,
-    };
-    if args.mode == CompareMode::Tree && bts.is_none() {
+    let bts = matches!(
+        (&la.policy.body, &lb.policy.body),
+        (PolicyBody::Bt(_), PolicyBody::Bt(_))
+    );
+    if args.mode == CompareMode::Tree && !bts {
         let other = if la.policy.kind() == PolicyKind::Bt {
             lb
         } else {
@@ -112,7 +112,11 @@ pub(super) fn run(args: CompareArgs) -> u8 {
         timeout: Duration::from_millis(args.timeout_ms),
         work: args.work,
     };
-    let pair = Pair::new(
+    let topts = TedOptions {
+        max_work: args.tree_max_work,
+        ..TedOptions::default()
+    };
+    let pair = Pair::with_tree_options(
         Side {
             file: &la.path,
             policy: &la.policy,
@@ -121,6 +125,7 @@ pub(super) fn run(args: CompareArgs) -> u8 {
             file: &lb.path,
             policy: &lb.policy,
         },
+        &topts,
     );
     let mut results = Vec::new();
     for mode in args.mode.ged_modes() {
@@ -129,14 +134,8 @@ pub(super) fn run(args: CompareArgs) -> u8 {
         drop(progress);
     }
     let mut report = pair.report(results);
-    if matches!(args.mode, CompareMode::Tree | CompareMode::All)
-        && let Some((a, b)) = bts
-    {
-        let topts = TedOptions {
-            max_work: args.tree_max_work,
-            ..TedOptions::default()
-        };
-        report.tree = Some(compare::tree::tree_report(a, b, &topts));
+    if matches!(args.mode, CompareMode::Tree | CompareMode::All) {
+        report.tree = pair.tree_report();
     }
     // The drawing first (its file is written or its error said), then the
     // comparison, which is printed whatever became of the drawing: a

@@ -8,6 +8,23 @@ pub(crate) fn btfsm(args: &[&str]) -> (i32, String, String) {
     run(Command::new(env!("CARGO_BIN_EXE_btfsm")).args(args))
 }
 
+/// [`btfsm`] with environment variables set and removed.
+pub(crate) fn btfsm_env(
+    args: &[&str],
+    set: &[(&str, &str)],
+    remove: &[&str],
+) -> (i32, String, String) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_btfsm"));
+    cmd.args(args);
+    for k in remove {
+        cmd.env_remove(k);
+    }
+    for (k, v) in set {
+        cmd.env(k, v);
+    }
+    run(&mut cmd)
+}
+
 /// Runs `cmd` in the crate root: (exit code, stdout, stderr).
 fn run(cmd: &mut Command) -> (i32, String, String) {
     let out = cmd

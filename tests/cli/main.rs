@@ -11,11 +11,14 @@ use std::path::{Path, PathBuf};
 
 mod common;
 mod compare;
+mod compare_field;
 mod compare_report;
 mod compare_tree;
 mod confine;
 mod conventions;
 mod dot;
+mod fault_tolerant;
+mod field_formats;
 mod formats;
 mod gate;
 mod hostile;

@@ -130,3 +130,47 @@ fn every_fixture_folder_is_in_the_provenance_table() {
         }
     }
 }
+
+/// Every file of `tests/fixtures/field/` that comes from a public project
+/// has a row in `field/README.md` naming its repository, commit and a
+/// licence text that exists; the folders written for btfsm are named there.
+#[test]
+fn every_field_file_has_a_provenance_row() {
+    let readme = std::fs::read_to_string(format!("{FIXTURES}/field/README.md")).expect("README");
+    let rows = rows(&readme);
+    for row in &rows {
+        assert!(
+            REDISTRIBUTABLE.iter().any(|l| row[4].contains(l)),
+            "{}: licence `{}`",
+            row[0],
+            row[4]
+        );
+        for n in row[4]
+            .split('`')
+            .filter(|s| s.starts_with("../corpus/LICENSES/"))
+        {
+            assert!(
+                Path::new(&format!("{FIXTURES}/field/{n}")).is_file(),
+                "{}: {n} missing",
+                row[0]
+            );
+        }
+    }
+    let ours = ["field/ros-ws/", "field/groot2-project/"];
+    for f in files_below(&Path::new(FIXTURES).join("field")) {
+        if f.ends_with("README.md") || ours.iter().any(|o| f.starts_with(o)) {
+            continue;
+        }
+        let rel = f.strip_prefix("field/").expect("under field/");
+        assert!(
+            rows.iter().any(|r| r[0] == rel),
+            "no provenance row in tests/fixtures/field/README.md for {f}"
+        );
+    }
+    for o in ours {
+        assert!(
+            readme.contains(&format!("`{}`", &o["field/".len()..])),
+            "{o}"
+        );
+    }
+}

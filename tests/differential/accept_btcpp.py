@@ -4,7 +4,7 @@ compared with the real BehaviorTree.CPP 4 engine (Python bindings
 `behaviortreepy`, see README "Differential tests" below).
 
 For every BT XML fixture (tests/fixtures/corpus*/bt-xml/**/*.xml,
-tests/fixtures/valid/**/*.xml, tests/fixtures/invalid/**/*.xml,
+tests/fixtures/field/bt-xml/**/*.xml, tests/fixtures/valid/**/*.xml, tests/fixtures/invalid/**/*.xml,
 tests/fixtures/lint/**/*.xml; a file that
 only holds a <TreeNodesModel> is skipped):
 
@@ -25,12 +25,20 @@ only holds a <TreeNodesModel> is skipped):
    project's model] FILE` (exit 0 = accept, 2 = reject, anything else = a
    crash, always a mismatch).
 3. Every file btfsm accepts is exported with `btfsm convert FILE --to
-   btcpp-xml` (the `btfsm:` attributes stripped, as README says) and loaded in
-   BehaviorTree.CPP with the same registrations: it must load, and when the
-   original loaded too, the instantiated trees must have the same shape (node
-   types and child counts in pre-order, SubTree nodes replaced by their
-   subtree's root; BehaviorTree.CPP's FileLogger2 header gives the
-   instantiated tree).
+   btcpp-xml` and loaded in BehaviorTree.CPP as written, with the same
+   registrations (nothing of the export is stripped but the ports of dummy
+   nodes, as for every file: the bindings cannot declare ports; a
+   `btfsm:` attribute, which BehaviorTree.CPP rejects as an undeclared
+   port, would make the export fail): it must load, and when the original
+   loaded too, the instantiated trees must have the same nodes (types and
+   names), child counts and ports (with BehaviorTree.CPP's defaults filled
+   in from the instantiated tree's own <TreeNodesModel>, so that a Parallel
+   written with `failure_count="1"` equals one that leaves it to the
+   default; values compared for the nodes of the main tree, names only
+   inside SubTrees, whose ports the export resolves through the remapping)
+   in pre-order, SubTree nodes replaced by their subtree's root
+   (BehaviorTree.CPP's FileLogger2 header gives the instantiated tree).
+   Every bundled TOML BT is exported and loaded too.
 
 Output: a table of mismatches with the reason from each side. Exit status:
 0 when every mismatch is listed in accept_btcpp_known.txt and every listed
@@ -158,28 +166,52 @@ def worker_main():
 
 
 def instantiated_shape(xml_text):
-    """[(type, children)] in pre-order of the instantiated tree, subtrees
-    expanded: a SubTree node is replaced by its subtree's root."""
+    """[(type, children, name, ports)] in pre-order of the instantiated tree,
+    subtrees expanded: a SubTree node is replaced by its subtree's root.
+    `ports` maps each port to its value as written, BehaviorTree.CPP's
+    default (from the <TreeNodesModel> of the same header) where the node
+    does not set it; inside a SubTree only the port names are kept (the
+    value None)."""
     root = ET.fromstring(xml_text)
     trees = {}
     for t in root.findall("BehaviorTree"):
         trees[t.get("_fullpath", "")] = t
+    defaults = {}
+    for m in root.findall("TreeNodesModel"):
+        for d in m:
+            defaults[d.get("ID")] = {p.get("name"): p.get("default") for p in d
+                                     if p.get("default") is not None}
     out = []
 
-    def visit(el):
+    def visit(el, inside):
         if el.tag == "SubTree":
             sub = trees.get(el.get("_fullpath", ""))
             if sub is not None and len(sub):
-                visit(sub[0])
+                visit(sub[0], True)
                 return
         kids = list(el)
-        out.append([el.tag, len(kids)])
+        ports = dict(defaults.get(el.tag, {}))
+        ports.update({k: v for k, v in el.attrib.items()
+                      if k not in ("name", "_uid", "_fullpath")})
+        if el.tag == "Parallel":
+            # A negative count is counted from the number of children
+            # (-1: all of them), as ParallelNode reads it.
+            for k in ("success_count", "failure_count"):
+                try:
+                    v = int(ports.get(k, ""))
+                except ValueError:
+                    continue
+                if v < 0:
+                    ports[k] = str(len(kids) + v + 1)
+        if inside:
+            ports = {k: None for k in ports}
+        out.append([el.tag, len(kids), el.get("name", ""), ports])
         for k in kids:
-            visit(k)
+            visit(k, inside)
 
     main = trees.get("")
     if main is not None and len(main):
-        visit(main[0])
+        visit(main[0], False)
     return out
 
 
@@ -374,9 +406,6 @@ def rewrite(files, roots, regs, controls, outdir, base):
         else:
             for el in root.iter():
                 tag = local(el.tag)
-                for a in list(el.attrib):
-                    if a.startswith("{") or a.startswith("xmlns"):
-                        del el.attrib[a]  # btfsm:id and friends
                 typ = el.get("ID") if tag in EXPLICIT else tag
                 if typ in regs or typ in controls:
                     for a in list(el.attrib):
@@ -402,9 +431,10 @@ def btcpp(path, outdir, base=None, statuses=None):
     files, roots, regs, controls, tree_ids = plan(path)
     if not files:
         return {"ok": False, "mode": "main", "error": "file not found", "shapes": {}}
-    # Rewrite only when needed (dummy ports, custom controls, btfsm: attributes
-    # of an export): otherwise tinyxml2 reads the file exactly as written.
-    need_rewrite = roots.get(files[0]) is not None and bool(regs or controls or base is not None)
+    # Rewrite only when needed (dummy ports, custom controls): otherwise
+    # tinyxml2 reads the file exactly as written. An export is loaded as
+    # written too: nothing BehaviorTree.CPP would reject is stripped.
+    need_rewrite = roots.get(files[0]) is not None and bool(regs or controls)
     target = files[0]
     if need_rewrite:
         written = rewrite(files, {p: roots[p] for p in files}, regs, controls, outdir,
@@ -480,6 +510,15 @@ def btfsm_export(exe, path, out):
     return res.returncode, res.stderr.strip()
 
 
+def same_node(o, e):
+    """An instantiated node of the original and of the export are the same:
+    type, child count, name and port names; and port values where the
+    original's is known (outside SubTrees: `instantiated_shape`)."""
+    if o[:3] != e[:3] or set(o[3]) != set(e[3]):
+        return False
+    return all(v is None or e[3][k] is None or v == e[3][k] for k, v in o[3].items())
+
+
 def check_export(exe, f, rel, work, b, r, mismatches):
     """btfsm's BehaviorTree.CPP export of an accepted file must load (and tick
     once) in BehaviorTree.CPP, with the original's shape when the original
@@ -509,13 +548,16 @@ def check_export(exe, f, rel, work, b, r, mismatches):
     if b is not None and b["ok"]:
         s0 = next(iter(b["shapes"].values()), [])
         s1 = e["shapes"].get("<main>", [])
-        r["shape_equal"] = s0 == s1
-        if s0 != s1:
-            diff = next((k for k in range(min(len(s0), len(s1))) if s0[k] != s1[k]),
+        same = len(s0) == len(s1) and all(same_node(x, y) for x, y in zip(s0, s1))
+        r["shape_equal"] = same
+        if not same:
+            diff = next((k for k in range(min(len(s0), len(s1))) if not same_node(s0[k], s1[k])),
                         min(len(s0), len(s1)))
             a0 = s0[diff] if diff < len(s0) else "end"
             a1 = s1[diff] if diff < len(s1) else "end"
-            mismatches.append((rel, "export", "shape differs", "shape differs",
+            what = ("shape differs" if [x[:2] for x in s0] != [x[:2] for x in s1]
+                    else "names or ports differ")
+            mismatches.append((rel, "export", what, what,
                                f"original node #{diff}: {a0} ({len(s0)} nodes)",
                                f"export node #{diff}: {a1} ({len(s1)} nodes)"))
 
@@ -617,6 +659,7 @@ def fixture_files():
     out = []
     for corpus in sorted(FIXTURES.glob("corpus*")):
         out += sorted((corpus / "bt-xml").rglob("*.xml")) if (corpus / "bt-xml").is_dir() else []
+    out += sorted((FIXTURES / "field" / "bt-xml").rglob("*.xml"))
     out += sorted((FIXTURES / "valid").rglob("*.xml"))
     out += sorted((FIXTURES / "invalid").rglob("*.xml"))
     out += sorted((FIXTURES / "lint").rglob("*.xml"))

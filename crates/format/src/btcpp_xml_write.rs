@@ -6,12 +6,25 @@
 //! Model kinds are written as BehaviorTree.CPP types by
 //! [`btcpp_xml::canonical_type`] (reactive `sequence` -> `ReactiveSequence`,
 //! `sequence_memory` -> `Sequence`, ...) unless the node keeps its original type
-//! name. A node's identity is written as `btfsm:id` only where the reader would
-//! not derive it from the written names and positions
-//! ([`btcpp_xml::derive_ids`]), so trees imported from XML export without it.
+//! name. What BehaviorTree.CPP 4 loads (`make differential` loads every
+//! export in it, `tests/differential/accept_btcpp.py`):
+//!
+//! - a node's identity is written only where the reader would not derive it
+//!   from the written names and positions ([`btcpp_xml::derive_ids`]), and
+//!   then as a comment before the element (`<!-- btfsm:id deliver -->`,
+//!   [`xml::ID_COMMENT`]): BehaviorTree.CPP 4 refuses an attribute
+//!   `btfsm:id` as a port its node does not declare. Trees imported from
+//!   XML export without any;
+//! - a `Parallel` always says its thresholds in format 4's ports
+//!   (`success_count`, `failure_count`), also when it was read from format
+//!   3 (`success_threshold`, `failure_threshold`, `threshold`);
+//! - format 3's built-ins that format 4 renamed or dropped are written as
+//!   format 4 names them ([`btcpp_xml::v4_name`]; `BlackboardCheckInt`,
+//!   `...Double`, `...String`, `...Bool` as a `Precondition` whose `if`
+//!   script compares the two values, its `else` the status on a mismatch).
 
 use super::btcpp_xml::{self, BUILTINS, Category};
-use super::xml::{BTFSM_NS, escape_attr, escape_comment};
+use super::xml::{self, escape_attr, escape_comment};
 use btfsm_model::{Bt, BtNode, BtNodeKind, Policy, PolicyBody};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
@@ -62,7 +75,17 @@ fn node_type(n: &BtNode) -> (String, Category) {
         k if k.is_decorator() => Category::Decorator,
         _ => Category::Control,
     };
-    let ty = if let Some(t) = &n.type_name {
+    let v4_ports = || {
+        n.ports
+            .iter()
+            .map(|(k, v)| (k.clone(), v4_port(v)))
+            .collect()
+    };
+    let ty = if let Some(check) = n.type_name.as_deref().and_then(blackboard_check)
+        && check_script(check, &v4_ports()).is_some()
+    {
+        "Precondition".to_string()
+    } else if let Some(t) = &n.type_name {
         btcpp_xml::v4_name(t).to_string()
     } else if let Some(call) = &n.skill {
         call.skill.clone()
@@ -98,22 +121,18 @@ fn write_bt(name: &str, description: Option<&str>, bt: &Bt) -> String {
     let (_, explicit) = btcpp_xml::derive_ids(&children, bt.root, name, &names, |i, derived| {
         (bt.nodes[i].id != derived).then(|| bt.nodes[i].id.clone())
     });
-    let need_ns = explicit.iter().any(|&e| e);
+    let explicit: Vec<bool> = explicit.iter().map(|s| !s.is_derived()).collect();
 
     let mut out = String::new();
     out.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     if let Some(d) = description {
         let _ = writeln!(out, "<!-- {} -->", escape_comment(d));
     }
-    let _ = write!(
+    let _ = writeln!(
         out,
-        "<root BTCPP_format=\"4\" main_tree_to_execute=\"{}\"",
+        "<root BTCPP_format=\"4\" main_tree_to_execute=\"{}\">",
         escape_attr(name)
     );
-    if need_ns {
-        let _ = write!(out, " xmlns:btfsm=\"{BTFSM_NS}\"");
-    }
-    out.push_str(">\n");
     let _ = writeln!(out, "  <BehaviorTree ID=\"{}\">", escape_attr(name));
     write_nodes(&mut out, bt, &types, &names, &explicit);
     out.push_str("  </BehaviorTree>\n");
@@ -148,14 +167,20 @@ fn write_nodes(
             let _ = writeln!(out, "{pad}</{end}>");
             continue;
         }
-        let attr_text: String = node_attrs(n, names[i].as_ref(), explicit[i])
+        // The id, when written, on the element's line, just before it.
+        let id = if explicit[i] {
+            format!("<!-- {}{} -->", xml::ID_COMMENT, xml::id_to_comment(&n.id))
+        } else {
+            String::new()
+        };
+        let attr_text: String = node_attrs(n, ty, names[i].as_ref())
             .iter()
             .map(|(k, v)| format!(" {k}=\"{}\"", escape_attr(v)))
             .collect();
         if n.children.is_empty() {
-            let _ = writeln!(out, "{pad}<{open}{attr_text}/>");
+            let _ = writeln!(out, "{pad}{id}<{open}{attr_text}/>");
         } else {
-            let _ = writeln!(out, "{pad}<{open}{attr_text}>");
+            let _ = writeln!(out, "{pad}{id}<{open}{attr_text}>");
             stack.push((i, depth, true));
             for &c in n.children.iter().rev() {
                 stack.push((c, depth + 1, false));
@@ -164,21 +189,32 @@ fn write_nodes(
     }
 }
 
-/// A node's attributes, unescaped: its `name`, its id when not derived
-/// (`btfsm:id`), its kind's parameters, skill arguments and ports.
-fn node_attrs(n: &BtNode, name: Option<&String>, explicit: bool) -> Vec<(String, String)> {
+/// A node's attributes, unescaped: its `name`, its kind's parameters,
+/// skill arguments and ports, format 3's as format 4 names them. `ty` is
+/// the type written.
+fn node_attrs(n: &BtNode, ty: &str, name: Option<&String>) -> Vec<(String, String)> {
     let mut attrs: Vec<(String, String)> = Vec::new();
     if let Some(nm) = name {
         attrs.push(("name".into(), nm.clone()));
     }
-    if explicit {
-        attrs.push(("btfsm:id".into(), n.id.clone()));
-    }
+    let mut ports: BTreeMap<String, String> = n
+        .ports
+        .iter()
+        .map(|(k, v)| (k.clone(), v4_port(v)))
+        .collect();
     match n.kind {
-        BtNodeKind::Parallel { success } if n.type_name.is_none() => {
+        BtNodeKind::Parallel { success } if ty == "Parallel" => {
             attrs.push(("success_count".into(), success.to_string()));
+            // Format 3's names of the thresholds (the success one is the
+            // kind's parameter).
+            for old in ["success_threshold", "threshold"] {
+                ports.remove(old);
+            }
+            if let Some(f) = ports.remove("failure_threshold") {
+                ports.entry("failure_count".into()).or_insert(f);
+            }
             // The paper's Parallel fails when it can no longer succeed.
-            if !n.ports.contains_key("failure_count") {
+            if !ports.contains_key("failure_count") {
                 let fail = n.children.len().saturating_sub(success) + 1;
                 attrs.push(("failure_count".into(), fail.to_string()));
             }
@@ -196,10 +232,62 @@ fn node_attrs(n: &BtNode, name: Option<&String>, explicit: bool) -> Vec<(String,
             attrs.push((k.clone(), v.to_string()));
         }
     }
-    for (k, v) in &n.ports {
-        attrs.push((k.clone(), v4_port(v)));
+    if ty == "Precondition"
+        && let Some(check) = n.type_name.as_deref().and_then(blackboard_check)
+        && let Some(script) = check_script(check, &ports)
+    {
+        attrs.push(("if".into(), script));
+        if let Some(st) = ports.get("return_on_mismatch").filter(|s| !s.is_empty()) {
+            attrs.push(("else".into(), st.clone()));
+        }
+        return attrs;
     }
+    attrs.extend(ports);
     attrs
+}
+
+/// The value type a format-3 `BlackboardCheck*` compares, if `t` is one.
+fn blackboard_check(t: &str) -> Option<&'static str> {
+    Some(match t {
+        "BlackboardCheckInt" => "int",
+        "BlackboardCheckDouble" => "double",
+        "BlackboardCheckString" => "string",
+        "BlackboardCheckBool" => "bool",
+        _ => return None,
+    })
+}
+
+/// The `if` script of the `Precondition` that stands for a format-3
+/// `BlackboardCheck*` of value type `ty` with ports `value_A`, `value_B`:
+/// each value a blackboard entry (`{key}`: the script's variable `key`) or
+/// a literal (a number, `true`/`false`, or a quoted string); `None` when a
+/// value cannot be written so.
+fn check_script(ty: &str, ports: &BTreeMap<String, String>) -> Option<String> {
+    let operand = |v: &str| -> Option<String> {
+        if let Some(key) = v.strip_prefix('{').and_then(|r| r.strip_suffix('}')) {
+            let ident = key.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+                && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            return ident.then(|| key.to_string());
+        }
+        let v = v.trim();
+        match ty {
+            "int" => v.parse::<i64>().ok().map(|x| x.to_string()),
+            "double" => v
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .map(|_| v.to_string()),
+            "bool" => match v {
+                "true" | "1" => Some("true".into()),
+                "false" | "0" => Some("false".into()),
+                _ => None,
+            },
+            _ => (!v.contains(['\'', '\\'])).then(|| format!("'{v}'")),
+        }
+    };
+    let a = operand(ports.get("value_A")?)?;
+    let b = operand(ports.get("value_B")?)?;
+    Some(format!("{a} == {b}"))
 }
 
 /// Writes `<TreeNodesModel>`: the types that are not built in, with the
@@ -330,5 +418,81 @@ k = { action = "Pick cube2!", skill = "Pick", args = { object = "cube2" } }
         }
         assert_eq!(x.nodes.len(), y.nodes.len());
         assert!(xml.contains("<TreeNodesModel>"), "{xml}");
+    }
+
+    /// BehaviorTree.CPP 4 refuses a `btfsm:id` attribute (an undeclared
+    /// port): ids travel in comments, and come back, `--` and `%` too.
+    #[test]
+    fn ids_travel_in_comments_not_attributes() {
+        let text = r#"kind = "bt"
+name = "t"
+root = "top"
+[nodes]
+top = { sequence = ["a--b", "c-"] }
+"a--b" = { action = "A" }
+"c-" = { fallback = ["100%"] }
+"100%" = { condition = "C" }
+"#;
+        let a = crate::toml::parse_str("t.toml", text, Path::new("."), &Limits::default())
+            .unwrap()
+            .policy;
+        let xml = write_policy(&a).unwrap();
+        assert!(
+            !xml.contains("btfsm:id=") && !xml.contains("xmlns:btfsm"),
+            "{xml}"
+        );
+        assert!(xml.contains("<!-- btfsm:id a%2D%2Db --><A"), "{xml}");
+        let b = parse_str("t.xml", &xml, Path::new("."), &Limits::default())
+            .unwrap()
+            .policy;
+        let ids = |p: &Policy| match &p.body {
+            PolicyBody::Bt(t) => t.nodes.iter().map(|n| n.id.clone()).collect::<Vec<_>>(),
+            PolicyBody::Machine(_) => panic!("a BT"),
+        };
+        assert_eq!(ids(&a), ids(&b));
+    }
+
+    /// Format 3's Parallel thresholds and BlackboardCheck* as format 4
+    /// writes them.
+    #[test]
+    fn format3_nodes_are_written_as_format4_names_them() {
+        let input = r#"<root main_tree_to_execute="M">
+  <BehaviorTree ID="M">
+    <Sequence>
+      <Parallel success_threshold="1" failure_threshold="2">
+        <AlwaysSuccess/>
+        <AlwaysFailure/>
+        <AlwaysFailure/>
+      </Parallel>
+      <BlackboardCheckInt value_A="${count}" value_B="42" return_on_mismatch="SUCCESS">
+        <AlwaysSuccess/>
+      </BlackboardCheckInt>
+      <BlackboardCheckString value_A="{mode}" value_B="auto">
+        <AlwaysSuccess/>
+      </BlackboardCheckString>
+      <SequenceStar><AlwaysSuccess/></SequenceStar>
+    </Sequence>
+  </BehaviorTree>
+</root>"#;
+        let p = parse_str("v3.xml", input, Path::new("."), &Limits::default())
+            .unwrap()
+            .policy;
+        let out = write_policy(&p).unwrap();
+        for want in [
+            r#"<Parallel success_count="1" failure_count="2">"#,
+            r#"<Precondition name="BlackboardCheckInt" if="count == 42" else="SUCCESS">"#,
+            r#"<Precondition name="BlackboardCheckString" if="mode == 'auto'">"#,
+            "<SequenceWithMemory name=\"SequenceStar\">",
+        ] {
+            assert!(out.contains(want), "{want}\n{out}");
+        }
+        for gone in [
+            "threshold",
+            "BlackboardCheckInt ",
+            "value_A",
+            "SequenceStar>",
+        ] {
+            assert!(!out.contains(gone), "{gone}\n{out}");
+        }
     }
 }

@@ -5,12 +5,15 @@
 //! followed, and the walk is bounded in entries and depth.
 //!
 //! A file below a directory is a candidate by its extension (`.toml`,
-//! `.xml`, `.scxml`) and is kept when its content is a policy: a TOML file
-//! with a top-level `kind` key, an XML file with a `<BehaviorTree>`, an
-//! `<scxml>` or a yasmin `<StateMachine>` document element. Other files
-//! (a `Cargo.toml`, a ROS `package.xml`, a Nav2 nodes model) are counted as
-//! skipped, not reported as errors. Files named on the command line are
-//! always read, whatever they hold.
+//! `.xml`, `.scxml`, Groot2's `.btproj`) and is kept when its content is a
+//! policy: a TOML file with a top-level `kind` key, an XML file with a
+//! `<BehaviorTree>`, an `<scxml>` or a yasmin `<StateMachine>` document
+//! element. Other files (a `Cargo.toml`, a ROS `package.xml`, a Nav2 nodes
+//! model) are counted as skipped, not reported as errors; a Groot2 project
+//! file found so is no policy either, but it is among the BehaviorTree.CPP
+//! files given together (`btcpp_xml::Companions`), whose node models the
+//! trees of the walk read. Files named on the command line are always
+//! read, whatever they hold.
 
 use super::source;
 use super::{FileFormat, Limits};
@@ -88,7 +91,7 @@ fn walk(dir: &Path, visited: &mut usize, out: &mut Vec<Input>) -> Result<(), Dia
                 stack.push((path, depth + 1));
             } else if ft.is_file()
                 && path.extension().and_then(|x| x.to_str()).is_some_and(|x| {
-                    ["toml", "xml", "scxml"].contains(&x.to_ascii_lowercase().as_str())
+                    ["toml", "xml", "scxml", "btproj"].contains(&x.to_ascii_lowercase().as_str())
                 })
             {
                 found.push(path);

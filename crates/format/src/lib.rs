@@ -4,6 +4,7 @@
 pub mod btcpp_xml;
 pub mod btcpp_xml_write;
 pub mod discover;
+pub mod ros_pkg;
 pub mod scxml;
 pub mod scxml_write;
 pub mod source;
@@ -74,6 +75,10 @@ pub struct Limits {
     /// a `<SubTree>` that no file it reads defines is looked up in them
     /// ([`btcpp_xml::Companions`]).
     pub companions: Option<Arc<btcpp_xml::Companions>>,
+    /// Where ROS packages are (`--ros-pkg`, `AMENT_PREFIX_PATH`, the
+    /// repository), for BehaviorTree.CPP's `<include ros_pkg>` and yasmin's
+    /// `package` includes ([`ros_pkg`]).
+    pub ros: Arc<ros_pkg::RosPackages>,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -122,6 +127,7 @@ impl Default for Limits {
             total_nodes: source::Budget::new(DEFAULT_MAX_TOTAL_NODES),
             tree: None,
             companions: None,
+            ros: Arc::default(),
         }
     }
 }

@@ -10,8 +10,40 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::Arc;
 
-/// The namespace of btfsm's own attributes in exported files (`btfsm:id`).
+/// The namespace of btfsm's own attributes (`btfsm:id`, read in files
+/// older exports wrote; exports now write the comment of [`ID_COMMENT`]).
 pub const BTFSM_NS: &str = "urn:btfsm";
+
+/// What opens the comment that gives the next element its node id in an
+/// export (`<!-- btfsm:id deliver -->`): BehaviorTree.CPP 4 refuses the
+/// attribute `btfsm:id` ("a port with name \[btfsm:id\] is found in the XML
+/// but not in the providedPorts()") and skips comments.
+pub const ID_COMMENT: &str = "btfsm:id ";
+
+/// An id as written in a comment: XML comments hold no `--` and do not end
+/// in `-`, so `%` is written `%25` always and every `-` `%2D` when the id
+/// would break the comment ([`id_from_comment`] reads it back).
+pub fn id_to_comment(id: &str) -> String {
+    let dashes = id.contains("--") || id.ends_with('-');
+    let mut out = String::with_capacity(id.len());
+    for c in id.chars() {
+        match c {
+            '%' => out.push_str("%25"),
+            '-' if dashes => out.push_str("%2D"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The id a comment's text gives (see [`id_to_comment`]), if it is one.
+pub fn id_from_comment(text: &str) -> Option<String> {
+    let raw = text.trim().strip_prefix(ID_COMMENT)?.trim();
+    if raw.is_empty() {
+        return None;
+    }
+    Some(raw.replace("%2D", "-").replace("%25", "%"))
+}
 
 /// One attribute as written.
 #[derive(Debug, Clone)]
@@ -38,6 +70,9 @@ pub struct XElem {
     pub children: Vec<usize>,
     /// Byte range of the element's name in its start tag (`<Name`).
     pub span: Range<usize>,
+    /// The node id given by the comment just before the element
+    /// (`<!-- btfsm:id deliver -->`, only whitespace between), if any.
+    pub id_comment: Option<String>,
 }
 
 impl XElem {
@@ -337,6 +372,7 @@ fn parse_text(
                 .collect(),
             children: Vec::new(),
             span: back(start..(start + 1 + qname_len(&text[start..]))),
+            id_comment: id_comment_before(n),
         });
         if let Some(p) = n.parent_element()
             && let Some(&pi) = index.get(p.id().get_usize())
@@ -350,6 +386,22 @@ fn parse_text(
         elems,
         root: 0,
     })
+}
+
+/// The id of an [`ID_COMMENT`] comment before element `n`, only
+/// whitespace between them.
+fn id_comment_before(n: roxmltree::Node<'_, '_>) -> Option<String> {
+    let mut p = n.prev_sibling();
+    while let Some(x) = p {
+        if x.is_comment() {
+            return x.text().and_then(id_from_comment);
+        }
+        if !(x.is_text() && x.text().is_some_and(|t| t.trim().is_empty())) {
+            return None;
+        }
+        p = x.prev_sibling();
+    }
+    None
 }
 
 /// Length of the qualified name after `<` at the start of `s`.

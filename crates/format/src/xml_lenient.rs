@@ -1,7 +1,7 @@
 //! The XML that BehaviorTree.CPP reads although it is not well-formed:
 //! tinyxml2 (BehaviorTree.CPP's parser) accepts a bare `&` or `<` in an
 //! attribute value (`_if="a && b"`, `code="x < 3"`), a bare `&` in text,
-//! `--` inside a comment, attributes without a space between them
+//! `--` inside a comment or a comment ending in `--->`, attributes without a space between them
 //! (`ID="A"name="x"`), and stray text before the document element. When a
 //! file is not well-formed, [`repair`] rewrites exactly these places (`&amp;`,
 //! `&lt;`, `- -` kept at the same length as `~~`, spaces), and the file is
@@ -132,13 +132,25 @@ impl Repairer<'_> {
         let inner_end = close.unwrap_or(text.len());
         let end = close.map_or(text.len(), |c| c + 3);
         let inner = &text[i + 4..inner_end];
-        if inner.contains("--") {
+        // `--->` (BehaviorTree.CPP 3.8's tutorial t05 ends a comment so):
+        // the comment's text ends in `-`, which XML forbids.
+        let dash_end = close.is_some() && inner.ends_with('-');
+        if inner.contains("--") || dash_end {
             self.fixes.push(Repair {
                 span: i..i + 4,
-                what: "`--` inside a comment",
+                what: if inner.contains("--") {
+                    "`--` inside a comment"
+                } else {
+                    "a comment ending in `--->`"
+                },
             });
             self.out.push_str("<!--");
-            self.out.push_str(&inner.replace("--", "~~"));
+            let mut fixed = inner.replace("--", "~~");
+            if fixed.ends_with('-') {
+                fixed.pop();
+                fixed.push('~');
+            }
+            self.out.push_str(&fixed);
             self.out.push_str(&text[inner_end..end]);
             self.i = end;
         } else {
@@ -267,6 +279,7 @@ pub fn warnings(file: &Arc<SourceFile>, fixes: &[Repair]) -> Vec<Diagnostic> {
             .at(file, r.span.clone())
             .hint(match r.what {
                 "`--` inside a comment" => "write `- -` or end the comment before it",
+                "a comment ending in `--->`" => "end the comment with ` -->`",
                 "text before the document element" => "remove the text before `<root>`",
                 "a bare `<` in an attribute value" => "write `&lt;`",
                 "no space between two attributes" => "separate attributes with a space",
@@ -307,5 +320,16 @@ mod tests {
         let (fixed, map, _) = repair("<A ID=\"A\"name=\"x\"/>").unwrap();
         assert_eq!(fixed, "<A ID=\"A\" name=\"x\"/>");
         assert_eq!(map.original(fixed.find("name").unwrap()), 9);
+    }
+
+    /// BehaviorTree.CPP 3.8's tutorial t05 ends a comment with `--->`,
+    /// which tinyxml2 reads (and BehaviorTree.CPP 4 loads).
+    #[test]
+    fn a_comment_ending_in_three_dashes_is_read() {
+        let text = "<root>\n  <!-- Simple tree --->\n  <B/>\n</root>";
+        let (fixed, _, fixes) = repair(text).unwrap();
+        assert_eq!(fixed, "<root>\n  <!-- Simple tree ~-->\n  <B/>\n</root>");
+        assert_eq!(fixes[0].what, "a comment ending in `--->`");
+        assert_eq!(fixes[0].span, 9..13);
     }
 }

@@ -6,13 +6,18 @@
 //!   `<StateMachine>` is a container (so a file with one is an HFSM), and a
 //!   nested `<StateMachine file_path="other.xml">` takes its states and
 //!   outcomes from that file (relative to the including file, kept inside the
-//!   root like every named file: `format::source::resolve`).
+//!   root like every named file: `format::source::resolve`), and one with
+//!   `package="PKG" file_name="F"` from the first file named `F` below ROS
+//!   package `PKG` (yasmin_factory's `create_sm`; where the package is:
+//!   `format::ros_pkg`).
 //! - A machine's outcomes are its `outcomes` attribute plus its
 //!   `<FinalOutcome name>` children. Its start state is `start_state`, else
 //!   its first state in document order (the first one added, as yasmin's
 //!   `StateMachine.add_state` makes it).
 //! - `<State name>` is a task state without a skill binding (its `class` /
-//!   `module` is code the model does not run); `<Transition from="OUTCOME" to="TARGET">` is an outcome
+//!   `module` is code the model does not run), and so is `<JoinState name
+//!   sync_id outcome>` (the barrier of yasmin's `JoinState`, whose one
+//!   outcome, `joined` by default, its `<Transition>` maps); `<Transition from="OUTCOME" to="TARGET">` is an outcome
 //!   transition. `to` is resolved as yasmin's `StateMachine.execute` does:
 //!   first an outcome of the enclosing machine, then a state of it; anything
 //!   else is an error at the attribute, as yasmin's `validate` refuses it.
@@ -24,7 +29,9 @@
 //!   machines and all run at once; its outcomes are its `outcomes` attribute,
 //!   the `outcome` of each `<OutcomeMap>`, its `default_outcome` and its
 //!   `<FinalOutcome>`s (yasmin_factory's `_create_orthogonal_state`), and its
-//!   own `<Transition>`s map them. Which region outcomes give which outcome
+//!   own `<Transition>`s map them. `<Concurrence name default_outcome>`
+//!   likewise, its children of any kind (states, machines) being what runs
+//!   at once. Which region outcomes give which outcome
 //!   (the `<Item>`s of an `<OutcomeMap>`) is not kept: the graph does not
 //!   count it. `<Param>`, `<Key>`, `<ParamRemap>`, `<Remap>` and other
 //!   elements (data flow, parameters, editor positions) are ignored.
@@ -208,18 +215,28 @@ impl Reader<'_> {
         // once; its outcomes also those its `<OutcomeMap>`s and
         // `default_outcome` give (yasmin's OrthogonalState).
         let orth = self.docs[doc].0.elems[elem].name == "OrthogonalState";
-        let (outcome_set, outcomes) = machine_outcomes(&self.docs[doc].0, elem, orth);
+        // A `<Concurrence>`: its states (of any kind) all run at once, its
+        // outcomes as an orthogonal state's (yasmin's Concurrence).
+        let conc = self.docs[doc].0.elems[elem].name == "Concurrence";
+        let (outcome_set, outcomes) = machine_outcomes(&self.docs[doc].0, elem, orth || conc);
         let Some(MachineStates { names, made }) = self.machine_states(m, &p, orth, &outcomes)
         else {
             return;
         };
         let start = self.start_state(doc, elem, &names, &made);
-        let start = if orth {
+        let start = if orth || conc {
             made.first().map(|&(_, s)| s)
         } else {
             start
         };
         if made.is_empty() {
+            // An empty Concurrence runs nothing and ends at once in its
+            // default outcome (yasmin_editor's own test file has one): a
+            // state whose outcomes its transitions map.
+            if let (true, Some(c)) = (conc, p.state) {
+                m.states[c].body = StateBody::Task(None);
+                return;
+            }
             if !self.diags.has_errors() {
                 let (msg, hint) = if orth {
                     (
@@ -239,7 +256,7 @@ impl Reader<'_> {
         // Transitions of each state (a container's are its outcome map; a
         // region of an orthogonal state has none: yasmin reads only its
         // states).
-        for &(c, s) in made.iter().filter(|_| !orth) {
+        for &(c, s) in made.iter().filter(|_| !orth && !conc) {
             self.state_transitions(m, doc, (c, s), &outcome_set, &names);
         }
         // Install the region.
@@ -248,7 +265,7 @@ impl Reader<'_> {
         };
         let states: Vec<usize> = made.iter().map(|&(_, s)| s).collect();
         let region = Region {
-            parallel: orth,
+            parallel: orth || conc,
             ..Region::at(start, outcomes, states)
         };
         match p.state {
@@ -277,8 +294,12 @@ impl Reader<'_> {
         for &c in &kids {
             let e = &self.docs[doc].0.elems[c];
             let container = match (orth, e.name.as_str()) {
-                (false, "State") => false,
-                (false, "StateMachine" | "OrthogonalState") | (true, "Region") => true,
+                // A JoinState (a barrier between orthogonal regions) is a
+                // task state with one outcome, `joined` by default.
+                (false, "State" | "JoinState") => false,
+                (false, "StateMachine" | "OrthogonalState" | "Concurrence") | (true, "Region") => {
+                    true
+                }
                 _ => continue,
             };
             let Some(name) = self.state_name(doc, c, &names, outcomes) else {
@@ -298,7 +319,7 @@ impl Reader<'_> {
             let span = (doc == 0).then(|| e.span.clone());
             let body = if container {
                 StateBody::Container(Region {
-                    parallel: e.name == "OrthogonalState",
+                    parallel: matches!(e.name.as_str(), "OrthogonalState" | "Concurrence"),
                     ..Region::unset(vec![])
                 })
             } else {
@@ -485,7 +506,7 @@ impl Reader<'_> {
         for &(c, s) in made {
             if !matches!(
                 self.docs[doc].0.elems[c].name.as_str(),
-                "StateMachine" | "OrthogonalState" | "Region"
+                "StateMachine" | "OrthogonalState" | "Region" | "Concurrence"
             ) {
                 continue;
             }
@@ -502,7 +523,21 @@ impl Reader<'_> {
                 );
                 continue;
             }
-            match self.docs[doc].0.elems[c].attr_full("file_path").cloned() {
+            let e = &self.docs[doc].0.elems[c];
+            // yasmin_factory's `create_sm`: `file_path`, else `package` and
+            // `file_name` (both), else the machine's own children.
+            let target = match (
+                e.attr_full("file_path"),
+                e.attr_full("package"),
+                e.attr("file_name"),
+            ) {
+                (Some(fp), _, _) => Some(Include::Path(fp.clone())),
+                (None, Some(pkg), Some(f)) if !f.is_empty() && !pkg.value.is_empty() => {
+                    Some(Include::Package(pkg.clone(), f.to_string()))
+                }
+                _ => None,
+            };
+            match target {
                 None => queue.push_back(Pending {
                     doc,
                     elem: c,
@@ -510,8 +545,8 @@ impl Reader<'_> {
                     depth: p.depth + 1,
                     chain: p.chain.clone(),
                 }),
-                Some(fp) => {
-                    if let Some((nd, chain)) = self.include(doc, &fp, &p.chain) {
+                Some(inc) => {
+                    if let Some((nd, chain)) = self.include(doc, &inc, &p.chain) {
                         let root = self.docs[nd].0.root;
                         queue.push_back(Pending {
                             doc: nd,
@@ -526,16 +561,23 @@ impl Reader<'_> {
         }
     }
 
-    /// Reads the file a `file_path` names: its document index, and the
+    /// Reads the file an include names: its document index, and the
     /// include chain through it.
     fn include(
         &mut self,
         doc: usize,
-        fp: &xml::XAttr,
+        inc: &Include,
         chain: &[PathBuf],
     ) -> Option<(usize, Vec<PathBuf>)> {
-        let full = match super::source::resolve(self.root.as_deref(), &self.docs[doc].1, &fp.value)
-        {
+        let fp = inc.attr();
+        let (root, base) = (self.root.as_deref(), &self.docs[doc].1);
+        let found = match inc {
+            Include::Path(a) => super::source::resolve(root, base, &a.value),
+            Include::Package(pkg, f) => {
+                super::ros_pkg::find_in_package(&self.limits.ros, root, base, &pkg.value, f)
+            }
+        };
+        let full = match found {
             Ok(p) => p,
             Err(r) => {
                 self.err(
@@ -607,6 +649,23 @@ impl Reader<'_> {
     }
 }
 
+/// Where a nested machine's states come from (yasmin_factory's
+/// `create_sm`): a `file_path` relative to the including file, or the file
+/// named `file_name` below ROS package `package` (`ros_pkg.rs`).
+enum Include {
+    Path(xml::XAttr),
+    Package(xml::XAttr, String),
+}
+
+impl Include {
+    /// The attribute errors point at.
+    fn attr(&self) -> &xml::XAttr {
+        match self {
+            Include::Path(a) | Include::Package(a, _) => a,
+        }
+    }
+}
+
 /// The outcomes of a machine element: its `outcomes` attribute, then (an
 /// `<OrthogonalState>`'s) its `default_outcome` and `<OutcomeMap>`
 /// outcomes, then its `<FinalOutcome>`s, each once; as a set and a list
@@ -651,7 +710,7 @@ fn machine_outcomes(x: &XDoc, elem: usize, orth: bool) -> (HashSet<String>, Vec<
 
 /// Is the element a nested machine (a container)?
 fn container_state(e: &XElem) -> bool {
-    e.name == "StateMachine" || e.name == "OrthogonalState"
+    e.name == "StateMachine" || e.name == "OrthogonalState" || e.name == "Concurrence"
 }
 
 /// The machine's `description` attribute, if any.
@@ -856,5 +915,39 @@ mod tests {
         ));
         assert!(!looks_like_yasmin("<root BTCPP_format=\"4\">"));
         assert!(!looks_like_yasmin("<StateMachineX/>"));
+    }
+
+    /// yasmin's `<JoinState>` (a barrier in an orthogonal region, one
+    /// outcome) is a state; a `<Concurrence>` is a parallel state whose
+    /// children all run at once, and an empty one (yasmin_editor's test
+    /// file) a state ending in its default outcome.
+    #[test]
+    fn join_states_and_concurrences_are_read() {
+        let m = machine(
+            r#"<StateMachine name="M" outcomes="ok" start_state="par">
+  <OrthogonalState name="par" outcomes="done" default_outcome="done">
+    <Region name="A" outcomes="end" start_state="w">
+      <State name="w"><Transition from="ready" to="j"/></State>
+      <JoinState name="j" sync_id="s" outcome="joined"><Transition from="joined" to="end"/></JoinState>
+    </Region>
+    <Transition from="done" to="cc"/>
+  </OrthogonalState>
+  <Concurrence name="cc" outcomes="both" default_outcome="both">
+    <State name="x"/>
+    <State name="y"/>
+    <Transition from="both" to="empty"/>
+  </Concurrence>
+  <Concurrence name="empty" outcomes="fin" default_outcome="fin">
+    <Transition from="fin" to="ok"/>
+  </Concurrence>
+</StateMachine>"#,
+        );
+        let by = |n: &str| m.states.iter().find(|s| s.name == n).unwrap_or_else(|| panic!("{n}"));
+        assert!(matches!(by("j").body, StateBody::Task(None)));
+        match &by("cc").body {
+            StateBody::Container(r) => assert!(r.parallel && r.states.len() == 2),
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(by("empty").body, StateBody::Task(None)));
     }
 }

@@ -9,41 +9,151 @@
 
 use crate::ged::EditScript;
 use btfsm_model::graph::{PolicyGraph, VertexType};
-use btfsm_model::{StateBody, StateMachine};
+use btfsm_model::{StateBody, StateMachine, Target, Trigger};
 
-/// The states Eq. 4 counts, by index, in file order.
+/// The states Eq. 4 counts, by index, in file order, and the task they
+/// make up.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Detected {
-    /// Action states that are not fully connected (M_s).
+    /// Action states that are not fully connected (M_s), side states
+    /// aside.
     pub sequential: Vec<usize>,
     /// Fully connected action states (M_fc), see
     /// [`crate::counts::fully_connected_states`].
     pub connected: Vec<usize>,
+    /// Side states: action states off the task's chain that other action
+    /// states enter on a guard only (a Recharge entered when the battery is
+    /// low, from some of the states: not every one, else it is connected).
+    /// Like a connected state, a recovery, not a step of the task.
+    pub side: Vec<usize>,
     /// The first top-level decision state (the paper's SELECTOR), if any.
     pub selector: Option<usize>,
+    /// The task's chain: the sequential states from the initial one along
+    /// their `SUCCESS` transitions, in order.
+    pub chain: Vec<usize>,
+    /// The outcome the task ends in (the goal, [`goal_outcome`]) and
+    /// whether the chain reaches it.
+    pub goal: Option<String>,
+    pub chain_reaches_goal: bool,
 }
 
-/// Detects M_s, M_fc and the SELECTOR of a flat FSM.
+/// Detects M_s, M_fc, the side states, the SELECTOR and the task of a flat
+/// FSM.
 pub fn detect(m: &StateMachine) -> Detected {
-    let connected = crate::counts::fully_connected_states(m);
-    let sequential = m
+    let all: Vec<usize> = m
         .top
         .states
         .iter()
         .copied()
-        .filter(|&i| is_action_state(m, i) && !connected.contains(&i))
+        .filter(|&i| is_action_state(m, i))
         .collect();
+    // The task first: a step of it that every other action state happens
+    // to reach (Pick, after Move-To and a Recharge that resumes there) is
+    // a step, not a fully connected recovery.
+    let (chain, reached) = success_chain(m, &all);
+    let mut on_chain = vec![false; m.states.len()];
+    for &c in &chain {
+        on_chain[c] = true;
+    }
+    let connected: Vec<usize> = crate::counts::fully_connected_states(m)
+        .into_iter()
+        .filter(|&c| !on_chain[c])
+        .collect();
+    let actions: Vec<usize> = all.into_iter().filter(|i| !connected.contains(i)).collect();
+    let side = side_states(m, &actions, &chain);
+    let sequential = actions.into_iter().filter(|i| !side.contains(i)).collect();
     let selector = m
         .top
         .states
         .iter()
         .copied()
         .find(|&i| matches!(m.states[i].body, StateBody::Decision));
+    let chain_reaches_goal = reached.is_some();
     Detected {
         sequential,
         connected,
+        side,
         selector,
+        chain,
+        goal: reached.or_else(|| goal_outcome(m)),
+        chain_reaches_goal,
     }
+}
+
+/// The states from the initial one along `SUCCESS` transitions while they
+/// are among `actions`, and the top-level outcome the walk ends in, if it
+/// ends in one.
+fn success_chain(m: &StateMachine, actions: &[usize]) -> (Vec<usize>, Option<String>) {
+    let mut is_action = vec![false; m.states.len()];
+    for &a in actions {
+        is_action[a] = true;
+    }
+    let mut chain: Vec<usize> = Vec::new();
+    let mut cur = m.top.initial_state();
+    while let Some(s) = cur.take() {
+        // Each state once: `is_action` is cleared as the walk passes.
+        if !is_action.get(s).copied().unwrap_or(false) {
+            break;
+        }
+        is_action[s] = false;
+        chain.push(s);
+        let next = m.states[s]
+            .transitions
+            .iter()
+            .find(|t| matches!(&t.trigger, Trigger::Outcome(o) if o == "SUCCESS"));
+        match next.map(|t| &t.target) {
+            Some(Target::State(j)) => cur = Some(*j),
+            Some(Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. }) => {
+                return (chain, Some(o.clone()));
+            }
+            None => {}
+        }
+    }
+    (chain, None)
+}
+
+/// The outcome a task ends in when no `SUCCESS` chain from the initial
+/// state says it: the one named like success (`SUCCESS`, `succeeded`,
+/// any case), else the first top-level outcome.
+pub fn goal_outcome(m: &StateMachine) -> Option<String> {
+    let outs = &m.top.outcomes;
+    outs.iter()
+        .find(|o| o.eq_ignore_ascii_case("success") || o.eq_ignore_ascii_case("succeeded"))
+        .or(outs.first())
+        .cloned()
+}
+
+/// Action states off `chain`, other than the initial one, that other
+/// action states enter on a guard and none on an outcome.
+fn side_states(m: &StateMachine, actions: &[usize], chain: &[usize]) -> Vec<usize> {
+    let n = m.states.len();
+    let (mut by_guard, mut by_outcome) = (vec![false; n], vec![false; n]);
+    let (mut is_action, mut on_chain) = (vec![false; n], vec![false; n]);
+    for &a in actions {
+        is_action[a] = true;
+    }
+    for &c in chain {
+        on_chain[c] = true;
+    }
+    for (i, st) in m.states.iter().enumerate() {
+        for t in &st.transitions {
+            let Target::State(j) = t.target else { continue };
+            if j == i || j >= n {
+                continue;
+            }
+            match t.trigger {
+                Trigger::Guard(_) if is_action[i] => by_guard[j] = true,
+                Trigger::Guard(_) => {}
+                _ => by_outcome[j] = true,
+            }
+        }
+    }
+    let initial = m.top.initial_state();
+    actions
+        .iter()
+        .copied()
+        .filter(|&s| !on_chain[s] && Some(s) != initial && by_guard[s] && !by_outcome[s])
+        .collect()
 }
 
 fn is_action_state(m: &StateMachine, i: usize) -> bool {
@@ -121,6 +231,77 @@ mod tests {
         let fig02 = machine("fig02-fsm");
         let d = detect(&fig02);
         assert_eq!((d.sequential.len(), d.connected.len()), (4, 0));
+    }
+
+    /// The machine of issue 29: a Recharge only two states enter, on a
+    /// guard, written last: a side state, not a step; the chain ends in
+    /// SUCCESS.
+    #[test]
+    fn a_recharge_entered_on_a_guard_is_a_side_state() {
+        let text = r#"kind = "fsm"
+name = "side"
+initial = "Move-To cube2"
+outcomes = ["SUCCESS", "FAILURE"]
+[states."Move-To cube2"]
+skill = "Move-To"
+args = { target = "cube2" }
+guards = [{ unless = "Battery-Level", args = { min = 20 }, to = "Recharge" }]
+on = { SUCCESS = "Pick cube2" }
+[states."Pick cube2"]
+skill = "Pick"
+args = { object = "cube2" }
+on = { SUCCESS = "Move-To delivery" }
+[states."Move-To delivery"]
+skill = "Move-To"
+args = { target = "delivery" }
+guards = [{ unless = "Battery-Level", args = { min = 20 }, to = "Recharge" }]
+on = { SUCCESS = "Place cube2" }
+[states."Place cube2"]
+skill = "Place"
+args = { object = "cube2", at = "delivery" }
+on = { SUCCESS = "SUCCESS" }
+[states.Recharge]
+skill = "Recharge"
+on = { SUCCESS = "Move-To cube2" }
+"#;
+        let m = match btfsm_format::toml::parse_str(
+            "side.toml",
+            text,
+            std::path::Path::new("."),
+            &Limits::default(),
+        )
+        .unwrap()
+        .policy
+        .body
+        {
+            btfsm_model::PolicyBody::Machine(m) => m,
+            btfsm_model::PolicyBody::Bt(_) => panic!("a machine"),
+        };
+        let d = detect(&m);
+        let name = |v: &[usize]| {
+            v.iter()
+                .map(|&i| m.states[i].name.as_str())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(name(&d.side), ["Recharge"]);
+        assert_eq!(
+            name(&d.sequential),
+            [
+                "Move-To cube2",
+                "Pick cube2",
+                "Move-To delivery",
+                "Place cube2"
+            ]
+        );
+        assert_eq!(name(&d.chain), name(&d.sequential));
+        assert_eq!(
+            (d.goal.as_deref(), d.chain_reaches_goal),
+            (Some("SUCCESS"), true)
+        );
+        // Fig. 8b's Safe-Move-To is entered on Move-To's FAILURE: an
+        // alternative step, not a side state.
+        let fig08b = machine("fig08b-fsm");
+        assert!(detect(&fig08b).side.is_empty());
     }
 
     /// Table II's "HFSM Eq. 3" column: Tuck arm 12, Safe-Move-To 4, Dock

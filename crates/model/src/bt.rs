@@ -38,7 +38,35 @@ pub struct BtNode {
     /// the TOML node that includes a `subtree` file. Kept for drawing
     /// (`dot --subtrees folded`); the graph and the metrics ignore it.
     pub subtree: Option<String>,
+    /// Where [`BtNode::id`] comes from: what `compare` may take as the
+    /// node's identity across two versions of a file.
+    pub id_source: IdSource,
     pub span: Option<Span>,
+}
+
+/// Where a node's id comes from. An id the author gave (a TOML key, a
+/// `btfsm:id`) names the node across versions; an id a reader derived from
+/// a display name or from the node's place does not: adding a `name`, or
+/// inserting a sibling before the node, changes it while the node stays
+/// (`compare` pairs such nodes by the ordered tree mapping instead).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum IdSource {
+    /// Given by the author: a TOML key, a BehaviorTree.CPP `btfsm:id`, an
+    /// id a transform chose.
+    #[default]
+    Given,
+    /// A BehaviorTree.CPP `name` attribute, unique in the tree.
+    Name,
+    /// The parent's id and the child's position (or the pre-order index).
+    Position,
+}
+
+impl IdSource {
+    /// Whether the id was derived by a reader (from a name or a position)
+    /// rather than given by the author.
+    pub fn is_derived(self) -> bool {
+        self != IdSource::Given
+    }
 }
 
 impl BtNode {
@@ -54,6 +82,7 @@ impl BtNode {
             type_name: None,
             ports: Default::default(),
             subtree: None,
+            id_source: IdSource::Given,
             span: None,
         }
     }

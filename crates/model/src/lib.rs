@@ -7,7 +7,7 @@ pub mod fsm;
 pub mod graph;
 pub mod skill;
 
-pub use bt::{Bt, BtNode, BtNodeKind};
+pub use bt::{Bt, BtNode, BtNodeKind, IdSource};
 pub use fsm::{Pseudo, Region, State, StateBody, StateMachine, Target, Transition, Trigger, UNSET};
 pub use skill::{ArgValue, Guard, GuardTerm, SkillCall, SkillKind};
 

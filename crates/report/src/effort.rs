@@ -17,6 +17,10 @@ pub struct Effort {
     pub sequential: Vec<String>,
     /// Fully connected states (M_fc), by name.
     pub connected: Vec<String>,
+    /// Side states (recoveries some states enter on a guard, off the
+    /// task's chain), by name: neither M_s nor M_fc, which Eq. 4 assumes
+    /// are all there is; the generated FSM treats them as connected ones.
+    pub side: Vec<String>,
     pub m_s: usize,
     pub m_fc: usize,
     /// Eq. 4 at (M_s, M_fc); 0 for BTs and HFSMs.
@@ -46,6 +50,7 @@ pub fn effort(p: &Policy, opts: &GedOptions) -> (Effort, Option<Policy>) {
                     kind,
                     sequential: Vec::new(),
                     connected: Vec::new(),
+                    side: Vec::new(),
                     m_s: 0,
                     m_fc: 0,
                     formula: 0,
@@ -63,6 +68,7 @@ pub fn effort(p: &Policy, opts: &GedOptions) -> (Effort, Option<Policy>) {
         kind,
         sequential: names(&d.sequential),
         connected: names(&d.connected),
+        side: names(&d.side),
         m_s: d.sequential.len(),
         m_fc: d.connected.len(),
         formula: effort_formula(d.sequential.len() as u64, d.connected.len() as u64),
@@ -74,6 +80,11 @@ pub fn effort(p: &Policy, opts: &GedOptions) -> (Effort, Option<Policy>) {
         e.note = Some(format!(
             "already has a decision state (`{}`): Eq. 4 counts the edits from a sequential design; the measured value counts only what is missing",
             m.states[s].name
+        ));
+    } else if !d.side.is_empty() {
+        e.note = Some(format!(
+            "side states [{}] (entered on a guard by some states, off the task's chain) are neither sequential nor fully connected: Eq. 4 does not count them, the measured value does",
+            e.side.join(", ")
         ));
     }
     match fault_tolerant_policy(p) {
@@ -104,6 +115,9 @@ pub struct EffortRow {
     pub m_fc: usize,
     pub sequential: Vec<String>,
     pub connected: Vec<String>,
+    /// Side states (see [`Effort::side`]); left out when there are none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub side: Vec<String>,
     /// Eq. 4 at (M_s, M_fc).
     pub formula: u64,
     /// Named GED to the generated fault-tolerant FSM (`null` if none).
@@ -123,6 +137,7 @@ impl EffortRow {
             m_fc: e.m_fc,
             sequential: e.sequential.clone(),
             connected: e.connected.clone(),
+            side: e.side.clone(),
             formula: e.formula,
             named_ged: e.named.as_ref().map(|g| g.ged),
             structural_ged: e.structural.as_ref().map(|g| g.ged),
@@ -214,8 +229,13 @@ pub fn render_effort(rows: &[EffortRow], format: Format) -> String {
             );
             for r in rows {
                 if !r.sequential.is_empty() || !r.connected.is_empty() {
+                    let side = if r.side.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; side [{}]", r.side.join(", "))
+                    };
                     s.push_str(&format!(
-                        "{}: sequential [{}]; connected [{}]\n",
+                        "{}: sequential [{}]; connected [{}]{side}\n",
                         r.file,
                         r.sequential.join(", "),
                         r.connected.join(", ")

@@ -7,6 +7,8 @@
 mod csv;
 pub mod episodes;
 pub mod exec;
+#[cfg(test)]
+mod fault_tolerant_tests;
 mod livelock;
 pub mod monte_carlo;
 #[cfg(test)]

@@ -163,6 +163,7 @@ pub fn insert_subtree(
             type_name: n.type_name.clone(),
             ports: n.ports.clone(),
             subtree: n.subtree.clone(),
+            id_source: btfsm_model::IdSource::Given,
             span: None,
         });
     }

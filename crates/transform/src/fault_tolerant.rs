@@ -12,7 +12,15 @@
 //!   gets `RUNNING` -> itself and `FAILURE` -> `SELECTOR`;
 //! - every connected state (Recharge) keeps the arcs other states have to it,
 //!   loses its own arcs to the sequential states and gets `RUNNING` -> itself
-//!   and `SUCCESS` -> `SELECTOR`.
+//!   and `SUCCESS` -> `SELECTOR`; so does every side state (a Recharge that
+//!   only some states enter, on a guard: a recovery off the task's chain,
+//!   never a step of it).
+//!
+//! The task is the chain of `SUCCESS` transitions from the initial state to
+//! the outcome it ends in, the goal (`effort::detect`), whose effect is the
+//! last step's: "done" never rests on a state appended after the chain
+//! (issue 29: a side Recharge last in the file made the goal "battery
+//! above 20%").
 //!
 //! Arcs already present are kept, so the transform of a fault-tolerant FSM is
 //! the FSM itself. The `SELECTOR`'s resume guards come from an action
@@ -106,6 +114,7 @@ pub fn fault_tolerant(
         return Err(vec![FaultTolerantError::NotAnFsm("hfsm")]);
     }
     let det = detect(m);
+    let recovery = recovery_states(&det);
     let mut out = m.clone();
     let mut errors = Vec::new();
     let (chain, end) = task_chain(m, &det);
@@ -113,9 +122,9 @@ pub fn fault_tolerant(
         Some(s) => s,
         None => add_selector(&mut out),
     };
-    complete_states(&mut out, &det, sel);
+    complete_states(&mut out, (&det.sequential, &recovery), sel);
     // The SELECTOR's arcs.
-    let front = connected_guards(m, domain, &det, &out.states[sel], &mut errors);
+    let front = connected_guards(m, domain, &recovery, &out.states[sel], &mut errors);
     let back = resume_guards(m, domain, (&chain, &end), &out.states[sel], &mut errors);
     if !errors.is_empty() {
         errors.dedup();
@@ -130,10 +139,19 @@ pub fn fault_tolerant(
         st.transitions
             .push(Transition::on_outcome(RUNNING, Target::State(sel)));
     }
-    for &i in det.sequential.iter().chain(&det.connected).chain([&sel]) {
+    for &i in det.sequential.iter().chain(&recovery).chain([&sel]) {
         guards_first(&mut out.states[i]);
     }
     Ok(out)
+}
+
+/// The states the construction treats as recoveries, in file order: the
+/// fully connected ones and the side states (entered on a guard, off the
+/// task's chain).
+fn recovery_states(det: &Detected) -> Vec<usize> {
+    let mut r: Vec<usize> = det.connected.iter().chain(&det.side).copied().collect();
+    r.sort_unstable();
+    r
 }
 
 /// The domain's step that runs state `i`'s skill, if any.
@@ -156,37 +174,36 @@ fn no_action(m: &StateMachine, domain: &Domain, i: usize) -> FaultTolerantError 
     }
 }
 
-/// The task's steps in execution order: the SUCCESS chain from the initial
-/// state, then sequential states off the chain in file order; and the
-/// outcome the task ends in (that of the chain, else the first top-level
-/// one).
+/// The task's steps in execution order and the outcome it ends in (the
+/// goal, from the machine's outcomes: `effort::detect`). When the `SUCCESS`
+/// chain from the initial state reaches that outcome, the chain is the
+/// task and its last state the final step, whose effect is the goal;
+/// sequential states off it (an alternative entered on an outcome, such as
+/// Fig. 8b's Safe-Move-To) keep their own arcs and get no resume guard.
+/// Otherwise (a machine whose initial state is not a step), the steps are
+/// the chain, then the sequential states off it in file order, up to the
+/// first one whose `SUCCESS` ends in the goal outcome. Side states are
+/// never steps (they are recoveries, `recovery_states`).
 fn task_chain(m: &StateMachine, det: &Detected) -> (Vec<usize>, Option<String>) {
-    let mut chain: Vec<usize> = Vec::new();
-    let mut end: Option<String> = None;
-    let mut cur = m.top.initial_state();
-    while let Some(s) = cur.take() {
-        if !det.sequential.contains(&s) || chain.contains(&s) {
-            break;
-        }
-        chain.push(s);
-        for t in &m.states[s].transitions {
-            if matches!(&t.trigger, Trigger::Outcome(o) if o == SUCCESS) {
-                match &t.target {
-                    Target::State(j) => cur = Some(*j),
-                    Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } => {
-                        end = Some(o.clone())
-                    }
-                }
-                break;
-            }
-        }
+    let end = det.goal.clone();
+    let mut chain = det.chain.clone();
+    if det.chain_reaches_goal {
+        return (chain, end);
     }
     for &s in &det.sequential {
         if !chain.contains(&s) {
             chain.push(s);
         }
     }
-    let end = end.or_else(|| m.top.outcomes.first().cloned());
+    let ends_task = |s: usize| {
+        m.states[s].transitions.iter().any(|t| {
+            matches!(&t.trigger, Trigger::Outcome(o) if o == SUCCESS)
+                && matches!(&t.target, Target::Outcome(o) | Target::OuterOutcome { outcome: o, .. } if Some(o) == end.as_ref())
+        })
+    };
+    if let Some(k) = chain.iter().position(|&s| ends_task(s)) {
+        chain.truncate(k + 1);
+    }
     (chain, end)
 }
 
@@ -216,11 +233,19 @@ fn add_selector(out: &mut StateMachine) -> usize {
 /// Connected states drop their arcs to sequential states and get `RUNNING`
 /// -> itself and `SUCCESS` -> SELECTOR; sequential states get `RUNNING` ->
 /// itself and `FAILURE` -> SELECTOR (arcs already present are kept).
-fn complete_states(out: &mut StateMachine, det: &Detected, sel: usize) {
-    for &c in &det.connected {
+fn complete_states(
+    out: &mut StateMachine,
+    (sequential, recovery): (&[usize], &[usize]),
+    sel: usize,
+) {
+    let mut is_seq = vec![false; out.states.len()];
+    for &s in sequential {
+        is_seq[s] = true;
+    }
+    for &c in recovery {
         let st = &mut out.states[c];
         st.transitions
-            .retain(|t| !matches!(t.target, Target::State(j) if det.sequential.contains(&j)));
+            .retain(|t| !matches!(t.target, Target::State(j) if is_seq.get(j) == Some(&true)));
         if !has_outcome(st, SUCCESS) {
             st.transitions
                 .push(Transition::on_outcome(SUCCESS, Target::State(sel)));
@@ -230,7 +255,7 @@ fn complete_states(out: &mut StateMachine, det: &Detected, sel: usize) {
                 .push(Transition::on_outcome(RUNNING, Target::State(c)));
         }
     }
-    for &s in &det.sequential {
+    for &s in sequential {
         let st = &mut out.states[s];
         if !has_outcome(st, FAILURE) {
             st.transitions
@@ -250,12 +275,12 @@ fn complete_states(out: &mut StateMachine, det: &Detected, sel: usize) {
 fn connected_guards(
     m: &StateMachine,
     domain: &Domain,
-    det: &Detected,
+    recovery: &[usize],
     selector: &State,
     errors: &mut Vec<FaultTolerantError>,
 ) -> Vec<Transition> {
     let mut front: Vec<Transition> = Vec::new();
-    for &c in &det.connected {
+    for &c in recovery {
         let target = Target::State(c);
         if goes_to(selector, &target) {
             continue;
@@ -364,6 +389,102 @@ fn resume_guards(
         }
     }
     back
+}
+
+/// A delivery task for the tests of this construction and of the
+/// simulator (`btfsm-sim`): the first `steps` (1 to 4) steps of fetching
+/// cube2 to the delivery station, each entering a side state `Recharge` on
+/// "battery < 20%" where `guarded` says, and going to the outcome FAILURE
+/// on failure where `fails_out` says; Recharge goes back to step
+/// `back_to` on SUCCESS (none: no arc) and is written at `recharge_at` in
+/// the file. Not part of the API.
+#[doc(hidden)]
+#[derive(Debug, Clone)]
+pub struct SideTask {
+    pub steps: usize,
+    pub guarded: Vec<bool>,
+    pub fails_out: Vec<bool>,
+    pub back_to: Option<usize>,
+    pub recharge_at: usize,
+}
+
+/// The steps of the delivery task: name, skill, arguments, and the goal
+/// term once the task ends after it (its effect, as the sim checks it).
+#[doc(hidden)]
+pub const DELIVERY: [(&str, &str, &str, &str); 4] = [
+    (
+        "Move-To cube2",
+        "Move-To",
+        r#"{ target = "cube2" }"#,
+        r#"{ if = "Robot-At", args = { target = "cube2" } }"#,
+    ),
+    (
+        "Pick cube2",
+        "Pick",
+        r#"{ object = "cube2" }"#,
+        r#"{ if = "In-Hand", args = { object = "cube2" } }"#,
+    ),
+    (
+        "Move-To delivery",
+        "Move-To",
+        r#"{ target = "delivery" }"#,
+        r#"{ if = "Robot-At", args = { target = "delivery" } }"#,
+    ),
+    (
+        "Place cube2",
+        "Place",
+        r#"{ object = "cube2", at = "delivery" }"#,
+        r#"{ if = "Object-At", args = { object = "cube2", at = "delivery" } }"#,
+    ),
+];
+
+impl SideTask {
+    /// The machine as policy TOML.
+    #[doc(hidden)]
+    pub fn toml(&self) -> String {
+        let n = self.steps.clamp(1, DELIVERY.len());
+        let mut blocks: Vec<String> = Vec::new();
+        for k in 0..n {
+            let (name, skill, args, _) = DELIVERY[k];
+            let next = if k + 1 < n {
+                format!("\"{}\"", DELIVERY[k + 1].0)
+            } else {
+                "\"SUCCESS\"".into()
+            };
+            let fail = if self.fails_out.get(k) == Some(&true) {
+                ", FAILURE = \"FAILURE\""
+            } else {
+                ""
+            };
+            let guard = if self.guarded.get(k) == Some(&true) {
+                "guards = [{ unless = \"Battery-Level\", args = { min = 20 }, to = \"Recharge\", label = \"battery < 20%\" }]\n"
+            } else {
+                ""
+            };
+            blocks.push(format!(
+                "[states.\"{name}\"]\nskill = \"{skill}\"\nargs = {args}\n{guard}on = {{ SUCCESS = {next}{fail} }}\n"
+            ));
+        }
+        let back = match self.back_to {
+            Some(j) if j < n => format!("on = {{ SUCCESS = \"{}\" }}\n", DELIVERY[j].0),
+            _ => String::new(),
+        };
+        blocks.insert(
+            self.recharge_at.min(n),
+            format!("[states.Recharge]\nskill = \"Recharge\"\n{back}"),
+        );
+        format!(
+            "kind = \"fsm\"\nname = \"side task\"\ninitial = \"{}\"\noutcomes = [\"SUCCESS\", \"FAILURE\"]\n\n{}",
+            DELIVERY[0].0,
+            blocks.join("\n")
+        )
+    }
+
+    /// The goal term of the task, as a scenario's `goal` writes it.
+    #[doc(hidden)]
+    pub fn goal(&self) -> &'static str {
+        DELIVERY[self.steps.clamp(1, DELIVERY.len()) - 1].3
+    }
 }
 
 #[cfg(test)]

@@ -3,6 +3,8 @@
 pub mod bt_to_hfsm;
 pub mod edit;
 pub mod fault_tolerant;
+#[cfg(test)]
+mod fault_tolerant_tests;
 
 /// Test helper shared by the transforms' and metrics' unit tests.
 #[cfg(test)]

@@ -34,6 +34,19 @@ impl Companions {
         }
     }
 
+    /// The Groot2 project files (`.btproj`) among them: their
+    /// `<TreeNodesModel>` declares the project's node types (Groot2 keeps
+    /// them there, not in the trees), read by every tree of the command.
+    pub fn projects(&self) -> impl Iterator<Item = &Path> {
+        self.files
+            .iter()
+            .filter(|p| {
+                p.extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("btproj"))
+            })
+            .map(PathBuf::as_path)
+    }
+
     /// How many files there are.
     pub fn len(&self) -> usize {
         self.files.len()

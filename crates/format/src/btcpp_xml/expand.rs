@@ -119,9 +119,10 @@ impl Loader<'_> {
             return None;
         }
         let children: Vec<Vec<usize>> = nodes.iter().map(|n| n.children.clone()).collect();
-        let (ids, _) = derive_ids(&children, 0, tree_id, &names, |i, _| explicit[i].clone());
-        for (n, id) in nodes.iter_mut().zip(ids) {
+        let (ids, sources) = derive_ids(&children, 0, tree_id, &names, |i, _| explicit[i].clone());
+        for ((n, id), source) in nodes.iter_mut().zip(ids).zip(sources) {
             n.id = id;
+            n.id_source = source;
         }
         self.flow.scopes = frames.iter().map(|f| f.id.clone()).collect();
         Some(Bt { nodes, root: 0 })
@@ -309,7 +310,11 @@ impl Loader<'_> {
             it.name_override
                 .or_else(|| el.attr("name").map(str::to_string)),
         );
-        w.explicit.push(el.btfsm_attr("id").map(str::to_string));
+        w.explicit.push(
+            el.btfsm_attr("id")
+                .map(str::to_string)
+                .or_else(|| el.id_comment.clone()),
+        );
         w.nodes.push(node);
         for &c in el.children.iter().rev() {
             w.stack.push(Item {

@@ -19,6 +19,8 @@ pub(super) struct ModelEntry {
     pub(super) cat: Category,
     /// Its `<input_port>`, `<output_port>` and `<inout_port>`s.
     pub(super) ports: Vec<super::ports::PortDecl>,
+    /// Where it is declared (`file:line:col`), for a conflicting one.
+    pub(super) at: String,
 }
 
 /// The files being included, outermost first: their canonical paths (for
@@ -153,10 +155,23 @@ impl Loader<'_> {
             );
             return None;
         }
-        self.includes(0, identity);
+        self.includes(0, identity.clone());
         let extra = self.limits.nodes_models.clone();
         for m in &extra {
             self.nodes_model_file(m);
+        }
+        // The node models of the Groot2 projects given together (a project
+        // folder walked as a directory), unless this file is one.
+        let projects: Vec<PathBuf> = self
+            .limits
+            .companions
+            .as_ref()
+            .map(|c| c.projects().map(Path::to_path_buf).collect())
+            .unwrap_or_default();
+        for p in projects {
+            if crate::toml::canonical(&p) != identity {
+                self.project_models(&p);
+            }
         }
         for d in 0..self.docs.len() {
             self.definitions(d);
@@ -241,25 +256,33 @@ impl Loader<'_> {
         el: &XElem,
         chain: &IncludeChain,
     ) -> Option<(PathBuf, PathBuf, Range<usize>)> {
-        if el.attr("ros_pkg").is_some() {
-            self.err(
-                d,
-                el.span.clone(),
-                "includes from ROS packages (`ros_pkg`) are not supported",
-            )
-            .hint = Some("give `path` relative to this file".into());
-            return None;
-        }
         let Some(p) = el.attr_full("path") else {
             self.err(d, el.span.clone(), "`<include>` needs a `path`")
                 .hint = Some("write `<include path=\"subtrees/other.xml\"/>`".into());
             return None;
         };
         let (pval, pspan) = (p.value.clone(), p.span.clone());
-        let full = match crate::source::resolve(self.root.as_deref(), &self.dirs[d], &pval) {
+        // `ros_pkg`: `path` is in that package's share directory
+        // (BehaviorTree.CPP's xml_parsing.cpp; `ros_pkg.rs`).
+        let found = match el.attr_full("ros_pkg") {
+            Some(pkg) => {
+                let (name, span) = (pkg.value.clone(), pkg.span.clone());
+                crate::ros_pkg::resolve_in_package(
+                    &self.limits.ros,
+                    self.root.as_deref(),
+                    &self.dirs[d],
+                    &name,
+                    &pval,
+                )
+                .map_err(|r| (r, span))
+            }
+            None => crate::source::resolve(self.root.as_deref(), &self.dirs[d], &pval)
+                .map_err(|r| (r, pspan.clone())),
+        };
+        let full = match found {
             Ok(p) => p,
-            Err(r) => {
-                self.err(d, pspan, format!("cannot include this file: {}", r.message))
+            Err((r, span)) => {
+                self.err(d, span, format!("cannot include this file: {}", r.message))
                     .hint = Some(r.hint);
                 return None;
             }
@@ -371,6 +394,26 @@ impl Loader<'_> {
         }
     }
 
+    /// The `<TreeNodesModel>`s of a Groot2 project file (`.btproj`) given
+    /// together with this one, if any (a project may declare none).
+    fn project_models(&mut self, path: &Path) {
+        let Some(doc) = self.read_named(path) else {
+            return;
+        };
+        let root = doc.root;
+        let models: Vec<usize> = doc
+            .children(root)
+            .filter(|(_, e)| e.name == "TreeNodesModel")
+            .map(|(i, _)| i)
+            .collect();
+        self.docs.push(doc);
+        let d = self.docs.len() - 1;
+        self.dirs.push(PathBuf::new());
+        for m in models {
+            self.read_model(d, m);
+        }
+    }
+
     pub(super) fn read_model(&mut self, d: usize, m: usize) {
         let kids = self.docs[d].elems[m].children.clone();
         for k in kids {
@@ -387,17 +430,24 @@ impl Loader<'_> {
                     }
                     continue;
                 }
+                // Metadata MoveIt Studio (and BehaviorTree.CPP's own
+                // writeTreeNodesModelXML) keeps in a model; BehaviorTree.CPP
+                // reads only what it registers, and ignores the rest.
+                "MetadataFields" | "Metadata" | "description" => continue,
                 other => {
                     let h = suggest(
                         other,
                         ["Action", "Condition", "Control", "Decorator", "SubTree"],
                     );
-                    self.err(
+                    self.warn(
                         d,
                         el.span.clone(),
-                        format!("unknown entry `<{}>` in `<TreeNodesModel>`", shown(other)),
+                        format!(
+                            "unknown entry `<{}>` in `<TreeNodesModel>` is ignored",
+                            shown(other)
+                        ),
                     )
-                    .hint = Some(h);
+                    .hint = Some(format!("{h} (BehaviorTree.CPP ignores it too)"));
                     continue;
                 }
             };
@@ -430,17 +480,27 @@ impl Loader<'_> {
                 );
                 continue;
             }
+            let at = {
+                let f = &self.docs[d].file;
+                let (l, c) = f.line_col(el.span.start);
+                format!("{}:{l}:{c}", f.path)
+            };
+            // BehaviorTree.CPP registers node types in code and reads no
+            // category from a model: two models that disagree are a
+            // warning naming both, and the first read (a --nodes-model
+            // file before the tree's own) is kept.
             if let Some(prev) = self.models.get(id)
                 && prev.cat != cat
             {
-                let was = prev.cat.tag();
-                self.err(
+                let (was, first) = (prev.cat.tag(), prev.at.clone());
+                self.warn(
                     d,
                     el.span.clone(),
                     format!(
-                        "`{}` is declared both as `{was}` and as `{}`",
+                        "`{}` is declared as `{}` here and as `{was}` at {}; read as `{was}`",
                         shown(id),
-                        cat.tag()
+                        cat.tag(),
+                        shown(&first)
                     ),
                 )
                 .hint = Some("keep one declaration per node type across the model files".into());
@@ -448,7 +508,7 @@ impl Loader<'_> {
             }
             let ports = super::ports::model_ports(&self.docs[d], d, k);
             self.models
-                .insert(id.to_string(), ModelEntry { cat, ports });
+                .insert(id.to_string(), ModelEntry { cat, ports, at });
         }
     }
 

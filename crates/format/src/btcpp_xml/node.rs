@@ -90,6 +90,8 @@ impl Loader<'_> {
             type_name: type_kept.then(|| v4_name(&ty).to_string()),
             ports,
             subtree: None,
+            // Set with the id, once the whole tree is read (`expand.rs`).
+            id_source: btfsm_model::IdSource::Position,
             span: Some(el.span.clone()),
         })
     }
@@ -155,6 +157,26 @@ impl Loader<'_> {
             ));
             *ty = real.to_string();
             Typed::builtin(real, *cat, el, n)
+        } else if explicit_cat.is_none() && self.trees.contains_key(ty.as_str()) {
+            // A tree's ID used as a tag: BehaviorTree.CPP 4 does not take
+            // it for the SubTree it names ("Node not recognized",
+            // xml_parsing.cpp), so neither does btfsm, even with
+            // --assume-leaf.
+            if self.unknown.insert(ty.clone()) {
+                self.err(
+                    d,
+                    el.span.clone(),
+                    format!(
+                        "`<{}>` names a tree, not a node type: BehaviorTree.CPP 4 refuses it (Node not recognized)",
+                        shown(ty)
+                    ),
+                )
+                .hint = Some(format!(
+                    "write `<SubTree ID=\"{}\"/>` to run that tree here",
+                    shown(ty)
+                ));
+            }
+            return None;
         } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
             match a {
                 AssumeLeaf::Action => Typed::generic(Category::Action),

@@ -243,19 +243,48 @@ fn generic_controls_keep_their_type_and_ports() {
     assert_eq!(b.nodes[3].ports["delay_msec"], "5");
 }
 
+/// BehaviorTree.CPP reads no category from a model: two that disagree
+/// are a warning naming both places, and the first one read is kept.
 #[test]
-fn conflicting_model_declarations_are_errors() {
-    let e = parse(
+fn conflicting_model_declarations_are_a_warning_naming_both() {
+    let l = parse(
         r#"<root><BehaviorTree ID="T"><Foo/></BehaviorTree>
 <TreeNodesModel><Action ID="Foo"/><Condition ID="Foo"/></TreeNodesModel></root>"#,
     )
-    .unwrap_err();
+    .unwrap();
+    let w = &l.warnings[0];
     assert!(
-        e[0].message
-            .contains("declared both as `Action` and as `Condition`"),
+        w.message.contains(
+            "`Foo` is declared as `Condition` here and as `Action` at t.xml:2:17; read as `Action`"
+        ),
         "{}",
-        e[0].message
+        w.message
     );
+    assert_eq!(bt(&l).nodes[0].kind, BtNodeKind::Action);
+}
+
+/// MoveIt Studio keeps `<MetadataFields>` in its models, inside an entry
+/// or beside them; BehaviorTree.CPP ignores what it does not read, so an
+/// unknown entry is a warning.
+#[test]
+fn metadata_in_a_model_is_read_past() {
+    let l = parse(
+        r#"<root BTCPP_format="4"><BehaviorTree ID="T"><Foo/></BehaviorTree>
+<TreeNodesModel>
+  <SubTree ID="T"><MetadataFields><Metadata runnable="true"/></MetadataFields></SubTree>
+  <MetadataFields><Metadata subcategory="Perception"/></MetadataFields>
+  <Action ID="Foo"><MetadataFields><Metadata subcategory="x"/></MetadataFields></Action>
+  <Acton ID="Bar"/>
+</TreeNodesModel></root>"#,
+    )
+    .unwrap();
+    assert_eq!(l.warnings.len(), 1, "{:?}", l.warnings);
+    assert!(
+        l.warnings[0].message.contains("unknown entry `<Acton>`"),
+        "{}",
+        l.warnings[0].message
+    );
+    assert_eq!(bt(&l).nodes[0].kind, BtNodeKind::Action);
 }
 
 #[test]
@@ -312,8 +341,21 @@ proptest::proptest! {
 fn repeated_names_fall_back_to_positions() {
     let children = vec![vec![1, 2], vec![], vec![]];
     let names = vec![None, Some("x".to_string()), Some("x".to_string())];
-    let (ids, _) = derive_ids(&children, 0, "T", &names, |_, _| None);
+    let (ids, sources) = derive_ids(&children, 0, "T", &names, |_, _| None);
     assert_eq!(ids, ["T", "T/0", "T/1"]);
+    assert!(
+        sources
+            .iter()
+            .all(|&s| s == btfsm_model::IdSource::Position)
+    );
+    // A unique name is the id, derived from the name; btfsm:id is given.
+    let names = vec![None, Some("x".to_string()), Some("y".to_string())];
+    let (ids, sources) = derive_ids(&children, 0, "T", &names, |i, _| {
+        (i == 2).then(|| "kept".to_string())
+    });
+    assert_eq!(ids, ["T", "x", "kept"]);
+    use btfsm_model::IdSource::{Given, Name, Position};
+    assert_eq!(sources, [Position, Name, Given]);
 }
 
 #[test]

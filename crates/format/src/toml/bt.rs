@@ -399,6 +399,7 @@ impl Loader {
                     type_name: raw.type_name.take(),
                     ports: std::mem::take(&mut raw.ports),
                     subtree: None,
+                    id_source: btfsm_model::IdSource::Given,
                     span: Some(ids[i].1.clone()),
                 }),
             }

@@ -11,6 +11,11 @@
 //! into a Sequence costs 1, binding a leaf to another skill or argument
 //! costs 1, and since order is part of an ordered tree, swapping two
 //! children of a Sequence costs at least 2.
+//!
+//! A node's *class* is its type without parameters, display name or
+//! arguments (`action:ComputePathToPose`, `fallback`): among mappings of
+//! equal cost, one that pairs nodes of one class is shown
+//! ([`super::prefer_same_class`]).
 
 use super::LabelledTree;
 use btfsm_model::{Bt, BtNode, BtNodeKind};
@@ -23,6 +28,9 @@ pub struct BtPair {
     pub b: LabelledTree,
     pub shown_a: Vec<String>,
     pub shown_b: Vec<String>,
+    /// Each node's class id (shared by both trees).
+    pub class_a: Vec<u32>,
+    pub class_b: Vec<u32>,
 }
 
 /// Labels both trees with ids shared between them (equal labels, equal ids).
@@ -30,12 +38,35 @@ pub fn label_pair(a: &Bt, b: &Bt) -> BtPair {
     let mut ids: BTreeMap<String, u32> = BTreeMap::new();
     let (ta, shown_a) = labelled(a, &mut ids);
     let (tb, shown_b) = labelled(b, &mut ids);
+    let mut classes: BTreeMap<(&str, Option<&str>), u32> = BTreeMap::new();
+    let class_a = classes_of(a, &mut classes);
+    let class_b = classes_of(b, &mut classes);
     BtPair {
         a: ta,
         b: tb,
         shown_a,
         shown_b,
+        class_a,
+        class_b,
     }
+}
+
+/// Each node's class id: its kind and its type name or skill.
+fn classes_of<'t>(
+    bt: &'t Bt,
+    ids: &mut BTreeMap<(&'static str, Option<&'t str>), u32>,
+) -> Vec<u32> {
+    bt.nodes
+        .iter()
+        .map(|n| {
+            let ty = n
+                .type_name
+                .as_deref()
+                .or(n.skill.as_ref().map(|s| s.skill.as_str()));
+            let next = ids.len() as u32;
+            *ids.entry((n.kind.keyword(), ty)).or_insert(next)
+        })
+        .collect()
 }
 
 fn labelled(bt: &Bt, ids: &mut BTreeMap<String, u32>) -> (LabelledTree, Vec<String>) {
@@ -73,7 +104,9 @@ pub fn type_of(n: &BtNode) -> String {
 }
 
 /// `(key, shown)`: the label as an unambiguous key (every part quoted) and
-/// as shown to a reviewer (`condition "Robot-At delivery?" Robot-At(target=delivery)`).
+/// as shown to a reviewer (`condition "Robot-At delivery?" Robot-At(target=delivery)`,
+/// `action:ClearEntireCostmap "ClearGlobalCostmap-Context"`: a leaf's type
+/// shown when its display name is not the type).
 pub fn label_of(n: &BtNode) -> (String, String) {
     let ty = type_of(n);
     let skill_key = n
@@ -89,7 +122,14 @@ pub fn label_of(n: &BtNode) -> (String, String) {
         })
         .unwrap_or_default();
     let key = format!("{:?}", (&ty, &n.type_name, &n.label, skill_key, &n.ports));
-    let mut shown = format!("{ty} \"{}\"", n.label);
+    // A leaf's display name may hide its type (`<Spin name="Recover"/>`):
+    // shown then, so that a type change under a kept name reads as one.
+    let mut shown = match (n.kind, &n.type_name) {
+        (BtNodeKind::Action | BtNodeKind::Condition, Some(t)) if *t != n.label => {
+            format!("{ty}:{t} \"{}\"", n.label)
+        }
+        _ => format!("{ty} \"{}\"", n.label),
+    };
     if let Some(s) = &n.skill {
         shown.push_str(&format!(" {s}"));
     }

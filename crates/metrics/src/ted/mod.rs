@@ -40,6 +40,7 @@ mod bounds;
 pub mod bt;
 mod greedy;
 mod mapping;
+mod refine;
 mod script;
 mod sed;
 #[cfg(test)]
@@ -47,6 +48,7 @@ mod tests;
 mod tree;
 pub mod tree_text;
 
+pub use refine::prefer_same_class;
 pub use script::{TreeEdit, edit_script};
 pub use tree::OrderedTree;
 

@@ -440,3 +440,30 @@ fn bounds_past_the_budgets_are_skipped() {
     assert!(r.peak_cells <= tight.max_cells);
     check_mapping(&a, &b, &r);
 }
+
+/// Preferring pairs of one class keeps a valid mapping of the same cost
+/// on random trees, and leaves fewer pairs of differing classes.
+#[test]
+fn preferring_same_class_keeps_a_valid_optimal_mapping() {
+    let mut rng = Rng(29);
+    let mut moved = 0;
+    for _ in 0..400 {
+        let alphabet = 2 + rng.below(5) as u64;
+        let (n1, n2) = (1 + rng.below(30), 1 + rng.below(30));
+        let a = random_tree(&mut rng, n1, alphabet);
+        let b = random_tree(&mut rng, n2, alphabet);
+        // Classes group labels two by two.
+        let class = |t: &LabelledTree| t.labels.iter().map(|l| l / 2).collect::<Vec<u32>>();
+        let (ca, cb) = (class(&a), class(&b));
+        let mut r = ted(&a, &b, &TedOptions::default());
+        let differing = |m: &[(usize, usize)]| m.iter().filter(|&&(x, y)| ca[x] != cb[y]).count();
+        let before = differing(&r.mapping);
+        let cost = prefer_same_class(&a, &b, &ca, &cb, &mut r.mapping);
+        assert_eq!(cost, r.upper, "{a:?} {b:?}");
+        check_mapping(&a, &b, &r);
+        let after = differing(&r.mapping);
+        assert!(after <= before);
+        moved += before - after;
+    }
+    assert!(moved > 0, "the random pairs never exercised a move");
+}

@@ -268,9 +268,13 @@ impl Pair<'_> {
         if aa != ab {
             self.relabel(s, "arguments", v, (aa, ab));
         }
-        // A default name (`Fallback`) changes with the type: no rename.
+        // A default name (`Fallback`) changes with the type: no rename. A
+        // node's name is compared under one id, or where both ids were
+        // derived by a reader (a BehaviorTree.CPP `name` added or changed
+        // changes the id with it).
         let default = |n: &BtNode| n.label == n.kind.default_label();
-        if na.label != nb.label && na.id == nb.id && !(default(na) && default(nb)) {
+        let same_node = na.id == nb.id || (na.id_source.is_derived() && nb.id_source.is_derived());
+        if na.label != nb.label && same_node && !(default(na) && default(nb)) {
             self.relabel(s, "name", v, (na.label.clone(), nb.label.clone()));
         }
     }

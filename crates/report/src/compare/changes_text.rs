@@ -159,7 +159,15 @@ pub(super) fn summary_markdown(r: &CompareReport) -> String {
         return String::new();
     };
     let s = &p.edit_script;
-    let mut out = format!("**What changed** ({} mapping): ", p.mode.as_str());
+    // BehaviorTree.CPP nodes without an id of their own were paired by
+    // the ordered tree mapping: said, since their keys then change.
+    let in_tree_order = s.vertices_kept.iter().any(|k| k.derived && k.a != k.b);
+    let how = if in_tree_order {
+        "; nodes without an id matched in tree order"
+    } else {
+        ""
+    };
+    let mut out = format!("**What changed** ({} mapping{how}): ", p.mode.as_str());
     if s.is_unchanged() {
         out.push_str(
             "nothing; the policies are the same graph with the same types, bindings and orders.\n",
@@ -175,7 +183,18 @@ pub(super) fn summary_markdown(r: &CompareReport) -> String {
         ("removed", &s.vertices_removed),
     ] {
         for v in list {
-            lines.push(format!("{sign} {} {}", v.vtype.as_str(), code(&v.key)));
+            // The display name too, when the key does not say it (a
+            // derived BehaviorTree.CPP id such as `Main/0/1`).
+            let name = if v.name == v.key || v.name.is_empty() {
+                String::new()
+            } else {
+                format!(" \"{}\"", btfsm_core::sanitize::markdown_cell(&v.name))
+            };
+            lines.push(format!(
+                "{sign} {} {}{name}",
+                v.vtype.as_str(),
+                code(&v.key)
+            ));
         }
     }
     if !lines.is_empty() {

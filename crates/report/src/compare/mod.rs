@@ -35,8 +35,9 @@ use btfsm_metrics::ged::{
     GedMode, GedOptions, Shape, StopReason, keep_same_labels, mapping_cost, named_mapping_of_ids,
     search_mapping,
 };
+use btfsm_metrics::ted::TedOptions;
 use btfsm_model::graph::{PolicyGraph, VertexType, policy_graph};
-use btfsm_model::{Policy, PolicyBody, PolicyKind};
+use btfsm_model::{IdSource, Policy, PolicyBody, PolicyKind};
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
@@ -72,6 +73,11 @@ pub struct VertexRef {
 pub struct KeptVertex {
     pub a: Text,
     pub b: Text,
+    /// Both keys were derived by a reader (BehaviorTree.CPP nodes without
+    /// `btfsm:id`): a new key says nothing of the node, so it is not told
+    /// as a rematch.
+    #[serde(skip)]
+    pub derived: bool,
 }
 
 /// Arcs between two vertices with one label.
@@ -118,10 +124,13 @@ impl Script {
             + arcs(&self.arcs_removed)
     }
 
-    /// Kept vertices whose key changes (only `structural` and `labeled`
-    /// mappings have them).
+    /// Kept vertices whose key changes, keys derived by a reader aside
+    /// (`structural` and `labeled` mappings have them; `named` only when a
+    /// node's given id changed into a derived one or back).
     pub fn rematched(&self) -> impl Iterator<Item = &KeptVertex> {
-        self.vertices_kept.iter().filter(|k| k.a != k.b)
+        self.vertices_kept
+            .iter()
+            .filter(|k| k.a != k.b && !k.derived)
     }
 
     /// Relabels: the entries of `relabelled` and the kept arcs whose label
@@ -221,14 +230,19 @@ pub struct Pair<'a> {
     gb: PolicyGraph,
     ia: ScriptIndex,
     ib: ScriptIndex,
-    /// Each vertex's key as an id shared by both graphs (equal keys, equal
-    /// ids), so that the mapping by name costs no string work per mode.
-    ids_a: Vec<u32>,
-    ids_b: Vec<u32>,
     /// HFSM containment in a: state key -> its container's key.
     parent_a: BTreeMap<String, String>,
     /// What relabels and reorders read of two BTs (`changes.rs`).
     bt_facts: Option<(changes::BtFacts, changes::BtFacts)>,
+    /// Per vertex, whether its key was derived by a reader (BT nodes
+    /// without a given id); empty for machines.
+    derived_a: Vec<bool>,
+    derived_b: Vec<bool>,
+    /// The ordered tree mapping of two BTs (`tree.rs`).
+    tree: Option<tree::TreeMapping>,
+    /// The `named` mapping (a → b): equal keys; for two BTs, derived keys
+    /// by the ordered tree mapping instead (`named_mapping`).
+    by_name: Vec<Option<usize>>,
 }
 
 /// State key -> container key, for every nested state of an HFSM.
@@ -244,22 +258,98 @@ fn containers(p: &Policy) -> BTreeMap<String, String> {
         .collect()
 }
 
+/// Per BT node, whether its id was derived by a reader.
+fn derived_ids(p: &Policy) -> Vec<bool> {
+    match &p.body {
+        PolicyBody::Bt(bt) => bt.nodes.iter().map(|n| n.id_source.is_derived()).collect(),
+        PolicyBody::Machine(_) => Vec::new(),
+    }
+}
+
+/// The `named` mapping of two graphs whose keys have ids `ids_a`, `ids_b`:
+/// equal keys, except that a key derived from a node's position names no
+/// node across versions (five Nav2 nodes inserted before a RateController
+/// give it the position of the first of them); then the nodes whose keys
+/// were derived (from a position or a display name) and are still
+/// unpaired, by the ordered tree mapping `tree` of two BTs. Keys the
+/// author gave (TOML keys, `btfsm:id`) pair by equality only, as the
+/// paper's named GED does.
+fn named_mapping(
+    (a, ids_a): (&Policy, &[u32]),
+    (b, ids_b): (&Policy, &[u32]),
+    tree: Option<&tree::TreeMapping>,
+) -> Vec<Option<usize>> {
+    let mut map = named_mapping_of_ids(ids_a, ids_b);
+    let (PolicyBody::Bt(ta), PolicyBody::Bt(tb)) = (&a.body, &b.body) else {
+        return map;
+    };
+    let positional =
+        |n: Option<&btfsm_model::BtNode>| n.is_some_and(|n| n.id_source == IdSource::Position);
+    for (u, m) in map.iter_mut().enumerate() {
+        if let Some(v) = *m
+            && (positional(ta.nodes.get(u)) || positional(tb.nodes.get(v)))
+        {
+            *m = None;
+        }
+    }
+    let Some(t) = tree else { return map };
+    let mut taken = vec![false; ids_b.len()];
+    for v in map.iter().flatten() {
+        taken[*v] = true;
+    }
+    let derived = |n: Option<&btfsm_model::BtNode>| n.is_some_and(|n| n.id_source.is_derived());
+    for &(x, y) in &t.result.mapping {
+        if map.get(x) == Some(&None)
+            && taken.get(y) == Some(&false)
+            && derived(ta.nodes.get(x))
+            && derived(tb.nodes.get(y))
+        {
+            map[x] = Some(y);
+            taken[y] = true;
+        }
+    }
+    map
+}
+
 impl<'a> Pair<'a> {
     pub fn new(a: Side<'a>, b: Side<'a>) -> Self {
+        Self::with_tree_options(a, b, &TedOptions::default())
+    }
+
+    /// [`Pair::new`], with the ordered tree mapping of two BTs computed
+    /// under `topts` (`compare --tree-max-work`).
+    pub fn with_tree_options(a: Side<'a>, b: Side<'a>, topts: &TedOptions) -> Self {
         let (ga, gb) = (policy_graph(a.policy), policy_graph(b.policy));
         let (ia, ib) = (ScriptIndex::new(&ga), ScriptIndex::new(&gb));
+        // Each vertex's key as an id shared by both graphs (equal keys,
+        // equal ids): the mapping by name costs no string work.
         let (ids_a, ids_b) = key_ids(&ia, &ib);
+        let tree = match (&a.policy.body, &b.policy.body) {
+            (PolicyBody::Bt(x), PolicyBody::Bt(y)) => Some(tree::TreeMapping::new(x, y, topts)),
+            _ => None,
+        };
+        let by_name = named_mapping((a.policy, &ids_a), (b.policy, &ids_b), tree.as_ref());
         Pair {
             ia,
             ib,
-            ids_a,
-            ids_b,
             ga,
             gb,
             parent_a: containers(a.policy),
             bt_facts: changes::bt_facts(a.policy, b.policy),
+            derived_a: derived_ids(a.policy),
+            derived_b: derived_ids(b.policy),
+            tree,
+            by_name,
             a,
             b,
+        }
+    }
+
+    /// The ordered tree edit distance of two BTs and its script.
+    pub fn tree_report(&self) -> Option<tree::TreeReport> {
+        match (&self.a.policy.body, &self.b.policy.body, &self.tree) {
+            (PolicyBody::Bt(a), PolicyBody::Bt(b), Some(t)) => Some(t.report(a, b)),
+            _ => None,
         }
     }
 
@@ -273,7 +363,7 @@ impl<'a> Pair<'a> {
     pub fn run(&self, mode: GedMode, opts: &GedOptions) -> ModeReport {
         let start = Instant::now();
         let (sa, sb) = (Shape::from(&self.ga), Shape::from(&self.gb));
-        let mut by_name = named_mapping_of_ids(&self.ids_a, &self.ids_b);
+        let mut by_name = self.by_name.clone();
         if mode == GedMode::Labeled {
             keep_same_labels(&sa, &sb, &mut by_name);
         }

@@ -301,6 +301,8 @@ impl Pair<'_> {
                 Some(v) => s.vertices_kept.push(KeptVertex {
                     a: ia.key(u),
                     b: ib.key(v),
+                    derived: self.derived_a.get(u).copied().unwrap_or(false)
+                        && self.derived_b.get(v).copied().unwrap_or(false),
                 }),
                 None => s.vertices_removed.push(vref(ia, u)),
             }

@@ -7,7 +7,8 @@
 //! section, JSON (the `tree` key beside SPEC §7's modes) and markdown.
 
 use btfsm_core::sanitize::shown;
-use btfsm_metrics::ted::{self, TedOptions, TreeEdit, bt::label_pair};
+use btfsm_metrics::ted::bt::{BtPair, label_pair};
+use btfsm_metrics::ted::{self, TedOptions, TedResult, TreeEdit};
 use btfsm_model::Bt;
 use std::time::Instant;
 
@@ -87,48 +88,83 @@ fn places(bt: &Bt) -> Vec<(Option<usize>, usize)> {
     out
 }
 
-/// The tree edit distance of `a` and `b` with its script.
-pub fn tree_report(a: &Bt, b: &Bt, opts: &TedOptions) -> TreeReport {
-    let start = Instant::now();
-    let pair = label_pair(a, b);
-    let r = ted::ted(&pair.a, &pair.b, opts);
-    let edits = ted::edit_script(&pair.a, &pair.b, &r.mapping);
-    let (pa, pb) = (places(a), places(b));
-    let place = |bt: &Bt, pl: &[(Option<usize>, usize)], shown: &[String], n: usize| Place {
-        id: bt.nodes[n].id.clone(),
-        label: shown[n].clone(),
-        parent: pl[n].0.map(|p| bt.nodes[p].id.clone()),
-        position: pl[n].1,
-    };
-    let mut s = TreeScript::default();
-    for e in edits {
-        match e {
-            TreeEdit::Rename { a: x, b: y } => s.renamed.push(TreeRename {
-                a: a.nodes[x].id.clone(),
-                b: b.nodes[y].id.clone(),
-                from: pair.shown_a[x].clone(),
-                to: pair.shown_b[y].clone(),
-            }),
-            TreeEdit::Move { a: x, b: y, size } => s.moved.push(TreeMove {
-                nodes: size,
-                from: place(a, &pa, &pair.shown_a, x),
-                to: place(b, &pb, &pair.shown_b, y),
-            }),
-            TreeEdit::Delete { a: x } => s.deleted.push(place(a, &pa, &pair.shown_a, x)),
-            TreeEdit::Insert { b: y } => s.inserted.push(place(b, &pb, &pair.shown_b, y)),
+/// The ordered tree mapping of two BTs: the distance (or its interval)
+/// with a mapping of its upper bound that pairs nodes of one class where an
+/// equally cheap mapping does ([`ted::prefer_same_class`]).
+pub struct TreeMapping {
+    pub pair: BtPair,
+    pub result: TedResult,
+    pub millis: u64,
+}
+
+impl TreeMapping {
+    pub fn new(a: &Bt, b: &Bt, opts: &TedOptions) -> TreeMapping {
+        let start = Instant::now();
+        let pair = label_pair(a, b);
+        let mut result = ted::ted(&pair.a, &pair.b, opts);
+        let cost = ted::prefer_same_class(
+            &pair.a,
+            &pair.b,
+            &pair.class_a,
+            &pair.class_b,
+            &mut result.mapping,
+        );
+        // Never above: on an interval's mapping, possibly below.
+        result.upper = result.upper.min(cost);
+        result.lower = result.lower.min(result.upper);
+        TreeMapping {
+            pair,
+            result,
+            millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
         }
     }
-    debug_assert_eq!(s.cost(), r.upper);
-    TreeReport {
-        ted: r.upper,
-        exact: r.exact(),
-        lower_bound: r.lower,
-        upper_bound: r.upper,
-        work: r.work,
-        millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
-        label: LABEL,
-        edit_script: s,
+
+    /// The report of this mapping, in the nodes' ids of `a` and `b`.
+    pub fn report(&self, a: &Bt, b: &Bt) -> TreeReport {
+        let (pair, r) = (&self.pair, &self.result);
+        let edits = ted::edit_script(&pair.a, &pair.b, &r.mapping);
+        let (pa, pb) = (places(a), places(b));
+        let place = |bt: &Bt, pl: &[(Option<usize>, usize)], shown: &[String], n: usize| Place {
+            id: bt.nodes[n].id.clone(),
+            label: shown[n].clone(),
+            parent: pl[n].0.map(|p| bt.nodes[p].id.clone()),
+            position: pl[n].1,
+        };
+        let mut s = TreeScript::default();
+        for e in edits {
+            match e {
+                TreeEdit::Rename { a: x, b: y } => s.renamed.push(TreeRename {
+                    a: a.nodes[x].id.clone(),
+                    b: b.nodes[y].id.clone(),
+                    from: pair.shown_a[x].clone(),
+                    to: pair.shown_b[y].clone(),
+                }),
+                TreeEdit::Move { a: x, b: y, size } => s.moved.push(TreeMove {
+                    nodes: size,
+                    from: place(a, &pa, &pair.shown_a, x),
+                    to: place(b, &pb, &pair.shown_b, y),
+                }),
+                TreeEdit::Delete { a: x } => s.deleted.push(place(a, &pa, &pair.shown_a, x)),
+                TreeEdit::Insert { b: y } => s.inserted.push(place(b, &pb, &pair.shown_b, y)),
+            }
+        }
+        debug_assert_eq!(s.cost(), r.upper);
+        TreeReport {
+            ted: r.upper,
+            exact: r.exact(),
+            lower_bound: r.lower,
+            upper_bound: r.upper,
+            work: r.work,
+            millis: self.millis,
+            label: LABEL,
+            edit_script: s,
+        }
     }
+}
+
+/// The tree edit distance of `a` and `b` with its script.
+pub fn tree_report(a: &Bt, b: &Bt, opts: &TedOptions) -> TreeReport {
+    TreeMapping::new(a, b, opts).report(a, b)
 }
 
 /// The summary line: distance, exactness, time.
