@@ -119,7 +119,7 @@ fn executor(s: &SymScenario, i: usize, w: &mut World) -> Exec {
 
 /// Runs policy `i` of the scenario with these disturbances and rates,
 /// until its verdict, `max_steps`, or the deadline (read every
-/// [`clock_every`] steps; the run is then `timeout` and `cut_short`).
+/// `clock_every` steps; the run is then `timeout` and `cut_short`).
 pub fn run_policy(
     s: &SymScenario,
     i: usize,
