@@ -943,7 +943,12 @@ mod tests {
   </Concurrence>
 </StateMachine>"#,
         );
-        let by = |n: &str| m.states.iter().find(|s| s.name == n).unwrap_or_else(|| panic!("{n}"));
+        let by = |n: &str| {
+            m.states
+                .iter()
+                .find(|s| s.name == n)
+                .unwrap_or_else(|| panic!("{n}"))
+        };
         assert!(matches!(by("j").body, StateBody::Task(None)));
         match &by("cc").body {
             StateBody::Container(r) => assert!(r.parallel && r.states.len() == 2),
