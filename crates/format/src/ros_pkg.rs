@@ -50,7 +50,7 @@ pub struct RosPackages {
     pub ament_prefixes: Vec<PathBuf>,
     /// What the `package.xml`s read may cost: the command's byte budget
     /// (`--max-total-bytes`), charged per file read; none: only
-    /// [`MAX_PACKAGE_XML`] per file and [`MAX_WALK`] entries bound it.
+    /// 64 KiB per file and [`MAX_WALK`] entries bound it.
     pub budget: Option<Arc<Budget>>,
     /// Per root searched: package name -> directories of its `package.xml`.
     found: Mutex<HashMap<PathBuf, Arc<PackageIndex>>>,
