@@ -274,6 +274,7 @@ impl DotLookArgs {
 
 impl LimitArgs {
     pub(crate) fn limits(&self) -> btfsm_format::Limits {
+        let read_budget = btfsm_format::source::Budget::new(self.max_total_bytes);
         btfsm_format::Limits {
             max_file_bytes: self.max_file_bytes,
             max_nodes: self.max_nodes,
@@ -289,11 +290,15 @@ impl LimitArgs {
                 (Some(r), false) => btfsm_format::source::Confinement::Root(r.clone()),
                 (None, false) => btfsm_format::source::Confinement::Auto,
             },
-            read_budget: btfsm_format::source::Budget::new(self.max_total_bytes),
+            read_budget: read_budget.clone(),
             expansion_budget: btfsm_format::source::Budget::new(self.max_nodes as u64),
             total_nodes: btfsm_format::source::Budget::new(self.max_total_nodes),
             tree: self.tree.clone(),
-            ros: btfsm_format::ros_pkg::RosPackages::new(self.ros_pkg.clone(), ament_prefixes()),
+            ros: btfsm_format::ros_pkg::RosPackages::new(
+                self.ros_pkg.clone(),
+                ament_prefixes(),
+                Some(read_budget),
+            ),
             ..Default::default()
         }
     }

@@ -126,6 +126,7 @@ pub(super) fn run(args: CompareArgs) -> u8 {
             policy: &lb.policy,
         },
         &topts,
+        matches!(args.mode, CompareMode::Tree | CompareMode::All),
     );
     let mut results = Vec::new();
     for mode in args.mode.ged_modes() {

@@ -152,6 +152,12 @@ fn adding_names_is_a_rename_never_a_remove_and_an_add() {
         v["tree"]["edit_script"]["renamed"].as_array().map(Vec::len),
         Some(4)
     );
+    // The same under `--mode named` alone (the tree mapping is computed
+    // for the pairing, not shown).
+    let w = json(&["compare", NAMES_BEFORE, NAMES_AFTER, "--mode", "named"]);
+    assert_eq!(w["named"]["ged"], 0, "{w}");
+    assert_eq!(w["named"]["relabels"], 4, "{w}");
+    assert!(w.get("tree").is_none(), "{w}");
     let md = run(&["compare", NAMES_BEFORE, NAMES_AFTER, "--format", "markdown"]);
     let summary: String = md.split("| | file |").next().unwrap_or_default().into();
     assert!(

@@ -16,7 +16,8 @@
 //!    `--root`; `format::source`), without following symbolic links, past
 //!    hidden directories, colcon's `build/`, `install/` and `log/` and any
 //!    directory with a `COLCON_IGNORE` or `AMENT_IGNORE`, visiting at most
-//!    [`MAX_WALK`] entries. A source package's files sit where its install
+//!    [`MAX_WALK`] entries and reading each `package.xml` (at most 64 KiB)
+//!    against the command's `--max-total-bytes`. A source package's files sit where its install
 //!    rule copies them into the share directory (Nav2's `behavior_trees/`).
 //!
 //! Every file found so is then read under the root rules of every named
@@ -25,7 +26,7 @@
 //! `--allow-outside-root` is given. The repository search is done once per
 //! root and command.
 
-use super::source::{Refusal, resolve};
+use super::source::{Budget, Refusal, resolve};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -37,8 +38,8 @@ type PackageIndex = BTreeMap<String, Vec<PathBuf>>;
 /// yasmin `file_name` in a package) visits.
 pub const MAX_WALK: usize = 200_000;
 
-/// Largest `package.xml` read, in bytes.
-const MAX_PACKAGE_XML: u64 = 1 << 20;
+/// Largest `package.xml` read, in bytes (a real one is a few kB).
+const MAX_PACKAGE_XML: u64 = 64 << 10;
 
 /// What the command knows of where ROS packages are.
 #[derive(Debug, Default)]
@@ -47,15 +48,24 @@ pub struct RosPackages {
     pub given: Vec<(String, PathBuf)>,
     /// The prefixes of `AMENT_PREFIX_PATH`, in order.
     pub ament_prefixes: Vec<PathBuf>,
+    /// What the `package.xml`s read may cost: the command's byte budget
+    /// (`--max-total-bytes`), charged per file read; none: only
+    /// 64 KiB per file and [`MAX_WALK`] entries bound it.
+    pub budget: Option<Arc<Budget>>,
     /// Per root searched: package name -> directories of its `package.xml`.
     found: Mutex<HashMap<PathBuf, Arc<PackageIndex>>>,
 }
 
 impl RosPackages {
-    pub fn new(given: Vec<(String, PathBuf)>, ament_prefixes: Vec<PathBuf>) -> Arc<Self> {
+    pub fn new(
+        given: Vec<(String, PathBuf)>,
+        ament_prefixes: Vec<PathBuf>,
+        budget: Option<Arc<Budget>>,
+    ) -> Arc<Self> {
         Arc::new(RosPackages {
             given,
             ament_prefixes,
+            budget,
             found: Mutex::default(),
         })
     }
@@ -104,7 +114,7 @@ impl RosPackages {
         let mut found = self.found.lock().unwrap_or_else(|e| e.into_inner());
         found
             .entry(key.clone())
-            .or_insert_with(|| Arc::new(packages_below(&key)))
+            .or_insert_with(|| Arc::new(packages_below(&key, self.budget.as_deref())))
             .clone()
     }
 }
@@ -169,12 +179,24 @@ fn walk(top: &Path, mut visit: impl FnMut(&Path) -> bool) {
     }
 }
 
-/// The packages below `top`.
-fn packages_below(top: &Path) -> PackageIndex {
+/// The packages below `top`, each `package.xml` read charged to `budget`
+/// (the search stops when it is spent).
+fn packages_below(top: &Path, budget: Option<&Budget>) -> PackageIndex {
     let mut out = PackageIndex::new();
     walk(top, |p| {
-        if p.file_name().is_some_and(|n| n == "package.xml")
-            && let Some(name) = package_name(p)
+        if p.file_name().is_none_or(|n| n != "package.xml") {
+            return false;
+        }
+        let Ok(m) = std::fs::metadata(p) else {
+            return false;
+        };
+        if !m.is_file() || m.len() > MAX_PACKAGE_XML {
+            return false;
+        }
+        if budget.is_some_and(|b| !b.charge(m.len())) {
+            return true;
+        }
+        if let Some(name) = package_name(p)
             && let Some(dir) = p.parent()
         {
             out.entry(name).or_default().push(dir.to_path_buf());
@@ -186,11 +208,12 @@ fn packages_below(top: &Path) -> PackageIndex {
 
 /// The `<name>` of a `package.xml` (REP 149), if it reads as one.
 fn package_name(p: &Path) -> Option<String> {
-    let m = std::fs::metadata(p).ok()?;
-    if m.len() > MAX_PACKAGE_XML {
-        return None;
-    }
-    let text = std::fs::read_to_string(p).ok()?;
+    let mut text = String::new();
+    std::io::Read::read_to_string(
+        &mut std::io::Read::take(std::fs::File::open(p).ok()?, MAX_PACKAGE_XML),
+        &mut text,
+    )
+    .ok()?;
     let opts = roxmltree::ParsingOptions {
         allow_dtd: false,
         nodes_limit: 100_000,
@@ -303,7 +326,7 @@ mod tests {
         );
         package(&top.join("src/old"), "old_pkg");
         std::fs::write(top.join("src/old/COLCON_IGNORE"), "").unwrap();
-        let ros = RosPackages::new(vec![], vec![]);
+        let ros = RosPackages::new(vec![], vec![], None);
         let root = Some(top.as_path());
         assert_eq!(
             ros.package_dir("nav2_bt_navigator", root, &top).unwrap(),
@@ -315,7 +338,7 @@ mod tests {
         // Given and installed come first.
         let prefix = top.join("opt");
         std::fs::create_dir_all(prefix.join("share/nav2_bt_navigator")).unwrap();
-        let ros = RosPackages::new(vec![], vec![prefix.clone()]);
+        let ros = RosPackages::new(vec![], vec![prefix.clone()], None);
         assert_eq!(
             ros.package_dir("nav2_bt_navigator", root, &top).unwrap(),
             prefix.join("share/nav2_bt_navigator")
@@ -323,6 +346,7 @@ mod tests {
         let ros = RosPackages::new(
             vec![("nav2_bt_navigator".into(), top.join("x"))],
             vec![prefix],
+            None,
         );
         assert_eq!(
             ros.package_dir("nav2_bt_navigator", root, &top).unwrap(),
@@ -330,7 +354,7 @@ mod tests {
         );
         // Two source packages of one name: say which.
         package(&top.join("src/copy"), "nav2_bt_navigator");
-        let ros = RosPackages::new(vec![], vec![]);
+        let ros = RosPackages::new(vec![], vec![], None);
         let two = ros
             .package_dir("nav2_bt_navigator", root, &top)
             .unwrap_err();
@@ -344,7 +368,7 @@ mod tests {
         let outside = scratch("outside");
         package(&outside.join("share/ext"), "ext");
         std::fs::write(outside.join("share/ext/t.xml"), "<root/>").unwrap();
-        let ros = RosPackages::new(vec![], vec![outside.clone()]);
+        let ros = RosPackages::new(vec![], vec![outside.clone()], None);
         let root = super::super::source::canonical(&top);
         let r = resolve_in_package(&ros, Some(&root), &top, "ext", "t.xml").unwrap_err();
         assert!(r.message.contains("outside the root"), "{r:?}");
@@ -355,5 +379,21 @@ mod tests {
         assert!(find_in_package(&ros, None, &top, "ext", "t.xml").is_ok());
         std::fs::remove_dir_all(&top).unwrap();
         std::fs::remove_dir_all(&outside).unwrap();
+    }
+
+    /// The `package.xml`s read are charged to the command's byte budget:
+    /// spent, the search stops.
+    #[test]
+    fn the_search_reads_within_the_byte_budget() {
+        let top = scratch("budget");
+        package(&top.join("a"), "pkg_a");
+        package(&top.join("b"), "pkg_b");
+        let one = std::fs::metadata(top.join("a/package.xml")).unwrap().len();
+        let ros = RosPackages::new(vec![], vec![], Some(Budget::new(one)));
+        let root = Some(top.as_path());
+        assert!(ros.package_dir("pkg_a", root, &top).is_ok());
+        // pkg_b's package.xml did not fit in what was left.
+        assert!(ros.package_dir("pkg_b", root, &top).is_err());
+        std::fs::remove_dir_all(&top).unwrap();
     }
 }

@@ -313,19 +313,24 @@ fn named_mapping(
 
 impl<'a> Pair<'a> {
     pub fn new(a: Side<'a>, b: Side<'a>) -> Self {
-        Self::with_tree_options(a, b, &TedOptions::default())
+        Self::with_tree_options(a, b, &TedOptions::default(), true)
     }
 
     /// [`Pair::new`], with the ordered tree mapping of two BTs computed
-    /// under `topts` (`compare --tree-max-work`).
-    pub fn with_tree_options(a: Side<'a>, b: Side<'a>, topts: &TedOptions) -> Self {
+    /// under `topts` (`compare --tree-max-work`) when `tree` asks for it or
+    /// the `named` mapping needs it (a node whose id a reader derived).
+    pub fn with_tree_options(a: Side<'a>, b: Side<'a>, topts: &TedOptions, tree: bool) -> Self {
         let (ga, gb) = (policy_graph(a.policy), policy_graph(b.policy));
         let (ia, ib) = (ScriptIndex::new(&ga), ScriptIndex::new(&gb));
         // Each vertex's key as an id shared by both graphs (equal keys,
         // equal ids): the mapping by name costs no string work.
         let (ids_a, ids_b) = key_ids(&ia, &ib);
+        let (derived_a, derived_b) = (derived_ids(a.policy), derived_ids(b.policy));
+        let needed = tree || derived_a.iter().chain(&derived_b).any(|&d| d);
         let tree = match (&a.policy.body, &b.policy.body) {
-            (PolicyBody::Bt(x), PolicyBody::Bt(y)) => Some(tree::TreeMapping::new(x, y, topts)),
+            (PolicyBody::Bt(x), PolicyBody::Bt(y)) if needed => {
+                Some(tree::TreeMapping::new(x, y, topts))
+            }
             _ => None,
         };
         let by_name = named_mapping((a.policy, &ids_a), (b.policy, &ids_b), tree.as_ref());
@@ -336,8 +341,8 @@ impl<'a> Pair<'a> {
             gb,
             parent_a: containers(a.policy),
             bt_facts: changes::bt_facts(a.policy, b.policy),
-            derived_a: derived_ids(a.policy),
-            derived_b: derived_ids(b.policy),
+            derived_a,
+            derived_b,
             tree,
             by_name,
             a,
