@@ -69,6 +69,19 @@ pub struct Limits {
     /// a `<SubTree>` that no file it reads defines is looked up in them
     /// ([`btcpp_xml::Companions`]).
     pub companions: Option<Arc<btcpp_xml::Companions>>,
+    /// `<TreeNodesModel>` files found beside the trees rather than given
+    /// (`lint`'s search of the repository, docs/lint.md "Node models"):
+    /// read after [`Limits::nodes_models`], whose declarations win, and
+    /// their problems are warnings (nobody asked for them).
+    pub found_models: Vec<PathBuf>,
+    /// Read as `lint` reads (docs/lint.md): a node type no model declares
+    /// is kept (as `--assume-leaf` or its shape says) and recorded in the
+    /// dataflow for the `unknown-node-type` rule rather than refused, and
+    /// what BehaviorTree.CPP 4 refuses only when it ticks the node (a
+    /// Parallel threshold, an IfThenElse or SwitchN child count, a missing
+    /// `num_attempts`) is a warning carrying its rule's code, so that the
+    /// other rules still run.
+    pub for_lint: bool,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -102,6 +115,8 @@ impl Default for Limits {
             expansion_budget: source::Budget::new(DEFAULT_MAX_NODES as u64),
             tree: None,
             companions: None,
+            found_models: Vec::new(),
+            for_lint: false,
         }
     }
 }

@@ -19,6 +19,8 @@ pub(super) struct ModelEntry {
     pub(super) cat: Category,
     /// Its `<input_port>`, `<output_port>` and `<inout_port>`s.
     pub(super) ports: Vec<super::ports::PortDecl>,
+    /// Where it is declared: document and span.
+    pub(super) at: (usize, Range<usize>),
 }
 
 /// The files being included, outermost first: their canonical paths (for
@@ -45,6 +47,8 @@ pub(super) struct Loader<'l> {
     /// Unknown node types already reported: each is an error once, at its
     /// first use, however often it is used.
     pub(super) unknown: std::collections::HashSet<String>,
+    /// SubTree IDs no file read defines, read as opaque nodes (`lint`).
+    pub(super) unknown_subtrees: std::collections::HashSet<String>,
     /// Files read so far (canonical paths): each is read once.
     pub(super) seen: HashSet<PathBuf>,
     /// The first document read as a companion (a file given together with
@@ -80,6 +84,7 @@ pub(super) fn load(
         trees: BTreeMap::new(),
         models: BTreeMap::new(),
         unknown: Default::default(),
+        unknown_subtrees: Default::default(),
         seen: HashSet::new(),
         first_companion: usize::MAX,
         ambiguous: BTreeMap::new(),
@@ -157,6 +162,18 @@ impl Loader<'_> {
         let extra = self.limits.nodes_models.clone();
         for m in &extra {
             self.nodes_model_file(m);
+        }
+        self.flow.node_types.given_model = !extra.is_empty();
+        // Models found rather than given: their problems are warnings.
+        let found = self.limits.found_models.clone();
+        self.flow.node_types.found_models = found
+            .iter()
+            .map(|m| shown(&m.display().to_string()).into_owned())
+            .collect();
+        for m in &found {
+            let mark = self.diags.mark();
+            self.nodes_model_file(m);
+            self.diags.demote_since(mark);
         }
         for d in 0..self.docs.len() {
             self.definitions(d);
@@ -427,26 +444,44 @@ impl Loader<'_> {
                 );
                 continue;
             }
-            if let Some(prev) = self.models.get(id)
-                && prev.cat != cat
-            {
-                let was = prev.cat.tag();
-                self.err(
-                    d,
-                    el.span.clone(),
-                    format!(
-                        "`{}` is declared both as `{was}` and as `{}`",
-                        shown(id),
-                        cat.tag()
-                    ),
-                )
-                .hint = Some("keep one declaration per node type across the model files".into());
-                continue;
+            if let Some(prev) = self.models.get(id) {
+                if prev.cat != cat {
+                    self.model_conflict(d, &el, id, prev.clone(), cat);
+                }
+                continue; // the first declaration read wins
             }
             let ports = super::ports::model_ports(&self.docs[d], d, k);
+            let at = (d, el.span.clone());
             self.models
-                .insert(id.to_string(), ModelEntry { cat, ports });
+                .insert(id.to_string(), ModelEntry { cat, ports, at });
         }
+    }
+
+    /// A type two models declare in different categories: a warning naming
+    /// both places; the first read (a model given, before one found; the
+    /// file's own, before its includes') is kept.
+    fn model_conflict(&mut self, d: usize, el: &XElem, id: &str, prev: ModelEntry, cat: Category) {
+        let (pd, pspan) = prev.at;
+        let first = {
+            let f = &self.docs[pd].file;
+            let (l, c) = f.line_col(pspan.start.min(f.text.len()));
+            format!("{}:{l}:{c}", shown(&f.path))
+        };
+        self.warn(
+            d,
+            el.span.clone(),
+            format!(
+                "`{}` is declared as `{}` here and as `{}` at {first}; read as `{}`",
+                shown(id),
+                cat.tag(),
+                prev.cat.tag(),
+                prev.cat.tag()
+            ),
+        )
+        .set_code("model-conflict")
+        .hint = Some(
+            "keep one declaration per node type across the model files (the C++ class the program registers decides)".into(),
+        );
     }
 
     /// Collects `<BehaviorTree>` definitions and `<TreeNodesModel>` entries.

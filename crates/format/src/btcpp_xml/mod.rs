@@ -36,7 +36,7 @@ pub mod ports;
 #[cfg(test)]
 mod tests;
 
-pub use companions::Companions;
+pub use companions::{Companions, root_trees};
 pub use ids::derive_ids;
 use loader::load;
 pub use ports::{Dataflow, builtin_ports};

@@ -65,10 +65,23 @@ impl Loader<'_> {
             && !self.models.contains_key(&ty)
             && let Some((msg, hint, code)) = builtin_rule(&ty, el, n)
         {
-            let e = self.err(d, el.span.clone(), msg);
-            e.hint = Some(hint.into());
-            e.code = code;
-            return None;
+            // For `lint`, what BehaviorTree.CPP refuses only when it ticks
+            // the node is a finding beside the others (the tree is built).
+            match tick_time(&ty, code) {
+                Some(code) if self.limits.for_lint => {
+                    if let Some(code) = code {
+                        let w = self.warn(d, el.span.clone(), msg);
+                        w.hint = Some(hint.into());
+                        w.code = Some(code);
+                    }
+                }
+                _ => {
+                    let e = self.err(d, el.span.clone(), msg);
+                    e.hint = Some(hint.into());
+                    e.code = code;
+                    return None;
+                }
+            }
         }
         let mut ports = node_ports(el, consumed, kind, &ty, resolve);
         let skill_call = bind_skill(kind, &ty, &mut ports);
@@ -136,9 +149,16 @@ impl Loader<'_> {
         Some(if let Some(cat) = builtin(ty) {
             Typed::builtin(ty, cat, el, n)
         } else if let Some(cat) = explicit_cat {
+            if self.models.contains_key(ty.as_str()) {
+                self.declared(ty);
+            } else if self.limits.for_lint {
+                self.record_unknown(d, el, ty, true);
+            }
             Typed::generic(cat)
         } else if let Some(m) = self.models.get(ty.as_str()) {
-            Typed::generic(m.cat)
+            let cat = m.cat;
+            self.declared(ty);
+            Typed::generic(cat)
         } else if let Some((real, cat)) = BUILTINS.iter().find(|(b, _)| b.eq_ignore_ascii_case(ty))
         {
             self.warn(
@@ -155,6 +175,15 @@ impl Loader<'_> {
             ));
             *ty = real.to_string();
             Typed::builtin(real, *cat, el, n)
+        } else if self.limits.for_lint {
+            // Kept as its shape says, for the `unknown-node-type` rule.
+            self.record_unknown(d, el, ty, false);
+            match (n, self.limits.assume_leaf) {
+                (0, Some(AssumeLeaf::Condition)) => Typed::generic(Category::Condition),
+                (0, _) => Typed::generic(Category::Action),
+                (1, _) => Typed::generic(Category::Decorator),
+                _ => Typed::generic(Category::Control),
+            }
         } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
             match a {
                 AssumeLeaf::Action => Typed::generic(Category::Action),
@@ -175,6 +204,43 @@ impl Loader<'_> {
                 _ => Typed::generic(Category::Control),
             }
         })
+    }
+
+    /// A type the tree uses that a model declares.
+    fn declared(&mut self, ty: &str) {
+        let types = &mut self.flow.node_types;
+        if !types.declared.contains(ty) {
+            types.declared.insert(ty.to_string());
+        }
+    }
+
+    /// A type no model declares, at its first use (`lint`): with the
+    /// closest known type for the first [`HINTED_TYPES`] of them.
+    fn record_unknown(&mut self, d: usize, el: &XElem, ty: &str, explicit: bool) {
+        if !self.unknown.insert(ty.to_string()) {
+            return;
+        }
+        let closest = (self.unknown.len() <= HINTED_TYPES)
+            .then(|| {
+                let cands = BUILTINS
+                    .iter()
+                    .map(|(b, _)| *b)
+                    .chain(self.models.keys().map(String::as_str));
+                btfsm_core::diagnostic::closest(ty, cands).map(str::to_string)
+            })
+            .flatten();
+        self.flow
+            .node_types
+            .unknown
+            .push(super::ports::UnknownType {
+                ty: ty.to_string(),
+                doc: d,
+                span: el.span.clone(),
+                children: el.children.len(),
+                explicit,
+                subtree: false,
+                closest,
+            });
     }
 
     /// The error of an unknown node type, with how to declare it.
@@ -254,6 +320,24 @@ impl Loader<'_> {
             _ => "a leaf has no children; is the type right in the `<TreeNodesModel>`?".into(),
         });
         false
+    }
+}
+
+/// Unknown types whose closest known type is looked for (each search scans
+/// the built-ins and the models once): bounded work under a million types.
+const HINTED_TYPES: usize = 256;
+
+/// Whether a problem `builtin_rule` finds is one BehaviorTree.CPP 4 meets
+/// only when it ticks the node (it creates the tree): `Some` with the
+/// rule's code (`None`: the rule that reports it runs on the loaded tree,
+/// `missing-required-port` for `num_attempts`). Checked against
+/// behaviortreepy by tests/differential/btcpp_when.py.
+fn tick_time(ty: &str, code: Option<&'static str>) -> Option<Option<&'static str>> {
+    match ty {
+        "Parallel" | "IfThenElse" | "WhileDoElse" | "Switch2" | "Switch3" | "Switch4"
+        | "Switch5" | "Switch6" => Some(code),
+        "RetryUntilSuccessful" => Some(None),
+        _ => None,
     }
 }
 
