@@ -92,7 +92,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
     let run = lint_inputs(&inputs, only.as_deref(), &limits, &cfg);
     let report = Findings {
         run: &run,
-        files: inputs.len(),
+        files: run.files,
     };
     let code = emit_report(None, &report, a.format);
     if a.format != Format::Text && !run.not_linted.is_empty() {
@@ -100,7 +100,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
             err,
             "{}",
             Diagnostic::error(format!(
-                "{} file{} not linted: {} not load (the `load-error` findings say why)",
+                "{} file{} not linted: {} not load (the findings say why)",
                 run.not_linted.len(),
                 if run.not_linted.len() == 1 { "" } else { "s" },
                 if run.not_linted.len() == 1 {
@@ -234,6 +234,8 @@ fn is_model_file(path: &Path, limits: &format::Limits) -> bool {
 /// path and why), and the node types no model declares, by file.
 #[derive(Default)]
 struct Run {
+    /// Policy files read (linted or not).
+    files: usize,
     findings: Vec<lint::Finding>,
     not_linted: Vec<(String, String)>,
     unchecked: std::collections::BTreeMap<String, Vec<String>>,
@@ -323,7 +325,11 @@ fn summary(
     }
     let names: std::collections::BTreeSet<&str> =
         by_file.values().flatten().map(String::as_str).collect();
-    let some: Vec<String> = names.iter().take(3).map(|t| format!("`{t}`")).collect();
+    let some: Vec<String> = names
+        .iter()
+        .take(3)
+        .map(|t| format!("`{}`", btfsm_core::sanitize::shown(t)))
+        .collect();
     let n = by_file.len();
     Some((
         format!(
@@ -362,10 +368,12 @@ fn lint_inputs(
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
             Ok(_) => continue,
             Err(d) => {
+                run.files += 1;
                 run.not_loaded(&d, &input.path.display().to_string(), cfg);
                 continue;
             }
         };
+        run.files += 1;
         let limits = tree_limits(&mut search, &input.path, fmt, limits);
         // A file of several trees that names none: each tree a program may
         // create from it, findings said once.
@@ -501,7 +509,7 @@ impl Findings<'_> {
             )),
         }
         for note in self.run.notes() {
-            s.push_str(&format!("note: {}\n", btfsm_core::sanitize::shown(&note)));
+            s.push_str(&format!("note: {note}\n"));
         }
         s
     }

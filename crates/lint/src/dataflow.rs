@@ -155,11 +155,18 @@ fn undeclared_port(s: &Subject, out: &mut Sink) {
             } else {
                 "remove it, or declare it in the `<TreeNodesModel>`".into()
             };
+            // A model given lists the ports the program's nodes provide; one
+            // found beside the trees (or in the file) may be out of date.
+            let why = if nf.builtin || df.node_types.given_model {
+                "BehaviorTree.CPP refuses a port its node type does not provide"
+            } else {
+                "BehaviorTree.CPP refuses it unless the model is out of date (the node's providedPorts() decide)"
+            };
             out.push(
                 id_of(s, nf.node),
                 span,
                 format!(
-                    "{whose} `{}` declares no port `{}`{at}; BehaviorTree.CPP refuses a port its node type does not provide",
+                    "{whose} `{}` declares no port `{}`{at}; {why}",
                     nf.ty, u.name
                 ),
                 help,
@@ -178,7 +185,7 @@ pub const MISSING_REQUIRED_PORT: Rule = Rule {
 pub const MISSING_MODEL_PORT: Rule = Rule {
     code: "missing-model-port",
     level: Level::Allow,
-    summary: "an input port a node model declares without a default is not given (off by default: models do not say which ports are optional)",
+    summary: "an input port a node model declares without a default is not given (off: a model does not say what is optional)",
     check: missing_model_port,
 };
 
@@ -477,6 +484,12 @@ impl<'a> Ancestry<'a> {
         Ancestry { bt, up, end }
     }
 
+    /// One past the last node of `a`'s subtree (`a` itself past the end:
+    /// nothing).
+    fn end_of(&self, a: usize) -> usize {
+        self.end.get(a).copied().unwrap_or(a)
+    }
+
     /// Does `a`'s subtree hold `b`?
     fn holds(&self, a: usize, b: usize) -> bool {
         a <= b && b < self.end[a]
@@ -651,7 +664,26 @@ pub const SUBTREE_REMAP_UNPROVIDED: Rule = Rule {
 
 fn subtree_remap_unprovided(s: &Subject, out: &mut Sink) {
     let Some(df) = flow(s) else { return };
+    let PolicyBody::Bt(bt) = &s.policy.body else {
+        return;
+    };
     let f = facts(df);
+    // Where each entry is read (node positions, in preorder), for the
+    // entries SubTrees remap: a remapping is reported only when a node of
+    // that SubTree reads the entry.
+    let mut readers: HashMap<&Key, Vec<usize>> = HashMap::new();
+    for (pos, nf) in df.nodes.iter().enumerate() {
+        for k in nf.keys.iter().filter(|k| {
+            f.remapped.contains(&k.key)
+                && matches!(
+                    k.access,
+                    Access::Read | Access::ReadWrite | Access::ScriptRead
+                )
+        }) {
+            readers.entry(&k.key).or_default().push(pos);
+        }
+    }
+    let mut lca: Option<Ancestry> = None;
     for st in &df.subtrees {
         for (port, value, key, aspan) in &st.remap {
             let Some(k) = key else { continue };
@@ -660,6 +692,19 @@ fn subtree_remap_unprovided(s: &Subject, out: &mut Sink) {
                 || f.provided.contains(k)
                 || (k.scope == 0 && df.tree_ports.is_none())
             {
+                continue;
+            }
+            // A remapped entry no node of the SubTree reads is a dead
+            // remapping, harmless (MoveIt Studio objectives pass
+            // `{parameters}` down chains of SubTrees that do not use it).
+            let end = lca.get_or_insert_with(|| Ancestry::new(bt)).end_of(st.node);
+            // Readers are in preorder: the first at or after the SubTree's
+            // root, by binary search.
+            let read_inside = readers.get(k).is_some_and(|r| {
+                let i = r.partition_point(|&p| p < st.node);
+                r.get(i).is_some_and(|&p| p < end)
+            });
+            if !read_inside {
                 continue;
             }
             let (span, at) = place(df, st.doc, aspan);

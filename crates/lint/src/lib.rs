@@ -197,7 +197,12 @@ pub fn lint_subject(
         }
         let mut sink = Sink::default();
         (r.check)(subject, &mut sink);
+        // A finding in a SubTree expanded several times is said once.
+        let mut said = std::collections::HashSet::new();
         for raw in sink.found {
+            if !said.insert((raw.message.clone(), raw.span.clone())) {
+                continue;
+            }
             let source = match (file, raw.span) {
                 (Some(f), Some(sp))
                     if sp.end <= f.text.len() && f.text.is_char_boundary(sp.start) =>

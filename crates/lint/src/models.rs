@@ -61,7 +61,16 @@ fn unknown_node_type(s: &Subject, out: &mut Sink) {
         }
         let (span, at) = super::dataflow::place(df, u.doc, &u.span);
         let t = &df.node_types;
-        let (message, help) = if t.given_model {
+        let tree = u.closest.as_deref() == Some(u.ty.as_str());
+        let (message, help) = if tree {
+            (
+                format!(
+                    "`{}`{at} is a tree, written as a node type: BehaviorTree.CPP's factory does not know it as one",
+                    u.ty
+                ),
+                format!("write `<SubTree ID=\"{}\"/>`", u.ty),
+            )
+        } else if t.given_model {
             (
                 format!(
                     "unknown node type `{}`{at}: the node models given do not declare it, and BehaviorTree.CPP refuses a tree with a type its factory does not know",
@@ -95,7 +104,11 @@ fn unknown_node_type(s: &Subject, out: &mut Sink) {
                 declare(u),
             )
         };
-        let level = if modelled { None } else { Some(Level::Note) };
+        let level = if modelled || tree {
+            None
+        } else {
+            Some(Level::Note)
+        };
         out.push_capped(&u.ty, span, message, help, level);
     }
 }
@@ -116,7 +129,7 @@ fn declare(u: &UnknownType) -> String {
 
 pub const UNKNOWN_SUBTREE: Rule = Rule {
     code: "unknown-subtree",
-    level: Level::Note,
+    level: Level::Warning,
     summary: "a SubTree no file given defines, close to a tree ID that is defined (a misspelt tree ID?)",
     check: unknown_subtree,
 };

@@ -112,7 +112,7 @@ fn unreachable_child(p: &Subject, out: &mut Sink) {
 pub const REACTIVE_ASYNC_SIBLINGS: Rule = Rule {
     code: "reactive-async-siblings",
     level: Level::Warning,
-    summary: "two asynchronous actions under a reactive Sequence or Fallback: BehaviorTree.CPP halts one when the other is ticked again",
+    summary: "two asynchronous actions under one reactive Sequence or Fallback: one halts the other",
     check: reactive_async_siblings,
 };
 

@@ -133,14 +133,15 @@ impl Loader<'_> {
     fn expand_subtree(&mut self, w: &mut Walk, it: Item, el: &XElem) -> Option<()> {
         // Among several files given together (a folder), a tree none of
         // them defines may come from a file the program registers and lint
-        // was not given (MoveIt Pro's objectives library): `lint` reads it
-        // as one opaque node. A single file given, or a tree several files
-        // define alike, is refused as every command refuses it.
+        // was not given (MoveIt Pro's objectives library), and a tree
+        // several of them define alike (robot configurations of one
+        // workspace) from the one the program registers: `lint` reads it
+        // as one opaque node. A single file given is refused as every
+        // command refuses it.
         if self.limits.for_lint
             && self.limits.companions.as_ref().is_some_and(|c| c.len() > 1)
             && let Some(id) = el.attr("ID")
             && !self.trees.contains_key(id)
-            && !self.ambiguous.contains_key(id)
         {
             return self.opaque_subtree(w, it, el);
         }
@@ -317,9 +318,18 @@ impl Loader<'_> {
         }
         w.budget -= 1;
         if self.unknown_subtrees.insert(id.clone()) {
+            // Among the trees read and those the files given define.
             let closest = (self.unknown_subtrees.len() <= 256)
                 .then(|| {
-                    btfsm_core::diagnostic::closest(&id, self.trees.keys().map(String::as_str))
+                    let given = self.limits.companions.clone();
+                    let given = given.as_deref().map(|c| c.tree_ids(self.limits));
+                    let cands = self
+                        .trees
+                        .keys()
+                        .map(String::as_str)
+                        .chain(given.into_iter().flatten());
+                    btfsm_core::diagnostic::closest(&id, cands)
+                        .filter(|c| *c != id)
                         .map(str::to_string)
                 })
                 .flatten();

@@ -47,6 +47,9 @@ pub(super) struct Loader<'l> {
     /// Unknown node types already reported: each is an error once, at its
     /// first use, however often it is used.
     pub(super) unknown: std::collections::HashSet<String>,
+    /// Types two models declare in different categories, with the warning
+    /// said when the tree uses the type.
+    pub(super) conflicts: Vec<(String, Diagnostic)>,
     /// SubTree IDs no file read defines, read as opaque nodes (`lint`).
     pub(super) unknown_subtrees: std::collections::HashSet<String>,
     /// Files read so far (canonical paths): each is read once.
@@ -85,6 +88,7 @@ pub(super) fn load(
         models: BTreeMap::new(),
         unknown: Default::default(),
         unknown_subtrees: Default::default(),
+        conflicts: Vec::new(),
         seen: HashSet::new(),
         first_companion: usize::MAX,
         ambiguous: BTreeMap::new(),
@@ -168,7 +172,7 @@ impl Loader<'_> {
         let found = self.limits.found_models.clone();
         self.flow.node_types.found_models = found
             .iter()
-            .map(|m| shown(&m.display().to_string()).into_owned())
+            .map(|m| btfsm_core::sanitize::shown_max(&m.display().to_string(), 240).into_owned())
             .collect();
         for m in &found {
             let mark = self.diags.mark();
@@ -187,6 +191,13 @@ impl Loader<'_> {
             return None;
         }
         let bt = self.expand(&tree_id, d, e)?;
+        // Model conflicts about types the tree uses (another tree's types
+        // are its own business).
+        for (id, w) in std::mem::take(&mut self.conflicts) {
+            if self.flow.node_types.declared.contains(&id) {
+                self.diags.push(w);
+            }
+        }
         Some(Policy {
             name: tree_id,
             description: None,
@@ -467,21 +478,20 @@ impl Loader<'_> {
             let (l, c) = f.line_col(pspan.start.min(f.text.len()));
             format!("{}:{l}:{c}", shown(&f.path))
         };
-        self.warn(
-            d,
-            el.span.clone(),
-            format!(
-                "`{}` is declared as `{}` here and as `{}` at {first}; read as `{}`",
-                shown(id),
-                cat.tag(),
-                prev.cat.tag(),
-                prev.cat.tag()
-            ),
-        )
-        .set_code("model-conflict")
-        .hint = Some(
-            "keep one declaration per node type across the model files (the C++ class the program registers decides)".into(),
+        let f = self.docs[d].file.clone();
+        let w = Diagnostic::warning(format!(
+            "`{}` is declared as `{}` here and as `{}` at {first}; read as `{}`",
+            shown(id),
+            cat.tag(),
+            prev.cat.tag(),
+            prev.cat.tag()
+        ))
+        .at(&f, el.span.clone())
+        .with_code("model-conflict")
+        .hint(
+            "keep one declaration per node type across the model files (the C++ class the program registers decides)",
         );
+        self.conflicts.push((id.to_string(), w));
     }
 
     /// Collects `<BehaviorTree>` definitions and `<TreeNodesModel>` entries.

@@ -116,7 +116,23 @@ impl Loader<'_> {
             "Condition" => Category::Condition,
             "Control" => Category::Control,
             "Decorator" => Category::Decorator,
-            _ => return Some((tag.to_string(), None)),
+            _ => {
+                // The compact syntax names the type by the tag: BehaviorTree.CPP
+                // 4 refuses an `ID` there ("Attribute [ID] is not allowed in
+                // <Fallback>", `XMLParser`'s createNodeFromXML).
+                if el.attr("ID").is_some() {
+                    self.err(
+                        d,
+                        el.span.clone(),
+                        format!("`ID` is not allowed on `<{}>`", shown(tag)),
+                    )
+                    .hint = Some(format!(
+                        "the tag names the type: remove `ID` (a display name is `name=\"...\"`), or write `<Action ID=\"...\">` to name the type by `ID`"
+                    ));
+                    return None;
+                }
+                return Some((tag.to_string(), None));
+            }
         };
         match el.attr("ID") {
             Some(id) => Some((id.to_string(), Some(cat))),
@@ -147,6 +163,9 @@ impl Loader<'_> {
     ) -> Option<Typed> {
         let n = el.children.len();
         Some(if let Some(cat) = builtin(ty) {
+            if self.limits.for_lint && !self.format_3(d) && v4_name(ty) != ty.as_str() {
+                self.v3_name(d, el, ty);
+            }
             Typed::builtin(ty, cat, el, n)
         } else if let Some(cat) = explicit_cat {
             if self.models.contains_key(ty.as_str()) {
@@ -169,6 +188,7 @@ impl Loader<'_> {
                     shown(ty)
                 ),
             )
+            .set_code("unknown-node-type")
             .hint = Some(format!(
                 "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{}>`)",
                 shown(ty)
@@ -206,6 +226,28 @@ impl Loader<'_> {
         })
     }
 
+    /// A format-3 name of a built-in in a file BehaviorTree.CPP 4 reads as
+    /// format 4 (`BTCPP_format="4"`): its factory does not know it ("Node
+    /// not recognized: SequenceStar"). A file without the attribute may be
+    /// written for BehaviorTree.CPP 3 (Nav2 Humble's): not reported.
+    fn v3_name(&mut self, d: usize, el: &XElem, ty: &str) {
+        let root = self.docs[d].root;
+        if self.docs[d].elems[root].attr("BTCPP_format") != Some("4") {
+            return;
+        }
+        let real = v4_name(ty);
+        self.warn(
+            d,
+            el.span.clone(),
+            format!(
+                "`{}` is BehaviorTree.CPP 3's name: BehaviorTree.CPP 4 does not know it, and this file says BTCPP_format=\"4\"",
+                shown(ty)
+            ),
+        )
+        .set_code("unknown-node-type")
+        .hint = Some(format!("write `<{real}>`"));
+    }
+
     /// A type the tree uses that a model declares.
     fn declared(&mut self, ty: &str) {
         let types = &mut self.flow.node_types;
@@ -220,15 +262,21 @@ impl Loader<'_> {
         if !self.unknown.insert(ty.to_string()) {
             return;
         }
-        let closest = (self.unknown.len() <= HINTED_TYPES)
-            .then(|| {
-                let cands = BUILTINS
-                    .iter()
-                    .map(|(b, _)| *b)
-                    .chain(self.models.keys().map(String::as_str));
-                btfsm_core::diagnostic::closest(ty, cands).map(str::to_string)
-            })
-            .flatten();
+        // A tree's ID written as a node type is its own closest (the
+        // `unknown-node-type` rule says to write a `<SubTree>`).
+        let closest = if self.trees.contains_key(ty) {
+            Some(ty.to_string())
+        } else {
+            (self.unknown.len() <= HINTED_TYPES)
+                .then(|| {
+                    let cands = BUILTINS
+                        .iter()
+                        .map(|(b, _)| *b)
+                        .chain(self.models.keys().map(String::as_str));
+                    btfsm_core::diagnostic::closest(ty, cands).map(str::to_string)
+                })
+                .flatten()
+        };
         self.flow
             .node_types
             .unknown
