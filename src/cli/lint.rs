@@ -374,7 +374,7 @@ fn lint_inputs(
             }
         };
         run.files += 1;
-        let limits = tree_limits(&mut search, &input.path, fmt, limits);
+        let limits = tree_limits(&mut search, &input.path, &file.text, fmt, limits);
         // A file of several trees that names none: each tree a program may
         // create from it, findings said once.
         let roots = (fmt == format::FileFormat::BtcppXml && limits.tree.is_none())
@@ -406,6 +406,20 @@ fn lint_inputs(
 /// Trees of one file (that names none as its main tree) linted at most.
 const MAX_ROOT_TREES: usize = 64;
 
+/// Does a file carry its own node model (Groot2 saves one in the file): a
+/// `<TreeNodesModel>` declaring node types, not only SubTree ports? Then
+/// no model is searched for it.
+fn has_leaf_model(text: &str) -> bool {
+    let Some(start) = text.find("<TreeNodesModel") else {
+        return false;
+    };
+    let model = &text[start..];
+    let model = &model[..model.find("</TreeNodesModel").unwrap_or(model.len())];
+    ["<Action", "<Condition", "<Control", "<Decorator"]
+        .iter()
+        .any(|t| model.contains(t))
+}
+
 /// The limits a BehaviorTree.CPP file is read with: unknown leaves as
 /// actions unless `--assume-leaf` says otherwise (their C++ registers them,
 /// lint checks what it can), and, when no model is given, the models found
@@ -413,6 +427,7 @@ const MAX_ROOT_TREES: usize = 64;
 fn tree_limits(
     search: &mut lint::search::ModelSearch,
     path: &Path,
+    text: &str,
     fmt: format::FileFormat,
     limits: &format::Limits,
 ) -> format::Limits {
@@ -421,7 +436,7 @@ fn tree_limits(
         return l;
     }
     l.assume_leaf = l.assume_leaf.or(Some(format::AssumeLeaf::Action));
-    if !l.nodes_models.is_empty() {
+    if !l.nodes_models.is_empty() || has_leaf_model(text) {
         return l;
     }
     let dir = path

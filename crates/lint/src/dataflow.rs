@@ -516,7 +516,7 @@ impl<'a> Ancestry<'a> {
 
 pub const KEY_NEVER_READ: Rule = Rule {
     code: "key-never-read",
-    level: Level::Note,
+    level: Level::Allow,
     summary: "a blackboard entry written and never read by the tree",
     check: key_never_read,
 };

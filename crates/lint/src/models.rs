@@ -14,8 +14,19 @@
 //! ([`unchecked`]).
 
 use super::{Level, Rule, Sink, Subject};
+use btfsm_core::diagnostic::edit_distance;
 use btfsm_format::btcpp_xml::Dataflow;
 use btfsm_format::btcpp_xml::ports::UnknownType;
+
+/// Is the closest known name a typo's distance away (at most 2 edits, case
+/// aside)? Without a model, only such a near miss is reported: a custom
+/// type merely resembling a built-in (or a library's objective resembling
+/// a local one, "Move to Pose" and "Move to Folded") is not a typo.
+fn near_miss(u: &UnknownType) -> bool {
+    u.closest
+        .as_deref()
+        .is_some_and(|c| edit_distance(&u.ty.to_lowercase(), &c.to_lowercase()) <= 2)
+}
 
 pub const UNKNOWN_NODE_TYPE: Rule = Rule {
     code: "unknown-node-type",
@@ -44,7 +55,7 @@ pub fn unchecked<'a>(s: &Subject<'a>) -> (Vec<&'a str>, Vec<&'a str>) {
         .node_types
         .unknown
         .iter()
-        .filter(|u| u.closest.is_none() && (u.subtree || !modelled));
+        .filter(|u| !near_miss(u) && (u.subtree || !modelled));
     let (trees, types): (Vec<&UnknownType>, Vec<&UnknownType>) = quiet.partition(|u| u.subtree);
     (
         types.iter().map(|u| u.ty.as_str()).collect(),
@@ -56,7 +67,7 @@ fn unknown_node_type(s: &Subject, out: &mut Sink) {
     let Some(df) = s.dataflow else { return };
     let modelled = modelled(df);
     for u in df.node_types.unknown.iter().filter(|u| !u.subtree) {
-        if !modelled && u.closest.is_none() {
+        if !modelled && !near_miss(u) {
             continue;
         }
         let (span, at) = super::dataflow::place(df, u.doc, &u.span);
@@ -89,10 +100,7 @@ fn unknown_node_type(s: &Subject, out: &mut Sink) {
                     "unknown node type `{}`{at}: {whose} does not declare it; BehaviorTree.CPP refuses the tree unless the program registers the type",
                     u.ty
                 ),
-                format!(
-                    "{}; if the program registers it, declare it in the model (Groot2 and lint read the model)",
-                    declare(u)
-                ),
+                outdated(u),
             )
         } else {
             (
@@ -113,14 +121,35 @@ fn unknown_node_type(s: &Subject, out: &mut Sink) {
     }
 }
 
-/// How to fix an unknown type: the close one, or declaring it.
-fn declare(u: &UnknownType) -> String {
-    let cats = match u.children {
+/// How to fix an unknown type a model found (or the file's) does not
+/// declare: the close one, or the model is out of date.
+fn outdated(u: &UnknownType) -> String {
+    let fix = format!(
+        "the program registers `{}`, the model is out of date: declare it there as {}",
+        u.ty,
+        kind_of(u)
+    );
+    match &u.closest {
+        Some(c) => format!("did you mean `{c}`? If {fix}"),
+        None => format!("if {fix}"),
+    }
+}
+
+/// The kinds a type of this shape may be declared as.
+fn kind_of(u: &UnknownType) -> &'static str {
+    match u.children {
         0 => "an Action or a Condition",
         1 => "a Decorator",
         _ => "a Control",
-    };
-    let decl = format!("declare it as {cats} in the `<TreeNodesModel>` of the program's nodes");
+    }
+}
+
+/// How to fix an unknown type: the close one, or declaring it.
+fn declare(u: &UnknownType) -> String {
+    let decl = format!(
+        "declare it as {} in the `<TreeNodesModel>` of the program's nodes",
+        kind_of(u)
+    );
     match &u.closest {
         Some(c) => format!("did you mean `{c}`? else {decl}"),
         None => decl,
@@ -139,7 +168,12 @@ pub const UNKNOWN_SUBTREE: Rule = Rule {
 /// program registers and lint was not given ([`unchecked`]).
 fn unknown_subtree(s: &Subject, out: &mut Sink) {
     let Some(df) = s.dataflow else { return };
-    for u in df.node_types.unknown.iter().filter(|u| u.subtree) {
+    for u in df
+        .node_types
+        .unknown
+        .iter()
+        .filter(|u| u.subtree && near_miss(u))
+    {
         let Some(c) = &u.closest else { continue };
         let (span, at) = super::dataflow::place(df, u.doc, &u.span);
         out.push(

@@ -1,9 +1,9 @@
 //! Structure rules: what the shape of a BT or an FSM says before it runs
 //! (docs/lint.md). BT semantics are BehaviorTree.CPP 4's
-//! (docs/bt-semantics.md). What BehaviorTree.CPP itself refuses — Parallel
-//! thresholds above the number of children, empty composites, decorators
-//! without one child, recursive SubTrees, includes too deep — is a load
-//! error (exit 2), which `lint` reports as `validate` does.
+//! (docs/bt-semantics.md). What BehaviorTree.CPP itself refuses — empty
+//! composites, decorators without one child, recursive SubTrees, Parallel
+//! thresholds above the number of children — is found by the readers and
+//! reported by the rules of [`super::load`].
 
 use super::{Level, Rule, Sink, Subject};
 use btfsm_model::{Bt, BtNodeKind, PolicyBody, StateBody, Target};

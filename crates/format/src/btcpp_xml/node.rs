@@ -126,9 +126,9 @@ impl Loader<'_> {
                         el.span.clone(),
                         format!("`ID` is not allowed on `<{}>`", shown(tag)),
                     )
-                    .hint = Some(format!(
-                        "the tag names the type: remove `ID` (a display name is `name=\"...\"`), or write `<Action ID=\"...\">` to name the type by `ID`"
-                    ));
+                    .hint = Some(
+                        "the tag names the type: remove `ID` (a display name is `name=\"...\"`), or write `<Action ID=\"...\">` to name the type by `ID`".into(),
+                    );
                     return None;
                 }
                 return Some((tag.to_string(), None));
