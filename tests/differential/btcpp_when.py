@@ -39,6 +39,7 @@ CASES = {
     "sleep_no_msec": ("<Sleep/>", "tick", "missing-required-port"),
     "repeat_no_cycles": ("<Repeat><A/></Repeat>", "tick", "missing-required-port"),
     "timeout_no_msec": ("<Timeout><A/></Timeout>", "tick", "missing-required-port"),
+    "delay_no_msec": ("<Delay><A/></Delay>", "tick", "missing-required-port"),
     "empty_sequence": ("<Sequence/>", "create", "empty-composite"),
     "inverter_2": ("<Inverter><A/><A/></Inverter>", "create", "wrong-child-count"),
     "script_no_code": ("<Script/>", "create", "load-error"),

@@ -182,6 +182,23 @@ fn builtin_rule(
             "write num_attempts=\"3\" (-1: forever)",
             None,
         )),
+        // Ports these built-ins read when they are ticked: BehaviorTree.CPP
+        // 4 fails the node ("Missing parameter [msec] in SleepNode").
+        "Sleep" | "Timeout" if el.attr("msec").is_none() => Some((
+            format!("`{ty}` needs `msec`"),
+            "write msec=\"1000\" (milliseconds)",
+            None,
+        )),
+        "Delay" if el.attr("delay_msec").is_none() => Some((
+            "`Delay` needs `delay_msec`".into(),
+            "write delay_msec=\"1000\" (milliseconds)",
+            None,
+        )),
+        "Repeat" if el.attr("num_cycles").is_none() => Some((
+            "`Repeat` needs `num_cycles`".into(),
+            "write num_cycles=\"3\" (-1: forever)",
+            None,
+        )),
         // Ports these built-ins read when they are created: BehaviorTree.CPP
         // 4 refuses the tree without them ("Missing port [code] in Script").
         "Script" | "ScriptCondition" if el.attr("code").is_none() => Some((

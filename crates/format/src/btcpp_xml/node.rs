@@ -378,13 +378,13 @@ const HINTED_TYPES: usize = 256;
 /// Whether a problem `builtin_rule` finds is one BehaviorTree.CPP 4 meets
 /// only when it ticks the node (it creates the tree): `Some` with the
 /// rule's code (`None`: the rule that reports it runs on the loaded tree,
-/// `missing-required-port` for `num_attempts`). Checked against
+/// `missing-required-port` for `num_attempts`, `msec`, ...). Checked against
 /// behaviortreepy by tests/differential/btcpp_when.py.
 fn tick_time(ty: &str, code: Option<&'static str>) -> Option<Option<&'static str>> {
     match ty {
         "Parallel" | "IfThenElse" | "WhileDoElse" | "Switch2" | "Switch3" | "Switch4"
         | "Switch5" | "Switch6" => Some(code),
-        "RetryUntilSuccessful" => Some(None),
+        "RetryUntilSuccessful" | "Sleep" | "Timeout" | "Delay" | "Repeat" => Some(None),
         _ => None,
     }
 }
