@@ -723,3 +723,40 @@ fn the_ci_recipe_fails_the_job_when_a_file_does_not_load() {
     assert_eq!(std::fs::read_to_string(&out_file).unwrap().trim(), "exit=2");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_file_of_several_trees_naming_none_is_linted_tree_by_tree() {
+    // BehaviorTree.CPP's examples register such a file and create a tree
+    // by ID: each tree no other uses is linted, findings said once (`Sub`,
+    // used by both, once).
+    let dir = scratch("lint-roots");
+    let f = dir.join("trees.xml");
+    std::fs::write(
+        &f,
+        r#"<root BTCPP_format="4">
+  <BehaviorTree ID="A"><Sequence><SubTree ID="Sub"/><AlwaysFailure/><AlwaysSuccess name="never"/></Sequence></BehaviorTree>
+  <BehaviorTree ID="B"><Sequence><SubTree ID="Sub"/><Sleep/></Sequence></BehaviorTree>
+  <BehaviorTree ID="Sub"><Fallback><AlwaysSuccess/><AlwaysFailure name="dead"/></Fallback></BehaviorTree>
+</root>"#,
+    )
+    .unwrap();
+    let (code, out, err) = btfsm(&["lint", f.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let found: Vec<String> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| format!("{} {}", x["code"].as_str().unwrap(), x["line"]))
+        .collect();
+    assert_eq!(
+        found,
+        [
+            "unreachable-child 2",
+            "unreachable-child 4",
+            "missing-required-port 3"
+        ],
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

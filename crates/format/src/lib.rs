@@ -77,10 +77,13 @@ pub struct Limits {
     /// Read as `lint` reads (docs/lint.md): a node type no model declares
     /// is kept (as `--assume-leaf` or its shape says) and recorded in the
     /// dataflow for the `unknown-node-type` rule rather than refused, and
-    /// what BehaviorTree.CPP 4 refuses only when it ticks the node (a
-    /// Parallel threshold, an IfThenElse or SwitchN child count, a missing
-    /// `num_attempts`) is a warning carrying its rule's code, so that the
-    /// other rules still run.
+    /// what BehaviorTree.CPP 4 refuses only when it ticks the node is read
+    /// on: a Parallel threshold or an IfThenElse or SwitchN child count is
+    /// a warning carrying its rule's code, and a built-in without a port it
+    /// reads when ticked (`num_attempts`, `msec`, ...) is left to the
+    /// `missing-required-port` rule, so that the other rules still run. A
+    /// `<SubTree>` no file given defines, among several files given, is one
+    /// opaque node.
     pub for_lint: bool,
 }
 
