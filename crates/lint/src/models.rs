@@ -18,14 +18,17 @@ use btfsm_core::diagnostic::edit_distance;
 use btfsm_format::btcpp_xml::Dataflow;
 use btfsm_format::btcpp_xml::ports::UnknownType;
 
-/// Is the closest known name a typo's distance away (at most 2 edits, case
-/// aside)? Without a model, only such a near miss is reported: a custom
+/// Is the closest known name a typo's distance away (at most 2 edits, 1 in
+/// a name of 6 characters or fewer, case aside)? Without a model, only such a near miss is reported: a custom
 /// type merely resembling a built-in (or a library's objective resembling
 /// a local one, "Move to Pose" and "Move to Folded") is not a typo.
 fn near_miss(u: &UnknownType) -> bool {
+    // Two edits in a long name, one in a short one (`Report` is not a
+    // misspelt `Repeat`).
+    let edits = if u.ty.chars().count() > 6 { 2 } else { 1 };
     u.closest
         .as_deref()
-        .is_some_and(|c| edit_distance(&u.ty.to_lowercase(), &c.to_lowercase()) <= 2)
+        .is_some_and(|c| edit_distance(&u.ty.to_lowercase(), &c.to_lowercase()) <= edits)
 }
 
 pub const UNKNOWN_NODE_TYPE: Rule = Rule {
