@@ -73,7 +73,9 @@ test: prerequisites
 # mismatches in accept_btcpp_known.txt, which must not go stale); then the
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
 # SubTrees are spread over files given together (projects_btcpp.py); every
-# SARIF log of `lint` against the official schema (sarif_check.py); the
+# SARIF log of `lint` against the official schema (sarif_check.py); which
+# problems BehaviorTree.CPP meets at creation and which at the first tick, as
+# `lint` reports them (btcpp_when.py); the
 # port rules of `lint` against BehaviorTree.CPP 4 creating 1000 seeded
 # random trees (dataflow_btcpp.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
@@ -104,6 +106,7 @@ differential: $(VENV)/.installed
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
 	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
+	$(VENV)/bin/python tests/differential/btcpp_when.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/dataflow_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm --trees 1000 > $(TARGET_DIR)/dataflow_btcpp.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/dataflow_btcpp.txt | tail -40; exit 1; }
 	@tail -1 $(TARGET_DIR)/dataflow_btcpp.txt

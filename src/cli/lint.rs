@@ -6,12 +6,14 @@
 use super::io::{emit_report, emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
+use btfsm_core::diagnostic::SourceFile;
 use btfsm_core::output::{Format, Report};
 use btfsm_format as format;
 use btfsm_lint::{self as lint, Level, config};
 use clap::Args;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The help of `lint`'s formats.
 const LINT_HELP: super::format::Help = &[
@@ -65,7 +67,6 @@ pub(super) fn execute(a: LintArgs) -> u8 {
     let Some(cfg) = levels(&a, &mut err) else {
         return EXIT_BAD_INPUT;
     };
-    let limits = a.limits.limits();
     let inputs = match format::discover::expand(&a.files) {
         Ok(i) => i,
         Err(d) => {
@@ -73,6 +74,18 @@ pub(super) fn execute(a: LintArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    let mut limits = a.limits.limits();
+    limits.for_lint = true;
+    // Node models given: `--nodes-model`, btfsm.toml's `models`, model
+    // files among the inputs.
+    let (inputs, given) = match given_models(inputs, &cfg, &limits) {
+        Ok(x) => x,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return EXIT_BAD_INPUT;
+        }
+    };
+    limits.nodes_models.extend(given);
     // BehaviorTree.CPP files given together resolve each other's SubTrees
     // (and models), as `analyze` reads them.
     let (limits, only) = match super::io::with_companions(&inputs, &limits) {
@@ -82,16 +95,37 @@ pub(super) fn execute(a: LintArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
-    let (findings, failed) = lint_inputs(&inputs, only.as_deref(), &limits, &cfg, &mut err);
+    let run = lint_inputs(&inputs, only.as_deref(), &limits, &cfg);
     let report = Findings {
-        findings: &findings,
-        files: inputs.len(),
+        run: &run,
+        files: run.files,
     };
     let code = emit_report(None, &report, a.format);
-    if code != EXIT_OK || failed {
+    if a.format != Format::Text && !run.not_linted.is_empty() {
+        let _ = write!(
+            err,
+            "{}",
+            Diagnostic::error(format!(
+                "{} file{} not linted: {} not load (the findings say why)",
+                run.not_linted.len(),
+                if run.not_linted.len() == 1 { "" } else { "s" },
+                if run.not_linted.len() == 1 {
+                    "it does"
+                } else {
+                    "they do"
+                },
+            ))
+        );
+    }
+    if code != EXIT_OK
+        || run
+            .findings
+            .iter()
+            .any(|f| f.code == lint::load::LOAD_ERROR.code)
+    {
         return EXIT_BAD_INPUT;
     }
-    if findings.iter().any(|f| f.level == Level::Error) {
+    if run.findings.iter().any(|f| f.level == Level::Error) {
         EXIT_CHECK_FAILED
     } else {
         EXIT_OK
@@ -151,19 +185,198 @@ fn levels(a: &LintArgs, err: &mut impl Write) -> Option<config::Config> {
     Some(cfg)
 }
 
+/// Model files given: btfsm.toml's `models` (relative to it, inside its
+/// repository), and the inputs named on the command line that are node
+/// models (a `.btproj`, or an XML file with a `<TreeNodesModel>` and no
+/// `<BehaviorTree>`), which are read as models and not linted as trees.
+/// The other inputs are returned.
+fn given_models(
+    inputs: Vec<format::discover::Input>,
+    cfg: &config::Config,
+    limits: &format::Limits,
+) -> Result<(Vec<format::discover::Input>, Vec<PathBuf>), Diagnostic> {
+    let mut models = Vec::new();
+    if let Some(toml) = &cfg.file {
+        let base = toml.parent().unwrap_or(Path::new(""));
+        let root = format::source::root_for(limits, base);
+        for m in &cfg.models {
+            let rel = m.to_string_lossy();
+            match format::source::resolve(root.as_deref(), base, &rel) {
+                Ok(p) => models.push(p),
+                Err(r) => {
+                    return Err(Diagnostic::error(format!(
+                        "{}: model `{}`: {}",
+                        btfsm_core::sanitize::shown(&toml.display().to_string()),
+                        btfsm_core::sanitize::shown(&rel),
+                        r.message
+                    ))
+                    .hint(format!(
+                        "`models` in [lint] are node model files relative to btfsm.toml; {}",
+                        r.hint
+                    )));
+                }
+            }
+        }
+    }
+    let mut rest = Vec::new();
+    for input in inputs {
+        if !input.found && is_model_file(&input.path, limits) {
+            models.push(input.path);
+        } else {
+            rest.push(input);
+        }
+    }
+    Ok((rest, models))
+}
+
+/// Is a file named on the command line a node model rather than a tree?
+fn is_model_file(path: &Path, limits: &format::Limits) -> bool {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext.eq_ignore_ascii_case("btproj") {
+        return true;
+    }
+    if !ext.eq_ignore_ascii_case("xml") || !path.is_file() {
+        return false;
+    }
+    let shown = path.display().to_string();
+    format::source::read(path, &shown, limits, false)
+        .is_ok_and(|f| f.text.contains("<TreeNodesModel") && !f.text.contains("<BehaviorTree"))
+}
+
+/// What linting every input gave: the findings, the files not linted (the
+/// path and why), and the node types no model declares, by file.
+#[derive(Default)]
+struct Run {
+    /// Policy files read (linted or not).
+    files: usize,
+    findings: Vec<lint::Finding>,
+    not_linted: Vec<(String, String)>,
+    unchecked: std::collections::BTreeMap<String, Vec<String>>,
+    /// SubTrees no file given defines, by file (read as opaque nodes).
+    opaque: std::collections::BTreeMap<String, Vec<String>>,
+}
+
+impl Run {
+    /// A policy that loaded: the rules' findings, then the readers' coded
+    /// warnings (a Parallel threshold).
+    fn loaded(&mut self, l: &format::Loaded, file: &Arc<SourceFile>, cfg: &config::Config) {
+        let subject = lint::Subject {
+            policy: &l.policy,
+            dataflow: l.dataflow.as_deref(),
+        };
+        self.findings
+            .extend(lint::lint_subject(&subject, Some(file), &l.path, cfg));
+        self.findings
+            .extend(lint::load::findings(&l.warnings, &l.path, cfg, true));
+        let (types, trees) = lint::models::unchecked(&subject);
+        let owned = |v: Vec<&str>| v.into_iter().map(str::to_string).collect::<Vec<_>>();
+        if !types.is_empty() {
+            self.unchecked.insert(l.path.clone(), owned(types));
+        }
+        if !trees.is_empty() {
+            self.opaque.insert(l.path.clone(), owned(trees));
+        }
+    }
+
+    /// Findings (from `before`) and files not linted (from `not_linted`)
+    /// said once: the trees of one file share nodes.
+    fn said_once(&mut self, before: usize, not_linted: usize) {
+        let mut seen = std::collections::HashSet::new();
+        let tail: Vec<lint::Finding> = self.findings.drain(before..).collect();
+        for f in tail {
+            // At one place one rule says one thing (a message names the
+            // node by its path in the tree linted, which differs per tree).
+            let said = if f.line.is_some() {
+                String::new()
+            } else {
+                f.message.clone()
+            };
+            let key = (f.code, f.file.clone(), f.line, f.column, said);
+            if seen.insert(key) {
+                self.findings.push(f);
+            }
+        }
+        let mut files = std::collections::HashSet::new();
+        let tail: Vec<(String, String)> = self.not_linted.drain(not_linted..).collect();
+        for (file, why) in tail {
+            if files.insert(file.clone()) {
+                self.not_linted.push((file, why));
+            }
+        }
+    }
+
+    /// An input that did not load: its errors as findings.
+    fn not_loaded(&mut self, diags: &[Diagnostic], display: &str, cfg: &config::Config) {
+        self.findings
+            .extend(lint::load::findings(diags, display, cfg, false));
+        let why = diags
+            .iter()
+            .find(|d| d.is_error())
+            .map_or_else(|| "it does not load".to_string(), |d| d.message.clone());
+        self.not_linted.push((display.to_string(), why));
+    }
+
+    /// The notes on what could not be checked: node types no model
+    /// declares, SubTrees no file given defines.
+    fn notes(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if let Some((files, n, names)) = summary(&self.unchecked) {
+            out.push(format!(
+                "{files} node type{} no node model declares ({names}): lint checks neither their names nor their ports; give the model with --nodes-model FILE or `models` in btfsm.toml's [lint]",
+                if n == 1 { "" } else { "s" },
+            ));
+        }
+        if let Some((files, n, names)) = summary(&self.opaque) {
+            out.push(format!(
+                "{files} SubTree{} no file given defines ({names}), each read as one node: give the files that define them with these",
+                if n == 1 { "" } else { "s" },
+            ));
+        }
+        out
+    }
+}
+
+/// Of names by file: "N file(s) use(s) K", K, and "`A`, `B`, `C`, ...".
+fn summary(
+    by_file: &std::collections::BTreeMap<String, Vec<String>>,
+) -> Option<(String, usize, String)> {
+    if by_file.is_empty() {
+        return None;
+    }
+    let names: std::collections::BTreeSet<&str> =
+        by_file.values().flatten().map(String::as_str).collect();
+    let some: Vec<String> = names
+        .iter()
+        .take(3)
+        .map(|t| format!("`{}`", btfsm_core::sanitize::shown(t)))
+        .collect();
+    let n = by_file.len();
+    Some((
+        format!(
+            "{n} file{} {} {}",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "uses" } else { "use" },
+            names.len()
+        ),
+        names.len(),
+        format!(
+            "{}{}",
+            some.join(", "),
+            if names.len() > 3 { ", ..." } else { "" }
+        ),
+    ))
+}
+
 /// Lints every input (only those of `only` among BehaviorTree.CPP files,
-/// when `--tree` chose some): the findings, and whether an input did not
-/// load.
+/// when `--tree` chose some).
 fn lint_inputs(
     inputs: &[format::discover::Input],
     only: Option<&[PathBuf]>,
     limits: &btfsm_format::Limits,
     cfg: &config::Config,
-    err: &mut impl Write,
-) -> (Vec<lint::Finding>, bool) {
-    let mut findings = Vec::new();
-    let mut failed = false;
-    let mut models = SiblingModels::default();
+) -> Run {
+    let mut run = Run::default();
+    let mut search = lint::search::ModelSearch::default();
     for input in inputs {
         if let Some(only) = only
             && super::io::is_btcpp_candidate(&input.path)
@@ -175,49 +388,125 @@ fn lint_inputs(
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
             Ok(_) => continue,
             Err(d) => {
-                failed = true;
-                print_diagnostics(err, &d);
+                run.files += 1;
+                run.not_loaded(&d, &input.path.display().to_string(), cfg);
                 continue;
             }
         };
-        let limits = models.limits_for(&input.path, fmt, limits);
-        match format::load_read(file.clone(), &input.path, fmt, &limits) {
-            Ok(l) => {
-                let subject = lint::Subject {
-                    policy: &l.policy,
-                    dataflow: l.dataflow.as_deref(),
-                };
-                findings.extend(lint::lint_subject(&subject, Some(&file), &l.path, cfg))
+        run.files += 1;
+        let limits = tree_limits(&mut search, &input.path, &file.text, fmt, limits);
+        // A file of several trees that names none: each tree a program may
+        // create from it, findings said once.
+        let roots = (fmt == format::FileFormat::BtcppXml && limits.tree.is_none())
+            .then(|| format::btcpp_xml::root_trees(&file, &limits, MAX_ROOT_TREES))
+            .flatten();
+        let Some(roots) = roots else {
+            match format::load_read(file.clone(), &input.path, fmt, &limits) {
+                Ok(l) => run.loaded(&l, &file, cfg),
+                Err(d) => run.not_loaded(&d, &file.path, cfg),
             }
-            Err(d) => {
-                // Coded load errors are findings (lint::load); the others
-                // mean the input does not load.
-                let (coded, rest) = lint::load::findings(&d, &file.path, cfg);
-                findings.extend(coded);
-                if rest.iter().any(|d| d.is_error()) {
-                    failed = true;
-                    print_diagnostics(err, &rest);
-                }
+            continue;
+        };
+        let (before, not_linted) = (run.findings.len(), run.not_linted.len());
+        for id in roots {
+            let limits = format::Limits {
+                tree: Some(id),
+                ..limits.clone()
+            };
+            match format::load_read(file.clone(), &input.path, fmt, &limits) {
+                Ok(l) => run.loaded(&l, &file, cfg),
+                Err(d) => run.not_loaded(&d, &file.path, cfg),
             }
         }
+        run.said_once(before, not_linted);
     }
-    (findings, failed)
+    run
 }
 
-/// `lint`'s report: the findings of every file linted.
+/// Trees of one file (that names none as its main tree) linted at most.
+const MAX_ROOT_TREES: usize = 64;
+
+/// Does a file carry its own node model (Groot2 saves one in the file): a
+/// `<TreeNodesModel>` declaring node types, not only SubTree ports? Then
+/// no model is searched for it.
+fn has_leaf_model(text: &str) -> bool {
+    let Some(start) = text.find("<TreeNodesModel") else {
+        return false;
+    };
+    let model = &text[start..];
+    let model = &model[..model.find("</TreeNodesModel").unwrap_or(model.len())];
+    ["<Action", "<Condition", "<Control", "<Decorator"]
+        .iter()
+        .any(|t| model.contains(t))
+}
+
+/// The limits a BehaviorTree.CPP file is read with: unknown leaves as
+/// actions unless `--assume-leaf` says otherwise (their C++ registers them,
+/// lint checks what it can), and, when no model is given, the models found
+/// as users keep them ([`lint::search`]).
+fn tree_limits(
+    search: &mut lint::search::ModelSearch,
+    path: &Path,
+    text: &str,
+    fmt: format::FileFormat,
+    limits: &format::Limits,
+) -> format::Limits {
+    let mut l = limits.clone();
+    if fmt != format::FileFormat::BtcppXml {
+        return l;
+    }
+    l.assume_leaf = l.assume_leaf.or(Some(format::AssumeLeaf::Action));
+    if !l.nodes_models.is_empty() || has_leaf_model(text) {
+        return l;
+    }
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let auto = format::Limits {
+        confinement: format::source::Confinement::Auto,
+        ..format::Limits::default()
+    };
+    let root = format::source::root_for(limits, dir)
+        .or_else(|| format::source::root_for(&auto, dir))
+        .unwrap_or_else(|| dir.to_path_buf());
+    let cwd = std::env::current_dir()
+        .ok()
+        .and_then(|c| std::fs::canonicalize(c).ok());
+    l.found_models = search
+        .for_tree(path, &root)
+        .into_iter()
+        .map(
+            |m| match cwd.as_deref().and_then(|c| m.strip_prefix(c).ok()) {
+                Some(rel) => rel.to_path_buf(),
+                None => m,
+            },
+        )
+        .collect();
+    l
+}
+
+/// `lint`'s report: the findings of every file linted, the files that were
+/// not, and what could not be checked.
 struct Findings<'a> {
-    findings: &'a [lint::Finding],
+    run: &'a Run,
     files: usize,
 }
 
 impl Report for Findings<'_> {
     const FORMATS: &'static [Format] = &[Format::Text, Format::Json, Format::Sarif];
 
-    /// The findings in `format`; the text ends with the counts.
+    /// The findings in `format`; the text ends with the counts and notes.
     fn write(&self, format: Format) -> String {
-        let (findings, files) = (self.findings, self.files);
+        let findings = &self.run.findings;
         match Self::supported(format) {
-            Format::Sarif => lint::sarif::render(findings),
+            Format::Sarif => {
+                let inv = lint::sarif::Invocation {
+                    not_linted: self.run.not_linted.clone(),
+                    notes: self.run.notes(),
+                };
+                lint::sarif::render(findings, &inv)
+            }
             Format::Json => {
                 let mut s = btfsm_core::sanitize::json(
                     serde_json::to_string_pretty(findings).expect("serializable"),
@@ -225,82 +514,38 @@ impl Report for Findings<'_> {
                 s.push('\n');
                 s
             }
-            _ => {
-                let mut s: String = findings.iter().map(lint::render_text).collect();
-                let count = |l: Level| findings.iter().filter(|f| f.level == l).count();
-                s.push_str(&format!(
-                    "{} error{}, {} warning{}, {} note{} in {} file{}\n",
-                    count(Level::Error),
-                    if count(Level::Error) == 1 { "" } else { "s" },
-                    count(Level::Warning),
-                    if count(Level::Warning) == 1 { "" } else { "s" },
-                    count(Level::Note),
-                    if count(Level::Note) == 1 { "" } else { "s" },
-                    files,
-                    if files == 1 { "" } else { "s" },
-                ));
-                s
-            }
+            _ => self.text(),
         }
     }
 }
 
-/// Most `*tree_nodes*.xml` files taken from one folder.
-const MAX_SIBLING_MODELS: usize = 8;
-
-/// The node models `lint` reads beside a BehaviorTree.CPP file when the
-/// command names none (`--nodes-model`): the `*tree_nodes*.xml` files of its
-/// folder (Nav2 keeps `nav2_tree_nodes.xml` beside its trees, as Groot
-/// projects do), at most [`MAX_SIBLING_MODELS`], sorted; each folder listed
-/// once. Unknown leaves are read as actions unless `--assume-leaf` says
-/// otherwise: their C++ registers them, and lint checks what it can.
-#[derive(Default)]
-struct SiblingModels {
-    by_dir: std::collections::HashMap<PathBuf, Vec<PathBuf>>,
-}
-
-impl SiblingModels {
-    fn limits_for(
-        &mut self,
-        path: &std::path::Path,
-        fmt: format::FileFormat,
-        limits: &format::Limits,
-    ) -> format::Limits {
-        let mut l = limits.clone();
-        if fmt != format::FileFormat::BtcppXml {
-            return l;
+impl Findings<'_> {
+    /// The findings as positioned text, then the counts (and the files not
+    /// linted), then the note on what could not be checked.
+    fn text(&self) -> String {
+        let (findings, files) = (&self.run.findings, self.files);
+        let plural =
+            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        let mut s: String = findings.iter().map(lint::render_text).collect();
+        let count = |l: Level| findings.iter().filter(|f| f.level == l).count();
+        s.push_str(&format!(
+            "{}, {}, {} in {}",
+            plural(count(Level::Error), "error", "errors"),
+            plural(count(Level::Warning), "warning", "warnings"),
+            plural(count(Level::Note), "note", "notes"),
+            plural(files, "file", "files"),
+        ));
+        match self.run.not_linted.len() {
+            0 => s.push('\n'),
+            n => s.push_str(&format!(
+                " ({} not linted: {} not load)\n",
+                plural(n, "file", "files"),
+                if n == 1 { "it does" } else { "they do" }
+            )),
         }
-        l.assume_leaf = l.assume_leaf.or(Some(format::AssumeLeaf::Action));
-        if !l.nodes_models.is_empty() {
-            return l;
+        for note in self.run.notes() {
+            s.push_str(&format!("note: {note}\n"));
         }
-        let dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(std::path::Path::new("."))
-            .to_path_buf();
-        let found = self.by_dir.entry(dir.clone()).or_insert_with(|| {
-            let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-                .into_iter()
-                .flatten()
-                .flatten()
-                .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
-                .map(|e| e.path())
-                .filter(|p| {
-                    p.file_name()
-                        .and_then(|n| n.to_str())
-                        .is_some_and(|n| n.contains("tree_nodes") && n.ends_with(".xml"))
-                })
-                .collect();
-            v.sort();
-            v.truncate(MAX_SIBLING_MODELS);
-            v
-        });
-        l.nodes_models = found
-            .iter()
-            .filter(|m| m.as_path() != path)
-            .cloned()
-            .collect();
-        l
+        s
     }
 }

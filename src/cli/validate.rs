@@ -1,6 +1,8 @@
 //! `btfsm validate FILE|DIR...`: reads every policy, scenario and action
 //! domain given (directories walked) and reports every problem with its
 //! position, or `ok` with what the file holds; nothing is computed.
+//! BehaviorTree.CPP files given together resolve each other's SubTrees, as
+//! `analyze` reads them.
 
 use super::args::LimitArgs;
 use super::io::{note_skipped, print_diagnostics, reported};
@@ -34,6 +36,16 @@ pub(super) fn run(a: ValidateArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    // BehaviorTree.CPP files given together (a folder) resolve each other's
+    // SubTrees, as `analyze` reads them and BehaviorTree.CPP's factory
+    // registers every file it loads.
+    let (limits, only) = match super::io::with_companions(&inputs, &limits) {
+        Ok(x) => x,
+        Err(d) => {
+            print_diagnostics(&mut err, &[d]);
+            return EXIT_BAD_INPUT;
+        }
+    };
     let (mut failed, mut skipped) = (false, 0usize);
     for (i, input) in inputs.iter().enumerate() {
         // Past the command's node budget, one message for the rest.
@@ -50,6 +62,12 @@ pub(super) fn run(a: ValidateArgs) -> u8 {
             );
             failed = true;
             break;
+        }
+        if let Some(only) = &only
+            && super::io::is_btcpp_candidate(&input.path)
+            && !only.contains(&input.path)
+        {
+            continue; // a companion of the files that define `--tree`
         }
         // Read once; a scenario is validated as `sim` reads it (its
         // policies included), without running it.

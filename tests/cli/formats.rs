@@ -914,7 +914,7 @@ fn subtrees_resolve_across_files_given_together() {
         err.contains("unknown tree `Approach` in `<SubTree>`"),
         "{err}"
     );
-    assert!(err.contains("given with this one"), "{err}");
+    assert!(err.contains("given together with this one"), "{err}");
 }
 
 #[test]

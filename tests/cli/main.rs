@@ -30,6 +30,7 @@ mod provenance;
 mod sim;
 mod tick;
 mod untrusted;
+mod validate;
 mod view;
 
 use common::btfsm;

@@ -462,6 +462,7 @@ fn a_pull_requests_btfsm_toml_is_bounded_and_can_be_ignored() {
     let list = run_in(&d.0, &["lint", "--list"], None);
     let all: Vec<String> = (list.stdout.lines().skip(1))
         .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "load-error") // a file that does not load is always said
         .map(|c| format!("\"{c}\""))
         .collect();
     assert!(all.len() > 10, "{}", list.stdout);

@@ -288,6 +288,32 @@ pub const SUGGEST_SCAN: usize = 5_000;
 /// Longest name (in characters) [`suggest`] computes an edit distance for.
 pub const SUGGEST_MAX_CHARS: usize = 128;
 
+/// The candidate closest to `wrong` when it is close enough to be what was
+/// meant (an edit distance of at most a third of its length, at least 2),
+/// as [`suggest`] finds it; bounded the same way.
+pub fn closest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let cands: Vec<&str> = candidates.into_iter().take(SUGGEST_SCAN).collect();
+    closest_of(wrong, &cands)
+}
+
+fn closest_of<'a>(wrong: &str, cands: &[&'a str]) -> Option<&'a str> {
+    let wrong_chars = wrong.chars().count();
+    if wrong_chars > SUGGEST_MAX_CHARS {
+        return None;
+    }
+    let lower = wrong.to_lowercase();
+    cands
+        .iter()
+        .filter(|c| {
+            c.len() <= 4 * SUGGEST_MAX_CHARS
+                && c.chars().count().abs_diff(wrong_chars) <= (wrong_chars / 3).max(2)
+        })
+        .map(|c| (edit_distance(&lower, &c.to_lowercase()), *c))
+        .min()
+        .filter(|(d, _)| *d <= (wrong_chars / 3).max(2))
+        .map(|(_, c)| c)
+}
+
 /// A hint naming the closest candidate, or listing the valid ones.
 ///
 /// Bounded work whatever the input: only the first [`SUGGEST_SCAN`]
@@ -297,24 +323,8 @@ pub fn suggest<'a>(wrong: &str, candidates: impl IntoIterator<Item = &'a str>) -
     let mut cands: Vec<&str> = candidates.into_iter().take(SUGGEST_SCAN + 1).collect();
     let more_than_scanned = cands.len() > SUGGEST_SCAN;
     cands.truncate(SUGGEST_SCAN);
-    let wrong_chars = wrong.chars().count();
-    let best = if wrong_chars <= SUGGEST_MAX_CHARS {
-        let lower = wrong.to_lowercase();
-        cands
-            .iter()
-            .filter(|c| {
-                c.len() <= 4 * SUGGEST_MAX_CHARS
-                    && c.chars().count().abs_diff(wrong_chars) <= (wrong_chars / 3).max(2)
-            })
-            .map(|c| (edit_distance(&lower, &c.to_lowercase()), *c))
-            .min()
-    } else {
-        None
-    };
-    match best {
-        Some((d, c)) if d <= (wrong.chars().count() / 3).max(2) => {
-            format!("did you mean `{c}`?")
-        }
+    match closest_of(wrong, &cands) {
+        Some(c) => format!("did you mean `{c}`?"),
         _ if cands.is_empty() => "nothing is defined here".to_string(),
         _ => {
             let shown: Vec<String> = cands

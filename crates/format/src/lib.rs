@@ -79,6 +79,22 @@ pub struct Limits {
     /// repository), for BehaviorTree.CPP's `<include ros_pkg>` and yasmin's
     /// `package` includes ([`ros_pkg`]).
     pub ros: Arc<ros_pkg::RosPackages>,
+    /// `<TreeNodesModel>` files found beside the trees rather than given
+    /// (`lint`'s search of the repository, docs/lint.md "Node models"):
+    /// read after [`Limits::nodes_models`], whose declarations win, and
+    /// their problems are warnings (nobody asked for them).
+    pub found_models: Vec<PathBuf>,
+    /// Read as `lint` reads (docs/lint.md): a node type no model declares
+    /// is kept (as `--assume-leaf` or its shape says) and recorded in the
+    /// dataflow for the `unknown-node-type` rule rather than refused, and
+    /// what BehaviorTree.CPP 4 refuses only when it ticks the node is read
+    /// on: a Parallel threshold or an IfThenElse or SwitchN child count is
+    /// a warning carrying its rule's code, and a built-in without a port it
+    /// reads when ticked (`num_attempts`, `msec`, ...) is left to the
+    /// `missing-required-port` rule, so that the other rules still run. A
+    /// `<SubTree>` no file given defines, among several files given, is one
+    /// opaque node.
+    pub for_lint: bool,
 }
 
 /// The kind given to BehaviorTree.CPP leaves of unknown type.
@@ -128,6 +144,8 @@ impl Default for Limits {
             tree: None,
             companions: None,
             ros: Arc::default(),
+            found_models: Vec::new(),
+            for_lint: false,
         }
     }
 }

@@ -226,6 +226,27 @@ impl Sink {
         self.errors > 0
     }
 
+    /// A mark to [`Sink::demote_since`] from: the messages kept and errors
+    /// dropped so far.
+    pub fn mark(&self) -> (usize, usize) {
+        (self.kept.len(), self.dropped_errors)
+    }
+
+    /// Makes the errors pushed since `mark` warnings (problems of a file
+    /// nobody asked to read, such as a node model `lint` found).
+    pub fn demote_since(&mut self, mark: (usize, usize)) {
+        for d in &mut self.kept[mark.0..] {
+            if d.is_error() {
+                d.severity = btfsm_core::diagnostic::Severity::Warning;
+                self.errors -= 1;
+                self.warnings += 1;
+            }
+        }
+        let dropped = self.dropped_errors - mark.1;
+        self.dropped_errors -= dropped;
+        self.dropped_warnings += dropped;
+    }
+
     /// Is there still room for an error (worth a did-you-mean search)?
     pub fn room_for_errors(&self) -> bool {
         self.errors < super::toml::MAX_DIAGNOSTICS

@@ -8,7 +8,12 @@
 //! deny = ["unguarded-fallback-action"]   # error
 //! warn = ["chattering-precondition-order"]
 //! allow = ["fully-connected-state"]      # not reported
+//! models = ["nav2_behavior_tree/nav2_tree_nodes.xml"]  # node models
 //! ```
+//!
+//! `models` are BehaviorTree.CPP `<TreeNodesModel>` files (paths relative
+//! to the `btfsm.toml`), read with every BehaviorTree.CPP tree as if given
+//! with `--nodes-model`.
 
 use super::{Level, Rule, rule};
 use btfsm_core::diagnostic::{Diagnostic, SourceFile, suggest};
@@ -22,6 +27,8 @@ pub struct Config {
     levels: BTreeMap<&'static str, Level>,
     /// The `btfsm.toml` read, if any.
     pub file: Option<PathBuf>,
+    /// Its `models`, relative to its folder (as written there).
+    pub models: Vec<PathBuf>,
 }
 
 impl Config {
@@ -34,6 +41,9 @@ impl Config {
     /// closest.
     pub fn set(&mut self, code: &str, level: Level) -> Result<(), String> {
         match rule(code) {
+            Some(r) if r.code == super::load::LOAD_ERROR.code && level != Level::Error => Err(
+                "`load-error` stays an error: a file that does not load is never linted, and lint always says so".into(),
+            ),
             Some(r) => {
                 self.levels.insert(r.code, level);
                 Ok(())
@@ -63,6 +73,8 @@ struct RawLint {
     warn: Vec<toml::Spanned<String>>,
     #[serde(default)]
     allow: Vec<toml::Spanned<String>>,
+    #[serde(default)]
+    models: Vec<String>,
 }
 
 /// `btfsm.toml` in `dir` or the nearest folder above it, stopping at the
@@ -96,7 +108,7 @@ pub fn read(file: &Arc<SourceFile>) -> Result<Config, Vec<Diagnostic>> {
     .map_err(|d| vec![d])?;
     let raw: RawFile = toml::from_str(&file.text).map_err(|e| {
         let d = Diagnostic::error(format!("invalid btfsm.toml: {}", e.message().trim()))
-            .hint("btfsm.toml holds `[lint]` with `deny`, `warn` and `allow` lists of rule codes");
+            .hint("btfsm.toml holds `[lint]` with `deny`, `warn` and `allow` lists of rule codes, and `models`, a list of node model files");
         vec![match e.span() {
             Some(s) => d.at(file, s),
             None => d,
@@ -104,6 +116,7 @@ pub fn read(file: &Arc<SourceFile>) -> Result<Config, Vec<Diagnostic>> {
     })?;
     let mut cfg = Config {
         file: Some(PathBuf::from(&file.path)),
+        models: raw.lint.models.iter().map(PathBuf::from).collect(),
         ..Config::default()
     };
     let mut errs = Vec::new();

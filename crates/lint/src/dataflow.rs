@@ -27,7 +27,11 @@ fn flow<'a>(s: &'a Subject) -> Option<&'a Dataflow> {
 }
 
 /// A finding's span (in the file linted), or where it is in another one.
-fn place(df: &Dataflow, doc: usize, span: &Range<usize>) -> (Option<Range<usize>>, String) {
+pub(crate) fn place(
+    df: &Dataflow,
+    doc: usize,
+    span: &Range<usize>,
+) -> (Option<Range<usize>>, String) {
     if doc == 0 {
         return (Some(span.clone()), String::new());
     }
@@ -151,11 +155,18 @@ fn undeclared_port(s: &Subject, out: &mut Sink) {
             } else {
                 "remove it, or declare it in the `<TreeNodesModel>`".into()
             };
+            // A model given lists the ports the program's nodes provide; one
+            // found beside the trees (or in the file) may be out of date.
+            let why = if nf.builtin || df.node_types.given_model {
+                "BehaviorTree.CPP refuses a port its node type does not provide"
+            } else {
+                "BehaviorTree.CPP refuses it unless the model is out of date (the node's providedPorts() decide)"
+            };
             out.push(
                 id_of(s, nf.node),
                 span,
                 format!(
-                    "{whose} `{}` declares no port `{}`{at}; BehaviorTree.CPP refuses a port its node type does not provide",
+                    "{whose} `{}` declares no port `{}`{at}; {why}",
                     nf.ty, u.name
                 ),
                 help,
@@ -167,11 +178,28 @@ fn undeclared_port(s: &Subject, out: &mut Sink) {
 pub const MISSING_REQUIRED_PORT: Rule = Rule {
     code: "missing-required-port",
     level: Level::Warning,
-    summary: "an input port declared without a default is not given on a node",
+    summary: "a built-in node without an input port it needs (Sleep's msec, Repeat's num_cycles...): it fails when ticked",
     check: missing_required_port,
 };
 
+pub const MISSING_MODEL_PORT: Rule = Rule {
+    code: "missing-model-port",
+    level: Level::Allow,
+    summary: "an input port a node model declares without a default is not given (off: a model does not say what is optional)",
+    check: missing_model_port,
+};
+
 fn missing_required_port(s: &Subject, out: &mut Sink) {
+    missing_inputs(s, out, true);
+}
+
+fn missing_model_port(s: &Subject, out: &mut Sink) {
+    missing_inputs(s, out, false);
+}
+
+/// Inputs declared without a default and not given: of built-ins (whose
+/// source says which they need) or of types a model declares.
+fn missing_inputs(s: &Subject, out: &mut Sink, builtins: bool) {
     let Some(df) = flow(s) else { return };
     // Per type, its required inputs (by name).
     let required: Vec<HashSet<&str>> = df
@@ -184,7 +212,7 @@ fn missing_required_port(s: &Subject, out: &mut Sink) {
                 .collect()
         })
         .collect();
-    for nf in &df.nodes {
+    for nf in df.nodes.iter().filter(|nf| nf.builtin == builtins) {
         let Some(x) = nf.decl else { continue };
         let req = &required[x];
         if req.is_empty() {
@@ -219,10 +247,17 @@ fn missing_required_port(s: &Subject, out: &mut Sink) {
                 if n == 1 { "" } else { "s" },
                 missing.join("`, `")
             ),
-            format!(
-                "give it, e.g. {}=\"{{{}}}\", or declare a `default` in the model",
-                missing[0], missing[0]
-            ),
+            if builtins {
+                format!(
+                    "give it, e.g. {}=\"...\" (BehaviorTree.CPP fails the node when it reads it)",
+                    missing[0]
+                )
+            } else {
+                format!(
+                    "give it, e.g. {}=\"{{{}}}\", or declare a `default` in the model",
+                    missing[0], missing[0]
+                )
+            },
         );
     }
 }
@@ -350,6 +385,7 @@ fn read_before_write(s: &Subject, out: &mut Sink) {
     };
     let f = facts(df);
     let mut found: Vec<(usize, usize, String, String)> = Vec::new();
+    let mut lca: Option<Ancestry> = None;
     for (k, kf) in sorted(&f) {
         let Some((r, fi, u)) = kf.first_read else {
             continue;
@@ -364,6 +400,13 @@ fn read_before_write(s: &Subject, out: &mut Sink) {
         // on {goals}) needs it from an earlier writer like any reader.
         let (msg, help) = match kf.first_write {
             Some((w, _)) if w < r => continue,
+            // Read in an earlier branch of a Fallback (or of a control whose
+            // order is not known) than the writer: the reader failing while
+            // the entry is unset leads to the writer, the "check, else
+            // compute" idiom (Nav2's ValidatePath on {path} before
+            // ComputePathToPose). Only a Sequence runs the reader first for
+            // sure.
+            Some((w, _)) if w > r && !lca.get_or_insert_with(|| Ancestry::new(bt)).in_sequence(r, w) => continue,
             Some((w, wi)) if w > r => (
                 format!(
                     "{} reads {} before any node writes it: the first writer, {}, comes later in tick order",
@@ -404,9 +447,76 @@ fn read_before_write(s: &Subject, out: &mut Sink) {
     }
 }
 
+/// Ancestors of a BT's nodes (numbered in preorder, as the loader makes
+/// them) by binary lifting: the lowest common ancestor of two nodes in
+/// O(log n) after O(n log n) work, whatever the depth.
+struct Ancestry<'a> {
+    bt: &'a btfsm_model::Bt,
+    /// `up[j][i]`: the 2^j-th ancestor of node `i` (the root its own).
+    up: Vec<Vec<usize>>,
+    /// One past the last node of each node's subtree, in preorder.
+    end: Vec<usize>,
+}
+
+impl<'a> Ancestry<'a> {
+    fn new(bt: &'a btfsm_model::Bt) -> Ancestry<'a> {
+        let n = bt.nodes.len();
+        let mut parent: Vec<usize> = (0..n).collect();
+        for (i, node) in bt.nodes.iter().enumerate() {
+            for &c in &node.children {
+                parent[c] = i;
+            }
+        }
+        // Preorder numbering: a subtree ends where the next node after
+        // its last descendant starts; computed children before parents.
+        let mut end: Vec<usize> = (1..=n).collect();
+        for i in (0..n).rev() {
+            if let Some(&last) = bt.nodes[i].children.last() {
+                end[i] = end[i].max(end[last]);
+            }
+        }
+        let mut up = vec![parent];
+        while (1usize << up.len()) < n.max(2) {
+            let prev = up.last().expect("one level");
+            let next: Vec<usize> = (0..n).map(|i| prev[prev[i]]).collect();
+            up.push(next);
+        }
+        Ancestry { bt, up, end }
+    }
+
+    /// One past the last node of `a`'s subtree (`a` itself past the end:
+    /// nothing).
+    fn end_of(&self, a: usize) -> usize {
+        self.end.get(a).copied().unwrap_or(a)
+    }
+
+    /// Does `a`'s subtree hold `b`?
+    fn holds(&self, a: usize, b: usize) -> bool {
+        a <= b && b < self.end[a]
+    }
+
+    /// Is the lowest common ancestor of `r` and `w` (`r` before `w`) a
+    /// Sequence, which runs `r`'s branch before `w`'s whatever they return?
+    fn in_sequence(&self, r: usize, w: usize) -> bool {
+        let mut a = r;
+        if !self.holds(a, w) {
+            for level in self.up.iter().rev() {
+                if !self.holds(level[a], w) {
+                    a = level[a];
+                }
+            }
+            a = self.up[0][a];
+        }
+        matches!(
+            self.bt.nodes.get(a).map(|n| n.kind),
+            Some(BtNodeKind::Sequence | BtNodeKind::SequenceMemory)
+        )
+    }
+}
+
 pub const KEY_NEVER_READ: Rule = Rule {
     code: "key-never-read",
-    level: Level::Note,
+    level: Level::Allow,
     summary: "a blackboard entry written and never read by the tree",
     check: key_never_read,
 };
@@ -414,13 +524,37 @@ pub const KEY_NEVER_READ: Rule = Rule {
 fn key_never_read(s: &Subject, out: &mut Sink) {
     let Some(df) = flow(s) else { return };
     let f = facts(df);
+    // The entries read somewhere, by blackboard: a close one is what a
+    // misspelt entry of the tree's own blackboard was meant to be.
+    let read_root: Vec<&str> = sorted(&f)
+        .into_iter()
+        .filter(|(k, kf)| k.scope == 0 && kf.read)
+        .map(|(k, _)| k.name.as_str())
+        .collect();
     let mut found = Vec::new();
+    let mut checked = 0;
     for (k, kf) in sorted(&f) {
         let Some((_, wi)) = kf.first_write else {
             continue;
         };
         if kf.read || kf.unknown || f.exported.contains(k) {
             continue;
+        }
+        // The tree's own blackboard is the application's too, which may
+        // read what the tree writes (Nav2's navigators read the error
+        // codes): reported when the tree declares its ports, or when a
+        // close entry is read (a misspelling).
+        let misspelt = || {
+            btfsm_core::diagnostic::closest(&k.name, read_root.iter().copied()).is_some_and(|c| {
+                c != k.name && btfsm_core::diagnostic::edit_distance(c, &k.name) <= 2
+            })
+        };
+        if k.scope == 0 && df.tree_ports.is_none() {
+            // Each look-up scans the entries read: bounded work.
+            checked += 1;
+            if checked > HINTED || !misspelt() {
+                continue;
+            }
         }
         found.push((wi, k));
     }
@@ -530,7 +664,26 @@ pub const SUBTREE_REMAP_UNPROVIDED: Rule = Rule {
 
 fn subtree_remap_unprovided(s: &Subject, out: &mut Sink) {
     let Some(df) = flow(s) else { return };
+    let PolicyBody::Bt(bt) = &s.policy.body else {
+        return;
+    };
     let f = facts(df);
+    // Where each entry is read (node positions, in preorder), for the
+    // entries SubTrees remap: a remapping is reported only when a node of
+    // that SubTree reads the entry.
+    let mut readers: HashMap<&Key, Vec<usize>> = HashMap::new();
+    for (pos, nf) in df.nodes.iter().enumerate() {
+        for k in nf.keys.iter().filter(|k| {
+            f.remapped.contains(&k.key)
+                && matches!(
+                    k.access,
+                    Access::Read | Access::ReadWrite | Access::ScriptRead
+                )
+        }) {
+            readers.entry(&k.key).or_default().push(pos);
+        }
+    }
+    let mut lca: Option<Ancestry> = None;
     for st in &df.subtrees {
         for (port, value, key, aspan) in &st.remap {
             let Some(k) = key else { continue };
@@ -539,6 +692,19 @@ fn subtree_remap_unprovided(s: &Subject, out: &mut Sink) {
                 || f.provided.contains(k)
                 || (k.scope == 0 && df.tree_ports.is_none())
             {
+                continue;
+            }
+            // A remapped entry no node of the SubTree reads is a dead
+            // remapping, harmless (MoveIt Studio objectives pass
+            // `{parameters}` down chains of SubTrees that do not use it).
+            let end = lca.get_or_insert_with(|| Ancestry::new(bt)).end_of(st.node);
+            // Readers are in preorder: the first at or after the SubTree's
+            // root, by binary search.
+            let read_inside = readers.get(k).is_some_and(|r| {
+                let i = r.partition_point(|&p| p < st.node);
+                r.get(i).is_some_and(|&p| p < end)
+            });
+            if !read_inside {
                 continue;
             }
             let (span, at) = place(df, st.doc, aspan);

@@ -7,14 +7,27 @@ use std::path::Path;
 
 /// The codes `lint` reports on BehaviorTree.CPP XML `xml`, with the
 /// message of each.
+/// (`key-never-read`, off by default, on.)
 fn run(xml: &str) -> Vec<(String, String)> {
-    let l = btfsm_format::btcpp_xml::parse_str("t.xml", xml, Path::new("."), &Default::default())
+    let mut cfg = config::Config::default();
+    cfg.set("key-never-read", Level::Note).unwrap();
+    run_with(xml, &cfg)
+}
+
+/// [`run`] at the levels of `cfg`.
+fn run_with(xml: &str, cfg: &config::Config) -> Vec<(String, String)> {
+    // Read as `lint` reads (a Sleep without `msec` loads: the rule says).
+    let limits = btfsm_format::Limits {
+        for_lint: true,
+        ..Default::default()
+    };
+    let l = btfsm_format::btcpp_xml::parse_str("t.xml", xml, Path::new("."), &limits)
         .unwrap_or_else(|e| panic!("{e:?}"));
     let s = Subject {
         policy: &l.policy,
         dataflow: l.dataflow.as_deref(),
     };
-    lint_subject(&s, None, "t.xml", &config::Config::default())
+    lint_subject(&s, None, "t.xml", cfg)
         .into_iter()
         .map(|f| (f.code.to_string(), f.message))
         .collect()
@@ -48,12 +61,19 @@ fn dataflow_rules_are_silent_without_a_model() {
     );
     assert_eq!(codes(&xml), Vec::<String>::new());
     // A `{key}` on an unmodelled node may write it: the modelled reader
-    // before it is not reported, nor the modelled writer after it.
+    // before it is not reported, nor the modelled writer after it. (The
+    // file's model declares the tree's other types: `Mystery` is an
+    // `unknown-node-type`.)
     let xml = tree(
         r#"<Sequence><Pick pose="{p}"/><Action ID="Mystery" x="{p}"/><Detect pose="{q}"/></Sequence>"#,
         MODEL,
     );
-    assert_eq!(codes(&xml), ["key-never-read"], "{:?}", run(&xml));
+    assert_eq!(
+        codes(&xml),
+        ["key-never-read", "unknown-node-type"],
+        "{:?}",
+        run(&xml)
+    );
 }
 
 #[test]
@@ -185,12 +205,11 @@ fn dataflow_rules_are_linear_in_nodes_and_ports() {
         ),
     );
     let t = std::time::Instant::now();
-    let found = run(&xml);
+    let mut cfg = config::Config::default();
+    cfg.set("missing-model-port", Level::Warning).unwrap();
+    let found = run_with(&xml, &cfg);
     assert_eq!(
-        found
-            .iter()
-            .filter(|f| f.0 == "missing-required-port")
-            .count(),
+        found.iter().filter(|f| f.0 == "missing-model-port").count(),
         5000
     );
     assert_eq!(
@@ -248,4 +267,80 @@ proptest::proptest! {
             let _ = lint_subject(&s, None, "t.xml", &config::Config::default());
         }
     }
+}
+
+#[test]
+fn a_read_in_a_fallback_branch_before_the_writer_is_the_check_else_compute_idiom() {
+    // Nav2's navigate_w_replanning_only_if_path_becomes_invalid.xml: the
+    // first branch checks {path} (failing while it is unset), the second
+    // computes it. Not reported; the same order under a Sequence is.
+    let model = r#"<TreeNodesModel>
+      <Action ID="ValidatePath"><input_port name="path"/></Action>
+      <Action ID="ComputePath"><output_port name="path"/></Action>
+      <Action ID="Follow"><input_port name="path"/></Action>
+    </TreeNodesModel>"#;
+    let fallback = tree(
+        r#"<Sequence><Fallback><ValidatePath path="{path}"/><ComputePath path="{path}"/></Fallback><Follow path="{path}"/></Sequence>"#,
+        model,
+    );
+    assert_eq!(codes(&fallback), Vec::<String>::new());
+    let sequence = tree(
+        r#"<Sequence><ValidatePath path="{path}"/><ComputePath path="{path}"/><Follow path="{path}"/></Sequence>"#,
+        model,
+    );
+    assert_eq!(codes(&sequence), ["read-before-write"]);
+    // Deep in the first branch of a Fallback inside a Sequence: the
+    // lowest common ancestor decides (a Fallback: not reported).
+    let deep = tree(
+        r#"<Sequence><Fallback><Inverter><Sequence><AlwaysSuccess/><ValidatePath path="{path}"/></Sequence></Inverter><Sequence><AlwaysSuccess/><ComputePath path="{path}"/></Sequence></Fallback><Follow path="{path}"/></Sequence>"#,
+        model,
+    );
+    assert_eq!(codes(&deep), Vec::<String>::new());
+}
+
+#[test]
+fn the_trees_own_entries_written_and_never_read_are_the_applications() {
+    // Nav2's error codes: written by the tree for the navigator. Not
+    // reported, unless the tree declares its ports or the entry is close
+    // to one that is read (a misspelling).
+    let model = r#"<TreeNodesModel>
+      <Action ID="Plan"><input_port name="goal"/><output_port name="error_code_id"/></Action>
+    </TreeNodesModel>"#;
+    let app = tree(
+        r#"<Plan goal="{goal}" error_code_id="{plan_error_code}"/>"#,
+        model,
+    );
+    assert_eq!(codes(&app), Vec::<String>::new());
+    let typo = tree(
+        r#"<Sequence><Plan goal="{goal}" error_code_id="{gaol}"/><Plan goal="{gaol_x}"/></Sequence>"#,
+        model,
+    );
+    let found = run(&typo);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(found[0].1.contains("writes {gaol}"), "{found:?}");
+    let declared = tree(
+        r#"<Plan goal="{goal}" error_code_id="{plan_error_code}"/>"#,
+        &model.replace(
+            "<TreeNodesModel>",
+            r#"<TreeNodesModel><SubTree ID="Main"><input_port name="goal"/></SubTree>"#,
+        ),
+    );
+    assert_eq!(codes(&declared), ["key-never-read"]);
+}
+
+#[test]
+fn a_subtree_remapping_no_node_reads_is_not_reported() {
+    // MoveIt Studio objectives pass `{parameters}` down SubTrees that do
+    // not use it: a dead remapping, harmless.
+    let xml = r#"<root BTCPP_format="4" main_tree_to_execute="Main">
+      <BehaviorTree ID="Main"><Sequence><SubTree ID="Sub" parameters="{parameters}"/><SubTree ID="Read" p="{parameters}"/></Sequence></BehaviorTree>
+      <BehaviorTree ID="Sub"><AlwaysSuccess/></BehaviorTree>
+      <BehaviorTree ID="Read"><Pick pose="{p}"/></BehaviorTree>
+      <TreeNodesModel><SubTree ID="Main"/><Action ID="Pick"><input_port name="pose"/></Action></TreeNodesModel>
+    </root>"#;
+    let found = run(xml);
+    // Only the remapping some node reads ({p} of Read, by Pick).
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].0, "subtree-remap-unprovided");
+    assert!(found[0].1.contains("SubTree `Read`"), "{found:?}");
 }

@@ -15,8 +15,10 @@
 pub mod config;
 pub mod dataflow;
 pub mod load;
+pub mod models;
 pub mod paper;
 pub mod sarif;
+pub mod search;
 pub mod structure;
 
 use btfsm_core::diagnostic::SourceFile;
@@ -82,6 +84,7 @@ pub const RULES: &[Rule] = &[
     dataflow::OUTPUT_PORT_LITERAL,
     dataflow::UNDECLARED_PORT,
     dataflow::MISSING_REQUIRED_PORT,
+    dataflow::MISSING_MODEL_PORT,
     dataflow::READ_BEFORE_WRITE,
     dataflow::KEY_NEVER_READ,
     dataflow::PORT_TYPE_MISMATCH,
@@ -91,6 +94,10 @@ pub const RULES: &[Rule] = &[
     load::PARALLEL_THRESHOLD,
     load::SUBTREE_RECURSION,
     load::INCLUDE_CYCLE,
+    models::UNKNOWN_NODE_TYPE,
+    models::UNKNOWN_SUBTREE,
+    models::MODEL_CONFLICT,
+    load::LOAD_ERROR,
 ];
 
 /// The rule of `code`.
@@ -106,6 +113,9 @@ pub struct Raw {
     /// The node or state (its id or path) the finding is about.
     pub at: String,
     pub span: Option<Range<usize>>,
+    /// The highest level it is reported at, whatever the rule's (a finding
+    /// the rule is less sure of: `unknown-node-type` without a model).
+    pub cap: Option<Level>,
 }
 
 /// Where rules put what they find.
@@ -116,11 +126,24 @@ pub struct Sink {
 
 impl Sink {
     pub fn push(&mut self, at: &str, span: Option<Range<usize>>, message: String, help: String) {
+        self.push_capped(at, span, message, help, None);
+    }
+
+    /// [`Sink::push`] of a finding reported at `cap` at most.
+    pub fn push_capped(
+        &mut self,
+        at: &str,
+        span: Option<Range<usize>>,
+        message: String,
+        help: String,
+        cap: Option<Level>,
+    ) {
         self.found.push(Raw {
             message,
             help,
             at: at.to_string(),
             span,
+            cap,
         });
     }
 }
@@ -174,7 +197,12 @@ pub fn lint_subject(
         }
         let mut sink = Sink::default();
         (r.check)(subject, &mut sink);
+        // A finding in a SubTree expanded several times is said once.
+        let mut said = std::collections::HashSet::new();
         for raw in sink.found {
+            if !said.insert((raw.message.clone(), raw.span.clone())) {
+                continue;
+            }
             let source = match (file, raw.span) {
                 (Some(f), Some(sp))
                     if sp.end <= f.text.len() && f.text.is_char_boundary(sp.start) =>
@@ -192,7 +220,7 @@ pub fn lint_subject(
             };
             out.push(Finding {
                 code: r.code,
-                level,
+                level: raw.cap.map_or(level, |c| c.min(level)),
                 file: display.to_string(),
                 line,
                 column,

@@ -4,8 +4,11 @@
 //! `tool.driver.rules` (id, short description, default level, where its
 //! page is),
 //! one result per finding with its rule, level, message and physical
-//! location (the file as a relative URI, the line and column when known).
-//! The output validates against the official schema
+//! location (the file as a relative URI, the line and column when known);
+//! one invocation saying whether every file was linted
+//! (`executionSuccessful`) and, as `toolExecutionNotifications`, each file
+//! that was not (with why) and what could not be checked (SARIF 2.1.0
+//! §3.20 `invocation`, §3.58 `notification`). The output validates against the official schema
 //! (`tests/differential/sarif_check.py`, run by `make differential`).
 
 use super::{Finding, Level, RULES};
@@ -15,8 +18,18 @@ fn level(l: Level) -> &'static str {
     match l {
         Level::Error => "error",
         Level::Warning => "warning",
-        Level::Note | Level::Allow => "note",
+        Level::Note => "note",
+        Level::Allow => "none",
     }
+}
+
+/// What the run could not do, for its invocation.
+#[derive(Debug, Default)]
+pub struct Invocation {
+    /// Files not linted (they do not load): the path and why.
+    pub not_linted: Vec<(String, String)>,
+    /// Notes on what was not checked (node types no model declares).
+    pub notes: Vec<String>,
 }
 
 /// A path as a relative URI reference: `/` separators, every byte outside
@@ -37,8 +50,8 @@ pub fn uri(path: &str) -> String {
     out
 }
 
-/// The SARIF log of `findings`.
-pub fn render(findings: &[Finding]) -> String {
+/// The SARIF log of `findings`, with the invocation `inv` describes.
+pub fn render(findings: &[Finding], inv: &Invocation) -> String {
     let rules: Vec<Value> = RULES
         .iter()
         .map(|r| {
@@ -47,7 +60,10 @@ pub fn render(findings: &[Finding]) -> String {
                 "name": r.code,
                 "shortDescription": { "text": r.summary },
                 "help": { "text": format!("docs/lint.md#{}", r.code) },
-                "defaultConfiguration": { "level": level(r.level) },
+                "defaultConfiguration": {
+                    "level": level(r.level),
+                    "enabled": r.level != Level::Allow,
+                },
             })
         })
         .collect();
@@ -82,6 +98,7 @@ pub fn render(findings: &[Finding]) -> String {
                 "version": env!("CARGO_PKG_VERSION"),
                 "rules": rules,
             } },
+            "invocations": [ invocation(inv) ],
             "columnKind": "unicodeCodePoints",
             "results": results,
         } ],
@@ -90,6 +107,38 @@ pub fn render(findings: &[Finding]) -> String {
         btfsm_core::sanitize::json(serde_json::to_string_pretty(&log).expect("serializable"));
     s.push('\n');
     s
+}
+
+/// The run's one invocation: successful when every file was linted; a
+/// notification per file that was not (an error, tied to the `load-error`
+/// rule) and per note.
+fn invocation(inv: &Invocation) -> Value {
+    let load_error = RULES
+        .iter()
+        .position(|r| r.code == super::load::LOAD_ERROR.code)
+        .unwrap_or(0);
+    let mut notes: Vec<Value> = inv
+        .not_linted
+        .iter()
+        .map(|(file, why)| {
+            json!({
+                "level": "error",
+                "message": { "text": format!("{file} was not linted: {why}") },
+                "locations": [ { "physicalLocation": { "artifactLocation": { "uri": uri(file) } } } ],
+                "associatedRule": { "id": super::load::LOAD_ERROR.code, "index": load_error },
+            })
+        })
+        .collect();
+    notes.extend(
+        inv.notes
+            .iter()
+            .map(|n| json!({ "level": "note", "message": { "text": n } })),
+    );
+    let mut v = json!({ "executionSuccessful": inv.not_linted.is_empty() });
+    if !notes.is_empty() {
+        v["toolExecutionNotifications"] = Value::Array(notes);
+    }
+    v
 }
 
 #[cfg(test)]

@@ -1,9 +1,9 @@
 //! Structure rules: what the shape of a BT or an FSM says before it runs
 //! (docs/lint.md). BT semantics are BehaviorTree.CPP 4's
-//! (docs/bt-semantics.md). What BehaviorTree.CPP itself refuses — Parallel
-//! thresholds above the number of children, empty composites, decorators
-//! without one child, recursive SubTrees, includes too deep — is a load
-//! error (exit 2), which `lint` reports as `validate` does.
+//! (docs/bt-semantics.md). What BehaviorTree.CPP itself refuses — empty
+//! composites, decorators without one child, recursive SubTrees, Parallel
+//! thresholds above the number of children — is found by the readers and
+//! reported by the rules of [`super::load`].
 
 use super::{Level, Rule, Sink, Subject};
 use btfsm_model::{Bt, BtNodeKind, PolicyBody, StateBody, Target};
@@ -112,41 +112,70 @@ fn unreachable_child(p: &Subject, out: &mut Sink) {
 pub const REACTIVE_ASYNC_SIBLINGS: Rule = Rule {
     code: "reactive-async-siblings",
     level: Level::Warning,
-    summary: "more than one action under a reactive Sequence or Fallback: BehaviorTree.CPP warns they halt each other",
+    summary: "two asynchronous actions under one reactive Sequence or Fallback: one halts the other",
     check: reactive_async_siblings,
 };
 
-/// Action types known to return at once (never RUNNING), which cannot halt
-/// a sibling: BehaviorTree.CPP 4's synchronous built-ins, and Nav2's
-/// plugins that derive `BT::SyncActionNode`, or `BT::ActionNodeBase` with an
-/// empty `halt()` and a `tick()` that returns SUCCESS or FAILURE (navigation2,
-/// nav2_behavior_tree/include/nav2_behavior_tree/plugins/action/: the
-/// selectors, `TruncatePath`, `TruncatePathLocal`, `RemovePassedGoals`).
-/// BehaviorTree.CPP XML does not say whether an action is asynchronous; an
-/// action of another type may be, and counts.
-const SYNCHRONOUS_ACTIONS: &[&str] = &[
-    "Script",
-    "SetBlackboard",
-    "UnsetBlackboard",
-    "ControllerSelector",
-    "PlannerSelector",
-    "GoalCheckerSelector",
-    "ProgressCheckerSelector",
-    "SmootherSelector",
-    "TruncatePath",
-    "TruncatePathLocal",
-    "RemovePassedGoals",
+/// BehaviorTree.CPP action types known to return RUNNING (asynchronous):
+/// BehaviorTree.CPP 4's `Sleep` (a `StatefulActionNode`), and Nav2's
+/// plugins that derive `BtActionNode` (an action client: RUNNING until the
+/// server's result) or `BtServiceNode` (RUNNING while the service has not
+/// answered), and `CheckStopStatus` (RUNNING until the robot has stood
+/// still long enough); read in navigation2's nav2_behavior_tree and
+/// nav2_docking sources, releases 1.1 to 1.4 and main (class bases and
+/// `registerNodeType`/`registerBuilder` names). A BehaviorTree.CPP XML file
+/// does not say which of its actions are asynchronous, and a `SyncActionNode`
+/// (Nav2's selectors) or an `ActionNodeBase` returning at once (Nav2's
+/// `GetCurrentPose`, `TruncatePath`, `ConcatenatePaths`...) halts nothing:
+/// an action of a type not listed here does not count.
+const ASYNCHRONOUS_ACTIONS: &[&str] = &[
+    "Sleep",
+    // Nav2 BtActionNode
+    "AssistedTeleop",
+    "BackUp",
+    "ComputeAndTrackRoute",
+    "ComputePathThroughPoses",
+    "ComputePathToPose",
+    "ComputeRoute",
+    "DockRobot",
+    "DriveOnHeading",
+    "FollowObject",
+    "FollowPath",
+    "NavigateThroughPoses",
+    "NavigateToPose",
+    "SmoothPath",
+    "Spin",
+    "UndockRobot",
+    "Wait",
+    // Nav2 BtServiceNode
+    "CheckPoseOccupancy",
+    "ClearCostmapAroundPose",
+    "ClearCostmapAroundRobot",
+    "ClearCostmapExceptRegion",
+    "ClearEntireCostmap",
+    "ReinitializeGlobalLocalization",
+    "RemoveInCollisionGoals",
+    "ToggleCollisionMonitor",
+    "ValidatePath",
+    // Nav2 ActionNodeBase returning RUNNING
+    "CheckStopStatus",
 ];
 
-/// Whether a leaf action may return RUNNING.
-fn may_run(bt: &Bt, c: usize) -> bool {
+/// Whether a leaf action may return RUNNING: in a BehaviorTree.CPP tree
+/// (`btcpp`), one of a type known to ([`ASYNCHRONOUS_ACTIONS`]); in the
+/// other formats, every action (a skill runs over several ticks) but one
+/// that always ends the same way.
+fn may_run(bt: &Bt, c: usize, btcpp: bool) -> bool {
     let n = &bt.nodes[c];
-    n.kind == BtNodeKind::Action
-        && always(bt, c).is_none()
-        && !n
-            .type_name
-            .as_deref()
-            .is_some_and(|t| SYNCHRONOUS_ACTIONS.contains(&t))
+    if n.kind != BtNodeKind::Action || always(bt, c).is_some() {
+        return false;
+    }
+    let ty = n.type_name.as_deref();
+    if btcpp {
+        ty.is_some_and(|t| ASYNCHRONOUS_ACTIONS.contains(&t))
+    } else {
+        !ty.is_some_and(|t| matches!(t, "Script" | "SetBlackboard" | "UnsetBlackboard"))
+    }
 }
 
 fn reactive_async_siblings(p: &Subject, out: &mut Sink) {
@@ -158,7 +187,7 @@ fn reactive_async_siblings(p: &Subject, out: &mut Sink) {
         let actions: Vec<&str> = node
             .children
             .iter()
-            .filter(|&&c| may_run(bt, c))
+            .filter(|&&c| may_run(bt, c, p.dataflow.is_some()))
             .map(|&c| bt.nodes[c].id.as_str())
             .collect();
         if actions.len() > 1 {

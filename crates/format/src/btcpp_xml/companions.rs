@@ -12,8 +12,10 @@
 
 use super::super::xml;
 use super::super::{Limits, source};
+use btfsm_core::diagnostic::SourceFile;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::OnceLock;
 
 /// The BehaviorTree.CPP files of one command and, once asked, the trees
@@ -85,6 +87,71 @@ impl Companions {
     }
 }
 
+/// Of `files`, those whose folder shares the most leading components with
+/// `dir` (canonical paths compared).
+fn nearest(dir: &Path, files: Vec<PathBuf>) -> Vec<PathBuf> {
+    if files.len() < 2 {
+        return files;
+    }
+    let dir = crate::source::canonical(if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    });
+    let shared = |f: &PathBuf| {
+        let parent = crate::source::canonical(f.parent().unwrap_or(Path::new(".")));
+        dir.components()
+            .zip(parent.components())
+            .take_while(|(a, b)| a == b)
+            .count()
+    };
+    let best = files.iter().map(shared).max().unwrap_or(0);
+    files.into_iter().filter(|f| shared(f) == best).collect()
+}
+
+/// Trees a program may create from a file that holds several and names
+/// none (`main_tree_to_execute`): those no other tree of the file uses as a
+/// `<SubTree>` (all of them if each is used), sorted, at most `max`; `None`
+/// when the file names its main tree, holds one tree, or does not parse.
+/// BehaviorTree.CPP's `createTreeFromFile` refuses such a file, but a
+/// program that registers it creates its trees by ID (`createTree("...")`,
+/// BehaviorTree.CPP's own examples): `lint` checks each.
+pub fn root_trees(file: &Arc<SourceFile>, limits: &Limits, max: usize) -> Option<Vec<String>> {
+    let (doc, _) = xml::parse_lenient(file, limits.max_nodes, limits.max_nodes).ok()?;
+    let root = &doc.elems[doc.root];
+    if root.name != "root" || root.attr("main_tree_to_execute").is_some() {
+        return None;
+    }
+    let trees: std::collections::BTreeSet<&str> = root
+        .children
+        .iter()
+        .map(|&k| &doc.elems[k])
+        .filter(|el| el.name == "BehaviorTree")
+        .map(|el| el.attr("ID").unwrap_or("MainTree"))
+        .collect();
+    if trees.len() < 2 {
+        return None;
+    }
+    let used: std::collections::HashSet<&str> = doc
+        .elems
+        .iter()
+        .filter(|el| el.name == "SubTree" || el.name == "SubTreePlus")
+        .filter_map(|el| el.attr("ID"))
+        .collect();
+    let roots: Vec<String> = trees
+        .iter()
+        .filter(|t| !used.contains(*t))
+        .map(|t| t.to_string())
+        .collect();
+    let mut roots = if roots.is_empty() {
+        trees.iter().map(|t| t.to_string()).collect()
+    } else {
+        roots
+    };
+    roots.truncate(max);
+    Some(roots)
+}
+
 /// The `<BehaviorTree ID>`s directly under the `<root>` of `path` (none
 /// when it cannot be read or is not a BehaviorTree.CPP document).
 fn trees_of(path: &Path, limits: &Limits) -> Vec<String> {
@@ -112,8 +179,11 @@ impl super::loader::Loader<'_> {
     /// defines, with their includes, until none is missing or no companion
     /// defines what is: each document is scanned once, each file read once.
     /// A tree the files read first define is theirs (a companion's tree of
-    /// the same ID is ignored); an ID several companions define is left
-    /// undefined and its use says which files define it.
+    /// the same ID is ignored). Among several companions that define an ID,
+    /// the nearest to the file that uses it is read (the deepest folder
+    /// shared with it: a package's own objectives before another's, as a
+    /// program registers its own folder); when several are nearest alike,
+    /// the ID is left undefined and its use says which files define it.
     pub(super) fn companion_trees(&mut self) {
         let Some(comp) = self.limits.companions.clone() else {
             return;
@@ -121,19 +191,20 @@ impl super::loader::Loader<'_> {
         let mut scanned = 0;
         while scanned < self.docs.len() {
             let end = self.docs.len();
-            let mut missing: std::collections::BTreeSet<String> = Default::default();
-            for doc in &self.docs[scanned..end] {
+            // Each missing ID, with the first document that uses it.
+            let mut missing: BTreeMap<String, usize> = BTreeMap::new();
+            for (d, doc) in self.docs[scanned..end].iter().enumerate() {
                 for el in &doc.elems {
                     if (el.name == "SubTree" || el.name == "SubTreePlus")
                         && let Some(id) = el.attr("ID")
                         && !self.trees.contains_key(id)
                     {
-                        missing.insert(id.to_string());
+                        missing.entry(id.to_string()).or_insert(scanned + d);
                     }
                 }
             }
             scanned = end;
-            for id in missing {
+            for (id, user) in missing {
                 if self.trees.contains_key(&id) || self.ambiguous.contains_key(&id) {
                     continue;
                 }
@@ -143,6 +214,7 @@ impl super::loader::Loader<'_> {
                     .filter(|p| !self.seen.contains(&crate::source::canonical(p)))
                     .map(Path::to_path_buf)
                     .collect();
+                let files = nearest(&self.dirs[user], files);
                 match files.as_slice() {
                     [] => {}
                     [one] => self.read_companion(one),

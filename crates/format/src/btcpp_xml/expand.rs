@@ -132,6 +132,20 @@ impl Loader<'_> {
     /// expansion whose root takes the element's place. `None` when the
     /// expansion limit is hit.
     fn expand_subtree(&mut self, w: &mut Walk, it: Item, el: &XElem) -> Option<()> {
+        // Among several files given together (a folder), a tree none of
+        // them defines may come from a file the program registers and lint
+        // was not given (MoveIt Pro's objectives library), and a tree
+        // several of them define alike (robot configurations of one
+        // workspace) from the one the program registers: `lint` reads it
+        // as one opaque node. A single file given is refused as every
+        // command refuses it.
+        if self.limits.for_lint
+            && self.limits.companions.as_ref().is_some_and(|c| c.len() > 1)
+            && let Some(id) = el.attr("ID")
+            && !self.trees.contains_key(id)
+        {
+            return self.opaque_subtree(w, it, el);
+        }
         let Some((id, sd, se)) = self.subtree_target(w, it.d, el) else {
             w.failed = true;
             return Some(());
@@ -197,9 +211,17 @@ impl Loader<'_> {
                 el.span.clone(),
                 format!("unknown tree `{}` in `<SubTree>`", shown(&id)),
             )
-            .hint = Some(format!(
-                "{h}; a tree of another file is found when that file is `<include>`d, or given with this one (`btfsm analyze main.xml subtrees/`)"
-            ));
+            .hint = Some(match self.limits.companions.as_deref() {
+                // Already given together: the file that defines it is not
+                // among them (suggesting the command just run would not help).
+                Some(c) if c.len() > 1 => format!(
+                    "{h}; none of the {} BehaviorTree.CPP files given together defines it: `<include>` the file that does, or give it too",
+                    c.len()
+                ),
+                _ => format!(
+                    "{h}; a tree of another file is found when that file is `<include>`d, or given together with this one (both files, or their folder)"
+                ),
+            });
             return None;
         };
         if w.chain.trees.get(&id).is_some_and(|&c| c > 0) {
@@ -277,6 +299,81 @@ impl Loader<'_> {
             keys,
             autoremap,
         }
+    }
+
+    /// For `lint`, a `<SubTree>` whose tree no file given defines (the
+    /// program may register a file that does: MoveIt Pro's objectives
+    /// library, a package not given): one opaque action node in its place,
+    /// its ports of unknown direction, recorded for the `unknown-subtree`
+    /// rule with the closest tree ID.
+    fn opaque_subtree(&mut self, w: &mut Walk, it: Item, el: &XElem) -> Option<()> {
+        let id = el.attr("ID").unwrap_or_default().to_string();
+        if w.budget == 0 {
+            self.err(
+                it.d,
+                el.span.clone(),
+                format!("more than {} nodes", self.limits.max_nodes),
+            )
+            .hint = Some("raise the limit with --max-nodes".into());
+            return None;
+        }
+        w.budget -= 1;
+        if self.unknown_subtrees.insert(id.clone()) {
+            // Among the trees read and those the files given define.
+            let closest = (self.unknown_subtrees.len() <= 256)
+                .then(|| {
+                    let given = self.limits.companions.clone();
+                    let given = given.as_deref().map(|c| c.tree_ids(self.limits));
+                    let cands = self
+                        .trees
+                        .keys()
+                        .map(String::as_str)
+                        .chain(given.into_iter().flatten());
+                    btfsm_core::diagnostic::closest(&id, cands)
+                        .filter(|c| *c != id)
+                        .map(str::to_string)
+                })
+                .flatten();
+            self.flow
+                .node_types
+                .unknown
+                .push(super::ports::UnknownType {
+                    ty: id.clone(),
+                    doc: it.d,
+                    span: el.span.clone(),
+                    children: 0,
+                    explicit: false,
+                    subtree: true,
+                    closest,
+                });
+        }
+        let idx = w.nodes.len();
+        for p in w.pending.drain(..) {
+            self.flow.subtrees[p].node = idx;
+        }
+        let flow = self.node_flow(it.d, el, idx, |k| w.chain.resolve_key(&w.frames, k));
+        self.flow.nodes.push(flow);
+        if let Some(p) = it.parent {
+            w.nodes[p].children.push(idx);
+        }
+        let name = it
+            .name_override
+            .or_else(|| el.attr("name").map(str::to_string));
+        w.names.push(name.clone());
+        w.explicit.push(el.btfsm_attr("id").map(str::to_string));
+        w.nodes.push(BtNode {
+            id: String::new(),
+            label: name.unwrap_or_else(|| id.clone()),
+            kind: btfsm_model::BtNodeKind::Action,
+            children: Vec::new(),
+            skill: None,
+            type_name: Some(id),
+            ports: Default::default(),
+            subtree: it.subtree,
+            id_source: Default::default(),
+            span: Some(el.span.clone()),
+        });
+        Some(())
     }
 
     /// Reads a node element into the arena and queues its children. `None`

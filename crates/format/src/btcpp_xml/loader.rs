@@ -19,8 +19,8 @@ pub(super) struct ModelEntry {
     pub(super) cat: Category,
     /// Its `<input_port>`, `<output_port>` and `<inout_port>`s.
     pub(super) ports: Vec<super::ports::PortDecl>,
-    /// Where it is declared (`file:line:col`), for a conflicting one.
-    pub(super) at: String,
+    /// Where it is declared: document and span.
+    pub(super) at: (usize, Range<usize>),
 }
 
 /// The files being included, outermost first: their canonical paths (for
@@ -47,6 +47,11 @@ pub(super) struct Loader<'l> {
     /// Unknown node types already reported: each is an error once, at its
     /// first use, however often it is used.
     pub(super) unknown: std::collections::HashSet<String>,
+    /// Types two models declare in different categories, with the warning
+    /// said when the tree uses the type.
+    pub(super) conflicts: Vec<(String, Diagnostic)>,
+    /// SubTree IDs no file read defines, read as opaque nodes (`lint`).
+    pub(super) unknown_subtrees: std::collections::HashSet<String>,
     /// Files read so far (canonical paths): each is read once.
     pub(super) seen: HashSet<PathBuf>,
     /// The first document read as a companion (a file given together with
@@ -82,6 +87,8 @@ pub(super) fn load(
         trees: BTreeMap::new(),
         models: BTreeMap::new(),
         unknown: Default::default(),
+        unknown_subtrees: Default::default(),
+        conflicts: Vec::new(),
         seen: HashSet::new(),
         first_companion: usize::MAX,
         ambiguous: BTreeMap::new(),
@@ -161,17 +168,31 @@ impl Loader<'_> {
             self.nodes_model_file(m);
         }
         // The node models of the Groot2 projects given together (a project
-        // folder walked as a directory), unless this file is one.
-        let projects: Vec<PathBuf> = self
-            .limits
-            .companions
-            .as_ref()
-            .map(|c| c.projects().map(Path::to_path_buf).collect())
-            .unwrap_or_default();
+        // folder walked as a directory), for the trees in the project's
+        // folder or below it, unless this file is one. `lint` finds them in
+        // its own search of the repository (`found_models`).
+        let projects: Vec<PathBuf> = match &self.limits.companions {
+            Some(c) if !self.limits.for_lint => c.projects().map(Path::to_path_buf).collect(),
+            _ => Vec::new(),
+        };
         for p in projects {
-            if crate::toml::canonical(&p) != identity {
+            let p = crate::toml::canonical(&p);
+            let governs = p.parent().is_some_and(|dir| identity.starts_with(dir));
+            if p != identity && governs {
                 self.project_models(&p);
             }
+        }
+        self.flow.node_types.given_model = !extra.is_empty();
+        // Models found rather than given: their problems are warnings.
+        let found = self.limits.found_models.clone();
+        self.flow.node_types.found_models = found
+            .iter()
+            .map(|m| btfsm_core::sanitize::shown_max(&m.display().to_string(), 240).into_owned())
+            .collect();
+        for m in &found {
+            let mark = self.diags.mark();
+            self.nodes_model_file(m);
+            self.diags.demote_since(mark);
         }
         for d in 0..self.docs.len() {
             self.definitions(d);
@@ -185,6 +206,13 @@ impl Loader<'_> {
             return None;
         }
         let bt = self.expand(&tree_id, d, e)?;
+        // Model conflicts about types the tree uses (another tree's types
+        // are its own business).
+        for (id, w) in std::mem::take(&mut self.conflicts) {
+            if self.flow.node_types.declared.contains(&id) {
+                self.diags.push(w);
+            }
+        }
         Some(Policy {
             name: tree_id,
             description: None,
@@ -480,36 +508,43 @@ impl Loader<'_> {
                 );
                 continue;
             }
-            let at = {
-                let f = &self.docs[d].file;
-                let (l, c) = f.line_col(el.span.start);
-                format!("{}:{l}:{c}", f.path)
-            };
-            // BehaviorTree.CPP registers node types in code and reads no
-            // category from a model: two models that disagree are a
-            // warning naming both, and the first read (a --nodes-model
-            // file before the tree's own) is kept.
-            if let Some(prev) = self.models.get(id)
-                && prev.cat != cat
-            {
-                let (was, first) = (prev.cat.tag(), prev.at.clone());
-                self.warn(
-                    d,
-                    el.span.clone(),
-                    format!(
-                        "`{}` is declared as `{}` here and as `{was}` at {}; read as `{was}`",
-                        shown(id),
-                        cat.tag(),
-                        shown(&first)
-                    ),
-                )
-                .hint = Some("keep one declaration per node type across the model files".into());
-                continue;
+            if let Some(prev) = self.models.get(id) {
+                if prev.cat != cat {
+                    self.model_conflict(d, &el, id, prev.clone(), cat);
+                }
+                continue; // the first declaration read wins
             }
             let ports = super::ports::model_ports(&self.docs[d], d, k);
+            let at = (d, el.span.clone());
             self.models
                 .insert(id.to_string(), ModelEntry { cat, ports, at });
         }
+    }
+
+    /// A type two models declare in different categories: a warning naming
+    /// both places; the first read (a model given, before one found; the
+    /// file's own, before its includes') is kept.
+    fn model_conflict(&mut self, d: usize, el: &XElem, id: &str, prev: ModelEntry, cat: Category) {
+        let (pd, pspan) = prev.at;
+        let first = {
+            let f = &self.docs[pd].file;
+            let (l, c) = f.line_col(pspan.start.min(f.text.len()));
+            format!("{}:{l}:{c}", shown(&f.path))
+        };
+        let f = self.docs[d].file.clone();
+        let w = Diagnostic::warning(format!(
+            "`{}` is declared as `{}` here and as `{}` at {first}; read as `{}`",
+            shown(id),
+            cat.tag(),
+            prev.cat.tag(),
+            prev.cat.tag()
+        ))
+        .at(&f, el.span.clone())
+        .with_code("model-conflict")
+        .hint(
+            "keep one declaration per node type across the model files (the C++ class the program registers decides)",
+        );
+        self.conflicts.push((id.to_string(), w));
     }
 
     /// Collects `<BehaviorTree>` definitions and `<TreeNodesModel>` entries.

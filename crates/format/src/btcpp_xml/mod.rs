@@ -36,7 +36,7 @@ pub mod ports;
 #[cfg(test)]
 mod tests;
 
-pub use companions::Companions;
+pub use companions::{Companions, root_trees};
 pub use ids::derive_ids;
 use loader::load;
 pub use ports::{Dataflow, builtin_ports};
@@ -133,6 +133,47 @@ pub fn v4_name(t: &str) -> &str {
     }
 }
 
+/// BehaviorTree.CPP 4's rules on a `Parallel` with `n` children: its
+/// thresholds are 32-bit `int`s, and one above `n` can never be met.
+fn parallel_rule(el: &XElem, n: usize) -> Option<(String, &'static str, Option<&'static str>)> {
+    let int = |a: &str| el.attr(a).and_then(|v| v.trim().parse::<i64>().ok());
+    // Its ports are `int`: BehaviorTree.CPP 4 refuses a literal out
+    // of its range when it creates the tree ("can not be
+    // converted"), where i64::MIN was read as a threshold of 1.
+    let out_of_range = ["success_count", "failure_count"]
+        .into_iter()
+        .find_map(|a| {
+            let v = el.attr(a)?.trim();
+            let digits = v.strip_prefix(['-', '+']).unwrap_or(v);
+            let literal = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
+            (literal && v.parse::<i32>().is_err()).then_some((a, v))
+        });
+    if let Some((a, v)) = out_of_range {
+        return Some((
+            format!(
+                "`Parallel` {a}={} is out of the range of a 32-bit `int`, which BehaviorTree.CPP 4 refuses",
+                btfsm_core::sanitize::shown_max(v, 40)
+            ),
+            "a number of children, or a negative count from the end (-1: all)",
+            None,
+        ));
+    }
+    let over = |k: i64| k > 0 && k as usize > n;
+    match (int("success_count"), int("failure_count")) {
+        (Some(k), _) if over(k) => Some((
+            format!("`Parallel` success_count={k} with {n} children can never succeed"),
+            "at most the number of children (-1: all)",
+            Some("parallel-threshold"),
+        )),
+        (_, Some(k)) if over(k) => Some((
+            format!("`Parallel` failure_count={k} with {n} children can never fail"),
+            "at most the number of children (-1: all)",
+            Some("parallel-threshold"),
+        )),
+        _ => None,
+    }
+}
+
 /// A rule BehaviorTree.CPP 4 enforces on a built-in node with `n`
 /// children (at load or at its first tick): the message, a hint, and the
 /// lint code when the problem is one (docs/lint.md).
@@ -141,7 +182,6 @@ fn builtin_rule(
     el: &XElem,
     n: usize,
 ) -> Option<(String, &'static str, Option<&'static str>)> {
-    let int = |a: &str| el.attr(a).and_then(|v| v.trim().parse::<i64>().ok());
     match ty {
         "IfThenElse" | "WhileDoElse" if !(2..=3).contains(&n) => Some((
             format!("`{ty}` takes 2 or 3 children, found {n}"),
@@ -161,46 +201,27 @@ fn builtin_rule(
                 )
             })
         }
-        "Parallel" => {
-            // Its ports are `int`: BehaviorTree.CPP 4 refuses a literal out
-            // of its range when it creates the tree ("can not be
-            // converted"), where i64::MIN was read as a threshold of 1.
-            let out_of_range = ["success_count", "failure_count"]
-                .into_iter()
-                .find_map(|a| {
-                    let v = el.attr(a)?.trim();
-                    let digits = v.strip_prefix(['-', '+']).unwrap_or(v);
-                    let literal = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
-                    (literal && v.parse::<i32>().is_err()).then_some((a, v))
-                });
-            if let Some((a, v)) = out_of_range {
-                return Some((
-                    format!(
-                        "`Parallel` {a}={} is out of the range of a 32-bit `int`, which BehaviorTree.CPP 4 refuses",
-                        btfsm_core::sanitize::shown_max(v, 40)
-                    ),
-                    "a number of children, or a negative count from the end (-1: all)",
-                    None,
-                ));
-            }
-            let over = |k: i64| k > 0 && k as usize > n;
-            match (int("success_count"), int("failure_count")) {
-                (Some(k), _) if over(k) => Some((
-                    format!("`Parallel` success_count={k} with {n} children can never succeed"),
-                    "at most the number of children (-1: all)",
-                    Some("parallel-threshold"),
-                )),
-                (_, Some(k)) if over(k) => Some((
-                    format!("`Parallel` failure_count={k} with {n} children can never fail"),
-                    "at most the number of children (-1: all)",
-                    Some("parallel-threshold"),
-                )),
-                _ => None,
-            }
-        }
+        "Parallel" => parallel_rule(el, n),
         "RetryUntilSuccessful" if el.attr("num_attempts").is_none() => Some((
             "`RetryUntilSuccessful` needs `num_attempts`".into(),
             "write num_attempts=\"3\" (-1: forever)",
+            None,
+        )),
+        // Ports these built-ins read when they are ticked: BehaviorTree.CPP
+        // 4 fails the node ("Missing parameter [msec] in SleepNode").
+        "Sleep" | "Timeout" if el.attr("msec").is_none() => Some((
+            format!("`{ty}` needs `msec`"),
+            "write msec=\"1000\" (milliseconds)",
+            None,
+        )),
+        "Delay" if el.attr("delay_msec").is_none() => Some((
+            "`Delay` needs `delay_msec`".into(),
+            "write delay_msec=\"1000\" (milliseconds)",
+            None,
+        )),
+        "Repeat" if el.attr("num_cycles").is_none() => Some((
+            "`Repeat` needs `num_cycles`".into(),
+            "write num_cycles=\"3\" (-1: forever)",
             None,
         )),
         // Ports these built-ins read when they are created: BehaviorTree.CPP

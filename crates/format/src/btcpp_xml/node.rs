@@ -65,10 +65,23 @@ impl Loader<'_> {
             && !self.models.contains_key(&ty)
             && let Some((msg, hint, code)) = builtin_rule(&ty, el, n)
         {
-            let e = self.err(d, el.span.clone(), msg);
-            e.hint = Some(hint.into());
-            e.code = code;
-            return None;
+            // For `lint`, what BehaviorTree.CPP refuses only when it ticks
+            // the node is a finding beside the others (the tree is built).
+            match tick_time(&ty, code) {
+                Some(code) if self.limits.for_lint => {
+                    if let Some(code) = code {
+                        let w = self.warn(d, el.span.clone(), msg);
+                        w.hint = Some(hint.into());
+                        w.code = Some(code);
+                    }
+                }
+                _ => {
+                    let e = self.err(d, el.span.clone(), msg);
+                    e.hint = Some(hint.into());
+                    e.code = code;
+                    return None;
+                }
+            }
         }
         let mut ports = node_ports(el, consumed, kind, &ty, resolve);
         let skill_call = bind_skill(kind, &ty, &mut ports);
@@ -105,7 +118,23 @@ impl Loader<'_> {
             "Condition" => Category::Condition,
             "Control" => Category::Control,
             "Decorator" => Category::Decorator,
-            _ => return Some((tag.to_string(), None)),
+            _ => {
+                // The compact syntax names the type by the tag: BehaviorTree.CPP
+                // 4 refuses an `ID` there ("Attribute [ID] is not allowed in
+                // <Fallback>", `XMLParser`'s createNodeFromXML).
+                if el.attr("ID").is_some() {
+                    self.err(
+                        d,
+                        el.span.clone(),
+                        format!("`ID` is not allowed on `<{}>`", shown(tag)),
+                    )
+                    .hint = Some(
+                        "the tag names the type: remove `ID` (a display name is `name=\"...\"`), or write `<Action ID=\"...\">` to name the type by `ID`".into(),
+                    );
+                    return None;
+                }
+                return Some((tag.to_string(), None));
+            }
         };
         match el.attr("ID") {
             Some(id) => Some((id.to_string(), Some(cat))),
@@ -136,11 +165,21 @@ impl Loader<'_> {
     ) -> Option<Typed> {
         let n = el.children.len();
         Some(if let Some(cat) = builtin(ty) {
+            if self.limits.for_lint && !self.format_3(d) && v4_name(ty) != ty.as_str() {
+                self.v3_name(d, el, ty);
+            }
             Typed::builtin(ty, cat, el, n)
         } else if let Some(cat) = explicit_cat {
+            if self.models.contains_key(ty.as_str()) {
+                self.declared(ty);
+            } else if self.limits.for_lint {
+                self.record_unknown(d, el, ty, true);
+            }
             Typed::generic(cat)
         } else if let Some(m) = self.models.get(ty.as_str()) {
-            Typed::generic(m.cat)
+            let cat = m.cat;
+            self.declared(ty);
+            Typed::generic(cat)
         } else if let Some((real, cat)) = BUILTINS.iter().find(|(b, _)| b.eq_ignore_ascii_case(ty))
         {
             self.warn(
@@ -151,6 +190,7 @@ impl Loader<'_> {
                     shown(ty)
                 ),
             )
+            .set_code("unknown-node-type")
             .hint = Some(format!(
                 "node types are case-sensitive: write `<{real}>` (BehaviorTree.CPP itself rejects `<{}>`)",
                 shown(ty)
@@ -177,6 +217,15 @@ impl Loader<'_> {
                 ));
             }
             return None;
+        } else if self.limits.for_lint {
+            // Kept as its shape says, for the `unknown-node-type` rule.
+            self.record_unknown(d, el, ty, false);
+            match (n, self.limits.assume_leaf) {
+                (0, Some(AssumeLeaf::Condition)) => Typed::generic(Category::Condition),
+                (0, _) => Typed::generic(Category::Action),
+                (1, _) => Typed::generic(Category::Decorator),
+                _ => Typed::generic(Category::Control),
+            }
         } else if let (Some(a), 0) = (self.limits.assume_leaf, n) {
             match a {
                 AssumeLeaf::Action => Typed::generic(Category::Action),
@@ -197,6 +246,71 @@ impl Loader<'_> {
                 _ => Typed::generic(Category::Control),
             }
         })
+    }
+
+    /// A format-3 name of a built-in in a file BehaviorTree.CPP 4 reads as
+    /// format 4 (`BTCPP_format="4"`): its factory does not know it ("Node
+    /// not recognized: SequenceStar"). A file without the attribute may be
+    /// written for BehaviorTree.CPP 3 (Nav2 Humble's): not reported.
+    fn v3_name(&mut self, d: usize, el: &XElem, ty: &str) {
+        let root = self.docs[d].root;
+        if self.docs[d].elems[root].attr("BTCPP_format") != Some("4") {
+            return;
+        }
+        let real = v4_name(ty);
+        self.warn(
+            d,
+            el.span.clone(),
+            format!(
+                "`{}` is BehaviorTree.CPP 3's name: BehaviorTree.CPP 4 does not know it, and this file says BTCPP_format=\"4\"",
+                shown(ty)
+            ),
+        )
+        .set_code("unknown-node-type")
+        .hint = Some(format!("write `<{real}>`"));
+    }
+
+    /// A type the tree uses that a model declares.
+    fn declared(&mut self, ty: &str) {
+        let types = &mut self.flow.node_types;
+        if !types.declared.contains(ty) {
+            types.declared.insert(ty.to_string());
+        }
+    }
+
+    /// A type no model declares, at its first use (`lint`): with the
+    /// closest known type for the first [`HINTED_TYPES`] of them.
+    fn record_unknown(&mut self, d: usize, el: &XElem, ty: &str, explicit: bool) {
+        if !self.unknown.insert(ty.to_string()) {
+            return;
+        }
+        // A tree's ID written as a node type is its own closest (the
+        // `unknown-node-type` rule says to write a `<SubTree>`).
+        let closest = if self.trees.contains_key(ty) {
+            Some(ty.to_string())
+        } else {
+            (self.unknown.len() <= HINTED_TYPES)
+                .then(|| {
+                    let cands = BUILTINS
+                        .iter()
+                        .map(|(b, _)| *b)
+                        .chain(self.models.keys().map(String::as_str));
+                    btfsm_core::diagnostic::closest(ty, cands).map(str::to_string)
+                })
+                .flatten()
+        };
+        self.flow
+            .node_types
+            .unknown
+            .push(super::ports::UnknownType {
+                ty: ty.to_string(),
+                doc: d,
+                span: el.span.clone(),
+                children: el.children.len(),
+                explicit,
+                subtree: false,
+                closest,
+            });
     }
 
     /// The error of an unknown node type, with how to declare it.
@@ -276,6 +390,24 @@ impl Loader<'_> {
             _ => "a leaf has no children; is the type right in the `<TreeNodesModel>`?".into(),
         });
         false
+    }
+}
+
+/// Unknown types whose closest known type is looked for (each search scans
+/// the built-ins and the models once): bounded work under a million types.
+const HINTED_TYPES: usize = 256;
+
+/// Whether a problem `builtin_rule` finds is one BehaviorTree.CPP 4 meets
+/// only when it ticks the node (it creates the tree): `Some` with the
+/// rule's code (`None`: the rule that reports it runs on the loaded tree,
+/// `missing-required-port` for `num_attempts`, `msec`, ...). Checked against
+/// behaviortreepy by tests/differential/btcpp_when.py.
+fn tick_time(ty: &str, code: Option<&'static str>) -> Option<Option<&'static str>> {
+    match ty {
+        "Parallel" | "IfThenElse" | "WhileDoElse" | "Switch2" | "Switch3" | "Switch4"
+        | "Switch5" | "Switch6" => Some(code),
+        "RetryUntilSuccessful" | "Sleep" | "Timeout" | "Delay" | "Repeat" => Some(None),
+        _ => None,
     }
 }
 

@@ -159,6 +159,44 @@ pub struct Dataflow {
     pub tree_ports: Option<Vec<PortDecl>>,
     /// Expansions (blackboards) in the tree: scope -> SubTree ID.
     pub scopes: Vec<String>,
+    /// The node types the tree uses that no model declares, and what the
+    /// models say of the others (read with [`crate::Limits::for_lint`]).
+    pub node_types: NodeTypes,
+}
+
+/// What the models say of the node types a tree uses (`unknown-node-type`).
+#[derive(Debug, Clone, Default)]
+pub struct NodeTypes {
+    /// A model was given (`--nodes-model`, `[lint] models`, a model file
+    /// given as an input): it is taken to declare every type the program
+    /// registers.
+    pub given_model: bool,
+    /// The model files found rather than given (as shown).
+    pub found_models: Vec<String>,
+    /// Types the tree uses, not built in, that a model declares.
+    pub declared: std::collections::BTreeSet<String>,
+    /// Types no model declares and BehaviorTree.CPP does not build in, and
+    /// SubTrees no file read defines, each at its first use, in tick order.
+    pub unknown: Vec<UnknownType>,
+}
+
+/// A node type no model declares, at its first use.
+#[derive(Debug, Clone)]
+pub struct UnknownType {
+    pub ty: String,
+    /// The document it is used in (index into [`Dataflow::files`]) and the
+    /// element's span there.
+    pub doc: usize,
+    pub span: Range<usize>,
+    /// Its number of children there.
+    pub children: usize,
+    /// Written in the explicit syntax (`<Action ID="...">`).
+    pub explicit: bool,
+    /// A `<SubTree ID>` no file read defines (read as one opaque node).
+    pub subtree: bool,
+    /// The closest known type (built-in or declared) or tree ID, when one
+    /// is close.
+    pub closest: Option<String>,
 }
 
 /// Reads the port declarations under a `<TreeNodesModel>` entry.

@@ -288,6 +288,43 @@ fn metadata_in_a_model_is_read_past() {
 }
 
 #[test]
+fn conflicting_model_declarations_are_a_warning_naming_both_and_the_first_wins() {
+    // A model given (`--nodes-model`) says Condition, the file's own says
+    // Action: the file loads, with a warning naming both places.
+    let dir = std::env::temp_dir().join(format!("btfsm-conflict-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("given_tree_nodes.xml");
+    std::fs::write(
+        &model,
+        r#"<root><TreeNodesModel><Condition ID="Foo"/></TreeNodesModel></root>"#,
+    )
+    .unwrap();
+    let lim = Limits {
+        nodes_models: vec![model.clone()],
+        ..Limits::default()
+    };
+    let l = parse_str(
+        "t.xml",
+        r#"<root><BehaviorTree ID="T"><Foo/></BehaviorTree>
+<TreeNodesModel><Action ID="Foo"/></TreeNodesModel></root>"#,
+        Path::new(""),
+        &lim,
+    )
+    .unwrap();
+    assert_eq!(bt(&l).nodes[0].kind, BtNodeKind::Condition);
+    let w = &l.warnings[0];
+    assert_eq!(w.code, Some("model-conflict"));
+    assert!(
+        w.message
+            .contains("declared as `Action` here and as `Condition` at")
+            && w.message.contains("given_tree_nodes.xml:1:"),
+        "{}",
+        w.message
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn decorator_arity_is_checked() {
     let e = parse(r#"<root><BehaviorTree ID="T"><Inverter><AlwaysSuccess/><AlwaysSuccess/></Inverter></BehaviorTree></root>"#).unwrap_err();
     assert!(
