@@ -69,6 +69,13 @@ pub(crate) struct SimArgs {
     /// (past the year 2^64 ns) is no budget
     #[arg(long, value_name = "MS")]
     pub timeout_ms: Option<u64>,
+    /// Run the scenario again with each policy-independent modelling
+    /// setting flipped (what the robot knows of a dropped object, after
+    /// SUCCESS/FAILURE for every policy, tolerances, budgets) and name,
+    /// beside each verdict, the flips that reverse it (an expectation that
+    /// fails gets them without this flag)
+    #[arg(long)]
+    pub sensitivity: bool,
     #[command(flatten)]
     pub limits: super::args::LimitArgs,
 }
@@ -141,7 +148,18 @@ fn monte_carlo_runs(
     let done = mc.runs;
     let expectations = btfsm_sim::scenario::expect::check_monte_carlo(&s.expect, &mc);
     note_single_run_expectations(s.expect.len() - expectations.len());
-    let rep = McReport {
+    // Every flip runs the same episodes, when all of them completed.
+    let sensitivity = (a.sensitivity && done == n).then(|| {
+        let base = btfsm_sim::sensitivity::monte_carlo_verdicts(&mc, &expectations);
+        let budget = btfsm_sim::episodes::Budget {
+            runs: n,
+            seed,
+            threads,
+            deadline,
+        };
+        btfsm_sim::sensitivity::of_monte_carlo(s, &base, &budget)
+    });
+    let mut rep = McReport {
         scenario: s.name.clone(),
         seed,
         // What the figures cover.
@@ -154,7 +172,11 @@ fn monte_carlo_runs(
             .filter(|e| e.status != btfsm_sim::scenario::expect::Status::Pass)
             .count(),
         expectations,
+        sensitivity: None,
     };
+    if let Some(x) = sensitivity {
+        rep.set_sensitivity(x);
+    }
     let budget = a.timeout_ms.map(|ms| Budget {
         timeout_ms: ms,
         exhausted: done < n,
@@ -269,6 +291,15 @@ fn one_run(
     let cut_runs: Vec<bool> = runs.iter().map(|r| run::cut_short(&s, r)).collect();
     let mut rep = SimReport::within(&s.name, &file, s.seed, s.dt, runs, points, deadline);
     rep.check(&s.expect, &cut_runs);
+    // The flips: asked for, or to name what would make a failed
+    // expectation hold.
+    if a.sensitivity || rep.expectations_failed > 0 {
+        let x = btfsm_sim::sensitivity::of_single_run(&s, &rep.verdict_values(), runs_deadline);
+        rep.set_sensitivity(x);
+        if !a.sensitivity {
+            rep.sensitivity = None;
+        }
+    }
     let millis = t0.elapsed().as_millis();
     let budget = a.timeout_ms.map(|ms| Budget {
         timeout_ms: ms,
@@ -525,6 +556,12 @@ fn symbolic(
         return fail(
             Diagnostic::error("a symbolic scenario has no trace, plot, markdown or csv report")
                 .hint("print `table` or `json`"),
+        );
+    }
+    if a.sensitivity {
+        return fail(
+            Diagnostic::error("--sensitivity flips the planar world's modelling settings; a symbolic scenario has none")
+                .hint("leave out --sensitivity"),
         );
     }
     let s = match btfsm_sim::symbolic::scenario::parse(file, base, limits) {

@@ -28,6 +28,7 @@ mod paper;
 mod plan;
 mod provenance;
 mod sim;
+mod sim_sensitivity;
 mod tick;
 mod untrusted;
 mod validate;

@@ -20,7 +20,10 @@ pub mod rng;
 pub mod robot;
 pub mod run;
 pub mod scenario;
+pub mod sensitivity;
 pub mod skills;
 pub mod symbolic;
+#[cfg(test)]
+mod test_support;
 pub mod trace;
 pub mod world;

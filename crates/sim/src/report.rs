@@ -5,6 +5,7 @@
 
 use super::monte_carlo::{McStats, PairStats};
 use super::scenario::expect::{ExpectResult, Status};
+use super::sensitivity::Sensitivity;
 use super::trace::{FRECHET_POINTS, Run, Verdict, verdicts_within};
 use btfsm_core::output::{Format, Report};
 use btfsm_core::table::Table;
@@ -28,6 +29,10 @@ pub struct SimReport {
     /// How many expectations failed or could not be decided (`sim` exits 1
     /// when this is not 0).
     pub expectations_failed: usize,
+    /// With `--sensitivity` (or an expectation that failed): which
+    /// policy-independent settings reverse which verdict.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensitivity: Option<Sensitivity>,
 }
 
 impl SimReport {
@@ -70,6 +75,7 @@ impl SimReport {
             skipped_verdicts,
             expectations: Vec::new(),
             expectations_failed: 0,
+            sensitivity: None,
         }
     }
 
@@ -145,8 +151,28 @@ impl SimReport {
         }
         self.verdicts_text(&mut out);
         self.skipped_text(&mut out);
-        self.expectations_text(&mut out);
+        expectations_text(
+            &mut out,
+            &self.expectations,
+            self.expectations_failed,
+            false,
+        );
+        if let Some(x) = &self.sensitivity {
+            x.text(&mut out, false);
+        }
         out
+    }
+
+    /// The verdicts as [`crate::sensitivity`] compares them.
+    pub fn verdict_values(&self) -> Vec<(String, String)> {
+        crate::sensitivity::run_verdicts(&self.policies, &self.verdicts, &self.expectations)
+    }
+
+    /// Adds the sensitivity report, and names beside each expectation that
+    /// does not hold the flips under which it would.
+    pub fn set_sensitivity(&mut self, x: Sensitivity) {
+        attach_reversals(&mut self.expectations, &x);
+        self.sensitivity = Some(x);
     }
 
     /// One row per run: kind, outcome, goal, times, distance, skills.
@@ -242,55 +268,60 @@ impl SimReport {
             }
         ));
     }
-
-    /// The expectations checked: how many hold, and each one's status.
-    fn expectations_text(&self, out: &mut String) {
-        expectations_text(out, &self.expectations, self.expectations_failed);
-    }
 }
 
-/// The expectations checked, as a markdown list (names escaped).
-fn markdown_expectations(out: &mut String, expectations: &[ExpectResult], failed: usize) {
-    if expectations.is_empty() {
-        return;
-    }
-    out.push_str(&format!(
-        "\nexpectations: {} of {} hold\n\n",
-        expectations.len() - failed,
-        expectations.len()
-    ));
-    for e in expectations {
-        let st = match e.status {
-            Status::Pass => "ok",
-            Status::Fail => "**FAIL**",
-            Status::Undecided => "**UNDECIDED**",
-        };
-        out.push_str(&format!(
-            "- {st} {} ({})\n",
-            btfsm_core::sanitize::markdown_cell(&e.name),
-            btfsm_core::sanitize::markdown_cell(&e.found)
-        ));
+/// Names, beside each expectation of `x`'s verdicts that does not hold,
+/// the flips under which it would.
+fn attach_reversals(expectations: &mut [ExpectResult], x: &Sensitivity) {
+    for e in expectations.iter_mut() {
+        if e.status != Status::Pass {
+            e.reversed_by = x.reversing(&format!("expect {}", e.name));
+        }
     }
 }
 
 /// The expectations checked (planar or symbolic): how many hold, and each
-/// one's status.
-pub(crate) fn expectations_text(out: &mut String, expectations: &[ExpectResult], failed: usize) {
+/// one's status, with the settings under which one that fails would hold;
+/// as text, or as a markdown list (names escaped).
+pub(crate) fn expectations_text(
+    out: &mut String,
+    expectations: &[ExpectResult],
+    failed: usize,
+    md: bool,
+) {
     if expectations.is_empty() {
         return;
     }
     out.push_str(&format!(
-        "\nexpectations: {} of {} hold\n",
+        "\nexpectations: {} of {} hold\n{}",
         expectations.len() - failed,
-        expectations.len()
+        expectations.len(),
+        if md { "\n" } else { "" }
     ));
+    let cell = |t: &str| {
+        if md {
+            btfsm_core::sanitize::markdown_cell(t)
+        } else {
+            t.to_string()
+        }
+    };
     for e in expectations {
-        let st = match e.status {
-            Status::Pass => "ok  ",
-            Status::Fail => "FAIL",
-            Status::Undecided => "UNDECIDED",
+        let st = match (e.status, md) {
+            (Status::Pass, true) => "- ok",
+            (Status::Fail, true) => "- **FAIL**",
+            (Status::Undecided, true) => "- **UNDECIDED**",
+            (Status::Pass, false) => "  ok  ",
+            (Status::Fail, false) => "  FAIL",
+            (Status::Undecided, false) => "  UNDECIDED",
         };
-        out.push_str(&format!("  {st} {} ({})\n", e.name, e.found));
+        out.push_str(&format!("{st} {} ({})", cell(&e.name), cell(&e.found)));
+        if !e.reversed_by.is_empty() {
+            out.push_str(&format!(
+                "; would hold with {}",
+                cell(&e.reversed_by.join(" or "))
+            ));
+        }
+        out.push('\n');
     }
 }
 
@@ -356,6 +387,10 @@ pub struct McReport {
     /// How many of them failed or are undecided (`sim` exits 1 when not 0).
     #[serde(skip_serializing_if = "is_zero")]
     pub expectations_failed: usize,
+    /// With `--sensitivity`: which policy-independent settings reverse
+    /// which verdict.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensitivity: Option<Sensitivity>,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -444,12 +479,18 @@ impl McReport {
                 .collect();
             out.push_str(&table(md, &head, rows));
         }
-        if md {
-            markdown_expectations(&mut out, &self.expectations, self.expectations_failed);
-        } else {
-            expectations_text(&mut out, &self.expectations, self.expectations_failed);
+        expectations_text(&mut out, &self.expectations, self.expectations_failed, md);
+        if let Some(x) = &self.sensitivity {
+            x.text(&mut out, md);
         }
         out
+    }
+
+    /// Adds the sensitivity report, and names beside each expectation that
+    /// does not hold the flips under which it would.
+    pub fn set_sensitivity(&mut self, x: Sensitivity) {
+        attach_reversals(&mut self.expectations, &x);
+        self.sensitivity = Some(x);
     }
 }
 

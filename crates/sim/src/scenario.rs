@@ -62,6 +62,11 @@ pub struct PolicyEntry {
     pub after_success: Afterwards,
     /// What the policy does after FAILURE.
     pub after_failure: Afterwards,
+    /// Whether the policy's own entry states `after_success` and
+    /// `after_failure` (a choice of the policy), rather than taking the
+    /// scenario's setting or the default (a modelling choice that
+    /// `sim --sensitivity` flips).
+    pub stated: [bool; 2],
 }
 
 /// When a disturbance fires.

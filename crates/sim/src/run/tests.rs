@@ -3,21 +3,10 @@
 use super::*;
 use crate::livelock::{LIVELOCK_STATES, Livelock};
 use crate::monte_carlo::{monte_carlo, monte_carlo_within};
+use crate::test_support::{deliver, scenario};
 use btfsm_core::diagnostic::SourceFile;
 use btfsm_format::Limits;
 use std::path::Path;
-
-/// The goal of Experiment 1 (cube2 from the east table to the delivery
-/// station) and its world, with `rest` (policies, disturbances) after them.
-fn deliver(rest: &str) -> String {
-    format!(
-        "{}{rest}",
-        r#"goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
-[world]
-objects = { cube2 = { at = "east-table" } }
-"#
-    )
-}
 
 /// Fig. 1's BT and Fig. 4's FSM fetching cube2 to the delivery station,
 /// with `rest` (disturbances, more policies) after them.
@@ -30,19 +19,6 @@ file = "../paper/fig01-bt.toml"
 file = "../paper/fig04-fsm.toml"
 "#
     ))
-}
-
-fn scenario(text: &str) -> Scenario {
-    let f = SourceFile::new("t.toml", text);
-    super::super::scenario::parse(
-        &f,
-        Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../policies/scenarios"
-        )),
-        &Limits::default(),
-    )
-    .expect("valid scenario")
 }
 
 const FLAKY: &str = r#"

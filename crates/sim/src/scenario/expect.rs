@@ -80,6 +80,11 @@ pub struct ExpectResult {
     pub status: Status,
     /// What was found (`outcome failure, goal not met`).
     pub found: String,
+    /// For an expectation that does not hold: the policy-independent
+    /// settings under which it would (`world.drop_sensed = false`), when
+    /// they were tried (`crate::sensitivity`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub reversed_by: Vec<String>,
 }
 
 const KEYS: &[&str] = &[
@@ -465,6 +470,7 @@ pub fn check_monte_carlo(
                 name: e.name.clone(),
                 status,
                 found,
+                reversed_by: Vec::new(),
             })
         })
         .collect()
@@ -554,6 +560,7 @@ pub fn check(
                 name: e.name.clone(),
                 status,
                 found,
+                reversed_by: Vec::new(),
             }
         })
         .collect()

@@ -292,6 +292,10 @@ impl Reader {
             policy,
             after_success,
             after_failure,
+            stated: [
+                t.get("after_success").is_some(),
+                t.get("after_failure").is_some(),
+            ],
         })
     }
 

@@ -188,6 +188,7 @@ pub fn check(expect: &[Expectation], runs: &[SymRun]) -> Vec<ExpectResult> {
                 name: e.name.clone(),
                 status,
                 found: text,
+                reversed_by: Vec::new(),
             }
         })
         .collect()

@@ -107,7 +107,12 @@ impl<'a> RunsReport<'a> {
             }
             out.push_str(&t.render());
         }
-        crate::report::expectations_text(&mut out, &self.expectations, self.expectations_failed);
+        crate::report::expectations_text(
+            &mut out,
+            &self.expectations,
+            self.expectations_failed,
+            false,
+        );
         out
     }
 }
