@@ -404,7 +404,9 @@ fn sim_monte_carlo_names_the_first_diverging_episode_and_its_seed_replays_it() {
     assert_eq!(code, 0);
     assert!(md.contains("| policy | success rate | 95% CI |"), "{md}");
     assert!(
-        md.contains("| pair | behavior match rate | 95% CI | first diverging episode (seed) |"),
+        md.contains(
+            "| pair | behavior match rate | 95% CI | moved alike | first diverging episode (seed) |"
+        ),
         "{md}"
     );
     // One run prints a table, JSON or CSV: markdown is refused.

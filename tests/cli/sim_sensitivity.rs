@@ -130,3 +130,41 @@ fn a_symbolic_scenario_has_no_settings_to_flip() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("a symbolic scenario has none"), "{err}");
 }
+
+/// `--runs` names per policy the first episode it did not succeed in; its
+/// seed replays that episode, and the policy does not succeed in it.
+#[test]
+fn the_first_unsuccessful_episode_of_a_policy_replays() {
+    let (_, out, err) = btfsm(&[
+        "sim",
+        "tests/fixtures/sim/rates-expect.toml",
+        "--runs",
+        "30",
+        "--format",
+        "json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap_or_else(|_| panic!("{err}"));
+    let fsm2 = (v["policies"].as_array().unwrap().iter())
+        .find(|p| p["policy"] == "Fig. 2 FSM sequential")
+        .unwrap();
+    assert!(fsm2["successes"].as_u64().unwrap() < 30, "{fsm2}");
+    let seed = fsm2["first_unsuccessful"]["seed"]
+        .as_u64()
+        .expect("a failure");
+    let (_, one, err) = btfsm(&[
+        "sim",
+        "tests/fixtures/sim/rates-expect.toml",
+        "--seed",
+        &seed.to_string(),
+        "--format",
+        "json",
+    ]);
+    let one: serde_json::Value = serde_json::from_str(&one).unwrap_or_else(|_| panic!("{err}"));
+    let run = (one["policies"].as_array().unwrap().iter())
+        .find(|p| p["policy"] == "Fig. 2 FSM sequential")
+        .unwrap();
+    assert!(
+        run["outcome"] != "success" || run["goal_met"] == false,
+        "{run}"
+    );
+}

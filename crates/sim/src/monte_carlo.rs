@@ -7,7 +7,7 @@ use super::rng::SimRng;
 use super::robot::round3;
 use super::run::{Prepared, RunOptions, cut_short, prepare, run_policy};
 use super::scenario::{Disturbance, Scenario, mc};
-use super::trace::{Outcome, behavior_matches};
+use super::trace::{Outcome, verdict_without_path};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -31,6 +31,10 @@ pub struct McStats {
     /// Mean latency from a battery-low event to the start of Recharge, s.
     pub mean_recharge_latency_s: Option<f64>,
     pub recharges: u32,
+    /// The first episode the policy did not succeed in (failure,
+    /// chattering or timeout): its index and its seed (`btfsm sim SCENARIO
+    /// --seed SEED` replays it).
+    pub first_unsuccessful: Option<Diverged>,
 }
 
 /// Per-pair figures of `--runs N`: how often the two policies' behavior
@@ -47,6 +51,13 @@ pub struct PairStats {
     /// The first episode whose behavior differs: its index and its seed
     /// (`btfsm sim SCENARIO --seed SEED` replays it).
     pub first_divergence: Option<Diverged>,
+    /// Episodes in which the robots moved alike (within the pose
+    /// tolerance at equal times) and ended alike (outcome, goal, final
+    /// world), whatever skills they called: a BT that starts a Move-To the
+    /// emergency stop aborts at once, where the FSM stays in Shut Down,
+    /// differs in behavior but not in motion.
+    pub moved_alike: u32,
+    pub moved_alike_rate: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -121,15 +132,17 @@ pub fn monte_carlo_within(
     };
     let mut policies: Vec<PolicyTally> = prepared.iter().map(|_| PolicyTally::default()).collect();
     let mut agree = vec![PairTally::default(); pairs.len()];
+    let mut moved = vec![0u32; pairs.len()];
     let done = episodes::stream(
         &budget,
         |_, ep_seed| one_episode(s, &prepared, &pairs, ep_seed, deadline),
         |i, ep_seed, (figures, same): Episode| {
             for (t, r) in policies.iter_mut().zip(figures) {
-                t.fold(r);
+                t.fold(i, ep_seed, r);
             }
-            for (t, m) in agree.iter_mut().zip(same) {
+            for ((t, k), (m, alike)) in agree.iter_mut().zip(moved.iter_mut()).zip(same) {
                 t.fold(i, ep_seed, m);
+                *k += u32::from(alike);
             }
         },
     );
@@ -137,8 +150,8 @@ pub fn monte_carlo_within(
         policies: (prepared.iter().zip(&policies))
             .map(|(p, t)| t.stats(&p.name, done))
             .collect(),
-        pairs: (pairs.iter().zip(&agree))
-            .map(|(&(a, b), t)| pair_stats(&prepared[a].name, &prepared[b].name, t, done))
+        pairs: (pairs.iter().zip(&agree).zip(&moved))
+            .map(|((&(a, b), t), &k)| pair_stats(&prepared[a].name, &prepared[b].name, t, k, done))
             .collect(),
         runs: done,
     }
@@ -149,7 +162,7 @@ pub fn monte_carlo_within(
 type Res = (Outcome, Option<bool>, Option<f64>, Vec<f64>);
 /// An episode: per policy its figures, per pair whether the behavior
 /// matched.
-type Episode = (Vec<Res>, Vec<bool>);
+type Episode = (Vec<Res>, Vec<(bool, bool)>);
 
 /// Every policy's run of the episode with seed `ep_seed`; `None` when the
 /// deadline cut one short.
@@ -175,7 +188,11 @@ fn one_episode(
         runs.push(r);
     }
     let same = (pairs.iter())
-        .map(|&(a, b)| behavior_matches(&runs[a], &runs[b]))
+        .map(|&(a, b)| {
+            let v = verdict_without_path(&runs[a], &runs[b]);
+            let moved = v.same_motion && v.same_outcome && v.same_final_world;
+            (v.matches, moved)
+        })
         .collect();
     let figures = (runs.into_iter())
         .map(|r| (r.outcome, r.goal_met, r.completion_s, r.recharge_latency_s))
@@ -196,6 +213,7 @@ struct PolicyTally {
     completions: BTreeMap<TotalF64, u32>,
     latency_sum: f64,
     latencies: u32,
+    first_unsuccessful: Option<Diverged>,
 }
 
 /// An `f64` ordered by `total_cmp`, as a map key.
@@ -220,7 +238,11 @@ impl Ord for TotalF64 {
 }
 
 impl PolicyTally {
-    fn fold(&mut self, (outcome, goal_met, completion, latencies): Res) {
+    fn fold(&mut self, episode: u32, seed: u64, (outcome, goal_met, completion, latencies): Res) {
+        let success = outcome == Outcome::Success && goal_met != Some(false);
+        if !success && self.first_unsuccessful.is_none() {
+            self.first_unsuccessful = Some(Diverged { episode, seed });
+        }
         match outcome {
             Outcome::Success if goal_met != Some(false) => {
                 self.successes += 1;
@@ -275,6 +297,7 @@ impl PolicyTally {
             completion_quantiles_s: self.quantiles(),
             mean_recharge_latency_s: mean(self.latency_sum, self.latencies),
             recharges: self.latencies,
+            first_unsuccessful: self.first_unsuccessful.clone(),
         }
     }
 }
@@ -290,7 +313,7 @@ fn rate(k: u32, n: u32) -> f64 {
 
 /// A pair's figures: how often their behavior matched, and the first
 /// episode where it did not.
-fn pair_stats(a: &str, b: &str, t: &PairTally, runs: u32) -> PairStats {
+fn pair_stats(a: &str, b: &str, t: &PairTally, moved_alike: u32, runs: u32) -> PairStats {
     PairStats {
         a: a.to_string(),
         b: b.to_string(),
@@ -301,5 +324,7 @@ fn pair_stats(a: &str, b: &str, t: &PairTally, runs: u32) -> PairStats {
         first_divergence: t
             .first_divergence
             .map(|(episode, seed)| Diverged { episode, seed }),
+        moved_alike,
+        moved_alike_rate: rate(moved_alike, runs),
     }
 }

@@ -463,6 +463,7 @@ impl McReport {
                 "pair",
                 "behavior match rate",
                 "95% CI",
+                "moved alike",
                 "first diverging episode (seed)",
             ];
             let rows = (self.pairs.iter())
@@ -471,6 +472,7 @@ impl McReport {
                         format!("{} vs {}", p.a, p.b),
                         format!("{:.3}", p.match_rate),
                         format!("[{:.4}, {:.4}]", p.match_ci95[0], p.match_ci95[1]),
+                        format!("{:.3}", p.moved_alike_rate),
                         p.first_divergence
                             .as_ref()
                             .map_or("-".into(), |d| format!("{} (--seed {})", d.episode, d.seed)),

@@ -354,9 +354,10 @@ pub fn verdict(a: &Run, b: &Run) -> Verdict {
     )
 }
 
-/// Whether two runs' behavior matches (the verdict without its distances).
-pub fn behavior_matches(a: &Run, b: &Run) -> bool {
-    verdict_on(a, b, &[], &[]).matches
+/// The verdict of two runs without the Fréchet distance of their paths
+/// (`path_distance_m` 0), which Monte Carlo episodes do not report.
+pub fn verdict_without_path(a: &Run, b: &Run) -> Verdict {
+    verdict_on(a, b, &[], &[])
 }
 
 fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
