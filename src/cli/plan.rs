@@ -38,6 +38,11 @@ pub(crate) struct PlanArgs {
     /// (repeat for several, in order)
     #[arg(long = "goal", value_name = "FACT")]
     pub goals: Vec<String>,
+    /// A fact that holds at the start, replacing the goal's `init` (repeat
+    /// for several; every other fact is false): the planned FSM starts at
+    /// the step these facts let it resume at
+    #[arg(long = "init", value_name = "FACT")]
+    pub init: Vec<String>,
     /// Which policies to make
     #[arg(long, value_enum, default_value_t = PlanTarget::All)]
     pub to: PlanTarget,
@@ -91,9 +96,16 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
     {
         return fail(Diagnostic::error(e.to_string()));
     }
-    if !a.goals.is_empty()
-        && let Err(es) = domain.set_goal(&a.goals)
-    {
+    let set = |d: &mut plan::domain::Domain| {
+        if !a.goals.is_empty() {
+            d.set_goal(&a.goals)?;
+        }
+        if !a.init.is_empty() {
+            d.set_init(&a.init)?;
+        }
+        Ok::<(), Vec<String>>(())
+    };
+    if let Err(es) = set(&mut domain) {
         for e in es {
             eprint!("{}", Diagnostic::error(e.to_string()));
         }

@@ -55,6 +55,8 @@ pub struct Planned {
     /// Per node of `bt`: the domain action (index) and its parameters'
     /// objects, for action nodes.
     pub steps: Vec<Option<(usize, BTreeMap<String, String>)>>,
+    /// Per node of `bt`: the fact a condition node checks.
+    pub ensured: Vec<Option<Fact>>,
 }
 
 /// Why planning failed.
@@ -140,6 +142,12 @@ pub fn plan_bt(d: &Domain, opts: &Options) -> Result<Planned, PlanError> {
             _ => None,
         })
         .collect();
+    let ensured = (order.iter())
+        .map(|&n| match bt.nodes[n].kind {
+            BtNodeKind::Condition => p.ensured[n].clone(),
+            _ => None,
+        })
+        .collect();
     let mut nodes: Vec<BtNode> = order.iter().map(|&n| bt.nodes[n].clone()).collect();
     for n in &mut nodes {
         for c in &mut n.children {
@@ -151,6 +159,7 @@ pub fn plan_bt(d: &Domain, opts: &Options) -> Result<Planned, PlanError> {
         bt,
         conflicts: p.conflicts,
         steps,
+        ensured,
     })
 }
 

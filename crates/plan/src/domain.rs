@@ -74,6 +74,10 @@ pub struct Goal {
     /// The actions the planner may use for this goal (`use`; `None`: all).
     pub actions: Option<Vec<String>>,
     pub facts: Vec<Fact>,
+    /// The facts that hold when the task starts (`init`; every other fact
+    /// is false): the planned FSM starts at the step they let it resume
+    /// at. Empty: unknown, the FSM starts at the plan's first step.
+    pub init: Vec<Fact>,
     /// Node id of a goal fact's condition, by its text (`Object-At(cube2, delivery)`).
     pub ids: BTreeMap<String, String>,
     pub labels: BTreeMap<String, String>,
@@ -185,28 +189,47 @@ impl Domain {
     /// Replaces the goal by `facts` (`--goal`), each checked as a goal fact
     /// of the domain is; the errors say what is wrong with each.
     pub fn set_goal(&mut self, facts: &[String]) -> Result<(), Vec<String>> {
+        self.goal.facts = self.ground_facts(facts, "--goal", "goal")?;
+        Ok(())
+    }
+
+    /// Replaces the facts that hold at the start by `facts` (`--init`),
+    /// each checked as a goal fact is.
+    pub fn set_init(&mut self, facts: &[String]) -> Result<(), Vec<String>> {
+        self.goal.init = self.ground_facts(facts, "--init", "initial")?;
+        Ok(())
+    }
+
+    /// `facts` checked and grounded, at most [`MAX_SIBLINGS`]; the errors
+    /// name the option `flag` they were given with.
+    fn ground_facts(
+        &self,
+        facts: &[String],
+        flag: &str,
+        what: &str,
+    ) -> Result<Vec<Fact>, Vec<String>> {
         let mut errors = Vec::new();
-        let mut goal = Vec::new();
+        let mut out = Vec::new();
         for text in facts {
             match self.ground_fact(text) {
-                Ok(f) => goal.push(f),
+                Ok(f) => out.push(f),
                 Err((msg, hint)) => errors.push(format!(
-                    "--goal `{}`: {msg} ({hint})",
+                    "{flag} `{}`: {msg} ({hint})",
                     btfsm_core::sanitize::shown(text)
                 )),
             }
         }
-        if goal.len() > MAX_SIBLINGS {
+        if out.len() > MAX_SIBLINGS {
             errors.push(format!(
-                "{} goal facts, more than {MAX_SIBLINGS}",
-                goal.len()
+                "{} {what} facts, more than {MAX_SIBLINGS}",
+                out.len()
             ));
         }
-        if !errors.is_empty() {
-            return Err(errors);
+        if errors.is_empty() {
+            Ok(out)
+        } else {
+            Err(errors)
         }
-        self.goal.facts = goal;
-        Ok(())
     }
 }
 

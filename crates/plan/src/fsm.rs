@@ -35,24 +35,35 @@ pub enum FsmError {
     NoStep,
 }
 
-/// The plan's steps in nominal execution order.
+/// The plan's steps in nominal execution order: the BT ticked from a world
+/// where nothing holds, each step's effects applied as it completes, so a
+/// Fallback whose condition an earlier step made true (and no step undid
+/// since) runs no achiever — a door unlocked once is not unlocked again
+/// for the next part, a robot at the bench does not drive there again.
 pub fn steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
     let bt = &p.bt;
     let mut out = Vec::new();
+    let mut holds: Vec<Option<Fact>> = Vec::new();
     let mut stack = vec![bt.root];
     while let Some(n) = stack.pop() {
         let node = &bt.nodes[n];
         match node.kind {
             BtNodeKind::Action => {
                 if let Some((a, bind)) = &p.steps[n] {
-                    out.push(Step {
+                    let step = Step {
                         action: &d.actions[*a],
                         bind: bind.clone(),
-                    });
+                    };
+                    apply(d, &step, &mut holds);
+                    out.push(step);
                 }
             }
             BtNodeKind::Fallback | BtNodeKind::FallbackMemory => {
                 // The condition is checked, then the first achiever runs.
+                let checked = node.children.first().and_then(|&c| p.ensured[c].as_ref());
+                if checked.is_some_and(|f| holds.iter().flatten().any(|h| h == f)) {
+                    continue;
+                }
                 if let Some(&first) = node.children.get(1) {
                     stack.push(first);
                 }
@@ -61,6 +72,17 @@ pub fn steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
         }
     }
     out
+}
+
+/// The facts that hold after `step` completes where `holds` held.
+fn apply(d: &Domain, step: &Step<'_>, holds: &mut Vec<Option<Fact>>) {
+    let undone = super::conflicts::undone_by(d, step, holds);
+    holds.retain(|f| f.as_ref().is_some_and(|f| !undone.contains(f)));
+    for f in step.adds() {
+        if !holds.iter().flatten().any(|h| *h == f) {
+            holds.push(Some(f));
+        }
+    }
 }
 
 /// The kernels `K(1)..K(n+1)` of `steps` for `goal` (facts in order: a
@@ -125,11 +147,29 @@ pub fn plan_fsm(d: &Domain, p: &Planned) -> Result<StateMachine, FsmError> {
         states.push(connected_state(s, n + 1 + c, n, &names[n + c]));
     }
     let count = states.len();
+    let start = start_state(&ks, &d.goal.init);
     Ok(StateMachine {
         hierarchical: false,
-        top: Region::at(0, vec!["SUCCESS".into()], (0..count).collect()),
+        top: Region::at(start, vec!["SUCCESS".into()], (0..count).collect()),
         states,
     })
+}
+
+/// Where the machine starts, with the `n + 1` kernels `ks`, when the facts
+/// `init` hold at the start (and no other): the latest step whose kernel
+/// holds, as the SELECTOR would resume; the SELECTOR (state `n`) when the
+/// goal itself holds (it goes to `SUCCESS`) or no kernel does. Without
+/// `init`: the first step, as Fig. 4 starts.
+fn start_state(ks: &[Vec<Fact>], init: &[Fact]) -> usize {
+    let n = ks.len() - 1;
+    if init.is_empty() {
+        return 0;
+    }
+    let holds = |k: &Vec<Fact>| k.iter().all(|f| init.contains(f));
+    if holds(&ks[n]) {
+        return n;
+    }
+    (0..n).rev().find(|&k| holds(&ks[k])).unwrap_or(n)
 }
 
 /// The states' names, the chain's steps then the connected ones: each

@@ -174,3 +174,79 @@ fn the_moma_plan_gives_the_fault_tolerant_fsm_of_fig_4() {
     };
     assert_eq!(machine_shape(&m), machine_shape(fig04));
 }
+
+const KITTING: &str = include_str!("../../../tests/fixtures/domains/kitting.toml");
+
+/// The planned FSM's chain is the BT's nominal execution with each step's
+/// effects applied: the door unlocked for the bolt stays unlocked for the
+/// nut, and a robot at the bench does not drive there again (before: three
+/// `Move-To bench` and two `Unlock door` in a row of 13 steps).
+#[test]
+fn the_plan_chain_does_not_redo_what_holds() {
+    let d = domain(KITTING);
+    let p = plan_bt(&d, &Options::default()).unwrap();
+    let m = fsm::plan_fsm(&d, &p).unwrap();
+    let names: Vec<&str> = m.states.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "Move-To bench",
+            "Unlock door",
+            "Enter shelf room",
+            "Pick bolt",
+            "Move-To bench (2)",
+            "Place bolt in tray",
+            "Enter shelf room (2)",
+            "Pick nut",
+            "Move-To bench (3)",
+            "Place nut in tray",
+            "SELECTOR",
+        ]
+    );
+}
+
+/// With `init` (or `--init`) the machine starts at the latest step whose
+/// triangle-table kernel the initial facts satisfy, as its SELECTOR would
+/// resume; without, at the first step (Fig. 4); at the SELECTOR when the
+/// goal already holds.
+#[test]
+fn the_planned_fsm_starts_where_the_initial_facts_let_it() {
+    let start = |init: &[&str]| {
+        let mut d = domain(KITTING);
+        let init: Vec<String> = init.iter().map(|s| s.to_string()).collect();
+        d.set_init(&init).unwrap();
+        let p = plan_bt(&d, &Options::default()).unwrap();
+        let m = fsm::plan_fsm(&d, &p).unwrap();
+        m.states[m.top.initial_state().unwrap()].name.clone()
+    };
+    assert_eq!(start(&[]), "Move-To bench");
+    assert_eq!(start(&["Robot-At(bench)"]), "Unlock door");
+    assert_eq!(start(&["Door-Unlocked", "Robot-At(shelf)"]), "Pick bolt");
+    assert_eq!(
+        start(&[
+            "Door-Unlocked",
+            "In-Tray(bolt)",
+            "In-Hand(nut)",
+            "Robot-At(bench)"
+        ]),
+        "Place nut in tray"
+    );
+    assert_eq!(start(&["In-Tray(bolt)", "In-Tray(nut)"]), "SELECTOR");
+    let mut d = domain(KITTING);
+    let e = d.set_init(&["In-Tray(screw)".into()]).unwrap_err();
+    assert!(e[0].starts_with("--init `In-Tray(screw)`"), "{e:?}");
+}
+
+/// `init` in the goal's table reads as `--init` does.
+#[test]
+fn init_in_the_domain_sets_the_start() {
+    let text = KITTING.replace(
+        "facts = [\"In-Tray(bolt)\", \"In-Tray(nut)\"]",
+        "facts = [\"In-Tray(bolt)\", \"In-Tray(nut)\"]\ninit = [\"Robot-At(bench)\"]",
+    );
+    let d = domain(&text);
+    assert_eq!(d.goal.init.len(), 1);
+    let p = plan_bt(&d, &Options::default()).unwrap();
+    let m = fsm::plan_fsm(&d, &p).unwrap();
+    assert_eq!(m.states[m.top.initial_state().unwrap()].name, "Unlock door");
+}

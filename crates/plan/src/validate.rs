@@ -130,6 +130,8 @@ struct RawGoal {
     use_actions: Option<Vec<Spanned<String>>>,
     facts: Vec<Spanned<String>>,
     #[serde(default)]
+    init: Vec<Spanned<String>>,
+    #[serde(default)]
     ids: BTreeMap<String, String>,
     #[serde(default)]
     labels: BTreeMap<String, String>,
@@ -360,6 +362,7 @@ impl Validator {
             id: g.id.clone().unwrap_or_else(|| d.name.clone()),
             actions: None,
             facts: Vec::new(),
+            init: Vec::new(),
             ids: g.ids.clone(),
             labels: g.labels.clone(),
         };
@@ -384,6 +387,20 @@ impl Validator {
         let empty_params: Vec<Param> = Vec::new();
         for f in self.patterns(&g.facts, &empty_params, d) {
             out.facts.push(f.ground(&|_| None));
+        }
+        if g.init.len() > MAX_SIBLINGS {
+            self.err(
+                raw.span(),
+                format!(
+                    "`init` has {} facts, more than {MAX_SIBLINGS}",
+                    g.init.len()
+                ),
+                "name only the facts the task depends on",
+            );
+        } else {
+            for f in self.patterns(&g.init, &empty_params, d) {
+                out.init.push(f.ground(&|_| None));
+            }
         }
         if let Some(names) = &g.use_actions {
             let mut ok = Vec::new();
