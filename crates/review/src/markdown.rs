@@ -10,7 +10,8 @@
 //! list items through `sanitize::markdown_cell`/`markdown_code`, file names
 //! in a `<summary>` as HTML-escaped `<code>` (no mention, link or tag),
 //! code blocks fenced longer than any run of backticks in them and with
-//! `<` written `\u{3c}`, Mermaid labels escaped by `render::mermaid`.
+//! `<` written `\u{3c}`, Mermaid labels escaped by `render::mermaid` and
+//! every `%` in a drawing as Mermaid's `#37;` (no `%%{init}%%` directive).
 
 use super::{FileReview, Metrics, Review, Status};
 use btfsm_core::sanitize::{code_fence, markdown_cell, markdown_code, markup};
@@ -103,7 +104,11 @@ fn head(r: &Review) -> String {
         .as_deref()
         .map_or_else(|| "no btfsm.toml in base".to_string(), markdown_code);
     if r.gates.is_empty() {
-        out.push_str(&format!("No gates set ({from}, `[review]`).\n\n"));
+        out.push_str(if r.gates.config.is_some() {
+            "No gates set: the base revision's `btfsm.toml` has no `[review]` gate.\n\n"
+        } else {
+            "No gates set: the base revision has no `btfsm.toml`.\n\n"
+        });
     } else if failures.is_empty() {
         out.push_str(&format!("**Gates passed** ({from}).\n\n"));
     } else {
@@ -280,6 +285,10 @@ fn changes(out: &mut String, f: &FileReview) {
 fn diagram(out: &mut String, f: &FileReview) {
     match &f.diagram {
         Some(Ok(text)) => {
+            // Mermaid reads a `%%{init}%%` directive anywhere in the text,
+            // a label included: `%` as its entity code (`#37;`); the
+            // drawings write no `%%` comment of their own.
+            let text = &text.replace('%', "#37;");
             let fence = code_fence(text);
             let what = if f.status == Status::Added {
                 "the new policy"
