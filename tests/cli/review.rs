@@ -155,22 +155,16 @@ fn review_finds_added_removed_renamed_and_modified_policies() {
         "bt/added.xml",
         &nav_fixture_small().replace("distance=\"1.0\"", "distance=\"2.0\""),
     );
-    let (code, out, _) = btfsm_in(
-        &d,
-        &[
-            "review",
-            "--base",
-            "HEAD",
-            "--format",
-            "json",
-            "bt/added.xml",
-        ],
-    );
+    write(&d, "bt/untracked.xml", UNREACHABLE);
+    write(&d, "elsewhere/x.xml", UNREACHABLE);
+    let args = ["review", "--base", "HEAD", "--format", "json", "bt"];
+    let (code, out, _) = btfsm_in(&d, &args);
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["head"]["commit"], serde_json::Value::Null);
-    assert_eq!(v["files"].as_array().unwrap().len(), 1);
+    assert_eq!(v["files"].as_array().unwrap().len(), 2, "{v:#}");
     assert_eq!(file(&v, "bt/added.xml")["status"], "modified");
+    assert_eq!(file(&v, "bt/untracked.xml")["status"], "added");
 }
 
 /// A small real Nav2 tree (Apache-2.0, tests/fixtures/corpus).

@@ -191,11 +191,15 @@ fn dependents(
     if changed.is_empty() {
         return Ok(());
     }
-    let names: Vec<(&str, &str)> = changed
-        .iter()
-        .filter(|p| is_candidate(p))
-        .map(|p| (p.as_str(), p.rsplit('/').next().unwrap_or(p)))
-        .collect();
+    // Changed files by file name: a file names another by a path ending
+    // in it (`<include path="../sub/sub.xml"/>`).
+    let mut names: std::collections::HashMap<&str, Vec<&str>> = std::collections::HashMap::new();
+    for p in changed.iter().filter(|p| is_candidate(p)) {
+        names
+            .entry(p.rsplit('/').next().unwrap_or(p))
+            .or_default()
+            .push(p);
+    }
     let models: Vec<&str> = changed
         .iter()
         .filter(|p| btfsm_lint::search::is_model_name(p.rsplit('/').next().unwrap_or(p)))
@@ -214,10 +218,10 @@ fn dependents(
         let Ok(text) = std::fs::read_to_string(&input.path) else {
             continue;
         };
-        let mut via: Vec<String> = names
-            .iter()
-            .filter(|(_, base)| text.contains(base))
-            .map(|(p, _)| p.to_string())
+        let mut via: Vec<String> = file_names(&text)
+            .filter_map(|n| names.get(n))
+            .flatten()
+            .map(|p| p.to_string())
             .collect();
         if !models.is_empty() && text.contains("<BehaviorTree") {
             let found = rh.found_models(&rel);
@@ -249,4 +253,25 @@ fn dependents(
         }
     }
     Ok(())
+}
+
+/// The file names a text mentions: each run of characters that may be
+/// part of a file name (no `/`, quote or blank) and ends in a reader's
+/// extension (one pass over the text; a name with a blank is found by its
+/// last word only).
+fn file_names(text: &str) -> impl Iterator<Item = &str> {
+    text.split(|c: char| {
+        !(c.is_alphanumeric() || matches!(c, '.' | '_' | '-' | '+' | '@' | '~' | '%'))
+    })
+    .filter(|w| is_candidate(w))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn file_names_are_found_in_one_pass() {
+        let t = r#"<include path="../sub/sub.xml"/> <include ros_pkg="p" path="a b.toml"/> x.xmlz"#;
+        let got: Vec<&str> = super::file_names(t).collect();
+        assert_eq!(got, ["sub.xml", "b.toml"]);
+    }
 }
