@@ -12,9 +12,10 @@
 //!   transitions labelled by outcome or guard.
 //!
 //! Identifiers are generated (`n0`, `s3`, ...), never taken from the file;
-//! every label is written between quotes with `"`, `#`, `<`, `>`, `:` and
-//! `;` as Mermaid entity codes and control characters removed, so no name
-//! can end a statement or inject markup.
+//! every label is written between quotes with `"`, `#`, `<`, `>`, `:`, `;`
+//! and `%` as Mermaid entity codes and control characters removed, so no
+//! name can end a statement, inject markup or open a `%%{init}%%`
+//! directive.
 
 use btfsm_model::Policy;
 use btfsm_model::bt::{Arity, Bt};
@@ -32,6 +33,9 @@ pub fn label(s: &str) -> String {
             '>' => out.push_str("#gt;"),
             ':' => out.push_str("#58;"),
             ';' => out.push_str("#59;"),
+            // Mermaid reads a `%%{init: ...}%%` directive anywhere in the
+            // text, inside a quoted label too.
+            '%' => out.push_str("#37;"),
             '\n' | '\r' | '\t' => out.push(' '),
             c if c.is_control() || btfsm_core::sanitize::is_unsafe(c, false) => {}
             c => out.push(c),
@@ -52,6 +56,8 @@ pub fn front_matter(name: &str) -> String {
             c => Some(c),
         })
         .collect();
+    // `%%` would open a directive (`%%{init}%%`) or a comment.
+    let title = title.replace("%%", "% %").replace("%%", "% %");
     format!("---\ntitle: '{}'\n---\n", title.replace('\'', "''"))
 }
 
@@ -356,6 +362,8 @@ mod tests {
             label("a\"b; c: <d> #e\nf\u{1b}"),
             "a#quot;b#59; c#58; #lt;d#gt; #35;e f"
         );
+        assert_eq!(label("%%{init: {}}%%"), "#37;#37;{init#58; {}}#37;#37;");
+        assert!(!front_matter("a %%%{init}%%").contains("%%"));
     }
 
     #[test]

@@ -11,7 +11,7 @@
 //! in a `<summary>` as HTML-escaped `<code>` (no mention, link or tag),
 //! code blocks fenced longer than any run of backticks in them and with
 //! `<` written `\u{3c}`, Mermaid labels escaped by `render::mermaid` and
-//! every `%` in a drawing as Mermaid's `#37;` (no `%%{init}%%` directive).
+//! every `%` in a drawing's labels as Mermaid's `#37;` (no `%%{init}%%` directive).
 
 use super::{FileReview, Metrics, Review, Status};
 use btfsm_core::sanitize::{code_fence, markdown_cell, markdown_code, markup};
@@ -285,10 +285,8 @@ fn changes(out: &mut String, f: &FileReview) {
 fn diagram(out: &mut String, f: &FileReview) {
     match &f.diagram {
         Some(Ok(text)) => {
-            // Mermaid reads a `%%{init}%%` directive anywhere in the text,
-            // a label included: `%` as its entity code (`#37;`); the
-            // drawings write no `%%` comment of their own.
-            let text = &text.replace('%', "#37;");
+            // Every label has `%` as its entity code (`#37;`,
+            // btfsm_render::mermaid::label): no `%%{init}%%` directive.
             let fence = code_fence(text);
             let what = if f.status == Status::Added {
                 "the new policy"
