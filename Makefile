@@ -77,7 +77,8 @@ test: prerequisites
 # problems BehaviorTree.CPP meets at creation and which at the first tick, as
 # `lint` reports them (btcpp_when.py); the
 # port rules of `lint` against BehaviorTree.CPP 4 creating 1000 seeded
-# random trees (dataflow_btcpp.py); logs
+# random trees (dataflow_btcpp.py); every JUnit report of `lint` read by
+# `junitparser` and `colcon test-result` as CI reads it (junit_check.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
 # compared by `log compare` as its Python leaves saw them (btlog_compare.py),
 # and as SqliteLogger .db3 sessions counted by SQL (btlog_db3.py); every
@@ -106,6 +107,7 @@ differential: $(VENV)/.installed
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
 	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
+	$(VENV)/bin/python tests/differential/junit_check.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/btcpp_when.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/dataflow_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm --trees 1000 > $(TARGET_DIR)/dataflow_btcpp.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/dataflow_btcpp.txt | tail -40; exit 1; }
