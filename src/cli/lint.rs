@@ -56,6 +56,11 @@ pub(crate) struct LintArgs {
     /// cannot change)
     #[arg(long, value_name = "FILE", conflicts_with = "no_config")]
     pub config: Option<PathBuf>,
+    /// Skip the files named that hold no policy, as those found below a
+    /// directory are (a pre-commit hook is given every changed .xml and
+    /// .toml file: a ROS package.xml, a Cargo.toml)
+    #[arg(long)]
+    pub only_policies: bool,
     /// List the rules with their default level and summary, and exit
     #[arg(long, exclusive = true)]
     pub list: bool,
@@ -73,7 +78,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
         return EXIT_BAD_INPUT;
     };
     let inputs = match format::discover::expand(&a.files) {
-        Ok(i) => i,
+        Ok(i) => super::io::only_policies(i, a.only_policies),
         Err(d) => {
             print_diagnostics(&mut err, &[d]);
             return EXIT_BAD_INPUT;
