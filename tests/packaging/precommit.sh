@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # The pre-commit hooks of .pre-commit-hooks.yaml, run as a user's
-# repository runs them: `pre-commit try-repo` of a snapshot of this work
-# tree (its uncommitted changes included) on a temporary git repository.
-# pre-commit installs the hooks' environment once (pip builds the wheel of
-# pyproject.toml: maturin, cargo with the CARGO_TARGET_DIR of the caller,
-# so dependencies already built are reused) and runs:
+# repository runs them: a `.pre-commit-config.yaml` naming a snapshot of
+# this work tree (its uncommitted changes included) at one commit, run by
+# `pre-commit run --all-files` in temporary git repositories. pre-commit
+# installs the hooks' environment once into a PRE_COMMIT_HOME shared by
+# every run (pip builds the wheel of pyproject.toml: maturin, then cargo
+# with the caller's CARGO_TARGET_DIR, so dependencies already built are
+# reused). `pre-commit try-repo` does the same with a store of its own per
+# call, so one build per call: the runs below share one instead.
 # - btfsm-validate and btfsm-lint: pass on good files (a TOML policy, a
 #   BehaviorTree.CPP tree, a ROS package.xml and a Cargo.toml, which hold
 #   no policy), fail on a node type the tree's model does not declare
@@ -38,11 +41,21 @@ git -C "$snap" add -A
 git -C "$snap" commit -qm snapshot
 rev=$(git -C "$snap" rev-parse HEAD)
 
+cat >"$tmp/config.yaml" <<CONFIG
+repos:
+  - repo: $snap
+    rev: $rev
+    hooks:
+      - id: btfsm-validate
+      - id: btfsm-lint
+      - id: btfsm-render
+CONFIG
+
 fail=0
 try() { # WANTED(pass|fail) HOOK DIR [GREP]
   local want=$1 hook=$2 dir=$3 grep=${4:-} t0 code=0
   t0=$(date +%s)
-  (cd "$dir" && "$pc" try-repo "$snap" "$hook" --ref "$rev" --all-files) >"$tmp/out" 2>&1 || code=$?
+  (cd "$dir" && "$pc" run "$hook" --all-files --config "$tmp/config.yaml") >"$tmp/out" 2>&1 || code=$?
   local got=pass
   [ "$code" = 0 ] || got=fail
   if [ "$got" != "$want" ] || { [ -n "$grep" ] && ! grep -q -- "$grep" "$tmp/out"; }; then
@@ -79,8 +92,10 @@ printf '<root BTCPP_format="4"><BehaviorTree ID="M">' >"$broken/trees/broken.xml
 git -C "$broken" add -A
 
 t0=$(date +%s)
+(cd "$good" && "$pc" install-hooks --config "$tmp/config.yaml") >"$tmp/out" 2>&1 \
+  || { echo "FAIL pre-commit install-hooks:"; tail -30 "$tmp/out"; exit 1; }
+echo "ok   pre-commit installed the hooks (pip -> maturin -> cargo): $(( $(date +%s) - t0 )) s"
 try pass btfsm-validate "$good" "Passed"
-echo "     (the first run installed the hooks: $(( $(date +%s) - t0 )) s)"
 try pass btfsm-lint "$good" "Passed"
 try fail btfsm-lint "$unknown" "unknown-node-type"
 try pass btfsm-validate "$unknown"
