@@ -11,10 +11,12 @@
 # - btfsm-validate and btfsm-lint: pass on good files (a TOML policy, a
 #   BehaviorTree.CPP tree, a ROS package.xml and a Cargo.toml, which hold
 #   no policy), fail on a node type the tree's model does not declare
-#   (lint) and on a file that does not load (both);
-# - btfsm-render: writes NAME.svg beside each policy (the first run fails,
-#   "files were modified", as formatters do), passes once they are added;
-#   without Graphviz's dot it fails saying what to install.
+#   and on a file that does not load;
+# - btfsm-render: writes NAME.svg beside each policy (new files, which the
+#   user adds); once they are committed, a change to a policy that changes
+#   its drawing fails the hook ("files were modified", as formatters do)
+#   until the new drawing is added; without Graphviz's dot it fails
+#   saying what to install.
 # Prints each step's time. Exit 0 when all pass, 1 otherwise.
 #
 # Usage: tests/packaging/precommit.sh PRE_COMMIT
@@ -98,14 +100,20 @@ echo "ok   pre-commit installed the hooks (pip -> maturin -> cargo): $(( $(date 
 try pass btfsm-validate "$good" "Passed"
 try pass btfsm-lint "$good" "Passed"
 try fail btfsm-lint "$unknown" "unknown-node-type"
-try pass btfsm-validate "$unknown"
+try fail btfsm-validate "$unknown" "ComputePathToPos"
 try fail btfsm-validate "$broken" "broken.xml"
 try fail btfsm-lint "$broken" "broken.xml"
-try fail btfsm-render "$good" "files were modified by this hook"
+try pass btfsm-render "$good" "Passed"
 for svg in policies/fig01.svg trees/tree.svg; do
   head -c 200 "$good/$svg" 2>/dev/null | grep -q "<svg\|<?xml" || { echo "FAIL btfsm-render wrote no $svg"; fail=1; }
 done
 [ ! -e "$good/package.svg" ] && [ ! -e "$good/Cargo.svg" ] || { echo "FAIL btfsm-render drew a file that holds no policy"; fail=1; }
+# Once the drawings are committed, a changed policy whose drawing changes
+# fails the hook, as a formatter does, until the new drawing is added.
+git -C "$good" add -A
+cp "$repo/policies/paper/fig03-bt.toml" "$good/policies/fig01.toml"
+git -C "$good" add -A
+try fail btfsm-render "$good" "files were modified by this hook"
 git -C "$good" add -A
 try pass btfsm-render "$good" "Passed"
 
