@@ -47,6 +47,11 @@ pub(crate) enum Command {
     /// smells, BehaviorTree.CPP ports and blackboard keys); text, JSON,
     /// SARIF or JUnit XML; exit 1 when an error-level finding remains
     Lint(super::lint::LintArgs),
+    /// Reviews the policy changes between two git revisions: metrics
+    /// before and after, GED, tree distance, changes, new lint findings
+    /// and diff drawings, as text, JSON or one pull-request comment; exit
+    /// 1 when a gate of the base revision's btfsm.toml fails
+    Review(super::review::ReviewArgs),
     /// Reads BehaviorTree.CPP execution logs (.btlog, .db3): `log report`,
     /// `log dot`, `log compare`, `log timeline`
     Log(super::log::LogArgs),
@@ -86,6 +91,7 @@ impl Command {
             Command::Tick(a) => &a.limits,
             Command::Plan(a) => &a.limits,
             Command::Lint(a) => &a.limits,
+            Command::Review(a) => &a.limits,
             Command::Log(a) => match &a.command {
                 LogCommand::Report(a) => &a.limits,
                 LogCommand::Dot(a) => &a.limits,

@@ -41,6 +41,7 @@ mod log;
 mod man;
 mod paper;
 mod plan;
+mod review;
 mod sim;
 mod ted_pairs;
 mod tick;
@@ -94,6 +95,7 @@ fn execute(command: args::Command) -> u8 {
         Command::Tick(a) => tick::execute(a),
         Command::Plan(a) => plan::execute(a),
         Command::Lint(a) => lint::execute(a),
+        Command::Review(a) => review::run(a),
         Command::Log(a) => log::execute(a),
         Command::View(a) => view::execute(a),
         Command::TedPairs(a) => ted_pairs::execute(a),

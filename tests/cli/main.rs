@@ -27,6 +27,7 @@ mod log;
 mod paper;
 mod plan;
 mod provenance;
+mod review;
 mod sim;
 mod tick;
 mod untrusted;

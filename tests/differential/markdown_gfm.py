@@ -7,7 +7,8 @@ names each markdown writer shows: `compare --format markdown` (policy
 names, node ids, labels, skill arguments, file names), `sim --runs N
 --format markdown` (scenario and policy names), `log report --format
 markdown` and `log compare --format markdown` (node names, ports, file
-names). Each output is rendered by cmark-gfm (PyPI `cmarkgfm`, GitHub's
+names), `review --format markdown` (file names, policy names, node ids,
+labels and arguments in a two-commit repository). Each output is rendered by cmark-gfm (PyPI `cmarkgfm`, GitHub's
 fork of cmark, with its GitHub extensions: tables, autolinks,
 strikethrough, task lists; raw HTML kept, as GitHub keeps it before its
 sanitiser) and compared with the output of the same inputs whose strings
@@ -226,8 +227,32 @@ def log_compare_case(exe, d, s):
     return run(exe, ["log", "compare", a.name, b.name, "--format", "markdown"], d)
 
 
+def git(d, *args):
+    env = {"GIT_CONFIG_NOSYSTEM": "1", "HOME": str(d), "PATH": "/usr/bin:/bin:/usr/local/bin"}
+    subprocess.run(["git", "-c", "user.name=t", "-c", "user.email=t@example.org",
+                    "-c", "commit.gpgsign=false", *args],
+                   cwd=d, env=env, check=True, capture_output=True, timeout=60)
+
+
+def review_case(exe, d, s):
+    """`review --format markdown` of a two-commit repository: a policy file
+    (hostile name, ids, labels) changed as compare_case changes it, and
+    another added."""
+    git(d, "init", "-q", "-b", "main")
+    fa, fb = d / file_name(s[8], ".toml"), d / file_name(s[9], ".toml")
+    fa.write_text(bt_policy(s[0], s[2:5], s[5:7], s[7]))
+    git(d, "add", "-A")
+    git(d, "commit", "-q", "-m", "base")
+    fa.write_text(bt_policy(s[1], [s[2], s[3], s[5]], [s[6], s[4]], s[7]))
+    fb.write_text(bt_policy(s[1], s[2:5], s[5:7], s[7]))
+    git(d, "add", "-A")
+    git(d, "commit", "-q", "-m", "head")
+    return run(exe, ["review", "--base", "HEAD~1", "--head", "HEAD", "--format", "markdown"], d)
+
+
 WRITERS = [("compare", compare_case, 10), ("sim", sim_case, 3),
-           ("log report", log_report_case, 5), ("log compare", log_compare_case, 7)]
+           ("log report", log_report_case, 5), ("log compare", log_compare_case, 7),
+           ("review", review_case, 10)]
 
 
 def main():

@@ -62,6 +62,9 @@ impl Config {
 struct RawFile {
     #[serde(default)]
     lint: RawLint,
+    /// `btfsm review`'s gates (`btfsm_review::gate`), read there.
+    #[serde(default, rename = "review")]
+    _review: Option<toml::Value>,
 }
 
 #[derive(serde::Deserialize, Default)]
