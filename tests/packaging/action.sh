@@ -112,8 +112,8 @@ marker='<!-- btfsm-review -->'
 
 # a. No comment yet: one POST of the markdown.
 echo '[]' >"$tmp/comments.json"
-run_action first
 review_code=$(cd "$r" && "$btfsm" review --base "$base_sha" --format markdown >"$tmp/expected.md" 2>/dev/null; echo $?)
+run_action first
 [ "$code" = "$review_code" ] || no "first run: exit $code, review's is $review_code"
 grep -q "^call 1: \[api\] \[--paginate\] \[repos/someone/repo/issues/7/comments?per_page=100\]" "$tmp/gh.log" || no "no comment list: $(cat "$tmp/gh.log")"
 grep -q "^call 2: \[api\] \[--method\] \[POST\] \[repos/someone/repo/issues/7/comments\] \[--input\]" "$tmp/gh.log" || no "no POST: $(cat "$tmp/gh.log")"
