@@ -88,14 +88,15 @@ pub(super) fn run(a: ValidateArgs) -> u8 {
         }
     }
     note_skipped(&mut err, skipped);
-    if inputs.len() == skipped && !a.only_policies {
+    let none = inputs.len() == skipped && !a.only_policies;
+    if none {
         let _ = write!(
             err,
             "{}",
             Diagnostic::error("no policy or scenario file below the directories given")
         );
     }
-    if failed || inputs.len() == skipped {
+    if failed || none {
         EXIT_BAD_INPUT
     } else {
         EXIT_OK
