@@ -7,7 +7,7 @@ VENV := .venv
 POLICIES := $(wildcard policies/paper/*.toml)
 SCENARIOS := $(wildcard policies/scenarios/*.toml)
 
-.PHONY: prerequisites build run test bench bench-ged bench-ted clean paper-docs fuzz mermaid-oracle man differential browser-test view-screenshots
+.PHONY: prerequisites build run test bench bench-ged bench-ted clean paper-docs fuzz mermaid-oracle man differential browser-test view-screenshots wheel packaging
 
 build:
 	$(CARGO) build --release --locked
@@ -64,6 +64,7 @@ test: prerequisites
 	$(MAKE) --no-print-directory mermaid-oracle
 	$(MAKE) --no-print-directory differential
 	$(MAKE) --no-print-directory browser-test
+	$(MAKE) --no-print-directory packaging
 
 # `btfsm tick` against BehaviorTree.CPP 4 (behaviortreepy, pinned in
 # tests/differential/requirements.txt, installed into .venv) on 3000 seeded
@@ -77,7 +78,8 @@ test: prerequisites
 # problems BehaviorTree.CPP meets at creation and which at the first tick, as
 # `lint` reports them (btcpp_when.py); the
 # port rules of `lint` against BehaviorTree.CPP 4 creating 1000 seeded
-# random trees (dataflow_btcpp.py); logs
+# random trees (dataflow_btcpp.py); every JUnit report of `lint` read by
+# `junitparser` and `colcon test-result` as CI reads it (junit_check.py); logs
 # BehaviorTree.CPP writes, read exactly by `log report` (btlog_check.py) and
 # compared by `log compare` as its Python leaves saw them (btlog_compare.py),
 # and as SqliteLogger .db3 sessions counted by SQL (btlog_db3.py); every
@@ -106,6 +108,7 @@ differential: $(VENV)/.installed
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
 	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
+	$(VENV)/bin/python tests/differential/junit_check.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/btcpp_when.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/dataflow_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm --trees 1000 > $(TARGET_DIR)/dataflow_btcpp.txt 2>&1 \
 	  || { grep -v '^Warnings\|^Please' $(TARGET_DIR)/dataflow_btcpp.txt | tail -40; exit 1; }
@@ -127,6 +130,33 @@ differential: $(VENV)/.installed
 # The paper's dense FSMs (and Fig. 6's HFSM) whose pairs ged_highs.py also
 # checks against HiGHS: every pair of them, both modes.
 GED_PAPER_FILES := policies/paper/fig16b-fsm.toml,policies/paper/fig08e-fsm.toml,policies/paper/fig09b-fsm.toml,policies/paper/fig06-hfsm.toml,policies/paper/fig08d-fsm.toml,policies/paper/scal-fsm.toml,policies/paper/fig15-fsm.toml
+
+# `pip install btfsm`: the wheel of pyproject.toml (maturin, `bindings =
+# "bin"`), built into $(TARGET_DIR)/wheels with the same target folder, so
+# after `make build` it only packs the binary. The tools of `make packaging`
+# (maturin, pre-commit, actionlint, zizmor) are pinned in
+# tests/packaging/requirements.txt and installed into .venv.
+$(VENV)/.packaging: tests/packaging/requirements.txt | $(VENV)/.installed
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tests/packaging/requirements.txt
+	touch $@
+
+wheel: $(VENV)/.packaging
+	@rm -f $(TARGET_DIR)/wheels/btfsm-*.whl
+	@t0=$$(date +%s); \
+	CARGO_TARGET_DIR=$(abspath $(TARGET_DIR)) $(VENV)/bin/maturin build --quiet --release --locked --out $(TARGET_DIR)/wheels \
+	  && echo "wheel: built in $$(( $$(date +%s) - t0 )) s"
+
+# The wheel installed into a fresh venv and run with no Rust toolchain on
+# PATH (tests/packaging/wheel.sh); the GitHub Action and the example
+# workflow checked by actionlint and zizmor, and action/review.sh run
+# against a local repository with a fake `gh` (tests/packaging/action.sh);
+# the pre-commit hooks run by `pre-commit run` on temporary repositories
+# (tests/packaging/precommit.sh; pip builds the package there once, with
+# this target folder, so only btfsm's own crates are compiled again).
+packaging: build wheel
+	tests/packaging/wheel.sh $(TARGET_DIR)/wheels
+	tests/packaging/action.sh $(VENV)/bin $(BIN)
+	CARGO_TARGET_DIR=$(abspath $(TARGET_DIR)) tests/packaging/precommit.sh $(VENV)/bin/pre-commit
 
 # `convert --to mermaid` parsed by Mermaid itself (npm packages pinned in
 # tests/differential/mermaid/package-lock.json; needs Node.js 18+ and npm).

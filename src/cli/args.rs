@@ -44,8 +44,8 @@ pub(crate) enum Command {
     /// precondition conflict no order resolves is left)
     Plan(super::plan::PlanArgs),
     /// Checks policies against coded rules (structure, the paper's
-    /// smells, BehaviorTree.CPP ports and blackboard keys); text, JSON or
-    /// SARIF; exit 1 when an error-level finding remains
+    /// smells, BehaviorTree.CPP ports and blackboard keys); text, JSON,
+    /// SARIF or JUnit XML; exit 1 when an error-level finding remains
     Lint(super::lint::LintArgs),
     /// Reviews the policy changes between two git revisions: metrics
     /// before and after, GED, tree distance, changes, new lint findings

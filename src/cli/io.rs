@@ -166,6 +166,20 @@ pub(super) fn with_companions(
 }
 
 /// Says how many files found below directories held no policy.
+/// With `--only-policies`, the files named are read as those found below
+/// a directory: skipped when they hold no policy (stdin is read as given).
+pub(super) fn only_policies(
+    mut inputs: Vec<format::discover::Input>,
+    only: bool,
+) -> Vec<format::discover::Input> {
+    if only {
+        for i in &mut inputs {
+            i.found |= i.path.as_os_str() != "-";
+        }
+    }
+    inputs
+}
+
 pub(super) fn note_skipped(err: &mut impl Write, skipped: usize) {
     if skipped > 0 {
         let _ = writeln!(

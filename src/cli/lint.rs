@@ -1,7 +1,8 @@
 //! `btfsm lint FILE|DIR...`: runs the lint rules (src/lint/) on every policy
 //! given or found below a directory; prints findings as positioned text,
-//! JSON or SARIF 2.1.0; exit 1 when an error-level finding remains, 2 when
-//! an input does not load (its errors printed, the others still linted).
+//! JSON, SARIF 2.1.0 or JUnit XML; exit 1 when an error-level finding
+//! remains, 2 when an input does not load (its errors printed, the others
+//! still linted).
 
 use super::io::{emit_report, emit_text, print_diagnostics};
 use super::{EXIT_BAD_INPUT, EXIT_CHECK_FAILED, EXIT_OK};
@@ -22,6 +23,10 @@ const LINT_HELP: super::format::Help = &[
         "Positioned messages with snippet and help, as `validate` prints",
     ),
     (Format::Sarif, "SARIF 2.1.0, for GitHub code scanning"),
+    (
+        Format::Junit,
+        "JUnit XML, one testcase per file, for colcon test, GitLab and Jenkins",
+    ),
 ];
 
 #[derive(Debug, Args)]
@@ -51,6 +56,11 @@ pub(crate) struct LintArgs {
     /// cannot change)
     #[arg(long, value_name = "FILE", conflicts_with = "no_config")]
     pub config: Option<PathBuf>,
+    /// Skip the files named that hold no policy, as those found below a
+    /// directory are (a pre-commit hook is given every changed .xml and
+    /// .toml file: a ROS package.xml, a Cargo.toml)
+    #[arg(long)]
+    pub only_policies: bool,
     /// List the rules with their default level and summary, and exit
     #[arg(long, exclusive = true)]
     pub list: bool,
@@ -68,7 +78,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
         return EXIT_BAD_INPUT;
     };
     let inputs = match format::discover::expand(&a.files) {
-        Ok(i) => i,
+        Ok(i) => super::io::only_policies(i, a.only_policies),
         Err(d) => {
             print_diagnostics(&mut err, &[d]);
             return EXIT_BAD_INPUT;
@@ -96,10 +106,7 @@ pub(super) fn execute(a: LintArgs) -> u8 {
         }
     };
     let run = lint_inputs(&inputs, only.as_deref(), &limits, &cfg);
-    let report = Findings {
-        run: &run,
-        files: run.files,
-    };
+    let report = Findings { run: &run };
     let code = emit_report(None, &report, a.format);
     if a.format != Format::Text && !run.not_linted.is_empty() {
         let _ = write!(
@@ -247,8 +254,8 @@ fn is_model_file(path: &Path, limits: &format::Limits) -> bool {
 /// path and why), and the node types no model declares, by file.
 #[derive(Default)]
 struct Run {
-    /// Policy files read (linted or not).
-    files: usize,
+    /// Policy files read (linted or not), as shown.
+    files: Vec<String>,
     findings: Vec<lint::Finding>,
     not_linted: Vec<(String, String)>,
     unchecked: std::collections::BTreeMap<String, Vec<String>>,
@@ -388,12 +395,12 @@ fn lint_inputs(
             Ok((file, Some(format::Input::Policy(fmt)))) => (file, fmt),
             Ok(_) => continue,
             Err(d) => {
-                run.files += 1;
+                run.files.push(input.path.display().to_string());
                 run.not_loaded(&d, &input.path.display().to_string(), cfg);
                 continue;
             }
         };
-        run.files += 1;
+        run.files.push(file.path.clone());
         let limits = tree_limits(&mut search, &input.path, &file.text, fmt, limits);
         // A file of several trees that names none: each tree a program may
         // create from it, findings said once.
@@ -490,11 +497,10 @@ fn tree_limits(
 /// not, and what could not be checked.
 struct Findings<'a> {
     run: &'a Run,
-    files: usize,
 }
 
 impl Report for Findings<'_> {
-    const FORMATS: &'static [Format] = &[Format::Text, Format::Json, Format::Sarif];
+    const FORMATS: &'static [Format] = &[Format::Text, Format::Json, Format::Sarif, Format::Junit];
 
     /// The findings in `format`; the text ends with the counts and notes.
     fn write(&self, format: Format) -> String {
@@ -507,6 +513,7 @@ impl Report for Findings<'_> {
                 };
                 lint::sarif::render(findings, &inv)
             }
+            Format::Junit => lint::junit::render(&self.run.files, findings, &self.run.not_linted),
             Format::Json => {
                 let mut s = btfsm_core::sanitize::json(
                     serde_json::to_string_pretty(findings).expect("serializable"),
@@ -523,7 +530,7 @@ impl Findings<'_> {
     /// The findings as positioned text, then the counts (and the files not
     /// linted), then the note on what could not be checked.
     fn text(&self) -> String {
-        let (findings, files) = (&self.run.findings, self.files);
+        let (findings, files) = (&self.run.findings, self.run.files.len());
         let plural =
             |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
         let mut s: String = findings.iter().map(lint::render_text).collect();

@@ -21,6 +21,11 @@ pub(crate) struct ValidateArgs {
     /// policy and scenario file below, sorted)
     #[arg(required = true)]
     pub(super) files: Vec<PathBuf>,
+    /// Skip the files named that hold no policy, scenario or domain, as
+    /// those found below a directory are (a pre-commit hook is given every
+    /// changed .xml and .toml file: a ROS package.xml, a Cargo.toml)
+    #[arg(long)]
+    pub(super) only_policies: bool,
     #[command(flatten)]
     pub(super) limits: LimitArgs,
 }
@@ -30,7 +35,7 @@ pub(super) fn run(a: ValidateArgs) -> u8 {
     let stderr = std::io::stderr();
     let mut err = stderr.lock();
     let inputs = match format::discover::expand(&a.files) {
-        Ok(i) => i,
+        Ok(i) => super::io::only_policies(i, a.only_policies),
         Err(d) => {
             print_diagnostics(&mut err, &[d]);
             return EXIT_BAD_INPUT;
@@ -83,14 +88,15 @@ pub(super) fn run(a: ValidateArgs) -> u8 {
         }
     }
     note_skipped(&mut err, skipped);
-    if inputs.len() == skipped {
+    let none = inputs.len() == skipped && !a.only_policies;
+    if none {
         let _ = write!(
             err,
             "{}",
             Diagnostic::error("no policy or scenario file below the directories given")
         );
     }
-    if failed || inputs.len() == skipped {
+    if failed || none {
         EXIT_BAD_INPUT
     } else {
         EXIT_OK

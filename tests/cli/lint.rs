@@ -760,3 +760,58 @@ fn a_file_of_several_trees_naming_none_is_linted_tree_by_tree() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn lint_junit_is_one_testcase_per_file_failing_on_errors_and_erroring_on_load() {
+    // `colcon test`, GitLab and Jenkins read JUnit XML: each file a
+    // testcase, an error finding its failure, a file that does not load an
+    // error; a warning passes. Hostile names stay text.
+    let dir = scratch("lint-junit");
+    let broken = dir.join("a<b>&\"c\u{1b}.xml");
+    std::fs::write(&broken, "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\">").unwrap();
+    let bad = fixture("chattering-precondition-order", "bad");
+    let warn = fixture("unreachable-child", "bad");
+    let good = "policies/paper/fig01-bt.toml";
+    let (code, out, _) = btfsm(&[
+        "lint",
+        &bad,
+        &warn,
+        good,
+        broken.to_str().unwrap(),
+        "--format",
+        "junit",
+    ]);
+    assert_eq!(code, 2, "{out}");
+    assert!(out.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites "));
+    assert!(
+        out.contains("tests=\"4\" failures=\"1\" errors=\"1\" skipped=\"0\""),
+        "{out}"
+    );
+    assert_eq!(out.matches("<testcase ").count(), 4, "{out}");
+    assert!(
+        out.contains("<failure type=\"chattering-precondition-order\" message=\""),
+        "{out}"
+    );
+    assert!(out.contains(":10:"), "the failure is positioned\n{out}");
+    assert!(
+        out.contains("<error type=\"load-error\" message=\"not linted: "),
+        "{out}"
+    );
+    assert!(out.contains("a&lt;b&gt;&amp;&quot;c\\u{1b}.xml"), "{out}");
+    assert!(!out.contains('\u{1b}'));
+    assert!(
+        out.contains("<system-out>") && out.contains("warning[unreachable-child]"),
+        "{out}"
+    );
+    assert!(out.contains(&format!("name=\"{good}\" classname=\"btfsm.lint\"")));
+    // Error findings only: exit 1; none: exit 0 with passing testcases.
+    let (code, _, _) = btfsm(&["lint", &bad, "--format", "junit"]);
+    assert_eq!(code, 1);
+    let (code, out, _) = btfsm(&["lint", good, "--format", "junit"]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("tests=\"1\" failures=\"0\" errors=\"0\""),
+        "{out}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

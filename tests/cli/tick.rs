@@ -178,7 +178,7 @@ fn a_format_a_command_does_not_write_is_a_usage_error() {
         ),
         (
             &["lint", "a.toml", "--format", "csv"][..],
-            "text, json, sarif",
+            "text, json, sarif, junit",
         ),
     ] {
         let (code, out, err) = btfsm(args);

@@ -107,3 +107,34 @@ fn among_several_files_defining_a_subtree_the_nearest_is_read() {
     assert!(err.contains("pick_arm_b.xml: ok"), "{err}");
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn only_policies_skips_the_files_named_that_hold_no_policy() {
+    // A pre-commit hook is given every changed .xml and .toml file: with
+    // --only-policies a ROS package.xml and a Cargo.toml are skipped as a
+    // directory walk skips them; a policy that does not load still fails.
+    let d = scratch("validate-only-policies");
+    let package = d.join("package.xml");
+    std::fs::write(&package, "<package format=\"3\"><name>x</name></package>").unwrap();
+    let cargo = d.join("Cargo.toml");
+    std::fs::write(&cargo, "[package]\nname = \"x\"\n").unwrap();
+    let broken = d.join("broken.xml");
+    std::fs::write(&broken, "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\">").unwrap();
+    let (p, c, b) = (
+        package.to_str().unwrap(),
+        cargo.to_str().unwrap(),
+        broken.to_str().unwrap(),
+    );
+    let good = "policies/paper/fig01-bt.toml";
+    let (code, _, err) = btfsm(&["validate", p, c, good]);
+    assert_eq!(code, 2, "named, they are read: {err}");
+    for cmd in ["validate", "lint"] {
+        let (code, _, err) = btfsm(&[cmd, "--only-policies", p, c, good]);
+        assert_eq!(code, 0, "{cmd}: {err}");
+        let (code, _, _) = btfsm(&[cmd, "--only-policies", p, c]);
+        assert_eq!(code, 0, "{cmd}: nothing to check is no failure");
+        let (code, out, err) = btfsm(&[cmd, "--only-policies", p, b]);
+        assert_eq!(code, 2, "{cmd}: {out}{err}");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}

@@ -18,17 +18,20 @@ pub enum Format {
     Markdown,
     /// SARIF 2.1.0, for code scanning (`lint`).
     Sarif,
+    /// JUnit XML, the test report CI systems read (`lint`).
+    Junit,
 }
 
 impl Format {
     /// Every format, in the order `--help` lists them.
-    pub const ALL: [Format; 6] = [
+    pub const ALL: [Format; 7] = [
         Format::Table,
         Format::Text,
         Format::Json,
         Format::Csv,
         Format::Markdown,
         Format::Sarif,
+        Format::Junit,
     ];
 
     /// The name `--format` takes.
@@ -40,6 +43,7 @@ impl Format {
             Format::Csv => "csv",
             Format::Markdown => "markdown",
             Format::Sarif => "sarif",
+            Format::Junit => "junit",
         }
     }
 

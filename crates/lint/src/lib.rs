@@ -4,7 +4,8 @@
 //! example (and a fixture under tests/fixtures/lint/ with a snapshot test).
 //! Levels are changed per code by `--deny`/`--warn`/`--allow` or a
 //! `[lint]` table in `btfsm.toml` ([`config`]). Findings print as
-//! positioned text, JSON, or SARIF 2.1.0 ([`sarif`]) for code scanning.
+//! positioned text, JSON, SARIF 2.1.0 ([`sarif`]) for code scanning, or a
+//! JUnit XML test report ([`junit`]) for CI.
 //!
 //! Rules: [`structure`] (BT and FSM shape), [`paper`] (the paper's notions:
 //! chattering-prone precondition order, unguarded actions, fault tolerance,
@@ -14,6 +15,7 @@
 
 pub mod config;
 pub mod dataflow;
+pub mod junit;
 pub mod load;
 pub mod models;
 pub mod paper;
