@@ -42,13 +42,7 @@ args=(review --format markdown)
 [ -n "$base" ] && args+=(--base "$base")
 [ -n "$head" ] && args+=(--head "$head")
 [ -n "${INPUT_SARIF:-}" ] && args+=(--sarif "$INPUT_SARIF")
-if [ -n "${INPUT_CONFIG:-}" ]; then
-  if ! btfsm review --help 2>/dev/null | grep -q -- '--config'; then
-    echo "::error::the config input needs a btfsm whose review takes --config; this one reads the base revision's btfsm.toml" >&2
-    exit 2
-  fi
-  args+=(--config "$INPUT_CONFIG")
-fi
+[ -n "${INPUT_CONFIG:-}" ] && args+=(--config "$INPUT_CONFIG")
 paths=()
 while IFS= read -r p; do
   [ -n "$p" ] && paths+=("$p")

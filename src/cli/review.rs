@@ -49,6 +49,10 @@ pub(crate) struct ReviewArgs {
     /// `dot` (a note when it is not installed)
     #[arg(long, value_name = "DIR")]
     pub(super) svg_dir: Option<PathBuf>,
+    /// Read the gates and lint levels from FILE instead of the base
+    /// revision's `btfsm.toml` (one the pull request cannot change)
+    #[arg(long, value_name = "FILE")]
+    pub(super) config: Option<PathBuf>,
     /// Wall-clock cap of one file's GED, in milliseconds
     #[arg(long, default_value_t = 10_000, value_name = "MS")]
     pub(super) timeout_ms: u64,
@@ -76,6 +80,7 @@ pub(super) fn run(a: ReviewArgs) -> u8 {
         timeout: Duration::from_millis(a.timeout_ms),
         tree_max_work: a.tree_max_work,
         dot: a.svg_dir.is_some(),
+        config: a.config.clone(),
     };
     let review = match btfsm_review::review(&opts) {
         Ok(r) => r,

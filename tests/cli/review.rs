@@ -295,6 +295,28 @@ fn gates_of_the_base_revision_fail_with_exit_1() {
     let (code, _, err) = btfsm_in(&d, &["review", "--base", "HEAD~1", "--head", "HEAD"]);
     assert_eq!(code, 1);
     assert!(err.contains("1 gate failure"), "{err}");
+    // `--config FILE` is read instead of the base's btfsm.toml.
+    let loose = super::common::scratch("gates-config").join("btfsm.toml");
+    std::fs::write(
+        &loose,
+        "[review]
+max-increase = { cc = 50 }
+",
+    )
+    .unwrap();
+    let (code, _, err) = btfsm_in(
+        &d,
+        &[
+            "review",
+            "--base",
+            "HEAD~1",
+            "--head",
+            "HEAD",
+            "--config",
+            loose.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
     // A bad gate is a positioned error, exit 2.
     write(&d, "btfsm.toml", "[review]\nmax = { cyclomatic = 3 }\n");
     commit(&d, "bad gate");

@@ -51,6 +51,9 @@ pub struct Options {
     pub tree_max_work: u64,
     /// Also make each diff's DOT text (for `--svg-dir`).
     pub dot: bool,
+    /// `--config FILE`: read instead of the base revision's `btfsm.toml`
+    /// (a file outside the pull request, never head's).
+    pub config: Option<PathBuf>,
 }
 
 /// The metrics of one side (SPEC §7's `analyze` numbers).

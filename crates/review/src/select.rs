@@ -41,7 +41,7 @@ pub(crate) fn run(opts: &Options) -> Result<Review, Diagnostic> {
         Some(h) => Snapshot::materialise(&repo, h, budget)?,
         None => Snapshot::work_tree(&repo),
     };
-    let (cfg, gates) = config(&base_snap, &opts.limits)?;
+    let (cfg, gates) = config(&base_snap, opts.config.as_deref(), &opts.limits)?;
     let mut rb = Reader::new(&base_snap, &opts.limits, &cfg);
     let mut rh = Reader::new(&head_snap, &opts.limits, &cfg);
     let mut review = Review {
@@ -152,17 +152,23 @@ fn in_scope(scope: &Option<Vec<String>>, path: &str) -> bool {
     }
 }
 
-/// The base revision's `btfsm.toml`: lint levels and models (`[lint]`),
-/// and the gates (`[review]`).
+/// The base revision's `btfsm.toml` (or `--config FILE`): lint levels and
+/// models (`[lint]`), and the gates (`[review]`).
 fn config(
     base: &Snapshot,
+    given: Option<&Path>,
     limits: &btfsm_format::Limits,
 ) -> Result<(Config, gate::Gates), Diagnostic> {
-    let path = base.path("btfsm.toml");
-    if !path.is_file() {
+    let (path, shown) = match given {
+        Some(p) => (p.to_path_buf(), p.display().to_string()),
+        None => (
+            base.path("btfsm.toml"),
+            format!("btfsm.toml (base {})", base.label()),
+        ),
+    };
+    if given.is_none() && !path.is_file() {
         return Ok((Config::default(), gate::Gates::default()));
     }
-    let shown = format!("btfsm.toml (base {})", base.label());
     let file = btfsm_format::source::read(&path, &shown, limits, true).map_err(first)?;
     let file = SourceFile::new(shown, file.text.clone());
     let mut cfg = btfsm_lint::config::read(&file).map_err(first)?;
