@@ -65,6 +65,15 @@ fn view_failed(e: ViewError) -> Option<Replay> {
     None
 }
 
+/// A log input, kept to compare its run with the other logs' as `btfsm log
+/// compare` does.
+enum LogSource {
+    /// A `.btlog`'s bytes.
+    Btlog(std::sync::Arc<[u8]>),
+    /// A `.db3`, opened again (its last session).
+    Db3(PathBuf),
+}
+
 /// One input's replay; `None` after printing why not. Every input is read
 /// once through `format::source` (bounded, never blocking on a FIFO).
 fn replay_of(
@@ -72,7 +81,7 @@ fn replay_of(
     a: &ViewArgs,
     limits: &btfsm_format::Limits,
     deadline: std::time::Instant,
-) -> Option<Replay> {
+) -> Option<(Replay, Option<LogSource>)> {
     let shown = path.display().to_string();
     let diags = |d: Vec<btfsm_core::diagnostic::Diagnostic>| {
         print_diagnostics(&mut std::io::stderr().lock(), &d);
@@ -99,11 +108,15 @@ fn replay_of(
     };
     match kind_of(path, &bytes[..bytes.len().min(32)]) {
         Kind::Log => {
-            btfsm_view::log::from_log(&bytes[..], &shown, limits).map_or_else(view_failed, Some)
+            let r = btfsm_view::log::from_log(&bytes[..], &shown, limits)
+                .map_or_else(view_failed, Some)?;
+            Some((r, Some(LogSource::Btlog(bytes.into()))))
         }
         Kind::Db3 => match btfsm_log::open(path, None, limits, deadline) {
             Ok(o) => {
-                btfsm_view::log::from_log(o.reader, &shown, limits).map_or_else(view_failed, Some)
+                let r = btfsm_view::log::from_log(o.reader, &shown, limits)
+                    .map_or_else(view_failed, Some)?;
+                Some((r, Some(LogSource::Db3(path.to_path_buf()))))
             }
             Err(e) => {
                 eprint!(
@@ -123,6 +136,7 @@ fn replay_of(
             let root = btfsm_format::source::root_for(limits, dir);
             btfsm_view::sim::from_trace(&text, &shown, root.as_deref(), limits)
                 .map_or_else(view_failed, Some)
+                .map(|r| (r, None))
         }
         Kind::Scenario => {
             let file = btfsm_core::diagnostic::SourceFile::new(&shown, text(bytes)?);
@@ -144,7 +158,9 @@ fn replay_of(
                 s.disturbances = ds;
                 s.rates = rates;
             }
-            btfsm_view::sim::from_scenario(&s, &shown).map_or_else(view_failed, Some)
+            btfsm_view::sim::from_scenario(&s, &shown)
+                .map_or_else(view_failed, Some)
+                .map(|r| (r, None))
         }
     }
 }
@@ -154,13 +170,18 @@ pub(super) fn execute(a: ViewArgs) -> u8 {
     // One deadline for every `.db3` query of the command (issue 33).
     let deadline = std::time::Instant::now() + btfsm_log::DEADLINE;
     let mut all: Option<Replay> = None;
+    // Per input: its first panel, and its log to compare.
+    let mut logs: Vec<(usize, Option<LogSource>, String)> = Vec::new();
     for path in &a.inputs {
-        let Some(r) = replay_of(path, &a, &limits, deadline) else {
+        let Some((r, log)) = replay_of(path, &a, &limits, deadline) else {
             return EXIT_BAD_INPUT;
         };
+        let first = all.as_ref().map_or(0, |acc| acc.panels.len());
+        logs.push((first, log, path.display().to_string()));
         all = Some(match all {
             None => r,
             Some(mut acc) => {
+                acc.compared_all &= r.compared_all;
                 let off = acc.panels.len();
                 acc.title = format!("{} + {}", acc.title, r.title);
                 acc.subtitle = format!("{}; {}", acc.subtitle, r.subtitle);
@@ -178,9 +199,12 @@ pub(super) fn execute(a: ViewArgs) -> u8 {
             }
         });
     }
-    let Some(replay) = all else {
+    let Some(mut replay) = all else {
         return EXIT_BAD_INPUT;
     };
+    if let Err(code) = compare_inputs(&mut replay, &logs, &limits, deadline) {
+        return code;
+    }
     let timeout = std::time::Duration::from_millis(a.timeout_ms);
     let page = match btfsm_view::html::page(&replay, timeout) {
         Ok(p) => p,
@@ -207,4 +231,57 @@ pub(super) fn execute(a: ViewArgs) -> u8 {
         );
     }
     code
+}
+
+/// Compares the runs of every two inputs, as `btfsm log compare` does
+/// when both are logs (its first divergence goes in the page's header);
+/// any other two inputs leave the replay not compared throughout.
+fn compare_inputs(
+    replay: &mut Replay,
+    logs: &[(usize, Option<LogSource>, String)],
+    limits: &btfsm_format::Limits,
+    deadline: std::time::Instant,
+) -> Result<(), u8> {
+    for (i, (pa, la, sa)) in logs.iter().enumerate() {
+        for (pb, lb, sb) in &logs[i + 1..] {
+            let (Some(la), Some(lb)) = (la, lb) else {
+                replay.compared_all = false;
+                continue;
+            };
+            let side = |l: &LogSource, shown: &str| -> Result<btfsm_log::compare::Side, String> {
+                let r: Box<dyn std::io::Read> = match l {
+                    LogSource::Btlog(b) => Box::new(std::io::Cursor::new(b.clone())),
+                    LogSource::Db3(p) => {
+                        btfsm_log::open(p, None, limits, deadline)
+                            .map_err(|e| e.to_string())?
+                            .reader
+                    }
+                };
+                btfsm_log::compare::open(shown, r, None, limits.max_file_bytes)
+                    .map_err(|e| e.to_string())
+            };
+            let cmp = side(la, sa).and_then(|a| {
+                let b = side(lb, sb)?;
+                btfsm_log::compare::compare(a, b, None, false).map_err(|e| e.to_string())
+            });
+            match cmp {
+                Ok(rep) => {
+                    if let Some(d) = rep.first_divergence {
+                        replay.divergences.push(btfsm_view::Divergence {
+                            a: *pa,
+                            b: *pb,
+                            t: d.t,
+                            text: d.summary(),
+                        });
+                    }
+                }
+                Err(e) => {
+                    return Err(fail(Diagnostic::error(
+                        btfsm_core::sanitize::shown(&e).into_owned(),
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
 }

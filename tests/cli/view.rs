@@ -363,3 +363,36 @@ fn a_db3_without_the_sqlite_feature_says_so() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("`sqlite` feature"), "{err}");
 }
+
+/// Two logs on one page are compared as `btfsm log compare` compares them:
+/// the page names the same first divergence (it said "the executed skills
+/// of all the runs are the same" where `log compare` found them diverging,
+/// issue 31); a log beside a scenario is not compared, and the page says so
+/// rather than calling the runs the same.
+#[test]
+fn view_of_two_logs_names_the_divergence_log_compare_finds() {
+    if !crate::common::graphviz("view_of_two_logs_names_the_divergence_log_compare_finds") {
+        return;
+    }
+    let (a, b) = (
+        "tests/fixtures/logs/compare-nominal.btlog",
+        "tests/fixtures/logs/compare-pick-fails.btlog",
+    );
+    let (_, out, _) = btfsm(&["log", "compare", a, b, "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let d = &v["first_divergence"];
+    let html = page("two-logs", &[a, b]);
+    let want = format!(
+        "at {} s, skill {}: ",
+        d["t"].as_f64().unwrap(),
+        d["index"].as_u64().unwrap() + 1
+    );
+    assert!(html.contains(&want), "{want}");
+    assert!(!html.contains("are the same, in the same order"));
+    let html = page(
+        "log-and-scenario",
+        &[a, "policies/scenarios/exp1-nominal.toml"],
+    );
+    assert!(html.contains("Not every pair of runs was compared"));
+    assert!(!html.contains("are the same, in the same order"));
+}

@@ -200,8 +200,11 @@ fn divergence_list(r: &Replay) -> String {
             );
         }
         divs.push_str("</ul>");
-    } else if r.panels.len() > 1 {
+    } else if r.panels.len() > 1 && r.compared_all {
         divs.push_str(r#"<p class="same">The executed skills of all the runs are the same, in the same order.</p>"#);
+    }
+    if r.panels.len() > 1 && !r.compared_all {
+        divs.push_str(r#"<p class="same">Not every pair of runs was compared: runs of different inputs are compared when both are BehaviorTree.CPP logs (<code>btfsm log compare</code> compares a log with a simulator run).</p>"#);
     }
     divs
 }

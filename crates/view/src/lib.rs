@@ -126,6 +126,11 @@ pub struct Replay {
     pub step_name: String,
     pub panels: Vec<Panel>,
     pub divergences: Vec<Divergence>,
+    /// Whether every pair of panels was compared (`divergences` then
+    /// lists every pair that differs; panels of inputs that cannot be
+    /// compared leave it `false`, and the page says so instead of calling
+    /// the runs the same).
+    pub compared_all: bool,
 }
 
 /// A run's statuses as per-step changes. Node numbers index `keys`, the

@@ -69,6 +69,7 @@ pub fn from_log(r: impl std::io::Read, shown: &str, limits: &Limits) -> Result<R
             marks: Vec::new(),
         }],
         divergences: Vec::new(),
+        compared_all: true,
     })
 }
 

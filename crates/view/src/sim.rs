@@ -170,6 +170,7 @@ pub fn from_scenario(s: &Scenario, file: &str) -> Result<Replay, ViewError> {
         step_name: format!("step of {} s", s.dt),
         panels,
         divergences: divs,
+        compared_all: true,
     })
 }
 
@@ -205,6 +206,10 @@ pub fn from_trace(
         step_name: format!("step of {} s", v["dt"].as_f64().unwrap_or(0.0)),
         panels,
         divergences: divs,
+        // A pair the run's budget skipped has no verdict in the trace.
+        compared_all: v["skipped_verdicts"]
+            .as_array()
+            .is_none_or(|s| s.is_empty()),
     })
 }
 
