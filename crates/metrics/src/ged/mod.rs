@@ -445,10 +445,12 @@ const ROUND_GROWTH: u64 = 8;
 /// The search of `o` by rounds of growing work: `FIRST_ROUND_WORK`, then
 /// `ROUND_GROWTH` times more each round, each from the cheapest mapping
 /// found so far and keeping the best lower bound, until the value is
-/// settled; a round that would leave less than itself of `work` gets all
-/// of it (at the default budget: 1, 8, 64 and 227 million units; at 5
-/// million: 1 and 4, so that a pair settled in the first round takes the
-/// same work at both). (The search's phases share the work they are
+/// settled; the third round, or one that would leave less than itself of
+/// `work`, gets all that is left (at the default budget: 1, 8 and 291
+/// million units; at 5 million: 1 and 4, so that a pair settled in the
+/// first round takes the same work at both). (A round of 64 million before
+/// the rest doubled the work of a structural FSM pair that needs 82
+/// million.) (The search's phases share the work they are
 /// given — the forest search three quarters on BTs, the root's ascent up
 /// to a quarter, a labeled seed an eighth — so one search with the whole
 /// budget spent those shares before a later phase settled a pair that a
@@ -477,7 +479,7 @@ fn rounds(o: &Oriented, seed: Option<&Oriented>, deadline: Deadline, work: u64) 
     let mut round = FIRST_ROUND_WORK;
     loop {
         let left = work.saturating_sub(r.work);
-        let last = left / 2 < round;
+        let last = round > FIRST_ROUND_WORK * ROUND_GROWTH || left / 2 < round;
         let budget = if last { left } else { round }.max(1);
         let hint = (!r.sigma.is_empty()).then(|| r.sigma.clone());
         let lim = search::Limits {
