@@ -363,7 +363,7 @@ fn count_bound(a: &Shape, b: &Shape, labeled: bool) -> u64 {
 /// Nothing but `work` decides how far the search goes; `deadline` only
 /// aborts it, and when it did (the clock is past it at the end) an inexact
 /// result says [`StopReason::Time`]. The search runs in rounds of growing
-/// work ([`rounds`]), so that a pair settled with little work takes little
+/// work (`rounds`), so that a pair settled with little work takes little
 /// work whatever the budget.
 pub fn search_mapping(
     a: &Shape,
