@@ -316,10 +316,11 @@ pub(crate) struct PaperArgs {
     /// Output format
     #[arg(long, value_parser = super::format::parser(<btfsm_report::paper::PaperReport as btfsm_core::output::Report>::FORMATS, &[]), default_value = "table")]
     pub format: btfsm_core::output::Format,
-    /// Time budget of each exact GED; when it runs out the cell shows the
-    /// certified interval
-    #[arg(long, default_value_t = 2000, value_name = "MS")]
-    pub timeout_ms: u64,
+    /// CPU-time safety cap of each exact GED (default: derived from the
+    /// default work budget, which decides every cell); when it runs out
+    /// first the cell shows the certified interval
+    #[arg(long, value_name = "MS")]
+    pub timeout_ms: Option<u64>,
     /// Exit 1 naming every cell whose computed value departs from DIR/tables/expected.toml
     #[arg(long, conflicts_with = "record")]
     pub check: bool,

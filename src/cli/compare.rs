@@ -9,11 +9,11 @@
 use super::args::{CompareMode, LimitArgs};
 use super::dot::draw;
 use super::io::{emit_report, fail, load_all, outputs_distinct};
-use super::{EXIT_BAD_INPUT, EXIT_OK};
+use super::{EXIT_BAD_INPUT, EXIT_NOT_REPRODUCIBLE, EXIT_OK};
 use btfsm_core::diagnostic::Diagnostic;
 use btfsm_core::output::{Format, Report};
 use btfsm_core::sanitize::shown;
-use btfsm_metrics::ged::{GedMode, GedOptions};
+use btfsm_metrics::ged::{GedMode, GedOptions, StopReason};
 use btfsm_metrics::ted::TedOptions;
 use btfsm_model::{PolicyBody, PolicyKind};
 use btfsm_report::compare::{self, Pair, Side};
@@ -36,12 +36,16 @@ pub(crate) struct CompareArgs {
     /// both policies are BTs
     #[arg(long, value_enum, default_value_t = CompareMode::All)]
     pub(super) mode: CompareMode,
-    /// Wall-clock safety cap per mode, its whole computation (graphs,
-    /// search, edit script; docs/robustness.md gives the floor on large
-    /// graphs). The work budget (--work) decides the result; when this
-    /// cap ends a search first the report says `stopped_by: timeout`
-    #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_TIMEOUT_MS, value_name = "MS")]
-    pub(super) timeout_ms: u64,
+    /// Safety cap per mode in CPU time of the search (not wall-clock time,
+    /// so a loaded machine does not make it fire sooner), its whole
+    /// computation (graphs, search, edit script; docs/robustness.md gives
+    /// the floor on large graphs). Default: 400 ns per --work unit, at
+    /// least 30 s (120 s at the default --work), far past what the work
+    /// takes. The work budget decides the result; when this cap ends a
+    /// search first the report says `stopped_by: time` and the exit code
+    /// is 3 (the interval may differ on another machine)
+    #[arg(long, value_name = "MS")]
+    pub(super) timeout_ms: Option<u64>,
     /// Work budget of the exact search per mode, in work units (one per
     /// assignment-matrix entry the search builds; 15-80 ns each: the
     /// default is about 4-5 s on the hardest pairs measured, idle).
@@ -65,7 +69,8 @@ pub(crate) struct CompareArgs {
     #[arg(long, value_name = "OUT")]
     pub(super) dot: Option<PathBuf>,
     /// With --dot: render through Graphviz instead of writing DOT (under
-    /// the --timeout-ms budget of one mode: past it `dot` is killed);
+    /// the --timeout-ms cap of one mode, in wall-clock time: past it `dot`
+    /// is killed);
     /// default: the extension of --dot when it is .svg, .png or .pdf
     #[arg(long, value_enum, requires = "dot")]
     pub(super) render: Option<btfsm_render::dot::RenderFormat>,
@@ -108,10 +113,10 @@ pub(super) fn run(args: CompareArgs) -> u8 {
             .hint("FSMs and HFSMs are graphs, not ordered trees: use --mode structural, labeled or named (or leave --mode out)"),
         );
     }
-    let opts = GedOptions {
-        timeout: Duration::from_millis(args.timeout_ms),
-        work: args.work,
-    };
+    let mut opts = GedOptions::with_work(args.work);
+    if let Some(ms) = args.timeout_ms {
+        opts.timeout = Duration::from_millis(ms);
+    }
     let topts = TedOptions {
         max_work: args.tree_max_work,
         ..TedOptions::default()
@@ -144,13 +149,27 @@ pub(super) fn run(args: CompareArgs) -> u8 {
     // that an output asked for was not made).
     let mut drawn = EXIT_OK;
     if let (Some(path), Some(primary)) = (&args.dot, report.primary()) {
+        let cap = Duration::from_millis(
+            args.timeout_ms
+                .unwrap_or(btfsm_metrics::ged::DEFAULT_TIMEOUT_MS),
+        );
         let opts = pair.dot_options(&primary.edit_script);
-        // Graphviz gets the budget of one mode (--timeout-ms).
-        let timeout = Duration::from_millis(args.timeout_ms);
-        drawn = draw(&lb.policy, &opts, Some(path), args.render, timeout);
+        // Graphviz gets the cap of one mode (--timeout-ms, by default 30 s),
+        // in wall-clock time.
+        drawn = draw(&lb.policy, &opts, Some(path), args.render, cap);
     }
     let printed = emit_report(None, &Comparison(&report), args.format);
-    if drawn != EXIT_OK { drawn } else { printed }
+    let timed = report
+        .modes
+        .iter()
+        .any(|m| m.stopped_by == Some(StopReason::Time));
+    if drawn != EXIT_OK {
+        drawn
+    } else if printed == EXIT_OK && timed {
+        EXIT_NOT_REPRODUCIBLE
+    } else {
+        printed
+    }
 }
 
 /// A progress line on stderr, shown after a short delay while a search runs
@@ -179,7 +198,7 @@ impl Progress {
             }
             loop {
                 let line = format!(
-                    "\r{} GED: searching, {:.1} s of the {:.1} s budget",
+                    "\r{} GED: searching, {:.1} s (CPU-time cap {:.1} s)",
                     mode.as_str(),
                     start.elapsed().as_secs_f64(),
                     budget.as_secs_f64()

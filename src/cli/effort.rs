@@ -19,10 +19,12 @@ pub(crate) struct EffortArgs {
     /// Output format
     #[arg(long, value_parser = super::format::parser(EffortTable::FORMATS, &[]), default_value = "table")]
     pub(super) format: Format,
-    /// Time budget of the structural GED per policy; when it runs out the
-    /// result is a certified interval (the named GED has no budget)
-    #[arg(long, default_value_t = 2000, value_name = "MS")]
-    pub(super) timeout_ms: u64,
+    /// CPU-time safety cap of the structural GED per policy (default:
+    /// derived from the default work budget, which decides the result);
+    /// when it runs out first the result is a certified interval (the named
+    /// GED has no budget)
+    #[arg(long, value_name = "MS")]
+    pub(super) timeout_ms: Option<u64>,
     #[command(flatten)]
     pub(super) limits: LimitArgs,
 }
@@ -31,10 +33,10 @@ pub(super) fn run(a: EffortArgs) -> u8 {
     let Some((loaded, failed)) = load_inputs(&a.files, &a.limits.limits()) else {
         return EXIT_BAD_INPUT;
     };
-    let opts = GedOptions {
-        timeout: std::time::Duration::from_millis(a.timeout_ms),
-        ..GedOptions::default()
-    };
+    let mut opts = GedOptions::default();
+    if let Some(ms) = a.timeout_ms {
+        opts.timeout = std::time::Duration::from_millis(ms);
+    }
     let rows: Vec<EffortRow> = loaded
         .iter()
         .map(|l| EffortRow::new(&l.path, &l.policy.name, &effort(&l.policy, &opts).0))

@@ -50,6 +50,20 @@ pub(super) fn load_all(files: &[PathBuf], limits: &Limits) -> Option<Vec<Loaded>
 /// failed; `None` when there is nothing to report (the walk failed, or no
 /// policy was found). Scenarios found below a directory are skipped.
 pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loaded>, bool)> {
+    let mut out = Vec::new();
+    let failed = each_input(files, limits, &mut |l| out.push(l))?;
+    Some((out, failed))
+}
+
+/// [`load_inputs`], handing each policy that loads to `each` in the order
+/// of the inputs and dropping it after, so that memory is bounded by the
+/// largest file, not the count (issue 34): whether any input failed;
+/// `None` when there is nothing to report.
+pub(super) fn each_input(
+    files: &[PathBuf],
+    limits: &Limits,
+    each: &mut dyn FnMut(Loaded),
+) -> Option<bool> {
     use format::discover;
     let stderr = std::io::stderr();
     let mut err = stderr.lock();
@@ -68,7 +82,7 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
         }
     };
     let limits = &limits;
-    let (mut out, mut failed, mut skipped) = (Vec::new(), false, 0usize);
+    let (mut loaded, mut failed, mut skipped) = (0usize, false, 0usize);
     for input in &inputs {
         if let Some(only) = &only
             && is_btcpp_candidate(&input.path)
@@ -97,12 +111,15 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
             Err(d) => Err(d),
         };
         match reported(r, &mut err) {
-            Some(l) => out.push(l),
+            Some(l) => {
+                loaded += 1;
+                each(l);
+            }
             None => failed = true,
         }
     }
     note_skipped(&mut err, skipped);
-    if out.is_empty() && !failed {
+    if loaded == 0 && !failed {
         let _ = write!(
             err,
             "{}",
@@ -110,7 +127,7 @@ pub(super) fn load_inputs(files: &[PathBuf], limits: &Limits) -> Option<(Vec<Loa
         );
         return None;
     }
-    Some((out, failed))
+    Some(failed)
 }
 
 /// May `path` be a BehaviorTree.CPP file given together with others (a

@@ -56,6 +56,9 @@ use std::process::ExitCode;
 pub(crate) const EXIT_OK: u8 = 0;
 pub(crate) const EXIT_CHECK_FAILED: u8 = 1;
 pub(crate) const EXIT_BAD_INPUT: u8 = 2;
+/// A result is not the deterministic one: a CPU-time safety cap ended a
+/// search before its work budget (`compare`, `stopped_by: time`).
+pub(crate) const EXIT_NOT_REPRODUCIBLE: u8 = 3;
 
 /// Runs btfsm with the given arguments (the first is the program name).
 pub(crate) fn run<I, T>(args: I) -> ExitCode

@@ -7,12 +7,13 @@ use btfsm_core::diagnostic::Diagnostic;
 use btfsm_metrics::ged::GedOptions;
 use btfsm_report::paper::{self, EXPECTED_FILE};
 
-/// The GED budget given with `--timeout-ms`.
-fn ged_options(timeout_ms: u64) -> GedOptions {
-    GedOptions {
-        timeout: std::time::Duration::from_millis(timeout_ms),
-        ..GedOptions::default()
+/// The default GED budget, with the CPU-time cap given by `--timeout-ms`.
+fn ged_options(timeout_ms: Option<u64>) -> GedOptions {
+    let mut o = GedOptions::default();
+    if let Some(ms) = timeout_ms {
+        o.timeout = std::time::Duration::from_millis(ms);
     }
+    o
 }
 
 /// `btfsm paper`.

@@ -21,6 +21,7 @@ mod fault_tolerant;
 mod field_formats;
 mod formats;
 mod gate;
+mod ged_budget;
 mod hostile;
 mod lint;
 mod log;

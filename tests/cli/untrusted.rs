@@ -717,3 +717,43 @@ fn standard_input_is_read_once() {
         assert!(stdout.contains("\"vertices\": 1"), "{arg}: {stdout}");
     }
 }
+
+/// A Behavior Tree of about 100 nodes (6 KB of TOML), named by `i`.
+fn wide_bt(i: usize) -> String {
+    let mut s =
+        format!("kind = \"bt\"\nname = \"wide {i}\"\nroot = \"r\"\n[nodes]\nr = {{ sequence = [");
+    let kids: Vec<String> = (0..33).map(|k| format!("\"f{k}\"")).collect();
+    s.push_str(&kids.join(", "));
+    s.push_str("] }\n");
+    for k in 0..33 {
+        s.push_str(&format!(
+            "f{k} = {{ fallback = [\"c{k}\", \"a{k}\"] }}\nc{k} = {{ condition = \"IsDone{k}_{i}\" }}\na{k} = {{ action = \"DoStep{k}_{i}\" }}\n"
+        ));
+    }
+    s
+}
+
+/// `analyze DIR` keeps a small row per policy, not the policy (issue 34: it
+/// held every file, about 45 KB each, 4.4 GB at the 100,000-file limit):
+/// 1,600 more files of 100 nodes raise the peak by less than 3 KB each
+/// (measured: under 1.5 KB; 25 KB each when every policy was kept).
+#[test]
+fn analyze_of_a_directory_keeps_rows_not_policies() {
+    let peak = |n: usize| {
+        let d = Dir::new(&format!("many{n}"));
+        for i in 0..n {
+            d.write(&format!("p/{i:05}.toml"), wide_bt(i));
+        }
+        let dir = d.path("p");
+        let r = run_in(&d.0, &["analyze", &dir, "--format", "json"], None);
+        assert_eq!(r.code, 0, "{}", &r.stderr[..r.stderr.len().min(2000)]);
+        assert_eq!(r.stdout.matches("\"vertices\"").count(), n);
+        r.peak_kb
+    };
+    let (small, large) = (peak(400), peak(2000));
+    let per_file = large.saturating_sub(small) * 1024 / 1600;
+    assert!(
+        per_file < 3 * 1024,
+        "{per_file} bytes a file ({small} kB for 400, {large} kB for 2000)"
+    );
+}

@@ -3,6 +3,7 @@
 
 pub mod complexity;
 pub mod counts;
+pub mod cpu;
 pub mod effort;
 pub mod ged;
 pub mod ted;

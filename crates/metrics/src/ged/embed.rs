@@ -18,7 +18,7 @@
 //! parity of vertex cost + m1 + m2, so when no embedding exists the GED is at
 //! least the count bound + 2.
 
-use std::time::Instant;
+use crate::cpu::Deadline;
 
 use super::problem::{NONE, Problem, Side, invert};
 
@@ -100,7 +100,7 @@ fn order(sub: &Side) -> Vec<u32> {
 }
 
 /// Searches for a count-bound mapping within `budget` candidate tries.
-pub(crate) fn find(p: &Problem, deadline: Instant, budget: u64) -> Embedding {
+pub(crate) fn find(p: &Problem, deadline: Deadline, budget: u64) -> Embedding {
     let flipped = p.s1.arcs > p.s2.arcs;
     let (sub, sup) = if flipped {
         (&p.s2, &p.s1)
@@ -115,7 +115,7 @@ pub(crate) fn find(p: &Problem, deadline: Instant, budget: u64) -> Embedding {
 
 /// Searches `sub` into `sup`: set-up, backtracking, then completion with the
 /// arc-less vertices.
-fn search(p: &Problem, sub: &Side, sup: &Side, deadline: Instant, budget: u64) -> Embedding {
+fn search(p: &Problem, sub: &Side, sup: &Side, deadline: Deadline, budget: u64) -> Embedding {
     let m = match Matcher::new(p, sub, sup, deadline) {
         Ok(m) => m,
         Err(settled) => return settled,
@@ -157,11 +157,11 @@ impl<'a> Matcher<'a> {
         p: &'a Problem,
         sub: &'a Side,
         sup: &'a Side,
-        deadline: Instant,
+        deadline: Deadline,
     ) -> Result<Self, Embedding> {
         // The set-up below is O((n + m) log m), milliseconds on 100k vertices:
         // the clock is read between its steps, so that a spent budget stops it.
-        let late = || Instant::now() > deadline;
+        let late = || deadline.passed();
         let ds = Degrees::of(sub);
         let dp = Degrees::of(sup);
         if late() {
@@ -261,7 +261,7 @@ impl<'a> Matcher<'a> {
         &self,
         sigma: &mut [u32],
         used: &mut [bool],
-        deadline: Instant,
+        deadline: Deadline,
         budget: u64,
     ) -> Result<(), Embedding> {
         let ord = &self.ord;
@@ -298,7 +298,7 @@ impl<'a> Matcher<'a> {
             tries += 1;
             // The clock is read at every try: one try builds a candidate list,
             // which on a large class costs far more than reading it.
-            if tries > budget || Instant::now() > deadline {
+            if tries > budget || deadline.passed() {
                 return Err(Embedding::Unknown);
             }
             let v = cands[top][i];
@@ -343,7 +343,7 @@ mod tests {
 
     #[test]
     fn finds_path_in_cycle_and_refuses_loop() {
-        let far = Instant::now() + Duration::from_secs(10);
+        let far = Deadline::after(Duration::from_secs(10));
         let path = g(3, &[(0, 1), (1, 2)]);
         let cycle = g(4, &[(0, 1), (1, 2), (2, 3), (3, 0)]);
         let p = Problem::new(&path, &cycle);

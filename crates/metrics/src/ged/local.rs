@@ -7,7 +7,7 @@
 //! "Improving approximate graph edit distance using genetic algorithms" and
 //! the local-search refinements surveyed by Blumenthal et al., VLDB J. 2020).
 
-use std::time::Instant;
+use crate::cpu::Deadline;
 
 use super::problem::Problem;
 
@@ -34,7 +34,7 @@ fn overlap_pair(p: &Problem, sigma: &[u32], u1: usize, u2: usize) -> u64 {
 
 /// Improves `sigma` in place by first-improvement 2-swaps until no swap helps
 /// or the deadline passes. Returns the number of preserved arcs gained.
-pub(crate) fn two_swap(p: &Problem, sigma: &mut [u32], deadline: Instant) -> u64 {
+pub(crate) fn two_swap(p: &Problem, sigma: &mut [u32], deadline: Deadline) -> u64 {
     let mut gained = 0u64;
     let mut improved = true;
     // The clock is read every 1024 candidate swaps: one pass of `u2` over a
@@ -52,7 +52,7 @@ pub(crate) fn two_swap(p: &Problem, sigma: &mut [u32], deadline: Instant) -> u64
                 let isolated = p.s1.degree(u1) == 0;
                 for u2 in (u1 + 1)..e {
                     tries = tries.wrapping_add(1);
-                    if tries % 1024 == 1 && Instant::now() > deadline {
+                    if tries % 1024 == 1 && deadline.passed() {
                         return gained;
                     }
                     if isolated && p.s1.degree(u2) == 0 {
@@ -85,7 +85,7 @@ pub(crate) fn iterated(
     sigma: &mut [u32],
     rounds: usize,
     seed: u64,
-    deadline: Instant,
+    deadline: Deadline,
 ) -> bool {
     // Classes with at least two real G1 vertices: where a swap can matter.
     let classes: Vec<(usize, usize)> = p
@@ -108,7 +108,7 @@ pub(crate) fn iterated(
     let mut best_cost = start;
     let mut cand = sigma.to_vec();
     for r in 0..rounds {
-        if Instant::now() > deadline {
+        if deadline.passed() {
             break;
         }
         cand.copy_from_slice(sigma);
@@ -139,7 +139,7 @@ mod tests {
     /// something 2-swaps alone miss on some random pairs.
     #[test]
     fn iterated_search_is_valid_deterministic_and_helps() {
-        let far = Instant::now() + Duration::from_secs(60);
+        let far = Deadline::after(Duration::from_secs(60));
         let mut helped = 0;
         for (a, b, _) in super::super::brute::random_pairs(150, 0x1_0CA1, 9) {
             let p = Problem::new(&a, &b);
@@ -166,7 +166,7 @@ mod tests {
         let p = Problem::new(&a, &b);
         let mut sigma = vec![1, 0, 2];
         let before = p.cost(&sigma);
-        two_swap(&p, &mut sigma, Instant::now() + Duration::from_secs(5));
+        two_swap(&p, &mut sigma, Deadline::after(Duration::from_secs(5)));
         assert!(p.cost(&sigma) < before);
         assert_eq!(p.cost(&sigma), 0);
     }

@@ -10,7 +10,7 @@
 //! `total + reduced_cost(i, j)` on every assignment that uses (i, j), which the
 //! branch and bound uses to discard children without solving them.
 
-use std::time::Instant;
+use crate::cpu::Deadline;
 
 const NIL: usize = usize::MAX;
 const INF: i64 = i64::MAX / 4;
@@ -55,7 +55,7 @@ impl Lsap {
         &mut self,
         n: usize,
         cost: &[i64],
-        deadline: Instant,
+        deadline: Deadline,
     ) -> Option<Assignment> {
         self.solve_warm(n, cost, deadline, None)
     }
@@ -70,7 +70,7 @@ impl Lsap {
         &mut self,
         n: usize,
         cost: &[i64],
-        deadline: Instant,
+        deadline: Deadline,
         init: Option<(&[i64], &[usize])>,
     ) -> Option<Assignment> {
         if cost.len() != n * n {
@@ -95,7 +95,7 @@ impl Lsap {
             if a.col_of_row[cur] != NIL {
                 continue;
             }
-            if n >= 48 && cur % every == 0 && Instant::now() > deadline {
+            if n >= 48 && cur % every == 0 && deadline.passed() {
                 return None;
             }
             self.reset_row_buffers(n);
@@ -265,7 +265,7 @@ mod tests {
             seed
         };
         let mut lsap = Lsap::default();
-        let deadline = Instant::now() + Duration::from_secs(60);
+        let deadline = Deadline::after(Duration::from_secs(60));
         for _ in 0..300 {
             let n = (next() % 7) as usize;
             let range = 1 + next() % 12;

@@ -13,7 +13,7 @@
 //!   exact by an embedding fast path (`embed.rs`), a Lagrangian forest
 //!   bound and search when one side is a forest (`treebound.rs`), and a
 //!   branch and bound with assignment lower bounds (`search.rs`); when the
-//!   work budget (or the wall-clock safety cap) runs out, a certified
+//!   work budget (or the CPU-time safety cap) runs out, a certified
 //!   interval `[lower_bound, upper_bound]` with `exact = false`, never a
 //!   guess, and the reason ([`StopReason`]).
 //! - `Labeled`: the same, but a vertex maps only to a vertex of the same
@@ -61,6 +61,8 @@ mod tests;
 
 use std::time::{Duration, Instant};
 
+pub use crate::cpu::Deadline;
+
 pub use graph::{GedGraph, GedGraphError, Shape};
 
 pub use script::{EditScript, injective, named_mapping_of_ids, named_mapping_of_keys};
@@ -95,10 +97,13 @@ impl GedMode {
 ///
 /// The search is decided by `work` alone: every step that may end it early
 /// counts work units, never the clock, so one pair gives one result (value,
-/// exactness, interval) on any machine under any load, as long as `timeout`
-/// is not reached. `timeout` is a wall-clock safety cap: when it ends a
-/// search first, the result says so ([`StopReason::Timeout`]) and may then
-/// depend on the machine.
+/// exactness, interval) on any machine under any load. `timeout` is a
+/// safety cap counted in CPU time of the searching thread ([`crate::cpu`]),
+/// so that a loaded machine does not make it fire sooner; by default it is
+/// derived from `work` ([`GedOptions::with_work`]) with a wide margin, so
+/// that the work budget always ends a search first. When the cap ends a
+/// search first anyway, the result says so ([`StopReason::Time`]) and may
+/// then depend on the machine.
 ///
 /// Memory does not grow with either budget: with n the larger vertex count,
 /// the search holds two n × n tables (4 + 1 bytes per entry) and a stack of
@@ -109,7 +114,7 @@ impl GedMode {
 /// (the count bound and a local-search mapping are returned).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GedOptions {
-    /// Wall-clock safety cap of the whole computation of a mode (graphs,
+    /// CPU-time safety cap of the whole computation of a mode (graphs,
     /// problems, search, script), checked at every search node and inside
     /// long loops (docs/robustness.md "Budgets" measures the overshoot).
     pub timeout: Duration,
@@ -117,33 +122,47 @@ pub struct GedOptions {
     /// entry of an assignment matrix built to bound a search node (a node
     /// with k unmapped vertices costs about k² units, plus n + 1 for its
     /// set-up), and per (vertex, image) pair scored by the forest bound
-    /// (`treebound.rs`): 20 to 50 ns each on the machine of
+    /// (`treebound.rs`): 15 to 40 ns each on the machine of
     /// docs/performance.md. Structural GED on labeled graphs runs a labeled
     /// search with an eighth, then a structural one with the rest (see
     /// `structural`).
     pub work: u64,
 }
 
-/// The default work budget ([`GedOptions::work`]): about 4-5 s on the
-/// hardest pairs measured (the random FSM-like pairs of
-/// docs/performance.md that no budget settles, otherwise idle machine),
-/// inside the default 30 s cap with room for a loaded machine; pairs
-/// settled sooner stop sooner (most policy pairs in milliseconds). It was
-/// 10,000,000 until the ascent bound (`ascent.rs`), then 100,000,000 until
-/// a labeled pair that HiGHS proves in 6 s (71, docs/performance.md) was
-/// found to need 2·10⁸.
+/// The default work budget ([`GedOptions::work`]): about 4-6 s of CPU on
+/// the hardest pairs measured (the random FSM-like pairs of
+/// docs/performance.md that no budget settles); pairs settled sooner stop
+/// sooner (most policy pairs in milliseconds). It was 10,000,000 until the
+/// ascent bound (`ascent.rs`), then 100,000,000 until a labeled pair that
+/// HiGHS proves in 6 s (71, docs/performance.md) was found to need 2·10⁸.
 pub const DEFAULT_WORK: u64 = 300_000_000;
 
-/// The default wall-clock safety cap ([`GedOptions::timeout`]), in ms: six
-/// times what the default work takes at most on an idle machine.
+/// The floor of the derived CPU-time cap ([`GedOptions::with_work`]), in
+/// ms: what a small budget's fixed phases (embedding, dives, local search on
+/// up to 2048 vertices) may take beside its work.
 pub const DEFAULT_TIMEOUT_MS: u64 = 30_000;
+
+/// CPU nanoseconds allowed per work unit by the derived cap: ten times the
+/// most measured (docs/performance.md, "Budgets and the CPU-time cap").
+pub const CAP_NANOS_PER_WORK: u64 = 400;
+
+impl GedOptions {
+    /// The budget `work` with its derived CPU-time cap: `work` ×
+    /// [`CAP_NANOS_PER_WORK`] ns, at least [`DEFAULT_TIMEOUT_MS`] (120 s at
+    /// the default work), far past what the work takes, so that the work
+    /// budget decides.
+    pub fn with_work(work: u64) -> GedOptions {
+        let nanos = work.saturating_mul(CAP_NANOS_PER_WORK);
+        GedOptions {
+            timeout: Duration::from_nanos(nanos).max(Duration::from_millis(DEFAULT_TIMEOUT_MS)),
+            work,
+        }
+    }
+}
 
 impl Default for GedOptions {
     fn default() -> Self {
-        GedOptions {
-            timeout: Duration::from_millis(DEFAULT_TIMEOUT_MS),
-            work: DEFAULT_WORK,
-        }
+        GedOptions::with_work(DEFAULT_WORK)
     }
 }
 
@@ -153,9 +172,9 @@ impl Default for GedOptions {
 pub enum StopReason {
     /// The work budget ran out: reproducible on any machine.
     Work,
-    /// The wall-clock cap (`--timeout-ms`) ran out first: the interval may
-    /// differ on another machine or under another load.
-    Timeout,
+    /// The CPU-time safety cap (`--timeout-ms`) ran out before the work
+    /// budget: the interval may differ on another machine.
+    Time,
     /// The padded graphs are too large for the exact search (above 2048
     /// vertices): the count bound and a local-search mapping.
     Size,
@@ -165,7 +184,7 @@ impl StopReason {
     pub fn as_str(self) -> &'static str {
         match self {
             StopReason::Work => "work",
-            StopReason::Timeout => "timeout",
+            StopReason::Time => "time",
             StopReason::Size => "size",
         }
     }
@@ -186,6 +205,9 @@ pub struct GedResult {
     pub millis: u64,
     /// Why the search stopped when `exact` is false.
     pub stopped_by: Option<StopReason>,
+    /// Work units the search spent ([`GedOptions::work`]): the same on any
+    /// machine.
+    pub work: u64,
     /// The edits of the best mapping found, a → b.
     pub edit_script: EditScript,
 }
@@ -202,43 +224,64 @@ pub struct GedMapping {
     pub map: Vec<Option<usize>>,
     /// Why the search stopped, when `lower_bound < upper_bound`.
     pub stopped_by: Option<StopReason>,
+    /// Work units the search spent ([`GedOptions::work`]): the same on any
+    /// machine.
+    pub work: u64,
 }
 
 /// GED between two policy graphs (see the module documentation); the
 /// budget's clock starts before the compact graphs are built.
 pub fn ged(a: &PolicyGraph, b: &PolicyGraph, mode: GedMode, opts: &GedOptions) -> GedResult {
     let start = Instant::now();
-    ged_since(start, &GedGraph::from(a), &GedGraph::from(b), mode, opts)
+    let deadline = Deadline::after(opts.timeout);
+    ged_since(
+        start,
+        deadline,
+        &GedGraph::from(a),
+        &GedGraph::from(b),
+        mode,
+        opts,
+    )
 }
 
 /// GED between two compact graphs; labels are used by `Labeled`, keys by
 /// `Named` and by the edit script.
 pub fn ged_graphs(a: &GedGraph, b: &GedGraph, mode: GedMode, opts: &GedOptions) -> GedResult {
-    ged_since(Instant::now(), a, b, mode, opts)
+    ged_since(
+        Instant::now(),
+        Deadline::after(opts.timeout),
+        a,
+        b,
+        mode,
+        opts,
+    )
 }
 
-/// [`ged_graphs`] with the budget counted from `start`.
+/// [`ged_graphs`] with the time counted from `start` and the safety cap
+/// `deadline`.
 fn ged_since(
     start: Instant,
+    deadline: Deadline,
     a: &GedGraph,
     b: &GedGraph,
     mode: GedMode,
     opts: &GedOptions,
 ) -> GedResult {
-    let finish = |lower: u64, upper: u64, edit_script: EditScript, why| GedResult {
+    let finish = |lower: u64, upper: u64, edit_script: EditScript, why, work| GedResult {
         ged: upper,
         exact: lower >= upper,
         lower_bound: lower.min(upper),
         upper_bound: upper,
         millis: u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX),
         stopped_by: if lower >= upper { None } else { why },
+        work,
         edit_script,
     };
     let mut by_name = script::named_mapping(a, b);
     if mode == GedMode::Named {
         let s = script::build(a, b, &by_name);
         let c = s.cost();
-        return finish(c, c, s, None);
+        return finish(c, c, s, None, 0);
     }
     // The mapping by name, and its script, first: it competes with the
     // search's mapping below, and building it measures what the script of
@@ -248,7 +291,6 @@ fn ged_since(
         keep_same_labels(a, b, &mut by_name);
     }
     let named = script::build(a, b, &by_name);
-    let deadline = start + opts.timeout.saturating_sub(start.elapsed());
     let found = search_mapping(a, b, mode == GedMode::Labeled, deadline, opts.work);
     // Among mappings of equal cost, prefer the one by name: its script reads
     // as the engineer's own edits rather than as an arbitrary rematching.
@@ -260,7 +302,13 @@ fn ged_since(
     };
     // The script scores the mapping kept, in the original graphs.
     let upper = s.cost();
-    finish(found.lower_bound.min(upper), upper, s, found.stopped_by)
+    finish(
+        found.lower_bound.min(upper),
+        upper,
+        s,
+        found.stopped_by,
+        found.work,
+    )
 }
 
 /// Unmaps the pairs of `map` whose labels differ (a mapping by name made
@@ -314,38 +362,47 @@ fn count_bound(a: &Shape, b: &Shape, labeled: bool) -> u64 {
 ///
 /// Nothing but `work` decides how far the search goes; `deadline` only
 /// aborts it, and when it did (the clock is past it at the end) an inexact
-/// result says [`StopReason::Timeout`].
+/// result says [`StopReason::Time`]. The search runs in rounds of growing
+/// work (`rounds`), so that a pair settled with little work takes little
+/// work whatever the budget.
 pub fn search_mapping(
     a: &Shape,
     b: &Shape,
     labeled: bool,
-    deadline: Instant,
+    deadline: Deadline,
     work: u64,
 ) -> GedMapping {
-    let mut too_large = false;
-    let (lower, map) = if Instant::now() >= deadline {
+    let mut out = Rounds::default();
+    let (lower, map) = if deadline.passed() {
         (count_bound(a, b, labeled), vec![None; a.n()])
-    } else if labeled {
-        match Oriented::within(a, b, deadline) {
+    } else {
+        let st = if labeled {
+            Oriented::within(a, b, deadline)
+        } else {
+            Oriented::within(&a.unlabeled(), &b.unlabeled(), deadline)
+        };
+        match st {
             Some(o) => {
-                let lim = search::Limits { deadline, work };
-                let out = search::solve(&o.p, &lim, None);
-                too_large = out.too_large;
+                // Structural GED on graphs of several labels, unless a side
+                // is a forest (BTs), is seeded by a labeled search (see
+                // `rounds`).
+                let seed = if !labeled && multi_class(a, b) && !treebound::has_forest(&o.p) {
+                    Oriented::within(a, b, deadline)
+                } else {
+                    None
+                };
+                out = rounds(&o, seed.as_ref(), deadline, work);
                 (out.lower, o.to_ab(&out.sigma))
             }
-            None => (count_bound(a, b, true), vec![None; a.n()]),
+            None => (count_bound(a, b, labeled), vec![None; a.n()]),
         }
-    } else {
-        let (lower, map, large) = structural(a, b, deadline, work);
-        too_large = large;
-        (lower, map)
     };
     let upper = mapping_cost(a, b, &map);
     let stopped_by = if lower >= upper {
         None
-    } else if Instant::now() >= deadline {
-        Some(StopReason::Timeout)
-    } else if too_large {
+    } else if deadline.passed() {
+        Some(StopReason::Time)
+    } else if out.too_large {
         Some(StopReason::Size)
     } else {
         Some(StopReason::Work)
@@ -355,63 +412,94 @@ pub fn search_mapping(
         upper_bound: upper,
         map,
         stopped_by,
+        work: out.work,
     }
 }
 
-/// Structural GED. When the graphs carry more than one label, a labeled
-/// mapping is also a structural one, and on policy graphs usually a very
-/// good one, while the labeled search is far easier (its classes are
-/// small); so, unless a side is a forest, a labeled search with an eighth
-/// of the work budget first finds a mapping, and one structural search
-/// with the rest starts from it. (Measured on the FSM-like pairs of
-/// `bench/ged_vs_highs.py`: this settled structural fsm-1 and fsm-2, which
-/// the earlier split — a structural search, then a labeled one seeding a
-/// second structural search, a third each — did not; each structural
-/// search repeated the root's bound.) The split is by work, never by time.
-/// Returns the bound, the mapping, and whether the graphs were too large
-/// for the exact search.
-fn structural(
-    a: &Shape,
-    b: &Shape,
-    deadline: Instant,
-    work: u64,
-) -> (u64, Vec<Option<usize>>, bool) {
-    let (ua, ub) = (a.unlabeled(), b.unlabeled());
-    let Some(st) = Oriented::within(&ua, &ub, deadline) else {
-        return (count_bound(a, b, false), vec![None; a.n()], false);
-    };
+/// Whether the two shapes carry more than one label between them.
+fn multi_class(a: &Shape, b: &Shape) -> bool {
     let first_label = a.labels().first().or(b.labels().first());
-    let multi_class = a
-        .labels()
+    a.labels()
         .iter()
         .chain(b.labels())
-        .any(|l| Some(l) != first_label);
-    // One search with the whole budget when there is one class, or when a
-    // side is a forest (BTs): the forest search settles those far better
-    // than a labeled seed would help it.
-    let seeded = multi_class && !treebound::has_forest(&st.p);
-    let hint = if seeded {
+        .any(|l| Some(l) != first_label)
+}
+
+/// What [`rounds`] found: a certified lower bound, the cheapest padded
+/// bijection, whether the problem was too large for the exact search, and
+/// the work spent.
+#[derive(Default)]
+struct Rounds {
+    lower: u64,
+    sigma: Vec<u32>,
+    too_large: bool,
+    work: u64,
+}
+
+/// Work of the first round of [`rounds`].
+const FIRST_ROUND_WORK: u64 = 1 << 20;
+/// Each round of [`rounds`] gets this many times the work of the one
+/// before.
+const ROUND_GROWTH: u64 = 8;
+
+/// The search of `o` by rounds of growing work: `FIRST_ROUND_WORK`, then
+/// `ROUND_GROWTH` times more each round, each from the cheapest mapping
+/// found so far and keeping the best lower bound, until the value is
+/// settled; the third round, or one that would leave less than itself of
+/// `work`, gets all that is left (at the default budget: 1, 8 and 291
+/// million units; at 5 million: 1 and 4, so that a pair settled in the
+/// first round takes the same work at both). (A round of 64 million before
+/// the rest doubled the work of a structural FSM pair that needs 82
+/// million.) (The search's phases share the work they are
+/// given — the forest search three quarters on BTs, the root's ascent up
+/// to a quarter, a labeled seed an eighth — so one search with the whole
+/// budget spent those shares before a later phase settled a pair that a
+/// small budget settles: issue 34 measured a pair exact in 0.28 s at
+/// `--work 5e6` take 3.42 s at the default.) The rounds take at most the
+/// budget in all. Pairs that need more than the first rounds pay for them:
+/// on the structural FSM pairs of docs/performance.md settled with 13 to
+/// 82 million units, 10 million more.
+///
+/// With `seed` (structural GED on graphs of several labels), each round
+/// first runs a labeled search of `seed` with an eighth of its work, whose
+/// mapping is also a structural one, and on policy graphs usually a very
+/// good one, while the labeled search is far easier (its classes are
+/// small). (Measured on the FSM-like pairs of `bench/ged_vs_highs.py`:
+/// this settled structural fsm-1 and fsm-2.) The split is by work, never
+/// by time.
+fn rounds(o: &Oriented, seed: Option<&Oriented>, deadline: Deadline, work: u64) -> Rounds {
+    let mut r = Rounds::default();
+    let mut best_cost = u64::MAX;
+    if let Some(lab) = seed {
+        let s = rounds(lab, None, deadline, work / LABELED_SEED_SHARE);
+        r.work = s.work;
+        r.sigma = o.padded_from_ab(&lab.to_ab(&s.sigma));
+        best_cost = o.p.cost(&r.sigma);
+    }
+    let mut round = FIRST_ROUND_WORK;
+    loop {
+        let left = work.saturating_sub(r.work);
+        let last = round > FIRST_ROUND_WORK * ROUND_GROWTH || left / 2 < round;
+        let budget = if last { left } else { round }.max(1);
+        let hint = (!r.sigma.is_empty()).then(|| r.sigma.clone());
         let lim = search::Limits {
             deadline,
-            work: work / LABELED_SEED_SHARE,
+            work: budget,
         };
-        Oriented::within(a, b, deadline).map(|labeled| {
-            let lab = search::solve(&labeled.p, &lim, None);
-            st.padded_from_ab(&labeled.to_ab(&lab.sigma))
-        })
-    } else {
-        None
-    };
-    let lim = search::Limits {
-        deadline,
-        work: if seeded {
-            (work - work / LABELED_SEED_SHARE).max(1)
-        } else {
-            work
-        },
-    };
-    let out = search::solve(&st.p, &lim, hint);
-    (out.lower, st.to_ab(&out.sigma), out.too_large)
+        let out = search::solve(&o.p, &lim, hint);
+        r.work += out.work;
+        r.lower = r.lower.max(out.lower);
+        r.too_large |= out.too_large;
+        let c = o.p.cost(&out.sigma);
+        if c < best_cost {
+            best_cost = c;
+            r.sigma = out.sigma;
+        }
+        if r.lower >= best_cost || last || r.too_large || deadline.passed() {
+            return r;
+        }
+        round = round.saturating_mul(ROUND_GROWTH);
+    }
 }
 
 /// The labeled search that seeds a structural one gets 1/this of the work.
@@ -430,13 +518,13 @@ impl Oriented {
     /// [`Oriented::new`], unless `deadline` passes before the padded
     /// problem is built (its set-up, O((n + m) log n), reads the clock
     /// between its steps: milliseconds each on 100k vertices).
-    fn within(a: &Shape, b: &Shape, deadline: Instant) -> Option<Oriented> {
+    fn within(a: &Shape, b: &Shape, deadline: Deadline) -> Option<Oriented> {
         let swap = Self::swap(a, b);
-        if Instant::now() >= deadline {
+        if deadline.passed() {
             return None;
         }
         let o = Self::build(a, b, swap);
-        (Instant::now() < deadline).then_some(o)
+        (!deadline.passed()).then_some(o)
     }
 
     #[cfg(test)]

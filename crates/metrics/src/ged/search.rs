@@ -77,8 +77,8 @@
 //! among the subtrees still open on the stack; the upper bound is the best
 //! mapping found.
 
+use crate::cpu::Deadline;
 use std::cmp::Reverse;
-use std::time::Instant;
 
 use super::ascent::{self, Ascent};
 use super::embed::{self, Embedding};
@@ -110,7 +110,7 @@ const ILS_SEED: u64 = 0x5EED_0F15;
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Limits {
     /// Wall-clock safety cap.
-    pub deadline: Instant,
+    pub deadline: Deadline,
     /// Work budget (see `GedOptions::work`).
     pub work: u64,
 }
@@ -124,6 +124,8 @@ pub(crate) struct Outcome {
     pub sigma: Vec<u32>,
     /// The instance was too large for the exact search (`MAX_SEARCH_N`).
     pub too_large: bool,
+    /// Work units spent, all phases (see `Limits::work`).
+    pub work: u64,
     /// Search statistics (printed by the timing report in the tests).
     #[allow(dead_code)]
     pub stats: Stats,
@@ -629,7 +631,7 @@ impl<'a> Bnb<'a> {
         let Some(u) = first else { return };
         let (s, e) = p.classes[p.class_of[u] as usize];
         for v in s..e {
-            if Instant::now() > self.lim.deadline {
+            if self.lim.deadline.passed() {
                 return;
             }
             let sigma = self.dive(Some((u as u32, v as u32)));
@@ -659,7 +661,7 @@ impl<'a> Bnb<'a> {
             assert!(a.consistent(p, &self.f, &self.used), "stale ascent values");
         }
         for &(s, e) in &p.classes {
-            if e - s >= 64 && Instant::now() > self.lim.deadline {
+            if e - s >= 64 && self.lim.deadline.passed() {
                 return None;
             }
             let rows: Vec<u32> = (s..e)
@@ -888,7 +890,7 @@ impl<'a> Bnb<'a> {
         } else {
             self.lim.work
         };
-        self.work > share || Instant::now() > self.lim.deadline
+        self.work > share || self.lim.deadline.passed()
     }
 
     /// Carries out the schedule's step `next` (other than `Next::Done`) on
@@ -1096,7 +1098,7 @@ impl<'a> Bnb<'a> {
             let start = self.work;
             self.expansions += 1;
             self.work += 1 + self.n as u64;
-            if self.work > self.lim.work || Instant::now() > self.lim.deadline {
+            if self.work > self.lim.work || self.lim.deadline.passed() {
                 timed_out = true;
                 break;
             }
@@ -1144,8 +1146,7 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
         let ub = run.ub;
         return run.done(ub);
     }
-    let now = Instant::now();
-    if now >= lim.deadline {
+    if lim.deadline.passed() {
         return run.done(count);
     }
     let lb = match run.embedding(count) {
@@ -1181,7 +1182,7 @@ pub(crate) fn solve(p: &Problem, lim: &Limits, hint: Option<Vec<u32>>) -> Outcom
     }
     // Setting the search up costs O(n²) (its tables): not when the budget
     // is already spent.
-    if p.n() > MAX_SEARCH_N || Instant::now() >= run.lim.deadline {
+    if p.n() > MAX_SEARCH_N || run.lim.deadline.passed() {
         let lower = lb.max(tree_lb).min(run.ub);
         let mut out = run.done(lower);
         out.too_large = p.n() > MAX_SEARCH_N;
@@ -1205,6 +1206,8 @@ struct Run<'a> {
     /// The cheapest mapping found, and its cost.
     best: Vec<u32>,
     ub: u64,
+    /// Work units spent by the phases so far.
+    spent: u64,
     stats: Stats,
 }
 
@@ -1219,6 +1222,7 @@ impl<'a> Run<'a> {
             total_work: lim.work,
             best,
             ub,
+            spent: 0,
             stats: Stats::default(),
         };
         if let Some(h) = hint
@@ -1245,6 +1249,7 @@ impl<'a> Run<'a> {
             lower,
             sigma: self.best,
             too_large: false,
+            work: self.spent,
             stats: self.stats,
         }
     }
@@ -1282,6 +1287,7 @@ impl<'a> Run<'a> {
             )
         {
             self.lim.work = self.lim.work.saturating_sub(tb.work);
+            self.spent += tb.work;
             self.stats.tree_lower = Some(tb.lower);
             if let Some(s) = tb.mapping {
                 self.keep_cheaper(s);
@@ -1314,6 +1320,7 @@ impl<'a> Run<'a> {
         self.stats.root_lower = bnb.root_lower;
         self.stats.expansions = bnb.expansions;
         self.stats.work = bnb.work;
+        self.spent += bnb.work;
         (self.ub, self.best) = (bnb.ub, bnb.best);
         (lower, total_work.saturating_sub(bnb.work))
     }
@@ -1325,9 +1332,10 @@ impl<'a> Run<'a> {
         let p = self.p;
         if lower < self.ub
             && left > 0
-            && Instant::now() < self.lim.deadline
+            && !self.lim.deadline.passed()
             && let Some(tb) = treebound::solve(p, &self.best, left, self.lim.deadline, true)
         {
+            self.spent += tb.work;
             if let Some(s) = tb.mapping {
                 self.keep_cheaper(s);
             }

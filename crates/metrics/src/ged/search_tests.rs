@@ -34,7 +34,7 @@ fn dives_recover_an_isomorphic_tree() {
     for (ga, gb) in [(a.clone(), b.clone()), (a.unlabeled(), b.unlabeled())] {
         let p = Problem::new(&ga, &gb);
         let lim = Limits {
-            deadline: Instant::now() + Duration::from_secs(60),
+            deadline: Deadline::after(Duration::from_secs(60)),
             work: 0,
         };
         let greedy = p.greedy();
@@ -79,7 +79,7 @@ fn bare_search_against_brute_force(ascent: bool, shakes: usize, everywhere: bool
     for (i, (a, b, labeled)) in pairs.into_iter().enumerate() {
         let p = Problem::new(&a, &b);
         let lim = Limits {
-            deadline: Instant::now() + Duration::from_secs(60),
+            deadline: Deadline::after(Duration::from_secs(60)),
             work: u64::MAX,
         };
         let greedy = p.greedy();
@@ -123,7 +123,7 @@ fn map_and_unmap_are_inverse() {
     .expect("valid");
     let p = Problem::new(&a, &b);
     let lim = Limits {
-        deadline: Instant::now() + Duration::from_secs(60),
+        deadline: Deadline::after(Duration::from_secs(60)),
         work: 0,
     };
     let mut bnb = Bnb::new(&p, u64::MAX, p.greedy(), lim);
@@ -167,7 +167,7 @@ fn re_optimised_shares_change_no_value() {
     {
         let p = Problem::new(&a, &b);
         let lim = Limits {
-            deadline: Instant::now() + Duration::from_secs(60),
+            deadline: Deadline::after(Duration::from_secs(60)),
             work: u64::MAX,
         };
         let run = |everywhere: bool| {

@@ -1069,7 +1069,7 @@ fn report() {
                 };
                 let o2 = Oriented::new(&ua, &ub);
                 let lim = search::Limits {
-                    deadline: std::time::Instant::now() + o.timeout,
+                    deadline: Deadline::after(o.timeout),
                     work: o.work,
                 };
                 let out = search::solve(&o2.p, &lim, None);
@@ -1184,7 +1184,7 @@ fn search_with_a_spent_deadline_returns_the_count_bound() {
         let a = random_graph(&mut rng, 6, 10, 2, "a");
         let b = random_graph(&mut rng, 5, 10, 2, "b");
         for labeled in [false, true] {
-            let m = search_mapping(&a, &b, labeled, Instant::now(), u64::MAX);
+            let m = search_mapping(&a, &b, labeled, Deadline::after(Duration::ZERO), u64::MAX);
             assert!(m.map.iter().all(Option::is_none));
             assert_eq!(m.upper_bound, mapping_cost(&a, &b, &m.map));
             assert!(m.lower_bound <= brute_ged(&a, &b, labeled));

@@ -38,7 +38,7 @@
 //! The relaxed optimum of each step, repaired into a bijection, is also
 //! offered as an upper bound.
 
-use std::time::Instant;
+use crate::cpu::Deadline;
 
 use super::lsap::Lsap;
 use super::problem::{NONE, Problem, Side};
@@ -207,7 +207,7 @@ impl<'a> Dp<'a> {
         &mut self,
         x: u32,
         y: u32,
-        deadline: Instant,
+        deadline: Deadline,
         pairs: bool,
     ) -> (i64, Vec<(u32, u32)>) {
         self.matching_free(x, y, deadline, pairs, None)
@@ -218,7 +218,7 @@ impl<'a> Dp<'a> {
         &mut self,
         x: u32,
         y: u32,
-        deadline: Instant,
+        deadline: Deadline,
         pairs: bool,
         taken: Option<&[bool]>,
     ) -> (i64, Vec<(u32, u32)>) {
@@ -293,12 +293,12 @@ impl<'a> Dp<'a> {
 
     /// Fills Q and R for multipliers `lambda` under the fixings; returns
     /// L(λ) (scaled), or `None` if some vertex has no image left.
-    fn evaluate(&mut self, lambda: &[i64], deadline: Instant) -> Option<i64> {
+    fn evaluate(&mut self, lambda: &[i64], deadline: Deadline) -> Option<i64> {
         let n = self.a.n;
         for oi in 0..self.order.len() {
             // Large instances: the budget and the clock are read at every
             // vertex, an evaluation cut short is flagged, not used.
-            if oi % 16 == 15 && (self.work > self.limit || Instant::now() > deadline) {
+            if oi % 16 == 15 && (self.work > self.limit || deadline.passed()) {
                 self.aborted = true;
                 return Some(i64::MAX);
             }
@@ -345,12 +345,12 @@ impl<'a> Dp<'a> {
 
     /// The images of the relaxed optimum (see `argmax`).
     fn arg_images(&mut self) -> Vec<u32> {
-        self.argmax(Instant::now() + std::time::Duration::from_secs(3600))
+        self.argmax(Deadline::never())
     }
 
     /// The relaxed optimum of the last `evaluate`: an image for each vertex
     /// of `a` (images may repeat).
-    fn argmax(&mut self, deadline: Instant) -> Vec<u32> {
+    fn argmax(&mut self, deadline: Deadline) -> Vec<u32> {
         let n = self.a.n;
         let mut img = vec![NONE; n];
         let mut stack: Vec<(u32, u32)> = self
@@ -384,7 +384,7 @@ impl<'a> Dp<'a> {
     /// other vertex takes them), and a child left out takes its relaxed
     /// image if free, else its free image of highest Q. Vertices whose
     /// class has no free image left stay `NONE` (for `repair`).
-    fn decode(&mut self, deadline: Instant) -> Vec<u32> {
+    fn decode(&mut self, deadline: Deadline) -> Vec<u32> {
         let n = self.a.n;
         let mut img = vec![NONE; n];
         let mut taken = vec![false; n];
@@ -471,7 +471,7 @@ struct Search<'a> {
     best: Vec<u32>,
     best_cost: u64,
     work_limit: u64,
-    deadline: Instant,
+    deadline: Deadline,
     /// Out of work or time: the search stopped with subtrees open.
     stopped: bool,
     /// While the root's multipliers are tuned: how often (weighted by the
@@ -482,7 +482,7 @@ struct Search<'a> {
 impl<'a> Search<'a> {
     /// The search over a forest side of `p` if there is one (else over a
     /// spanning branching of `s1`), from the mapping `best`, within `work`.
-    fn new(p: &'a Problem, best: &[u32], work: u64, deadline: Instant) -> Search<'a> {
+    fn new(p: &'a Problem, best: &[u32], work: u64, deadline: Deadline) -> Search<'a> {
         let b1 = Branching::of(&p.s1);
         let (flip, br, forest) = if b1.is_forest() {
             (false, b1, true)
@@ -612,7 +612,7 @@ impl<'a> Search<'a> {
         let mut stale = 0;
         let mut step_no = 0u32;
         for _ in 0..iters {
-            if self.dp.work > self.work_limit || Instant::now() > self.deadline {
+            if self.dp.work > self.work_limit || self.deadline.passed() {
                 self.stopped = true;
                 break;
             }
@@ -760,7 +760,7 @@ pub(crate) fn solve(
     p: &Problem,
     best: &[u32],
     work: u64,
-    deadline: Instant,
+    deadline: Deadline,
     search_any: bool,
 ) -> Option<TreeBound> {
     let mut s = Search::new(p, best, work, deadline);
@@ -862,7 +862,7 @@ mod tests {
             for (g1, g2) in [(&a, &b), (&b, &a)] {
                 let p = Problem::new(g1, g2);
                 let start = p.greedy();
-                let far = Instant::now() + Duration::from_secs(60);
+                let far = Deadline::after(Duration::from_secs(60));
                 let tb = solve(&p, &start, u64::MAX, far, true).expect("one side is a forest");
                 let best = tb.mapping.unwrap_or_else(|| start.clone());
                 assert!(p.is_valid(&best));
@@ -890,7 +890,7 @@ mod tests {
     fn primal_heuristics_give_valid_mappings() {
         let mut next = xorshift(0xDEC0_DE5Au64);
         let keys = |n: usize| (0..n).map(|i| format!("v{i}")).collect::<Vec<_>>();
-        let far = Instant::now() + Duration::from_secs(60);
+        let far = Deadline::after(Duration::from_secs(60));
         let (mut decoded, mut fixed_kept, mut voted) = (0, 0, 0);
         for i in 0..200 {
             let labels = if i % 2 == 0 { 1 } else { 3 };
@@ -995,7 +995,7 @@ mod tests {
             let truth = brute_ged(&a, &b, labels > 1);
             let p = Problem::new(&a, &b);
             let start = p.greedy();
-            let far = Instant::now() + Duration::from_secs(60);
+            let far = Deadline::after(Duration::from_secs(60));
             let tb = solve(&p, &start, u64::MAX, far, true).expect("a branching always exists");
             assert_eq!(tb.lower, truth, "pair {i}");
             let best = tb.mapping.unwrap_or_else(|| start.clone());

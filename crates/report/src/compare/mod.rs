@@ -31,15 +31,16 @@ pub use render::{render_json, render_markdown, render_table};
 use script::{ScriptIndex, key_ids};
 pub use text::Text;
 
+use btfsm_metrics::cpu::thread_cpu_time;
 use btfsm_metrics::ged::{
-    GedMode, GedOptions, Shape, StopReason, keep_same_labels, mapping_cost, named_mapping_of_ids,
-    search_mapping,
+    Deadline, GedMode, GedOptions, Shape, StopReason, keep_same_labels, mapping_cost,
+    named_mapping_of_ids, search_mapping,
 };
 use btfsm_metrics::ted::TedOptions;
 use btfsm_model::graph::{PolicyGraph, VertexType, policy_graph};
 use btfsm_model::{IdSource, Policy, PolicyBody, PolicyKind};
 use std::collections::BTreeMap;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// One policy being compared.
 #[derive(Debug, Clone, Copy)]
@@ -178,11 +179,15 @@ pub struct ModeReport {
     /// millisecond; `millis` = `micros` / 1000, rounded down).
     pub micros: u64,
     /// When `exact` is false: what ended the search, `work` (the work
-    /// budget, reproducible on any machine), `timeout` (the wall-clock cap
-    /// `--timeout-ms`) or `size` (too large for the exact search). Absent
-    /// when exact.
+    /// budget, reproducible on any machine), `time` (the CPU-time safety
+    /// cap `--timeout-ms`, before the work budget: the interval may differ
+    /// on another machine) or `size` (too large for the exact search).
+    /// Absent when exact.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stopped_by: Option<StopReason>,
+    /// Work units the search spent (`--work`; 0 for `named`): the same on
+    /// any machine.
+    pub work: u64,
     pub edit_script: Script,
 }
 
@@ -359,40 +364,47 @@ impl<'a> Pair<'a> {
     }
 
     /// GED in one mode, with its labelled edit script, within
-    /// `opts.timeout` for the whole of it: the clock starts before the
-    /// compact graphs are built, the mapping by name and its script come
-    /// next, and the search gets what remains minus twice the time that
-    /// script took (the script of the search's mapping, if better, costs
-    /// about as much, and the unused one must be freed: 1.3 to 1.6 times
-    /// the first on 100k-vertex BTs). `millis` is the time of all of it.
+    /// `opts.timeout` of CPU time for the whole of it: the clock starts
+    /// before the compact graphs are built, the mapping by name and its
+    /// script come next, and the search gets what remains minus twice the
+    /// CPU time that script took (the script of the search's mapping, if
+    /// better, costs about as much, and the unused one must be freed: 1.3
+    /// to 1.6 times the first on 100k-vertex BTs). `millis` is the
+    /// wall-clock time of all of it.
     pub fn run(&self, mode: GedMode, opts: &GedOptions) -> ModeReport {
         let start = Instant::now();
+        let cpu = || thread_cpu_time().unwrap_or_else(|| start.elapsed());
+        let cpu_start = cpu();
         let (sa, sb) = (Shape::from(&self.ga), Shape::from(&self.gb));
         let mut by_name = self.by_name.clone();
         if mode == GedMode::Labeled {
             keep_same_labels(&sa, &sb, &mut by_name);
         }
         let named_cost = mapping_cost(&sa, &sb, &by_name);
-        let before_script = Instant::now();
+        let before_script = cpu();
         let named = self.script(&by_name);
-        let (lower, upper, edit_script, stopped_by) = if mode == GedMode::Named {
-            (named_cost, named_cost, named, None)
+        let (lower, upper, edit_script, stopped_by, work) = if mode == GedMode::Named {
+            (named_cost, named_cost, named, None, 0)
         } else {
-            let reserve = before_script.elapsed() * 2;
-            // Checked: a budget past the clock's range means no deadline.
-            let deadline = start
-                .checked_add(opts.timeout)
-                .unwrap_or_else(|| start + Duration::from_secs(1 << 32))
-                .checked_sub(reserve)
-                .map_or(start, |d| d.max(start));
+            let now = cpu();
+            let reserve = now.saturating_sub(before_script) * 2;
+            let used = now.saturating_sub(cpu_start);
+            let deadline = Deadline::after(opts.timeout.saturating_sub(used + reserve));
             let found = search_mapping(&sa, &sb, mode == GedMode::Labeled, deadline, opts.work);
             // Among mappings of equal cost, prefer the one by name: its
             // script reads as the engineer's own edits.
             if named_cost <= found.upper_bound {
-                (found.lower_bound, named_cost, named, found.stopped_by)
+                (
+                    found.lower_bound,
+                    named_cost,
+                    named,
+                    found.stopped_by,
+                    found.work,
+                )
             } else {
                 let s = self.script(&found.map);
-                (found.lower_bound, found.upper_bound, s, found.stopped_by)
+                let (lo, hi) = (found.lower_bound, found.upper_bound);
+                (lo, hi, s, found.stopped_by, found.work)
             }
         };
         debug_assert_eq!(edit_script.cost(), upper);
@@ -408,6 +420,7 @@ impl<'a> Pair<'a> {
             millis: micros / 1000,
             micros,
             stopped_by: if lower >= upper { None } else { stopped_by },
+            work,
             edit_script,
         }
     }

@@ -99,8 +99,8 @@ fn stop_notes(r: &CompareReport) -> Vec<String> {
         .filter(|m| !m.exact)
         .map(|m| {
             let why = match m.stopped_by {
-                Some(StopReason::Timeout) => {
-                    "the wall-clock cap (--timeout-ms) ended the search before the work budget; the interval may differ on another machine (raise --timeout-ms)"
+                Some(StopReason::Time) => {
+                    "the CPU-time safety cap (--timeout-ms) ended the search before the work budget; the interval may differ on another machine (raise --timeout-ms)"
                 }
                 Some(StopReason::Size) => {
                     "the graphs are too large for the exact search (above 2048 vertices): count bound and local search"
