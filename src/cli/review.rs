@@ -53,9 +53,12 @@ pub(crate) struct ReviewArgs {
     /// revision's `btfsm.toml` (one the pull request cannot change)
     #[arg(long, value_name = "FILE")]
     pub(super) config: Option<PathBuf>,
-    /// Wall-clock cap of one file's GED, in milliseconds
-    #[arg(long, default_value_t = 10_000, value_name = "MS")]
-    pub(super) timeout_ms: u64,
+    /// CPU-time safety cap of one file's GED, in milliseconds [default:
+    /// derived from the work budget, far past what it takes, so that the
+    /// work budget decides and the review is the same on any machine]; it
+    /// also bounds each Graphviz rendering of `--svg-dir` (default 10 s)
+    #[arg(long, value_name = "MS")]
+    pub(super) timeout_ms: Option<u64>,
     /// Work budget of one file's tree edit distance, in table cells
     #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
     pub(super) tree_max_work: u64,
@@ -77,7 +80,7 @@ pub(super) fn run(a: ReviewArgs) -> u8 {
         head: a.head.clone(),
         paths: a.paths.clone(),
         limits: a.limits.limits(),
-        timeout: Duration::from_millis(a.timeout_ms),
+        timeout: a.timeout_ms.map(Duration::from_millis),
         tree_max_work: a.tree_max_work,
         dot: a.svg_dir.is_some(),
         config: a.config.clone(),
@@ -91,7 +94,11 @@ pub(super) fn run(a: ReviewArgs) -> u8 {
         code = code.max(sarif(&review, path));
     }
     if let Some(dir) = &a.svg_dir {
-        code = code.max(svgs(&review, dir, Duration::from_millis(a.timeout_ms)));
+        code = code.max(svgs(
+            &review,
+            dir,
+            Duration::from_millis(a.timeout_ms.unwrap_or(10_000)),
+        ));
     }
     let not_loaded = review.not_loaded();
     for (file, why) in &not_loaded {

@@ -45,8 +45,9 @@ pub struct Options {
     /// Paths (files or folders, relative to `cwd`) the review is limited to.
     pub paths: Vec<PathBuf>,
     pub limits: Limits,
-    /// Wall-clock cap of one GED computation.
-    pub timeout: Duration,
+    /// CPU-time safety cap of one GED computation (`None`: the one derived
+    /// from the work budget, so that the work budget decides).
+    pub timeout: Option<Duration>,
     /// Work budget of one tree edit distance, in table cells.
     pub tree_max_work: u64,
     /// Also make each diff's DOT text (for `--svg-dir`).

@@ -129,10 +129,10 @@ fn compare_pair(
         &topts,
         true,
     );
-    let gopts = GedOptions {
-        timeout: opts.timeout,
-        work: btfsm_metrics::ged::DEFAULT_WORK,
-    };
+    let mut gopts = GedOptions::with_work(btfsm_metrics::ged::DEFAULT_WORK);
+    if let Some(t) = opts.timeout {
+        gopts.timeout = t;
+    }
     let named = pair.run(GedMode::Named, &gopts);
     r.ged = Some(named.ged);
     let tree = pair.tree_report();
