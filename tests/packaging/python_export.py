@@ -251,6 +251,13 @@ def mappings(py, btfsm, env, tmp):
                      'type = "Condition", ports = { status = "SUCCESS" }', 'parallel = ["x", "y"], success = 2', '"a (2)" = { action = "a" }',
                      '"has key" = { condition', '"wait key" = { action'):
             check(frag in text, f"py_trees export holds `{frag}`")
+    r, out = export("py_trees", "pt_all:make", "--leaf-kind", "docked=action", "--leaf-kind", "p1=condition",
+                    "--leaf-kind", "p2=condition")
+    a, err = analyze(btfsm, env, out) if r.returncode == 0 else (None, r.stderr)
+    got = a and (a["counts"]["action"], a["counts"]["condition"])
+    check(got == (19, 4), "py_trees --leaf-kind overrides the rule both ways (19 actions, 4 conditions)", f"{got} {err}")
+    r, _ = export("py_trees", "no_such_module:make")
+    check(r.returncode == 2 and "cannot import" in r.stderr, "export of a module that does not import: exit 2", r.stderr)
     r, _ = export("py_trees", "pt_all:make", "--strict")
     check(r.returncode == 2 and "`fir`" in r.stderr and "FailureIsRunning" in r.stderr,
           "py_trees --strict refuses FailureIsRunning naming the node", r.stderr)
