@@ -166,7 +166,11 @@ class _Walk:
         if isinstance(policy, pp.SuccessOnAll):
             return "parallel", [("success", str(n))]
         if isinstance(policy, pp.SuccessOnOne):
-            return "parallel", [("success", "1")]
+            # py_trees fails at any child's failure; btfsm's parallel by
+            # default when success is out of reach (n - k + 1 failures), so
+            # the BehaviorTree.CPP port says 1 (crates/sim/src/exec/ops.rs).
+            extra = [("ports", '{ failure_count = "1" }')] if n > 1 else []
+            return "parallel", [("success", "1")] + extra
         if isinstance(policy, pp.SuccessOnSelected):
             selected = {id(c) for c in policy.children}
             if selected == {id(c) for c in b.children}:

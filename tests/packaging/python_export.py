@@ -245,7 +245,7 @@ def mappings(py, btfsm, env, tmp):
         check(a is not None and a["vertices"] == 40 and a["edges"] == 39, "py_trees: 40 vertices, 39 edges",
               f"{a and (a['vertices'], a['edges'])}")
         text = open(out, encoding="utf-8").read()
-        for frag in ('parallel = ["p3", "p4", "p5"], success = 1', 'repeat = "r", times = 3', 'retry = "t", times = 2',
+        for frag in ('parallel = ["p3", "p4", "p5"], success = 1, ports = { failure_count = "1" }', 'repeat = "r", times = 3', 'retry = "t", times = 2',
                      'timeout = "o", ms = 1500', 'type = "EternalGuard"', 'inv = { inverter = "i" }',
                      'fis = { force_success = "f" }', 'sif = { force_failure = "s" }', 'rep-forever = { repeat = "rf" }',
                      'type = "Condition", ports = { status = "SUCCESS" }', 'parallel = ["x", "y"], success = 2', '"a (2)" = { action = "a" }',
