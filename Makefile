@@ -152,9 +152,14 @@ wheel: $(VENV)/.packaging
 # against a local repository with a fake `gh` (tests/packaging/action.sh);
 # the pre-commit hooks run by `pre-commit run` on temporary repositories
 # (tests/packaging/precommit.sh; pip builds the package there once, with
-# this target folder, so only btfsm's own crates are compiled again).
+# this target folder, so only btfsm's own crates are compiled again); the
+# wheel's Python module `btfsm` with py_trees (tests/packaging/
+# requirements-python.txt) and SMACH's core (tests/fixtures/smach/):
+# the paper's Figs. 1, 2 and 4 written in py_trees and SMACH exported and
+# checked against policies/paper/ (tests/packaging/python_export.py).
 packaging: build wheel
 	tests/packaging/wheel.sh $(TARGET_DIR)/wheels
+	python3 tests/packaging/python_export.py $(TARGET_DIR)/wheels
 	tests/packaging/action.sh $(VENV)/bin $(BIN)
 	CARGO_TARGET_DIR=$(abspath $(TARGET_DIR)) tests/packaging/precommit.sh $(VENV)/bin/pre-commit
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The wheel `pip install btfsm` installs (pyproject.toml, maturin
-# `bindings = "bin"`), installed into a fresh venv and run with no Rust
-# toolchain on PATH: `btfsm --version`, `btfsm lint` on a bad and a good
+# `bindings = "bin"`, `python-source = "python"`), installed into a fresh venv
+# and run with no Rust toolchain on PATH: `btfsm --version`, `import btfsm`
+# (the Python module beside the binary), `btfsm lint` on a bad and a good
 # fixture (exit 1 and 0), and — when the binary has the `review` command —
 # `btfsm review` on a temporary repository of two commits. Prints the
 # wheel's size. Exit 0 when all pass, 1 otherwise.
@@ -46,6 +47,7 @@ if clean sh -c 'command -v cargo || command -v rustc'; then
   fail=1
 fi
 check "btfsm on PATH is the venv's" 0 sh -c "test \"\$(command -v btfsm)\" = '$tmp/venv/bin/btfsm'"
+check "python -c 'import btfsm'" 0 python -c 'import btfsm; btfsm.from_py_trees; btfsm.from_smach; btfsm.ExportError'
 check "btfsm --version" 0 btfsm --version
 grep -q "^btfsm $(sed -n 's/^version = "\(.*\)"/\1/p' "$repo/Cargo.toml" | head -1)\$" "$tmp/out" \
   || { echo "FAIL --version printed: $(cat "$tmp/out")"; fail=1; }
