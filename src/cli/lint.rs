@@ -433,20 +433,6 @@ fn lint_inputs(
 /// Trees of one file (that names none as its main tree) linted at most.
 const MAX_ROOT_TREES: usize = 64;
 
-/// Does a file carry its own node model (Groot2 saves one in the file): a
-/// `<TreeNodesModel>` declaring node types, not only SubTree ports? Then
-/// no model is searched for it.
-fn has_leaf_model(text: &str) -> bool {
-    let Some(start) = text.find("<TreeNodesModel") else {
-        return false;
-    };
-    let model = &text[start..];
-    let model = &model[..model.find("</TreeNodesModel").unwrap_or(model.len())];
-    ["<Action", "<Condition", "<Control", "<Decorator"]
-        .iter()
-        .any(|t| model.contains(t))
-}
-
 /// The limits a BehaviorTree.CPP file is read with: unknown leaves as
 /// actions unless `--assume-leaf` says otherwise (their C++ registers them,
 /// lint checks what it can), and, when no model is given, the models found
@@ -463,7 +449,7 @@ fn tree_limits(
         return l;
     }
     l.assume_leaf = l.assume_leaf.or(Some(format::AssumeLeaf::Action));
-    if !l.nodes_models.is_empty() || has_leaf_model(text) {
+    if !l.nodes_models.is_empty() || btfsm_lint::models::has_leaf_model(text) {
         return l;
     }
     let dir = path

@@ -197,3 +197,17 @@ pub const MODEL_CONFLICT: Rule = Rule {
     summary: "two node models declare one type as different kinds (Action here, Condition there)",
     check: super::load::found_by_the_reader,
 };
+
+/// Does a file carry its own node model (Groot2 saves one in the file): a
+/// `<TreeNodesModel>` declaring node types, not only SubTree ports? Then
+/// no model is searched for it (`lint`, `review`).
+pub fn has_leaf_model(text: &str) -> bool {
+    let Some(start) = text.find("<TreeNodesModel") else {
+        return false;
+    };
+    let model = &text[start..];
+    let model = &model[..model.find("</TreeNodesModel").unwrap_or(model.len())];
+    ["<Action", "<Condition", "<Control", "<Decorator"]
+        .iter()
+        .any(|t| model.contains(t))
+}

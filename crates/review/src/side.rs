@@ -170,7 +170,7 @@ impl<'a> Reader<'a> {
         }
         l.assume_leaf = l.assume_leaf.or(Some(format::AssumeLeaf::Action));
         l.nodes_models.extend(self.models.iter().cloned());
-        if l.nodes_models.is_empty() && !has_leaf_model(text) {
+        if l.nodes_models.is_empty() && !btfsm_lint::models::has_leaf_model(text) {
             l.found_models = self.search.for_tree(path, &self.snap.root);
         }
         l
@@ -203,17 +203,4 @@ fn bare(holds: Holds) -> Side {
         findings: Vec::new(),
         load_error: None,
     }
-}
-
-/// Does a file carry its own node model declaring leaf types (Groot2 saves
-/// one in the file)? Then no model is searched for it (as `lint`).
-fn has_leaf_model(text: &str) -> bool {
-    let Some(start) = text.find("<TreeNodesModel") else {
-        return false;
-    };
-    let model = &text[start..];
-    let model = &model[..model.find("</TreeNodesModel").unwrap_or(model.len())];
-    ["<Action", "<Condition", "<Control", "<Decorator"]
-        .iter()
-        .any(|t| model.contains(t))
 }
