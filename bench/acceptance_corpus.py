@@ -20,7 +20,8 @@ entry). For every BehaviorTree.CPP XML file below it (a file holding a
 2. `btfsm validate --assume-leaf action [--nodes-model M]... FILE` (with
    `--tree ID` for each tree of a file that has several and no main tree):
    exit 0 accepts, 2 rejects, anything else is a crash.
-3. `btfsm lint FILE --format json --no-config [--nodes-model M]...`: the
+3. `btfsm lint FILE --format json` at default settings, run from the
+   repository's root (node models found as lint finds them): the
    error-level findings (codes).
 
 Tallies: valid files (BehaviorTree.CPP creates them) that btfsm validate
@@ -80,6 +81,52 @@ def declared_format(path):
     return root.get("BTCPP_format") or "none"
 
 
+# A type the file itself writes in the explicit form with children
+# (`<Decorator ID="ForEachString">`, `<Control ID="X">`) is declared by that
+# form: the program registers it (MoveIt Pro's ForEachString), so it is
+# registered as a dummy of that category, as a model entry would be.
+_models_in = ac.models_in
+
+
+def models_in(root):
+    out = _models_in(root)
+    if root is not None:
+        for el in root.iter():
+            kind = ac.local(el.tag)
+            if kind in ("Decorator", "Control") and el.get("ID") and len(el):
+                out.setdefault(el.get("ID"), kind.lower())
+    return out
+
+
+ac.models_in = models_in
+
+# Format-3 names BehaviorTree.CPP 4 no longer knows (and format 3's Parallel
+# ports), which btfsm reads in a file that does not say BTCPP_format="4".
+FORMAT3 = ("SequenceStar", "FallbackStar", "RetryUntilSuccesful", "BlackboardCheck",
+           "SubTreePlus", "[failure_threshold]", "[success_threshold]", "[threshold]")
+# Built-ins of BehaviorTree.CPP 4.10 that the bindings' older 4.x lacks.
+NEWER_BUILTINS = ("TryCatch",)
+
+
+def explain(r):
+    """Why BehaviorTree.CPP and btfsm disagree on a file, when the reason
+    is known and not btfsm's error (None otherwise)."""
+    err = r["btcpp_error"]
+    if any(f"recognized: {n}" in err for n in NEWER_BUILTINS):
+        return "bindings older than BehaviorTree.CPP 4.10 (no TryCatch)"
+    if any(n in err for n in FORMAT3) and r["format"] != "4":
+        return "format-3 file (no BTCPP_format): btfsm reads format 3"
+    if any(n in err for n in FORMAT3):
+        return "format-3 name in a BTCPP_format=\"4\" file: validate reads it, lint reports it"
+    if "crashed" in err and "Error in script" in err:
+        return "created; a script fails on an entry the program sets (BehaviorTree.CPP aborts)"
+    if "Node not recognized: " in err and r["custom_with_children"]:
+        return "a custom control/decorator no model declares (the program registers it in C++)"
+    if "Node not recognized: inverter" in err:
+        return "`<inverter>`: btfsm reads the built-in with a warning, lint reports it"
+    return None
+
+
 # The models of each file (a file is checked in one thread; the functions of
 # accept_btcpp.py look them up by path).
 MODELS = {}
@@ -97,12 +144,12 @@ def validate(exe, path):
     return ac.btfsm_validate(exe, path)
 
 
-def lint(exe, path, models):
-    args = [exe, "lint", str(path), "--format", "json", "--no-config"]
-    for m in models:
-        args += ["--nodes-model", str(m)]
+def lint(exe, path, root):
+    """`btfsm lint FILE` at default settings, from the repository's root
+    (its models found as lint finds them)."""
+    args = [exe, "lint", str(path.relative_to(root)), "--format", "json"]
     r = subprocess.run(args, capture_output=True, text=True, timeout=ac.WORKER_TIMEOUT,
-                       check=False)
+                       check=False, cwd=root)
     try:
         found = json.loads(r.stdout)
     except json.JSONDecodeError:
@@ -115,28 +162,45 @@ def check(job):
     with tempfile.TemporaryDirectory(dir=tmp) as work:
         b = btcpp_verdict(path, repo_root(path, corpus), Path(work))
     code, why = validate(exe, path)
-    lcode, lerrors = lint(exe, path, models)
-    return {"file": str(path.relative_to(corpus)), "repo": str(repo_root(path, corpus).relative_to(corpus)),
+    lcode, lerrors = lint(exe, path, repo_root(path, corpus))
+    bad = b["error"].split("Node not recognized: ", 1)
+    custom = len(bad) > 1 and any(
+        n > 0 for t, n in ac.node_uses(ac.parse(path)).items() if t == bad[1].split()[0])
+    return {"file": str(path.relative_to(corpus)), "custom_with_children": custom, "repo": str(repo_root(path, corpus).relative_to(corpus)),
             "format": declared_format(path), "models": [str(m.relative_to(corpus)) for m in models],
             "btcpp_ok": b["ok"], "btcpp_error": b["error"], "btcpp_tick": b["tick"],
             "validate_exit": code, "validate_error": ac.short(why, 200),
             "lint_exit": lcode, "lint_errors": lerrors}
 
 
+def verdict(r):
+    """valid (created, first tick clean), tick (created, the first tick
+    fails: a child count BehaviorTree.CPP checks when the node runs, or an
+    entry the program sets), refused (not created), or explained (a
+    disagreement whose reason is not btfsm's: `explain`)."""
+    if r["btcpp_ok"]:
+        return "tick" if r["btcpp_tick"] else "valid"
+    return "refused"
+
+
 def tally(rows):
     t = collections.Counter()
     for r in rows:
         t["files"] += 1
-        ok, acc, lint_err = r["btcpp_ok"], r["validate_exit"] == 0, bool(r["lint_errors"])
-        t["btcpp_creates"] += ok
+        v, acc, lint_err = verdict(r), r["validate_exit"] == 0, bool(r["lint_errors"])
+        why = explain(r)
+        t["btcpp_valid"] += v == "valid"
+        t["btcpp_tick_fails"] += v == "tick"
+        t["btcpp_refuses"] += v == "refused"
         t["validate_accepts"] += acc
         t["crash"] += r["validate_exit"] not in (0, 2)
-        t["false_rejections"] += ok and not acc
-        t["false_acceptances"] += (not ok) and acc
-        t["agree"] += ok == acc
-        t["lint_misses"] += (not ok) and not lint_err
-        t["lint_errors_on_created"] += ok and lint_err
-        t["lint_agree"] += ok != lint_err
+        t["false_rejections"] += v == "valid" and not acc
+        t["false_acceptances"] += v == "refused" and acc and not why
+        t["lint_misses"] += v == "refused" and not lint_err and not why
+        t["explained"] += v == "refused" and (acc or not lint_err) and bool(why)
+        t["lint_errors_on_valid"] += v == "valid" and lint_err
+        t["tick_fails_validate_rejects"] += v == "tick" and not acc
+        t["agree"] += (v != "refused") == acc if v != "tick" else 1
     return t
 
 
@@ -183,8 +247,9 @@ def report(rows):
     by_repo = collections.defaultdict(list)
     for r in rows:
         by_repo[r["repo"].split("/")[0]].append(r)
-    cols = ["files", "btcpp_creates", "validate_accepts", "false_rejections",
-            "false_acceptances", "lint_misses", "lint_errors_on_created", "crash"]
+    cols = ["files", "btcpp_valid", "btcpp_tick_fails", "btcpp_refuses", "validate_accepts",
+            "false_rejections", "false_acceptances", "lint_misses", "explained",
+            "lint_errors_on_valid", "tick_fails_validate_rejects", "crash"]
     print("| repository | " + " | ".join(cols) + " |")
     print("|---" * (len(cols) + 1) + "|")
     for repo in sorted(by_repo):
@@ -195,21 +260,28 @@ def report(rows):
     for fmt in sorted({r["format"] for r in rows}):
         ft = tally([r for r in rows if r["format"] == fmt])
         print(f"| BTCPP_format={fmt} | " + " | ".join(str(ft[c]) for c in cols) + " |")
-    n = t["files"] or 1
-    print(f"\nvalidate agrees with BehaviorTree.CPP on {t['agree']}/{t['files']} "
-          f"({100 * t['agree'] / n:.1f} %); lint (error = refused) on {t['lint_agree']}/{t['files']}")
+    n = t["files"] - t["btcpp_tick_fails"] or 1
+    print(f"\nvalidate agrees with BehaviorTree.CPP on {t['agree'] - t['btcpp_tick_fails']}/{n} "
+          f"files it creates or refuses ({100 * (t['agree'] - t['btcpp_tick_fails']) / n:.1f} %)")
+    why = collections.Counter()
     for r in rows:
-        ok, acc = r["btcpp_ok"], r["validate_exit"] == 0
-        if ok and not acc:
-            print(f"FALSE-REJECTION {r['file']} [{r['format']}]: {r['validate_error']}")
-        elif not ok and acc:
-            print(f"FALSE-ACCEPTANCE {r['file']} [{r['format']}]: btcpp: {r['btcpp_error']}")
-        if not ok and not r["lint_errors"]:
-            print(f"LINT-MISS {r['file']} [{r['format']}]: btcpp: {r['btcpp_error']}")
-        if ok and r["lint_errors"]:
-            print(f"LINT-ERROR-ON-CREATED {r['file']} [{r['format']}]: {' '.join(r['lint_errors'])}")
-        if ok and r["btcpp_tick"]:
-            print(f"TICK-ERROR {r['file']}: {r['btcpp_tick']}")
+        v, acc, e = verdict(r), r["validate_exit"] == 0, explain(r)
+        tag = f"{r['file']} [{r['format']}]"
+        if v == "valid" and not acc:
+            print(f"FALSE-REJECTION {tag}: {r['validate_error']}")
+        if v == "refused" and (acc or not r["lint_errors"]):
+            kind = ("FALSE-ACCEPTANCE+LINT-MISS" if acc and not r["lint_errors"] else
+                    "FALSE-ACCEPTANCE" if acc else "LINT-MISS")
+            if e:
+                why[e] += 1
+                kind = "EXPLAINED " + kind
+            print(f"{kind} {tag}: btcpp: {r['btcpp_error']}" + (f" — {e}" if e else ""))
+        if v == "valid" and r["lint_errors"]:
+            print(f"LINT-ERROR-ON-VALID {tag}: {' '.join(r['lint_errors'])}")
+        if v == "tick":
+            print(f"TICK-FAILS {tag} (validate {'accepts' if acc else 'rejects'}): {r['btcpp_tick']}")
+    for e, c in why.most_common():
+        print(f"explained: {c} x {e}")
 
 
 if __name__ == "__main__":
