@@ -106,6 +106,10 @@ FORMAT3 = ("SequenceStar", "FallbackStar", "RetryUntilSuccesful", "BlackboardChe
            "SubTreePlus", "[failure_threshold]", "[success_threshold]", "[threshold]")
 # Built-ins of BehaviorTree.CPP 4.10 that the bindings' older 4.x lacks.
 NEWER_BUILTINS = ("TryCatch",)
+# BehaviorTree.CPP 4.10's load checks (xml_parsing.cpp) that 3.8 lacks.
+LOAD_CHECKS_4 = ("Unknown node type: ", "more than one async child",
+                 "The tag <BehaviorTree> must have the attribute [ID]",
+                 "Missing attribute 'ID' in SubTree")
 
 
 def explain(r):
@@ -118,6 +122,9 @@ def explain(r):
         return "format-3 file (no BTCPP_format): btfsm reads format 3"
     if any(n in err for n in FORMAT3):
         return "format-3 name in a BTCPP_format=\"4\" file: validate reads it, lint reports it"
+    if r["format"] != "4" and any(m in err for m in LOAD_CHECKS_4):
+        return ("no BTCPP_format: a load check of BehaviorTree.CPP 4.10 that btfsm applies "
+                "only under BTCPP_format=\"4\" (BehaviorTree.CPP 3 loads the file)")
     if "crashed" in err and "Error in script" in err:
         return "created; a script fails on an entry the program sets (BehaviorTree.CPP aborts)"
     if "Node not recognized: " in err and r["custom_with_children"]:

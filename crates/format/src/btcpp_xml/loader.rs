@@ -457,7 +457,7 @@ impl Loader<'_> {
                     if let Some(id) = el.attr("ID") {
                         let ports = super::ports::model_ports(&self.docs[d], d, k);
                         self.tree_ports.insert(id.to_string(), ports);
-                    } else {
+                    } else if self.says_format_4(d) {
                         self.err(
                             d,
                             el.span.clone(),
@@ -586,7 +586,10 @@ impl Loader<'_> {
             let el = self.docs[d].elems[k].clone();
             match el.name.as_str() {
                 "BehaviorTree" => {
-                    if el.attr("ID").is_none_or(str::is_empty) && kids.len() > 1 {
+                    if el.attr("ID").is_none_or(str::is_empty)
+                        && kids.len() > 1
+                        && self.says_format_4(d)
+                    {
                         self.untitled_tree(d, &el);
                         continue;
                     }
@@ -651,7 +654,7 @@ impl Loader<'_> {
     }
 
     /// A `<BehaviorTree>` without `ID` (or with an empty one) beside other
-    /// elements under `<root>`: BehaviorTree.CPP refuses it ("The tag
+    /// elements under `<root>` of a `BTCPP_format="4"` file: BehaviorTree.CPP 4 refuses it ("The tag
     /// <BehaviorTree> must have the attribute [ID]", xml_parsing.cpp,
     /// `VerifyXML`, which counts every element under `<root>`).
     fn untitled_tree(&mut self, d: usize, el: &XElem) {

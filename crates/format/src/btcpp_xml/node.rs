@@ -85,7 +85,7 @@ impl Loader<'_> {
         }
         if ty == "ReactiveSequence"
             && !self.models.contains_key(&ty)
-            && !self.format_3(d)
+            && self.says_format_4(d)
             && !self.reactive_children_fit(d, el)
         {
             return None;
@@ -360,8 +360,8 @@ impl Loader<'_> {
         .hint = Some(hint);
     }
 
-    /// BehaviorTree.CPP 4 checks a ReactiveSequence's children when it
-    /// loads the file (xml_parsing.cpp, `VerifyXML`): it looks each child up
+    /// BehaviorTree.CPP 4 (4.10, not 3) checks a ReactiveSequence's children
+    /// when it loads the file (xml_parsing.cpp, `VerifyXML`): it looks each child up
     /// by its tag name, so the explicit form `<Action ID="X"/>` is refused
     /// ("Unknown node type: Action"), and two asynchronous children
     /// (`AsyncSequence`) are refused ("A ReactiveSequence cannot have more

@@ -765,8 +765,13 @@ fn what_behaviortree_cpp_refuses_on_load_is_an_error() {
     }
     // What BehaviorTree.CPP loads: the compact form under a
     // ReactiveSequence, a SubTree child, one AsyncSequence, an explicit
-    // child under a ReactiveFallback, one tree without ID alone.
+    // child under a ReactiveFallback, one tree without ID alone; and
+    // BehaviorTree.CPP 3 (3.8 has none of these checks) a file without
+    // `BTCPP_format`.
     for text in [
+        format!(
+            "<root><BehaviorTree><ReactiveSequence><Action ID=\"Go\"/>{x}</ReactiveSequence></BehaviorTree><TreeNodesModel><Action ID=\"Go\"/></TreeNodesModel></root>"
+        ),
         file(
             &format!("<ReactiveSequence><Go/><SubTree ID=\"S\"/>{asyncs}</ReactiveSequence>"),
             &format!(
