@@ -282,3 +282,48 @@ fn a_tree_id_used_as_a_tag_is_refused_with_the_fix() {
         "{err}"
     );
 }
+
+/// What BehaviorTree.CPP 4 refuses when it loads a file (xml_parsing.cpp,
+/// `VerifyXML`; found by bench/acceptance_corpus.py on a MoveIt Pro
+/// objective and BehaviorTree.CPP 4.10's unit tests): `validate` refuses
+/// it and `lint` reports a `load-error` at the element, never "0 errors".
+#[test]
+fn what_behaviortree_cpp_refuses_on_load_is_a_lint_error() {
+    let dir = common::scratch("refused-on-load");
+    let cases = [
+        (
+            "reactive-explicit.xml",
+            r#"<root BTCPP_format="4"><BehaviorTree ID="M"><ReactiveSequence><Action ID="Go"/><AlwaysSuccess/></ReactiveSequence></BehaviorTree><TreeNodesModel><Action ID="Go"/></TreeNodesModel></root>"#,
+            "refuses `<Action>` as a child of `ReactiveSequence`",
+        ),
+        (
+            "untitled-tree.xml",
+            r#"<root BTCPP_format="4" main_tree_to_execute="Other"><BehaviorTree ID=""><AlwaysSuccess/></BehaviorTree><BehaviorTree ID="Other"><AlwaysSuccess/></BehaviorTree></root>"#,
+            "`<BehaviorTree>` needs an `ID`",
+        ),
+        (
+            "model-subtree.xml",
+            r#"<root BTCPP_format="4"><BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree><TreeNodesModel><SubTree/></TreeNodesModel></root>"#,
+            "`<SubTree>` in `<TreeNodesModel>` needs an `ID`",
+        ),
+    ];
+    for (name, text, msg) in cases {
+        let f = dir.join(name);
+        std::fs::write(&f, text).expect("write");
+        let f = f.to_string_lossy().to_string();
+        let (code, _, err) = run(&["validate", &f]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(err.contains(msg), "{name}: {err}");
+        let (code, out, _) = run(&["lint", "--no-config", &f, "--format", "json"]);
+        assert_eq!(code, 2, "{name}: {out}");
+        assert!(
+            out.contains("\"load-error\"") && out.contains(&msg.replace('"', "\\\"")),
+            "{name}: {out}"
+        );
+    }
+    // The compact form loads in BehaviorTree.CPP and in btfsm.
+    let f = dir.join("reactive-compact.xml");
+    std::fs::write(&f, r#"<root BTCPP_format="4"><BehaviorTree ID="M"><ReactiveSequence><Go/><AlwaysSuccess/></ReactiveSequence></BehaviorTree><TreeNodesModel><Action ID="Go"/></TreeNodesModel></root>"#).expect("write");
+    let (code, _, err) = run(&["validate", &f.to_string_lossy()]);
+    assert_eq!(code, 0, "{err}");
+}

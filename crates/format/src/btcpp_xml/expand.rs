@@ -483,6 +483,15 @@ impl Loader<'_> {
         let doc = &self.docs[d];
         doc.elems[doc.root].attr("BTCPP_format") == Some("3")
     }
+
+    /// Whether document `d` says `BTCPP_format="4"`: BehaviorTree.CPP 4's
+    /// own load checks that BehaviorTree.CPP 3 does not make apply (a file
+    /// without the attribute may be written for BehaviorTree.CPP 3, as
+    /// format 3's names are reported only under this attribute).
+    pub(super) fn says_format_4(&self, d: usize) -> bool {
+        let doc = &self.docs[d];
+        doc.elems[doc.root].attr("BTCPP_format") == Some("4")
+    }
 }
 
 /// Attributes of a `<SubTree>` element that are not port remappings.

@@ -452,9 +452,20 @@ impl Loader<'_> {
                 "Control" => Category::Control,
                 "Decorator" => Category::Decorator,
                 "SubTree" => {
+                    // BehaviorTree.CPP 4 (xml_parsing.cpp, loadSubtreeModel)
+                    // refuses a model's `<SubTree>` without `ID`.
                     if let Some(id) = el.attr("ID") {
                         let ports = super::ports::model_ports(&self.docs[d], d, k);
                         self.tree_ports.insert(id.to_string(), ports);
+                    } else if self.says_format_4(d) {
+                        self.err(
+                            d,
+                            el.span.clone(),
+                            "`<SubTree>` in `<TreeNodesModel>` needs an `ID`".to_string(),
+                        )
+                        .hint = Some(
+                            "name the tree whose ports it declares: `<SubTree ID=\"Name\">` (BehaviorTree.CPP refuses it too)".into(),
+                        );
                     }
                     continue;
                 }
@@ -570,10 +581,18 @@ impl Loader<'_> {
             .hint = Some("BehaviorTree.CPP writes `BTCPP_format=\"4\"` (or \"3\")".into());
         }
         let kids = self.docs[d].elems[root].children.clone();
-        for k in kids {
+        let mut models_seen = 0;
+        for &k in &kids {
             let el = self.docs[d].elems[k].clone();
             match el.name.as_str() {
                 "BehaviorTree" => {
+                    if el.attr("ID").is_none_or(str::is_empty)
+                        && kids.len() > 1
+                        && self.says_format_4(d)
+                    {
+                        self.untitled_tree(d, &el);
+                        continue;
+                    }
                     let id = el.attr("ID").unwrap_or("MainTree").to_string();
                     if self.too_long(d, &el, "tree ID", &id) {
                         continue;
@@ -612,7 +631,14 @@ impl Loader<'_> {
                     }
                     self.trees.insert(id, (d, k));
                 }
-                "TreeNodesModel" => self.read_model(d, k),
+                "TreeNodesModel" => {
+                    models_seen += 1;
+                    if models_seen > 1 {
+                        self.second_model(d, &el);
+                        continue;
+                    }
+                    self.read_model(d, k);
+                }
                 "include" => {}
                 other => {
                     let h = suggest(other, ["BehaviorTree", "TreeNodesModel", "include"]);
@@ -625,6 +651,34 @@ impl Loader<'_> {
                 }
             }
         }
+    }
+
+    /// A `<BehaviorTree>` without `ID` (or with an empty one) beside other
+    /// elements under `<root>` of a `BTCPP_format="4"` file: BehaviorTree.CPP 4 refuses it ("The tag
+    /// <BehaviorTree> must have the attribute [ID]", xml_parsing.cpp,
+    /// `VerifyXML`, which counts every element under `<root>`).
+    fn untitled_tree(&mut self, d: usize, el: &XElem) {
+        self.err(
+            d,
+            el.span.clone(),
+            "`<BehaviorTree>` needs an `ID` when `<root>` holds other elements".to_string(),
+        )
+        .hint = Some(
+            "give it one: `<BehaviorTree ID=\"MainTree\">` (BehaviorTree.CPP refuses it too)"
+                .into(),
+        );
+    }
+
+    /// A second `<TreeNodesModel>` in one file: BehaviorTree.CPP refuses it
+    /// ("Only a single node <TreeNodesModel> is supported", xml_parsing.cpp,
+    /// `VerifyXML`).
+    fn second_model(&mut self, d: usize, el: &XElem) {
+        self.err(
+            d,
+            el.span.clone(),
+            "a second `<TreeNodesModel>` in one file".to_string(),
+        )
+        .hint = Some("merge its entries into the first (BehaviorTree.CPP reads one per file and refuses the file)".into());
     }
 
     /// The tree to run: `--tree ID`, else `main_tree_to_execute`, else the

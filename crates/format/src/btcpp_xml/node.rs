@@ -83,6 +83,13 @@ impl Loader<'_> {
                 }
             }
         }
+        if ty == "ReactiveSequence"
+            && !self.models.contains_key(&ty)
+            && self.says_format_4(d)
+            && !self.reactive_children_fit(d, el)
+        {
+            return None;
+        }
         let mut ports = node_ports(el, consumed, kind, &ty, resolve);
         let skill_call = bind_skill(kind, &ty, &mut ports);
         if skill_call.is_some() {
@@ -351,6 +358,51 @@ impl Loader<'_> {
             ),
         )
         .hint = Some(hint);
+    }
+
+    /// BehaviorTree.CPP 4 (4.10, not 3) checks a ReactiveSequence's children
+    /// when it loads the file (xml_parsing.cpp, `VerifyXML`): it looks each child up
+    /// by its tag name, so the explicit form `<Action ID="X"/>` is refused
+    /// ("Unknown node type: Action"), and two asynchronous children
+    /// (`AsyncSequence`) are refused ("A ReactiveSequence cannot have more
+    /// than one async child"). An error when not.
+    fn reactive_children_fit(&mut self, d: usize, el: &XElem) -> bool {
+        let mut asyncs = 0;
+        for &c in &el.children {
+            let child = self.docs[d].elems[c].clone();
+            let name = child.name.as_str();
+            if matches!(name, "Action" | "Condition" | "Control" | "Decorator") {
+                let id = child.attr("ID").unwrap_or("TYPE");
+                let hint = format!(
+                    "write it in the compact form `<{}/>`: BehaviorTree.CPP looks a ReactiveSequence's children up by tag name",
+                    shown(id)
+                );
+                self.err(
+                    d,
+                    child.span.clone(),
+                    format!(
+                        "BehaviorTree.CPP 4 refuses `<{name}>` as a child of `ReactiveSequence` (Unknown node type: {name})"
+                    ),
+                )
+                .hint = Some(hint);
+                return false;
+            }
+            if name == "AsyncSequence" {
+                asyncs += 1;
+                if asyncs > 1 {
+                    self.err(
+                        d,
+                        el.span.clone(),
+                        "a `ReactiveSequence` with more than one `AsyncSequence` child: BehaviorTree.CPP 4 refuses it".to_string(),
+                    )
+                    .hint = Some(
+                        "keep one asynchronous child (BehaviorTree.CPP: \"A ReactiveSequence cannot have more than one async child\"); use a `Sequence` for the others".into(),
+                    );
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     /// Whether the element's number of children fits its category (a

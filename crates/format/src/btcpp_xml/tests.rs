@@ -167,14 +167,14 @@ fn compact_and_explicit_syntax_with_subtrees() {
   <BehaviorTree ID="Main">
 <ReactiveSequence name="top">
   <SubTree ID="Sub"/>
-  <Action ID="Move-To" target="cube2"/>
+  <Move-To target="cube2"/>
   <Repeat num_cycles="3"><AlwaysSuccess/></Repeat>
 </ReactiveSequence>
   </BehaviorTree>
   <BehaviorTree ID="Sub">
 <Fallback><Condition ID="Found"/><Search/></Fallback>
   </BehaviorTree>
-  <TreeNodesModel><Action ID="Search"/></TreeNodesModel>
+  <TreeNodesModel><Action ID="Search"/><Action ID="Move-To"/></TreeNodesModel>
 </root>"#,
     )
     .unwrap();
@@ -695,4 +695,95 @@ fn format_3_subtree_ports_name_outer_entries() {
             r#"Str("{move_goal}")"#
         ]
     );
+}
+
+/// What BehaviorTree.CPP 4's `VerifyXML` and `loadSubtreeModel`
+/// (xml_parsing.cpp) refuse when the file is loaded, found by
+/// bench/acceptance_corpus.py on BehaviorTree.CPP 4.10's own unit tests
+/// (gtest_reactive.cpp, gtest_factory.cpp, gtest_xml_null_subtree_id.cpp)
+/// and MoveIt Pro objectives: each is an error, and the file without the
+/// fault loads.
+#[test]
+fn what_behaviortree_cpp_refuses_on_load_is_an_error() {
+    let file = |tree: &str, rest: &str| {
+        format!(
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"M\"><BehaviorTree ID=\"M\">{tree}</BehaviorTree>{rest}</root>"
+        )
+    };
+    let x = "<AlwaysSuccess/>";
+    let asyncs = format!("<AsyncSequence>{x}</AsyncSequence>");
+    for (text, msg) in [
+        (
+            file(
+                &format!("<ReactiveSequence><Action ID=\"Go\"/>{x}</ReactiveSequence>"),
+                "<TreeNodesModel><Action ID=\"Go\"/></TreeNodesModel>",
+            ),
+            "refuses `<Action>` as a child of `ReactiveSequence`",
+        ),
+        (
+            file(
+                &format!("<ReactiveSequence><Condition ID=\"Ok\"/>{x}</ReactiveSequence>"),
+                "<TreeNodesModel><Condition ID=\"Ok\"/></TreeNodesModel>",
+            ),
+            "refuses `<Condition>` as a child of `ReactiveSequence`",
+        ),
+        (
+            file(
+                &format!("<ReactiveSequence>{asyncs}{asyncs}</ReactiveSequence>"),
+                "",
+            ),
+            "more than one `AsyncSequence` child",
+        ),
+        (
+            file(x, &format!("<BehaviorTree ID=\"\">{x}</BehaviorTree>")),
+            "`<BehaviorTree>` needs an `ID` when `<root>` holds other elements",
+        ),
+        (
+            format!(
+                "<root BTCPP_format=\"4\"><BehaviorTree>{x}</BehaviorTree><TreeNodesModel/></root>"
+            ),
+            "`<BehaviorTree>` needs an `ID` when `<root>` holds other elements",
+        ),
+        (
+            file(
+                x,
+                "<TreeNodesModel><SubTree><input_port name=\"p\"/></SubTree></TreeNodesModel>",
+            ),
+            "`<SubTree>` in `<TreeNodesModel>` needs an `ID`",
+        ),
+        (
+            file(x, "<TreeNodesModel/><TreeNodesModel/>"),
+            "a second `<TreeNodesModel>` in one file",
+        ),
+    ] {
+        let e = parse(&text).unwrap_err();
+        assert!(
+            e.iter().any(|d| d.message.contains(msg)),
+            "{text}: {:?}",
+            e.iter().map(|d| &d.message).collect::<Vec<_>>()
+        );
+    }
+    // What BehaviorTree.CPP loads: the compact form under a
+    // ReactiveSequence, a SubTree child, one AsyncSequence, an explicit
+    // child under a ReactiveFallback, one tree without ID alone; and
+    // BehaviorTree.CPP 3 (3.8 has none of these checks) a file without
+    // `BTCPP_format`.
+    for text in [
+        format!(
+            "<root><BehaviorTree><ReactiveSequence><Action ID=\"Go\"/>{x}</ReactiveSequence></BehaviorTree><TreeNodesModel><Action ID=\"Go\"/></TreeNodesModel></root>"
+        ),
+        file(
+            &format!("<ReactiveSequence><Go/><SubTree ID=\"S\"/>{asyncs}</ReactiveSequence>"),
+            &format!(
+                "<BehaviorTree ID=\"S\">{x}</BehaviorTree><TreeNodesModel><Action ID=\"Go\"/></TreeNodesModel>"
+            ),
+        ),
+        file(
+            &format!("<ReactiveFallback><Action ID=\"Go\"/>{x}</ReactiveFallback>"),
+            "<TreeNodesModel><Action ID=\"Go\"/><SubTree ID=\"M\"/></TreeNodesModel>",
+        ),
+        format!("<root BTCPP_format=\"4\"><BehaviorTree>{x}</BehaviorTree></root>"),
+    ] {
+        assert!(parse(&text).is_ok(), "{text}: {:?}", parse(&text).err());
+    }
 }
