@@ -41,7 +41,7 @@ fn sensitivity_names_the_setting_that_decides_a_verdict() {
     ]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    assert_eq!(v["sensitivity"]["flips"].as_array().unwrap().len(), 12);
+    assert_eq!(v["sensitivity"]["flips"].as_array().unwrap().len(), 14);
     let r = reversals(&v);
     assert_eq!(
         r["outcome of Fig. 2 FSM sequential"],

@@ -215,10 +215,15 @@ impl SimReport {
         if self.verdicts.is_empty() {
             return;
         }
-        let (tol_s, tol_m) = (self.verdicts.iter()).fold((0.0f64, 0.0f64), |(s, m), v| {
-            (s.max(v.tolerance_s), m.max(v.pose_tolerance_m))
-        });
-        out.push_str(&format!("\nbehavior match (same executed skills with arguments and results, started within {tol_s} s; robots within {tol_m} m at equal times; same goal outcome; same final world):\n"));
+        let (tol_s, tol_m, shift_s) =
+            (self.verdicts.iter()).fold((0.0f64, 0.0f64, 0.0f64), |(s, m, h), v| {
+                (
+                    s.max(v.tolerance_s),
+                    m.max(v.pose_tolerance_m),
+                    h.max(v.max_time_shift_s),
+                )
+            });
+        out.push_str(&format!("\nbehavior match (same executed skills with arguments and results, started within {tol_s} s; robots within {tol_m} m at equal times, shifted by up to {shift_s} s; same goal outcome; same final world):\n"));
         for v in &self.verdicts {
             let what = if v.matches {
                 "MATCH".to_string()
@@ -238,12 +243,20 @@ impl SimReport {
                 }
                 format!("DIFFER ({})", why.join(", "))
             };
+            let shift = if v.time_shift_s == 0.0 {
+                String::new()
+            } else {
+                format!(" shifted by {} s", v.time_shift_s)
+            };
             out.push_str(&format!(
-                "  {} vs {}: {what}, trajectory distance {:.3} m at equal times ({:.3} m between the paths)\n",
+                "  {} vs {}: {what}, trajectory distance {:.3} m at equal times{shift} ({:.3} m between the paths)\n",
                 v.a, v.b, v.trajectory_distance_m, v.path_distance_m
             ));
             if let Some(d) = &v.first_divergence {
                 out.push_str(&format!("    first divergence {}\n", d.summary()));
+            }
+            if let Some(t) = v.worlds_diverge_s {
+                out.push_str(&format!("    worlds diverge at {t} s\n"));
             }
         }
     }
@@ -724,6 +737,9 @@ mod tests {
             "first_divergence",
             "trajectory_distance_m",
             "path_distance_m",
+            "time_shift_s",
+            "max_time_shift_s",
+            "worlds_diverge_s",
         ] {
             assert!(v["verdicts"][0].get(k).is_some(), "{k}");
         }

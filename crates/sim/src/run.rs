@@ -562,6 +562,7 @@ impl<'a> Episode<'a> {
             dt: s.dt,
             pose_tolerance_m: s.pose_tolerance_m,
             start_tolerance_s: s.start_tolerance_s,
+            time_shift_s: s.time_shift_s,
             after_success: p.after_success.as_str(),
             after_failure: p.after_failure.as_str(),
             completion_s: self.completion.map(round3),

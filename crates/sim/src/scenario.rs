@@ -120,6 +120,10 @@ pub struct Scenario {
     /// for their behavior to match (defaults 0.2 m and one step).
     pub pose_tolerance_m: f64,
     pub start_tolerance_s: f64,
+    /// The largest time shift between two runs under which their poses
+    /// are compared, s (default `start_tolerance_s`): a run that does the
+    /// same a step later moves alike.
+    pub time_shift_s: f64,
     pub world: World,
     pub policies: Vec<PolicyEntry>,
     pub rates: BTreeMap<String, f64>,
@@ -288,6 +292,7 @@ const TOP_KEYS: &[&str] = &[
     "after_failure",
     "pose_tolerance_m",
     "start_tolerance_s",
+    "time_shift_s",
     "expect",
     "goal",
     "world",

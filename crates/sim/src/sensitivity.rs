@@ -141,6 +141,9 @@ fn scaled_flips(s: &Scenario, out: &mut Vec<(Flip, Scenario)>) {
             t,
         ));
         let mut t = s.clone();
+        t.time_shift_s = s.time_shift_s * k;
+        out.push((flip("time_shift_s", s.time_shift_s, t.time_shift_s), t));
+        let mut t = s.clone();
         t.start_tolerance_s = s.start_tolerance_s * k;
         out.push((
             flip(

@@ -216,6 +216,9 @@ pub struct Run {
     pub pose_tolerance_m: f64,
     #[serde(skip)]
     pub start_tolerance_s: f64,
+    /// The largest time shift under which poses are compared, s.
+    #[serde(skip)]
+    pub time_shift_s: f64,
     /// What the policy did after SUCCESS (`stop` or `keep-ticking`).
     pub after_success: &'static str,
     /// What the policy did after FAILURE (`stop` or `keep-ticking`).
@@ -247,16 +250,25 @@ pub struct Divergence {
     pub index: usize,
     pub a: Option<String>,
     pub b: Option<String>,
-    /// When: the earlier start of the two skills, s (the end of the shorter
-    /// run when one has no skill there).
+    /// When, s: the earlier start of the two skills (`skill`, `start`),
+    /// the earlier end of the two calls (`outcome`: when the worlds
+    /// stopped doing the same), or the end of the shorter run when one has
+    /// no skill there (`missing`).
     pub t: f64,
-    /// `skill` (skill, arguments or outcome differ), `start` (the same skill
+    /// `skill` (skill or arguments differ), `outcome` (the same call
+    /// completed in one run and not in the other), `start` (the same skill
     /// started more than the tolerance apart) or `missing` (one run has no
     /// skill there).
     pub kind: &'static str,
     /// The two start times, s, for `start`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub starts: Option<[f64; 2]>,
+    /// When the differing calls made the worlds differ, s: `t` for
+    /// `outcome`, else the earliest end of one of the two that completed
+    /// (its effect is in one world only from then); `None` when neither
+    /// completed.
+    #[serde(skip)]
+    pub parted: Option<f64>,
 }
 
 impl Divergence {
@@ -295,10 +307,23 @@ pub struct Verdict {
     pub same_motion: bool,
     pub tolerance_s: f64,
     pub pose_tolerance_m: f64,
+    /// The scenario's `time_shift_s`: the largest shift tried, s.
+    pub max_time_shift_s: f64,
     pub first_divergence: Option<Divergence>,
-    /// The largest distance between the two robots at the same time, m
-    /// (after its run ended, a robot stands where it stopped).
+    /// The largest distance between the two robots at the same time, m,
+    /// once the second run's clock is shifted by `time_shift_s` (after its
+    /// run ended, a robot stands where it stopped).
     pub trajectory_distance_m: f64,
+    /// The shift of the second run's clock, s, within the scenario's
+    /// `time_shift_s`, that brings the two robots closest (the smallest
+    /// such shift; positive: the second run is later).
+    pub time_shift_s: f64,
+    /// When the two worlds stopped being the same, s: the first time the
+    /// robots are more than `pose_tolerance_m` apart (at that shift), or
+    /// one of the first differing calls completed (its effect is then in
+    /// one world only: [`Divergence::parted`]); `None` when neither
+    /// happened.
+    pub worlds_diverge_s: Option<f64>,
     /// Discrete Fréchet distance between the two paths, m: how far apart
     /// the paths are, whatever the time each took.
     pub path_distance_m: f64,
@@ -371,8 +396,17 @@ fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
     };
     let same_world = a.final_world.same_state(&b.final_world);
     let same_outcome = a.outcome == b.outcome && a.goal_met == b.goal_met;
-    let apart = (aligned_distance(&a.track, &b.track) * 1000.0).round() / 1000.0;
+    let max_shift = (a.time_shift_s.max(b.time_shift_s) / a.dt.max(1e-9)).round() as i64;
+    let aligned = best_alignment(&a.track, &b.track, max_shift, pose_tol);
+    let apart = (aligned.distance * 1000.0).round() / 1000.0;
     let same_motion = apart <= pose_tol + 1e-9;
+    let moved_apart = aligned.first_apart.map(|k| k as f64 * a.dt);
+    let ended_apart = first.as_ref().and_then(|d| d.parted);
+    let worlds_diverge_s = match (moved_apart, ended_apart) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, y) => x.or(y),
+    }
+    .map(|t| (t * 1000.0).round() / 1000.0);
     Verdict {
         a: a.policy.clone(),
         b: b.policy.clone(),
@@ -383,25 +417,76 @@ fn verdict_on(a: &Run, b: &Run, ta: &[P2], tb: &[P2]) -> Verdict {
         same_motion,
         tolerance_s: (tol * 1000.0).round() / 1000.0,
         pose_tolerance_m: pose_tol,
+        max_time_shift_s: (max_shift as f64 * a.dt * 1000.0).round() / 1000.0,
         first_divergence: first,
         trajectory_distance_m: apart,
+        time_shift_s: (aligned.shift as f64 * a.dt * 1000.0).round() / 1000.0,
+        worlds_diverge_s,
         path_distance_m: (frechet_thinned(ta, tb) * 1000.0).round() / 1000.0,
     }
+}
+
+/// Two tracks compared at one time shift.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Alignment {
+    /// Steps the second track's clock is shifted by (positive: it is later).
+    pub shift: i64,
+    /// The largest distance between the two at the same (shifted) step.
+    pub distance: f64,
+    /// The first step at which they were more than the tolerance apart.
+    pub first_apart: Option<u64>,
+}
+
+/// Shifts tried on each side of zero at most: past this many steps, a grid
+/// of this many (every k-th step) up to the largest shift.
+pub const MAX_SHIFTS: i64 = 64;
+
+/// Of the shifts of the second track's clock within `±max_shift` steps, the
+/// one that brings the two tracks closest ([`aligned_distance`]); among
+/// equals, the smallest in magnitude (zero first, then the later second).
+/// At most `2·MAX_SHIFTS + 1` shifts, each linear in the points.
+pub fn best_alignment(a: &[(u64, P2)], b: &[(u64, P2)], max_shift: i64, tol: f64) -> Alignment {
+    let stride = (max_shift.max(0) + MAX_SHIFTS - 1) / MAX_SHIFTS;
+    let mut best = shifted_alignment(a, b, 0, tol);
+    let mut k = stride;
+    while stride > 0 && k <= max_shift {
+        for shift in [k, -k] {
+            let c = shifted_alignment(a, b, shift, tol);
+            if c.distance < best.distance - 1e-9 {
+                best = c;
+            }
+        }
+        k += stride;
+    }
+    best
 }
 
 /// The largest distance between two tracks at the same step: each holds its
 /// position between two points and after its last. Linear in the points.
 pub fn aligned_distance(a: &[(u64, P2)], b: &[(u64, P2)]) -> f64 {
+    shifted_alignment(a, b, 0, f64::INFINITY).distance
+}
+
+/// [`aligned_distance`] with the second track's steps read `shift` steps earlier
+/// (`shift` steps earlier on the first's clock: a point moved before step
+/// 0 stands at step 0).
+fn shifted_alignment(a: &[(u64, P2)], b: &[(u64, P2)], shift: i64, tol: f64) -> Alignment {
+    let at = |k: u64| (k as i64 - shift).max(0) as u64;
     let (Some(&(_, mut pa)), Some(&(_, mut pb))) = (a.first(), b.first()) else {
-        return 0.0;
+        return Alignment {
+            shift,
+            distance: 0.0,
+            first_apart: None,
+        };
     };
     let (mut i, mut j) = (0, 0);
     let mut best = dist(pa, pb);
+    let mut first_apart = (best > tol + 1e-9).then_some(0);
     while i < a.len() || j < b.len() {
         let next = match (a.get(i), b.get(j)) {
-            (Some(x), Some(y)) => x.0.min(y.0),
+            (Some(x), Some(y)) => x.0.min(at(y.0)),
             (Some(x), None) => x.0,
-            (None, Some(y)) => y.0,
+            (None, Some(y)) => at(y.0),
             (None, None) => break,
         };
         while let Some(&(k, p)) = a.get(i)
@@ -411,14 +496,22 @@ pub fn aligned_distance(a: &[(u64, P2)], b: &[(u64, P2)]) -> f64 {
             i += 1;
         }
         while let Some(&(k, p)) = b.get(j)
-            && k == next
+            && at(k) == next
         {
             pb = p;
             j += 1;
         }
-        best = best.max(dist(pa, pb));
+        let d = dist(pa, pb);
+        if d > tol + 1e-9 && first_apart.is_none() {
+            first_apart = Some(next);
+        }
+        best = best.max(d);
     }
-    best
+    Alignment {
+        shift,
+        distance: best,
+        first_apart,
+    }
 }
 
 /// A run's track as kept: every k-th point when there are more than
@@ -556,6 +649,81 @@ mod tests {
         );
         assert_eq!(frechet_points(6, Duration::ZERO), FRECHET_POINTS_MIN);
         assert_eq!(frechet_points(1, Duration::from_millis(2)), 632);
+    }
+
+    /// A straight run at 0.1 m a step from `start`, 100 steps long.
+    fn drive(start: u64) -> Vec<(u64, P2)> {
+        let mut t = vec![(0, (0.0, 0.0))];
+        t.extend((1..=100).map(|i| (start + i, (i as f64 * 0.1, 0.0))));
+        t
+    }
+
+    #[test]
+    fn the_best_alignment_finds_the_shift_within_the_bound() {
+        let (a, b) = (drive(0), drive(5));
+        let none = best_alignment(&a, &b, 0, 0.2);
+        assert_eq!((none.shift, none.first_apart), (0, Some(3)));
+        assert!((none.distance - 0.5).abs() < 1e-9, "{none:?}");
+        let within = best_alignment(&a, &b, 10, 0.2);
+        assert_eq!((within.shift, within.distance), (5, 0.0));
+        assert_eq!(within.first_apart, None);
+        // Either order: the first run later is a negative shift.
+        assert_eq!(best_alignment(&b, &a, 10, 0.2).shift, -5);
+        // Past 64 steps a grid: 32 is on the grid of every 16th up to 1000.
+        let far = best_alignment(&a, &drive(32), 1000, 0.2);
+        assert_eq!((far.shift, far.distance), (32, 0.0));
+        assert_eq!(aligned_distance(&a, &a), 0.0);
+    }
+
+    #[test]
+    fn the_worlds_diverge_when_the_robots_part() {
+        let a = drive(0);
+        let mut b = drive(0);
+        for p in b.iter_mut().skip(40) {
+            p.1.1 = 1.0;
+        }
+        let al = best_alignment(&a, &b, 2, 0.2);
+        assert_eq!(al.first_apart, Some(40), "{al:?}");
+        assert_eq!(al.shift, 0);
+    }
+
+    #[test]
+    fn an_outcome_divergence_is_timed_when_the_calls_part() {
+        let call = |skill: &str, outcome: &str, start: f64, end: f64| SkillRecord {
+            skill: skill.into(),
+            args: BTreeMap::from([("object".to_string(), "cube".to_string())]),
+            outcome: outcome.into(),
+            start,
+            end: Some(end),
+        };
+        let a = [call("Pick", "success", 2.0, 5.0)];
+        let b = [call("Pick", "failure", 2.0, 3.5)];
+        let d = first_divergence(
+            &mut SkillSlice::new(&a, 9.0),
+            &mut SkillSlice::new(&b, 9.0),
+            0.1,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!((d.kind, d.t, d.index), ("outcome", 3.5, 0));
+        // `failure` and `cancelled` are the same for the world.
+        let c = [call("Pick", "cancelled", 2.0, 3.0)];
+        let same = first_divergence(
+            &mut SkillSlice::new(&b, 9.0),
+            &mut SkillSlice::new(&c, 9.0),
+            0.1,
+        );
+        assert_eq!(same.unwrap(), None);
+        // Another skill: at the earlier start.
+        let e = [call("Place", "success", 1.5, 3.0)];
+        let d = first_divergence(
+            &mut SkillSlice::new(&a, 9.0),
+            &mut SkillSlice::new(&e, 9.0),
+            0.1,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!((d.kind, d.t), ("skill", 1.5));
     }
 
     #[test]

@@ -69,6 +69,7 @@ impl Reader {
             max_failures: run.max_failures,
             pose_tolerance_m: run.pose_tolerance_m,
             start_tolerance_s: run.start_tolerance_s,
+            time_shift_s: run.time_shift_s,
             world,
             policies,
             rates,
@@ -124,6 +125,10 @@ impl Reader {
             .get("start_tolerance_s")
             .and_then(|v| self.number(v, "`start_tolerance_s`", 0.0, 3600.0))
             .unwrap_or(dt);
+        let time_shift_s = t
+            .get("time_shift_s")
+            .and_then(|v| self.number(v, "`time_shift_s`", 0.0, 60.0))
+            .unwrap_or(start_tolerance_s.min(60.0));
         Settings {
             seed,
             dt,
@@ -132,6 +137,7 @@ impl Reader {
             max_failures,
             pose_tolerance_m,
             start_tolerance_s,
+            time_shift_s,
         }
     }
 
@@ -189,14 +195,61 @@ impl Reader {
                 if !self.at_most(p.span(), a.len(), MAX_POLICIES, "policies") {
                     return None;
                 }
+                let mut seen: BTreeMap<String, usize> = BTreeMap::new();
                 for e in a {
-                    if let Some(pe) = self.policy(e, base, limits, world) {
+                    if let Some(mut pe) = self.policy(e, base, limits, world) {
+                        self.disambiguate(&mut pe, e, &mut seen);
                         policies.push(pe);
                     }
                 }
             }
         }
         Some(policies)
+    }
+
+    /// A policy whose name (from its file) is an earlier one's is reported
+    /// as `NAME#2` (`#3`, ...), with a warning saying so: two entries of
+    /// one file (with different settings, say) would otherwise be
+    /// indistinguishable in the verdicts and in `[expect]`. A generated
+    /// name never takes an existing one; a `name` the entry states twice is
+    /// an error.
+    fn disambiguate(
+        &mut self,
+        pe: &mut PolicyEntry,
+        e: &Val<'_>,
+        seen: &mut BTreeMap<String, usize>,
+    ) {
+        let name = pe.policy.name.clone();
+        let count = seen.entry(name.clone()).or_insert(0);
+        *count += 1;
+        if *count == 1 {
+            return;
+        }
+        if let Some(n) = e.get_ref().as_table().and_then(|t| t.get("name")) {
+            self.err(
+                n.span(),
+                format!("two policies are named `{name}`"),
+                "names tell policies apart in reports and `[expect]`: give this entry another `name`",
+            );
+            return;
+        }
+        let mut k = *count;
+        let renamed = loop {
+            let candidate = format!("{name}#{k}");
+            if !seen.contains_key(&candidate) {
+                break candidate;
+            }
+            k += 1;
+        };
+        seen.insert(renamed.clone(), 1);
+        self.diags.push(
+            Diagnostic::warning(format!(
+                "two policies are named `{name}`: this one is reported as `{renamed}`"
+            ))
+            .at(&self.file, e.span())
+            .hint("give each `[[policies]]` entry its own `name = \"...\"`"),
+        );
+        pe.policy.name = renamed;
     }
 
     /// `after_success` / `after_failure`: `"stop"` or `"keep-ticking"`.
@@ -442,6 +495,7 @@ struct Settings {
     max_failures: u32,
     pose_tolerance_m: f64,
     start_tolerance_s: f64,
+    time_shift_s: f64,
 }
 
 /// The default of `pose_tolerance_m`: two robots within 0.2 m of each

@@ -501,3 +501,49 @@ emergency = true
     // Still spread over the whole range.
     assert!(spread.0 < 3.0 && spread.1 > 13.0, "{spread:?}");
 }
+
+#[test]
+fn duplicate_policy_names_are_told_apart_or_refused() {
+    let s = parse_text(
+        r#"
+[world]
+robot = "start"
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+[[policies]]
+file = "../paper/fig01-bt.toml"
+after_failure = "stop"
+[[policies]]
+file = "../paper/fig01-bt.toml"
+name = "fig01-bt#2b"
+"#,
+    )
+    .unwrap();
+    let names: Vec<&str> = s.policies.iter().map(|p| p.policy.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["Fig. 1 BT baseline", "Fig. 1 BT baseline#2", "fig01-bt#2b"]
+    );
+    let w: Vec<String> = s.warnings.iter().map(|d| d.to_string()).collect();
+    assert!(
+        w.iter().any(|w| w.contains("reported as `Fig. 1 BT baseline#2`")),
+        "{w:?}"
+    );
+    let e = parse_text(
+        r#"
+[world]
+robot = "start"
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "../paper/fig01-bt.toml"
+name = "a"
+[[policies]]
+file = "../paper/fig02-fsm.toml"
+name = "a"
+"#,
+    )
+    .unwrap_err();
+    let all: String = e.iter().map(|d| d.to_string()).collect();
+    assert!(all.contains("two policies are named `a`"), "{all}");
+}

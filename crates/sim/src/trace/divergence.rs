@@ -40,8 +40,9 @@ impl SkillSeq for SkillSlice<'_> {
     }
 }
 
-/// The first index where two sequences of executed skills differ: skill,
-/// arguments or outcome (`skill`), start times more than `tol` s apart
+/// The first index where two sequences of executed skills differ: skill or
+/// arguments (`skill`, at the earlier start), how the same call ended
+/// (`outcome`, when the first of the two ended), start times more than `tol` s apart
 /// (`start`; an infinite `tol` compares the order only), or one sequence
 /// ended (`missing`). Reads both in step and stops there: the last skill
 /// each yielded is the one that differs. The verdict's skill comparison,
@@ -56,6 +57,9 @@ pub fn first_divergence<E>(
         let x = a.next_skill().transpose()?;
         let y = b.next_skill().transpose()?;
         let (kind, t, starts) = match (&x, &y) {
+            (Some(x), Some(y)) if x.skill == y.skill && x.args == y.args && !x.same(y) => {
+                ("outcome", outcomes_part(x, y), None)
+            }
             (Some(x), Some(y)) if !x.same(y) => ("skill", x.start.min(y.start), None),
             (Some(x), Some(y)) if (x.start - y.start).abs() > tol => {
                 ("start", x.start.min(y.start), Some([x.start, y.start]))
@@ -68,6 +72,16 @@ pub fn first_divergence<E>(
             (None, Some(y)) => ("missing", y.start.min(a.end_s()), None),
             (None, None) => return Ok(None),
         };
+        let parted = if kind == "outcome" {
+            Some(t)
+        } else {
+            [&x, &y]
+                .into_iter()
+                .flatten()
+                .filter(|r| r.outcome == "success")
+                .filter_map(|r| r.end)
+                .reduce(f64::min)
+        };
         return Ok(Some(Divergence {
             index,
             a: x.as_ref().map(SkillRecord::text),
@@ -75,6 +89,17 @@ pub fn first_divergence<E>(
             t,
             kind,
             starts,
+            parted,
         }));
+    }
+}
+
+/// When two calls of the same skill with the same arguments stopped doing
+/// the same thing: the earlier end (a call still running has not ended).
+fn outcomes_part(x: &SkillRecord, y: &SkillRecord) -> f64 {
+    match (x.end, y.end) {
+        (Some(a), Some(b)) => a.min(b),
+        (Some(a), None) | (None, Some(a)) => a,
+        (None, None) => x.start.max(y.start),
     }
 }
