@@ -433,8 +433,9 @@ fn the_plans_bt_fsm_and_hfsm_started_alike_behave_alike() {
     let (code, one, err) = btfsm(&["sim", s, "--format", "json"]);
     assert_eq!(code, 0, "{err}");
     let one: serde_json::Value = serde_json::from_str(&one).unwrap();
-    for v in one["pairs"].as_array().unwrap() {
-        assert_eq!(v["matches"], true, "{v}");
+    for v in one["verdicts"].as_array().unwrap() {
+        assert_eq!(v["match"], true, "{v}");
+        assert!(v["first_divergence"].is_null(), "{v}");
     }
     let (code, mc, err) = btfsm(&["sim", s, "--runs", "100", "--format", "json"]);
     assert_eq!(code, 0, "{err}");

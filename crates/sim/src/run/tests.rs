@@ -530,8 +530,7 @@ fn a_run_steps_later_moves_alike_within_the_time_shift() {
     assert!(strict.worlds_diverge_s.is_some(), "{strict:?}");
     let allowed = late("time_shift_s = 0.6\n");
     assert!(allowed.same_motion && allowed.matches, "{allowed:?}");
-    assert_eq!((allowed.time_shift_s, allowed.max_time_shift_s),
-        (0.6, 0.6));
+    assert_eq!((allowed.time_shift_s, allowed.max_time_shift_s), (0.6, 0.6));
     assert_eq!(allowed.trajectory_distance_m, 0.0);
     assert_eq!(allowed.worlds_diverge_s, None);
     // By default the shift is one step (`start_tolerance_s`).

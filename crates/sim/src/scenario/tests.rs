@@ -527,7 +527,8 @@ name = "fig01-bt#2b"
     );
     let w: Vec<String> = s.warnings.iter().map(|d| d.to_string()).collect();
     assert!(
-        w.iter().any(|w| w.contains("reported as `Fig. 1 BT baseline#2`")),
+        w.iter()
+            .any(|w| w.contains("reported as `Fig. 1 BT baseline#2`")),
         "{w:?}"
     );
     let e = parse_text(

@@ -8,14 +8,48 @@ use btfsm_core::output::{Format, Report};
 use btfsm_core::sanitize::shown;
 use btfsm_core::table::Table;
 
-/// A pair's verdict of one run per policy.
+/// A pair's verdict of one run per policy, under the planar verdict's
+/// keys (`a`, `b`, `match`, `first_divergence`).
 #[derive(Debug, serde::Serialize)]
 pub struct PairVerdict<'a> {
     pub a: &'a str,
     pub b: &'a str,
+    #[serde(rename = "match")]
     pub matches: bool,
-    /// The index of the first action that differs.
-    pub first_difference: Option<usize>,
+    pub first_divergence: Option<SymDivergence>,
+}
+
+/// Where two symbolic runs first differ: the index in their lists of
+/// successful actions, the two actions there (`None` past a list's end:
+/// `missing`; both present: `action`; both ended: `outcome`).
+#[derive(Debug, serde::Serialize)]
+pub struct SymDivergence {
+    pub index: usize,
+    pub a: Option<String>,
+    pub b: Option<String>,
+    /// `action`, `missing` or `outcome`.
+    pub kind: &'static str,
+}
+
+impl SymDivergence {
+    fn of(a: &SymRun, b: &SymRun, index: usize) -> Self {
+        let (x, y) = (a.effective(), b.effective());
+        let (x, y) = (
+            x.get(index).map(|s| s.to_string()),
+            y.get(index).map(|s| s.to_string()),
+        );
+        let kind = match (&x, &y) {
+            (Some(_), Some(_)) => "action",
+            (None, None) => "outcome",
+            _ => "missing",
+        };
+        SymDivergence {
+            index,
+            a: x,
+            b: y,
+            kind,
+        }
+    }
 }
 
 /// What a symbolic `sim` prints for one run per policy: outcomes, steps,
@@ -27,7 +61,7 @@ pub struct RunsReport<'a> {
     pub domain: &'a str,
     pub goal: Vec<String>,
     pub runs: &'a [SymRun],
-    pub pairs: Vec<PairVerdict<'a>>,
+    pub verdicts: Vec<PairVerdict<'a>>,
     /// The scenario's `[expect]`, checked (empty when it has none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub expectations: Vec<ExpectResult>,
@@ -43,7 +77,7 @@ fn is_zero(n: &usize) -> bool {
 
 impl<'a> RunsReport<'a> {
     pub fn new(s: &'a SymScenario, runs: &'a [SymRun]) -> Self {
-        let pairs = (0..runs.len())
+        let verdicts = (0..runs.len())
             .flat_map(|a| (a + 1..runs.len()).map(move |b| (a, b)))
             .map(|(a, b)| {
                 let d = first_difference(&runs[a], &runs[b]);
@@ -51,7 +85,7 @@ impl<'a> RunsReport<'a> {
                     a: &runs[a].policy,
                     b: &runs[b].policy,
                     matches: d.is_none(),
-                    first_difference: d,
+                    first_divergence: d.map(|i| SymDivergence::of(&runs[a], &runs[b], i)),
                 }
             })
             .collect();
@@ -64,7 +98,7 @@ impl<'a> RunsReport<'a> {
             domain: &s.domain.name,
             goal: s.goal.iter().map(ToString::to_string).collect(),
             runs,
-            pairs,
+            verdicts,
             expectations,
             expectations_failed,
         }
@@ -95,13 +129,13 @@ impl<'a> RunsReport<'a> {
                 shown(&r.effective().join(", "))
             ));
         }
-        if !self.pairs.is_empty() {
+        if !self.verdicts.is_empty() {
             out.push('\n');
             let mut t = Table::new(&["pair", "verdict"]);
-            for p in &self.pairs {
-                let v = match p.first_difference {
+            for p in &self.verdicts {
+                let v = match &p.first_divergence {
                     None => "match".to_string(),
-                    Some(i) => format!("differ from action {}", i + 1),
+                    Some(d) => format!("differ from action {}", d.index + 1),
                 };
                 t.row(vec![format!("{} vs {}", shown(p.a), shown(p.b)), v]);
             }

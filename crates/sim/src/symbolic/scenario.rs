@@ -488,7 +488,10 @@ fn load_policies(
                     if let Some(n) = &p.name {
                         l.policy.name = n.clone();
                     }
-                    policies.push((path, l.policy));
+                    if let Some(name) = distinct_name(&policies, &l.policy.name, p, pb) {
+                        l.policy.name = name;
+                        policies.push((path, l.policy));
+                    }
                 }
                 Some(why) => pb.err(
                     p.file.span(),
@@ -504,6 +507,34 @@ fn load_policies(
     }
     pb.diags.extend(loaded_errors);
     policies
+}
+
+/// The name a policy is reported by: its own, or `NAME#2` (`#3`, ...)
+/// when an earlier policy has it (two entries of one file); a `name` the
+/// scenario states twice is an error (`None`).
+fn distinct_name(
+    policies: &[(PathBuf, Policy)],
+    name: &str,
+    p: &RawPolicy,
+    pb: &mut Problems<'_>,
+) -> Option<String> {
+    let taken = |n: &str| policies.iter().any(|(_, q)| q.name == n);
+    if !taken(name) {
+        return Some(name.to_string());
+    }
+    if p.name.is_some() {
+        pb.err(
+            p.file.span(),
+            format!(
+                "two policies are named `{}`",
+                btfsm_core::sanitize::shown(name)
+            ),
+            "names tell policies apart in reports and `[expect]`: give this entry another `name`"
+                .into(),
+        );
+        return None;
+    }
+    (2..).map(|k| format!("{name}#{k}")).find(|n| !taken(n))
 }
 
 /// Why a policy cannot run in the domain's world (a leaf or guard bound to

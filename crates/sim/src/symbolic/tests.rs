@@ -225,3 +225,43 @@ fn named_policies_and_expectations_are_checked_against_the_runs() {
     assert_eq!(&bad[span], "\"bq\"");
     assert!(e[0].to_string().contains("did you mean `bt`?"), "{}", e[0]);
 }
+
+/// A symbolic run's JSON has the planar run's verdict keys: `verdicts`,
+/// `match`, `first_divergence` (with the actions where the runs part).
+#[test]
+fn symbolic_verdicts_use_the_planar_keys() {
+    use btfsm_core::output::{Format, Report};
+    let s = scenario(&format!(
+        "{HEAD}{}",
+        policies(&["fig01-bt", "fig04-fsm", "fig03-bt"])
+    ));
+    let runs = run::run_all(&s, None, None);
+    let r = super::report::RunsReport::new(&s, &runs);
+    let v: serde_json::Value = serde_json::from_str(&r.write(Format::Json)).unwrap();
+    assert!(v.get("pairs").is_none());
+    let verdicts = v["verdicts"].as_array().expect("verdicts");
+    assert_eq!(verdicts[0]["match"], true, "{v}");
+    assert!(verdicts[0]["first_divergence"].is_null());
+    // Fig. 1 against Fig. 3: Fig. 3 first goes to the delivery station.
+    let d = &verdicts[1]["first_divergence"];
+    assert_eq!(d["index"], 0, "{d}");
+    assert_eq!(
+        (d["a"].as_str(), d["b"].as_str()),
+        (Some("Move-To(cube2)"), Some("Move-To(delivery)"))
+    );
+    assert_eq!(d["kind"], "action");
+}
+
+/// Two entries of one file are told apart (`NAME#2`); a stated name given
+/// twice is refused.
+#[test]
+fn duplicate_symbolic_policy_names_are_told_apart_or_refused() {
+    let s = scenario(&format!("{HEAD}{}", policies(&["fig01-bt", "fig01-bt"])));
+    let names: Vec<&str> = s.policies.iter().map(|(_, p)| p.name.as_str()).collect();
+    assert_eq!(names, ["Fig. 1 BT baseline", "Fig. 1 BT baseline#2"]);
+    let e = refused(&format!(
+        "{HEAD}[[policies]]\nfile = \"../paper/fig01-bt.toml\"\nname = \"x\"\n[[policies]]\nfile = \"../paper/fig04-fsm.toml\"\nname = \"x\"\n"
+    ));
+    let all: String = e.iter().map(|d| d.to_string()).collect();
+    assert!(all.contains("two policies are named `x`"), "{all}");
+}
