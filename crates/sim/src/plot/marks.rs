@@ -99,6 +99,16 @@ pub(super) fn trajectories(o: &mut String, f: &Frame, runs: &[Run], ink: &mut Pl
             r#"<path d="{d}" fill="none" stroke="{c}" stroke-width="2" stroke-opacity="0.85"{}/>"#,
             dash(k)
         );
+        let pts: Vec<(f64, f64)> = (run.trajectory.iter())
+            .map(|p| (f.px(p.0) + off, f.py(p.1) + off))
+            .collect();
+        let heads = arrows(&pts);
+        if !heads.is_empty() {
+            let _ = writeln!(
+                o,
+                r#"<path class="arrows" d="{heads}" fill="{c}" stroke="none"/>"#
+            );
+        }
         for e in &run.events {
             let (x, y) = (f.px(e.x) + off, f.py(e.y) + off);
             let Some(shape) = marker(e.kind.as_str(), &e.text, x, y, c) else {
@@ -112,6 +122,47 @@ pub(super) fn trajectories(o: &mut String, f: &Frame, runs: &[Run], ink: &mut Pl
             );
         }
     }
+}
+
+/// Arrow spacing along a path, px (1 m), widened so that a run draws at
+/// most [`MAX_ARROWS`].
+const ARROW_EVERY: f64 = 100.0;
+pub(super) const MAX_ARROWS: usize = 200;
+
+/// Arrowheads along a path (screen points) in its direction of travel,
+/// every metre of drawn length (the first half a metre in): an
+/// out-and-back trip on one corridor shows arrows both ways. SVG path data
+/// of closed triangles; linear in the points.
+pub(super) fn arrows(pts: &[(f64, f64)]) -> String {
+    let total: f64 = pts.windows(2).map(|w| seg_len(w[0], w[1])).sum();
+    let every = ARROW_EVERY.max(total / MAX_ARROWS as f64);
+    let mut next = every / 2.0;
+    let (mut done, mut out) = (0.0, String::new());
+    for w in pts.windows(2) {
+        let len = seg_len(w[0], w[1]);
+        while len > 1e-9 && next <= done + len {
+            let s = (next - done) / len;
+            let (dx, dy) = ((w[1].0 - w[0].0) / len, (w[1].1 - w[0].1) / len);
+            let (x, y) = (w[0].0 + dx * len * s, w[0].1 + dy * len * s);
+            // A 9 px long, 7 px wide head, its tip at the point.
+            let (bx, by) = (x - 9.0 * dx, y - 9.0 * dy);
+            let _ = write!(
+                out,
+                "M{x:.1},{y:.1} L{:.1},{:.1} L{:.1},{:.1} Z ",
+                bx - 3.5 * dy,
+                by + 3.5 * dx,
+                bx + 3.5 * dy,
+                by - 3.5 * dx
+            );
+            next += every;
+        }
+        done += len;
+    }
+    out
+}
+
+fn seg_len(a: (f64, f64), b: (f64, f64)) -> f64 {
+    ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt()
 }
 
 fn dash(k: usize) -> &'static str {
@@ -221,7 +272,7 @@ pub(super) fn legend(o: &mut String, runs: &[Run], groups: &[Vec<usize>], top: f
     }
     let _ = writeln!(
         o,
-        r##"<text x="{LEFT}" y="{:.1}" font-size="11" fill="#444">● pick  ■ place  ⚡ recharge start  ◆ dock  △ battery low  ◇ disturbance  ✕ failed action  ◌ chattering</text>"##,
+        r##"<text x="{LEFT}" y="{:.1}" font-size="11" fill="#444">▶ direction of travel (every metre)  ● pick  ■ place  ⚡ recharge start  ◆ dock  △ battery low  ◇ disturbance  ✕ failed action  ◌ chattering</text>"##,
         y + 4.0
     );
     y += LINE;

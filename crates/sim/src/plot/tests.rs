@@ -162,3 +162,33 @@ file = "../paper/fig01-bt.toml"
     );
     roxmltree::Document::parse(&svg).expect("well-formed XML");
 }
+
+/// Arrowheads every metre point along the direction of travel: out and
+/// back along one line gives arrows both ways; their number is bounded
+/// whatever the length.
+#[test]
+fn arrows_show_out_and_back_motion() {
+    let tip_dirs = |d: &str| -> Vec<f64> {
+        // Each head: `M tip L base1 L base2 Z`; its direction is tip − the
+        // bases' midpoint, in x.
+        d.split('Z')
+            .filter(|h| !h.trim().is_empty())
+            .map(|h| {
+                let n: Vec<f64> = h
+                    .split(|c: char| c == 'M' || c == 'L' || c == ',' || c == ' ')
+                    .filter_map(|t| t.parse().ok())
+                    .collect();
+                n[0] - (n[2] + n[4]) / 2.0
+            })
+            .collect()
+    };
+    let out_and_back = [(0.0, 0.0), (500.0, 0.0), (0.0, 0.0)];
+    let dirs = tip_dirs(&marks::arrows(&out_and_back));
+    assert_eq!(dirs.len(), 10, "{dirs:?}");
+    assert!(dirs[..5].iter().all(|&x| x > 0.0) && dirs[5..].iter().all(|&x| x < 0.0));
+    let far = [(0.0, 0.0), (1e7, 0.0)];
+    assert!(tip_dirs(&marks::arrows(&far)).len() <= marks::MAX_ARROWS + 1);
+    assert!(marks::arrows(&[(1.0, 1.0)]).is_empty());
+    let (_, _, svg) = plot(TWO_POLICIES);
+    assert_eq!(svg.matches(r#"class="arrows""#).count(), 2);
+}
