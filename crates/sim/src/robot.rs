@@ -283,8 +283,17 @@ impl Robot {
             let rec = r.record;
             self.close_at(rec, outcome(s), end);
         }
-        if self.world.sense() > 0 {
+        let mut seen = Vec::new();
+        if self.world.sense_noting(self.log.then_some(&mut seen)) > 0 {
             self.world.progress += 1;
+        }
+        for i in seen {
+            let o = &self.world.objects[i];
+            let text = format!(
+                "camera: {} believed at ({:.2}, {:.2})",
+                o.name, o.belief.0, o.belief.1
+            );
+            self.event("belief", text);
         }
         if let Some(k) = self.base
             && let Some(r) = self.live[k].as_mut()
@@ -407,6 +416,12 @@ pub(super) fn apply(d: &Disturbance, r: &mut Robot) {
                 if w.params.drop_sensed {
                     w.objects[*object].belief = w.robot;
                     w.objects[*object].found = true;
+                    let o = &w.objects[*object];
+                    let text = format!(
+                        "drop sensed: {} believed at ({:.2}, {:.2})",
+                        o.name, o.belief.0, o.belief.1
+                    );
+                    r.event("belief", text);
                 }
             }
         }

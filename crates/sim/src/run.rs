@@ -435,6 +435,11 @@ impl<'a> Episode<'a> {
             })
             .collect();
         let keys = &self.p.keys;
+        let goal = (robot.base)
+            .and_then(|k| robot.live[k].as_ref())
+            .filter(|r| r.result.is_none())
+            .and_then(|r| r.nav_goal())
+            .map(|p| [round3(p.0), round3(p.1)]);
         let step = Step {
             t: round3(robot.world.time),
             x: robot.world.robot.0,
@@ -442,6 +447,7 @@ impl<'a> Episode<'a> {
             yaw: robot.world.yaw,
             battery: (robot.world.battery * 100.0).round() / 100.0,
             running,
+            goal,
             statuses: st
                 .map(|v| {
                     v.iter()

@@ -75,6 +75,11 @@ pub struct Step {
     pub battery: f64,
     /// Action skills running after the step.
     pub running: Vec<String>,
+    /// Where the navigation running after the step is going, m: the goal
+    /// fixed when it started (for an object, its believed pose then), so a
+    /// detour to a stale belief shows. `None` when nothing drives the base.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub goal: Option<[f64; 2]>,
     /// Node id (BT) or state path (FSM/HFSM) of everything ticked in the step,
     /// with its status.
     pub statuses: Vec<(String, String)>,

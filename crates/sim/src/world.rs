@@ -563,6 +563,12 @@ impl World {
     /// many beliefs changed (newly found or seen elsewhere). O(objects x
     /// range / grid) per call.
     pub fn sense(&mut self) -> usize {
+        self.sense_noting(None)
+    }
+
+    /// [`World::sense`], pushing the index of each object whose belief
+    /// changed onto `changed` when given (the trace's `belief` events).
+    pub fn sense_noting(&mut self, mut noted: Option<&mut Vec<usize>>) -> usize {
         let (r, range) = (self.robot, self.params.camera_range);
         let mut changed = 0;
         for i in 0..self.objects.len() {
@@ -579,6 +585,9 @@ impl World {
                 o.found = true;
                 o.belief = p;
                 changed += 1;
+                if let Some(n) = noted.as_mut() {
+                    n.push(i);
+                }
             }
         }
         changed

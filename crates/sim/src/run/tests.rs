@@ -536,3 +536,46 @@ fn a_run_steps_later_moves_alike_within_the_time_shift() {
     // By default the shift is one step (`start_tolerance_s`).
     assert_eq!(late("").max_time_shift_s, 0.1);
 }
+
+/// The trace says where the base is going and what the robot believes, so
+/// that a detour can be explained: cube2 moved 0.8 m at 4 s while the robot
+/// drives to it; the first Move-To goes where the cube was believed at its
+/// start, the camera then sees it elsewhere (a `belief` event), and a later
+/// Move-To goes to the new belief.
+#[test]
+fn the_trace_records_navigation_goals_and_beliefs() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../policies/scenarios/exp1-cube-moved-during.toml"
+    ))
+    .unwrap();
+    let s = crate::scenario::parse(
+        &btfsm_core::diagnostic::SourceFile::new("exp1.toml", &text),
+        std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../policies/scenarios"
+        )),
+        &btfsm_format::Limits::default(),
+    )
+    .unwrap();
+    let bt = &run_scenario(&s, true)[0];
+    let seen: Vec<&crate::trace::Event> = bt.events.iter().filter(|e| e.kind == "belief").collect();
+    assert!(
+        seen.iter()
+            .any(|e| e.t > 4.0 && e.text.starts_with("camera: cube2 believed at")),
+        "{:?}",
+        bt.events
+    );
+    let goals: Vec<[f64; 2]> = bt.trace.iter().filter_map(|st| st.goal).collect();
+    assert!(!goals.is_empty());
+    let mut distinct = goals.clone();
+    distinct.dedup();
+    // Out to the cube's first believed place, to its new one, to delivery.
+    assert!(distinct.len() >= 3, "{distinct:?}");
+    assert!(
+        bt.trace
+            .iter()
+            .all(|st| st.goal.is_none() || !st.running.is_empty()),
+        "a goal only while something drives"
+    );
+}
