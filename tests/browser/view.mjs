@@ -9,7 +9,9 @@
 // --step K+1` for a log, rendered by Graphviz with the statuses as DOT
 // fills, and read by the same browser. Some node must change fill between
 // the steps checked. The page must make no request (it is self-contained)
-// and print no error. --scale FILE measures the page of a long run: its
+// and print no error. On a scenario's page, each robot on the room map must
+// have moved from step 0 as the trace's run did (100 px a metre).
+// --scale FILE measures the page of a long run: its
 // size, load time and the time to jump to the last step (printed).
 // Screenshots go to OUT (and, with --screenshots DIR, the first scenario's
 // to DIR, for the README).
@@ -102,9 +104,34 @@ async function openPage(html) {
 
 const stepOf = (page) => page.evaluate('window.btfsmView.step()');
 
+// The map's robots (a scenario's page): each circle's move from step 0 to
+// the current step must be the trace's move of that run, at 100 px a metre
+// with y up (within the half pixel the page's positions are rounded to and
+// thinned by).
+async function checkMap(page, what, k, runs) {
+  const at = await page.evaluate(`[...document.querySelectorAll('#map circle.robot')].map((c) => [+c.getAttribute('cx'), +c.getAttribute('cy'), c.getAttribute('visibility')])`);
+  if (at.length !== runs.length) { fail(`${what}: ${at.length} robots on the map, ${runs.length} runs`); return; }
+  for (let i = 0; i < runs.length; i++) {
+    const tr = runs[i].trace;
+    if (!tr.length) continue;
+    const s = tr[Math.min(k, tr.length - 1)];
+    if (at[i][2] !== 'visible') { fail(`${what}: robot ${i} hidden at step ${k}`); continue; }
+    if (!runs[i].origin) runs[i].origin = { px: null };
+    if (k === 0) runs[i].origin.px = [at[i][0], at[i][1]];
+    const o = runs[i].origin.px;
+    if (!o) continue;
+    const want = [100 * (s.x - tr[0].x), -100 * (s.y - tr[0].y)];
+    const got = [at[i][0] - o[0], at[i][1] - o[1]];
+    if (Math.abs(got[0] - want[0]) > 1.1 || Math.abs(got[1] - want[1]) > 1.1) {
+      fail(`${what}: robot ${i} at step ${k} moved ${got.map((v) => v.toFixed(1))} px on the map, the trace ${want.map((v) => v.toFixed(1))}`);
+    }
+  }
+}
+
 // Compares every panel's fills at the page's current step with the oracle.
-async function check(page, what, oracleArgv, lengths) {
+async function check(page, what, oracleArgv, lengths, runs) {
   const k = await stepOf(page);
+  if (runs) await checkMap(page, what, k, runs);
   const n = lengths.length;
   let coloured = 0;
   const seen = [];
@@ -125,12 +152,12 @@ async function check(page, what, oracleArgv, lengths) {
 }
 
 // Drives a page through its controls; returns the fills seen per step.
-async function drive(name, html, oracleArgv, lengths, shots) {
+async function drive(name, html, oracleArgv, lengths, shots, runs) {
   const { page, requests, errors } = await openPage(html);
   const total = await page.evaluate('window.btfsmView.total');
   const states = [];
   const at = async (what) => {
-    const s = await check(page, `${name} (${what})`, oracleArgv, lengths);
+    const s = await check(page, `${name} (${what})`, oracleArgv, lengths, runs);
     states.push(s);
     return s;
   };
@@ -178,7 +205,7 @@ for (const scenario of opt.scenarios) {
   const runs = JSON.parse(readFileSync(trace, 'utf8')).policies;
   const lengths = runs.map((r) => r.trace.length);
   const oracle = (i, k) => ['dot', runs[i].file, '--trace', trace, '--step', String(k), '--policy', runs[i].policy];
-  await drive(name, html, oracle, lengths, true);
+  await drive(name, html, oracle, lengths, true, runs);
 }
 
 for (const log of opt.logs) {

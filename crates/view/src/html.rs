@@ -83,6 +83,9 @@ struct Data<'a> {
     fill: [&'static str; 4],
     panels: Vec<PanelData<'a>>,
     divergences: Vec<Divergence<'a>>,
+    /// Per panel, the robot's positions on the map: `[step, x, y, ...]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    map: Option<&'a [Vec<f32>]>,
 }
 
 fn round(t: f64) -> f64 {
@@ -111,6 +114,11 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
         })
         .filter(|t| t.is_finite())
         .fold(0.0f64, f64::max);
+    let map = r
+        .map
+        .as_ref()
+        .map(|m| map_section(r, m))
+        .unwrap_or_default();
     for (i, p) in r.panels.iter().enumerate() {
         panels.push(panel(&mut body, i, p, t_end, timeout)?);
     }
@@ -124,7 +132,9 @@ pub fn page(r: &Replay, timeout: Duration) -> Result<String, ViewError> {
         ],
         panels,
         divergences: divergence_steps(r, steps),
+        map: r.map.as_ref().map(|m| m.tracks.as_slice()),
     };
+    let body = format!("{map}<main class=\"panels cols-{}\">{body}</main>", cols(r));
     Ok(document(r, &body, &divergence_list(r), &data, steps))
 }
 
@@ -164,6 +174,29 @@ fn panel<'a>(
         axis,
         digits: timeline::digits(t_end / 100.0).max(2),
     })
+}
+
+/// The map's section: `sim --plot`'s picture of the room and the runs'
+/// paths, with one robot per panel (a circle in the run's colour, its
+/// policy named in its tooltip) that the page's script moves.
+fn map_section(r: &Replay, m: &super::Map) -> String {
+    let svg = inline_svg(&m.svg, "map");
+    let mut robots = String::new();
+    for (i, p) in r.panels.iter().enumerate() {
+        let c = btfsm_sim::plot::COLORS[i % btfsm_sim::plot::COLORS.len()];
+        let _ = write!(
+            robots,
+            r##"<circle id="map-robot-{i}" class="robot" r="7" fill="{c}" stroke="#000" stroke-width="1.5" visibility="hidden"><title>{}</title></circle>"##,
+            esc(&p.title)
+        );
+    }
+    let svg = match svg.rfind("</svg>") {
+        Some(k) => format!("{}{robots}{}", &svg[..k], &svg[k..]),
+        None => svg,
+    };
+    format!(
+        r#"<section class="map" id="map"><h2>Room</h2><p class="sub">the runs' paths (arrows: direction of travel); a circle per run is the robot at the current step</p><div class="room">{svg}</div></section>"#
+    )
 }
 
 /// Each divergence with the step it is at (in its first panel's steps,
@@ -237,7 +270,7 @@ fn document(r: &Replay, body: &str, divs: &str, data: &Data<'_>, steps: usize) -
 <span class="legend">{r}{s}{f}</span>
 <span class="hint">one step: {step_name}</span>
 </nav>
-<main class="panels cols-{cols}">{body}</main>
+{body}
 <script type="application/json" id="btfsm-data">{json}</script>
 <script>{SCRIPT}</script>
 </body></html>
@@ -250,14 +283,18 @@ fn document(r: &Replay, body: &str, divs: &str, data: &Data<'_>, steps: usize) -
         f = swatch(Status::Failure, "FAILURE"),
         step_name = esc(&r.step_name),
         json = script_json(data),
-        // Four panels as two rows of two, more in rows of three.
-        cols = match r.panels.len() {
-            0 | 1 => 1,
-            2 | 4 => 2,
-            _ => 3,
-        },
     );
     html
+}
+
+/// Columns of the panels' grid: four panels as two rows of two, more in
+/// rows of three.
+fn cols(r: &Replay) -> usize {
+    match r.panels.len() {
+        0 | 1 => 1,
+        2 | 4 => 2,
+        _ => 3,
+    }
 }
 
 #[cfg(test)]

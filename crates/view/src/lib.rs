@@ -131,6 +131,41 @@ pub struct Replay {
     /// compared leave it `false`, and the page says so instead of calling
     /// the runs the same).
     pub compared_all: bool,
+    /// The room with the runs' paths and a robot per panel that moves with
+    /// the slider (a scenario run here; a trace file has no room).
+    pub map: Option<Map>,
+}
+
+/// Most robot positions a map keeps per panel: past this, every k-th
+/// (the robot then jumps k steps at a time on the map).
+pub const MAP_POINTS: usize = 20_000;
+
+/// The room of a simulator replay: `sim --plot`'s picture, and each
+/// panel's robot positions as `[step, x, y, ...]` in the picture's pixels,
+/// one entry where the robot moved (and the first step).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Map {
+    pub svg: String,
+    pub tracks: Vec<Vec<f32>>,
+}
+
+impl Map {
+    /// A track of positions by step, thinned to at most [`MAP_POINTS`]
+    /// (every k-th, and the last).
+    pub fn thin(track: Vec<(usize, (f64, f64))>) -> Vec<f32> {
+        let stride = track.len().div_ceil(MAP_POINTS).max(1);
+        let last = track.last().copied();
+        let mut kept: Vec<(usize, (f64, f64))> = track.into_iter().step_by(stride).collect();
+        if let Some(l) = last
+            && kept.last() != Some(&l)
+        {
+            kept.push(l);
+        }
+        let r1 = |v: f64| ((v * 10.0).round() / 10.0) as f32;
+        kept.into_iter()
+            .flat_map(|(k, (x, y))| [k as f32, r1(x), r1(y)])
+            .collect()
+    }
 }
 
 /// A run's statuses as per-step changes. Node numbers index `keys`, the

@@ -70,6 +70,7 @@ pub fn from_log(r: impl std::io::Read, shown: &str, limits: &Limits) -> Result<R
         }],
         divergences: Vec::new(),
         compared_all: true,
+        map: None,
     })
 }
 

@@ -1,5 +1,6 @@
 // btfsm view: applies the per-step status changes of the JSON data block to
-// the diagrams (fill of each node's shapes), moves the timeline cursors, and
+// the diagrams (fill of each node's shapes), moves the timeline cursors and
+// the robots on the map, and
 // drives the slider, buttons and keys. Hand-written, no library; inlined by
 // src/view/html.rs. A jump restores the nearest checkpoint (one every
 // D.checkpoint steps, made once at load) and applies at most that many steps.
@@ -92,12 +93,33 @@
     }
   }
 
+  // The map: each panel's robot at the last position recorded at or
+  // before step k (tracks are [step, x, y, ...], steps ascending).
+  var robots = D.map ? D.map.map(function (tr, i) {
+    return { tr: tr, el: document.getElementById('map-robot-' + i) };
+  }) : [];
+  function moveRobots(k) {
+    for (var i = 0; i < robots.length; i++) {
+      var R = robots[i], tr = R.tr, lo = 0, hi = tr.length / 3 - 1;
+      if (!R.el || hi < 0) continue;
+      if (tr[0] > k) { R.el.setAttribute('visibility', 'hidden'); continue; }
+      while (lo < hi) {
+        var mid = (lo + hi + 1) >> 1;
+        if (tr[3 * mid] <= k) lo = mid; else hi = mid - 1;
+      }
+      R.el.setAttribute('cx', tr[3 * lo + 1]);
+      R.el.setAttribute('cy', tr[3 * lo + 2]);
+      R.el.setAttribute('visibility', 'visible');
+    }
+  }
+
   var current = 0;
   function go(k) {
     k = Math.max(0, Math.min(total - 1, k | 0));
     current = k;
     slider.value = k;
     for (var i = 0; i < panels.length; i++) goPanel(panels[i], k);
+    moveRobots(k);
     var t = panels.length && panels[0].p.times.length ? panels[0].p.times[Math.min(k, panels[0].p.times.length - 1)] : 0;
     pos.textContent = 'step ' + k + ' / ' + (total - 1) + ' · t = ' + t.toFixed(panels.length ? panels[0].p.digits : 2) + ' s';
     document.body.setAttribute('data-step', k);

@@ -4,7 +4,9 @@
 //! `btfsm sim --trace` wrote (its policies read from the files it names,
 //! inside the root, its verdicts as recorded).
 
-use super::{Divergence, Mark, Panel, Recorder, Replay, Row, Span, ViewError, code, drawn_keys};
+use super::{
+    Divergence, Map, Mark, Panel, Recorder, Replay, Row, Span, ViewError, code, drawn_keys,
+};
 use btfsm_format::Limits;
 use btfsm_render::dot::Status;
 use btfsm_sim::scenario::Scenario;
@@ -60,16 +62,22 @@ fn status_code(s: &str) -> u8 {
 type Drawn = (Vec<String>, Vec<(String, usize)>, String);
 
 /// Collects each run's statuses as the runs are made (`TraceOut`).
-struct Collect {
+struct Collect<'s> {
     recorders: Vec<Recorder>,
     keys: Vec<Drawn>,
     err: Option<ViewError>,
+    /// The scenario, for the map's pixels.
+    scenario: &'s Scenario,
+    /// Per run: the step and the robot's position in the map's pixels,
+    /// where it moved by half a pixel or more.
+    tracks: Vec<Vec<(usize, (f64, f64))>>,
 }
 
-impl btfsm_sim::run::TraceOut for Collect {
+impl btfsm_sim::run::TraceOut for Collect<'_> {
     fn begin(&mut self) {
         let (keys, alias, _) = &self.keys[self.recorders.len()];
         self.recorders.push(Recorder::new(keys.clone(), alias));
+        self.tracks.push(Vec::new());
     }
 
     fn step(&mut self, st: &Step) {
@@ -84,6 +92,15 @@ impl btfsm_sim::run::TraceOut for Collect {
             .map(|(k, s)| (k.as_str(), status_code(s)));
         if let Err(e) = self.recorders[i].snapshot(name, st.t, statuses) {
             self.err = Some(e);
+        }
+        let k = self.recorders[i].times.len().saturating_sub(1);
+        let q = btfsm_sim::plot::pixel(self.scenario, (st.x, st.y));
+        let track = &mut self.tracks[i];
+        if track
+            .last()
+            .is_none_or(|(_, p)| (p.0 - q.0).abs() >= 0.5 || (p.1 - q.1).abs() >= 0.5)
+        {
+            track.push((k, q));
         }
     }
 
@@ -125,11 +142,17 @@ pub fn from_scenario(s: &Scenario, file: &str) -> Result<Replay, ViewError> {
             })
             .collect(),
         err: None,
+        scenario: s,
+        tracks: Vec::new(),
     };
     let (runs, _cut) = btfsm_sim::run::run_scenario_traced(s, None, &mut collect);
     if let Some(e) = collect.err {
         return Err(e);
     }
+    let map = Map {
+        svg: btfsm_sim::plot::svg(s, &runs),
+        tracks: collect.tracks.into_iter().map(Map::thin).collect(),
+    };
     // The page shows the first divergences, which the path distance does
     // not change: trajectories thinned to two points keep the 2,016 pairs
     // of 64 policies cheap.
@@ -171,6 +194,7 @@ pub fn from_scenario(s: &Scenario, file: &str) -> Result<Replay, ViewError> {
         panels,
         divergences: divs,
         compared_all: true,
+        map: Some(map),
     })
 }
 
@@ -210,6 +234,7 @@ pub fn from_trace(
         compared_all: v["skipped_verdicts"]
             .as_array()
             .is_none_or(|s| s.is_empty()),
+        map: None,
     })
 }
 
@@ -411,5 +436,49 @@ times = 1
             r.panels.iter().all(|p| !p.marks.is_empty()),
             "every panel marked"
         );
+    }
+
+    /// A scenario's replay has the room map: one track per panel, steps
+    /// ascending from 0, positions in the plot's pixels (100 px a metre),
+    /// and the page a robot per panel on it.
+    #[test]
+    fn a_scenario_replay_has_a_map_with_a_robot_per_run() {
+        let base = std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../policies/scenarios"
+        ));
+        let text = std::fs::read_to_string(base.join("exp1-pick-fails.toml")).unwrap();
+        let file = std::sync::Arc::new(btfsm_core::diagnostic::SourceFile::new("e.toml", text));
+        let s = btfsm_sim::scenario::parse(&file, base, &Limits::default()).expect("scenario");
+        let r = from_scenario(&s, "e.toml").expect("replay");
+        let m = r.map.as_ref().expect("a map");
+        assert_eq!(m.tracks.len(), r.panels.len());
+        for (t, p) in m.tracks.iter().zip(&r.panels) {
+            assert!(t.len() >= 6 && t.len() % 3 == 0);
+            assert_eq!(t[0], 0.0, "from the first step");
+            let steps: Vec<f32> = t.iter().step_by(3).copied().collect();
+            assert!(steps.windows(2).all(|w| w[0] < w[1]));
+            assert!(*steps.last().unwrap() as usize <= p.rec.times.len());
+        }
+        // The robot starts at `start` (-2.0, -2.2): its pixel is the plot's.
+        let (x, y) = btfsm_sim::plot::pixel(&s, (-2.0, -2.2));
+        let t = &m.tracks[0];
+        assert!((t[1] as f64 - x).abs() < 60.0 && (t[2] as f64 - y).abs() < 60.0);
+        assert!(m.svg.contains("<svg") && m.svg.contains("class=\"arrows\""));
+        if !btfsm_render::dot::installed() {
+            return;
+        }
+        let html = super::super::html::page(&r, std::time::Duration::from_secs(60)).unwrap();
+        for i in 0..r.panels.len() {
+            assert!(html.contains(&format!("id=\"map-robot-{i}\"")));
+        }
+    }
+
+    #[test]
+    fn a_long_track_is_thinned_to_the_map_bound() {
+        let track: Vec<(usize, (f64, f64))> = (0..100_000).map(|k| (k, (k as f64, 0.0))).collect();
+        let t = Map::thin(track);
+        assert!(t.len() / 3 <= crate::MAP_POINTS + 1, "{}", t.len());
+        assert_eq!(t[t.len() - 3], 99_999.0, "the last kept");
     }
 }

@@ -19,7 +19,8 @@ use labels::{BBox, Ink, Placer};
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write;
 
-const COLORS: &[&str] = &[
+/// The runs' colours, in policy order (the map of `btfsm view` uses them too).
+pub const COLORS: &[&str] = &[
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
 ];
 /// Pixels per metre.
@@ -59,6 +60,14 @@ impl Frame {
     fn py(&self, y: f64) -> f64 {
         TOP + (self.y1 - y) * SCALE
     }
+}
+
+/// Where a point of the room, m, is drawn in [`svg`]'s picture, px (the
+/// map of `btfsm view` moves its robots with it).
+pub fn pixel(s: &Scenario, p: super::world::P2) -> (f64, f64) {
+    let r = &s.world.layout.room;
+    let f = Frame { x0: r.x0, y1: r.y1 };
+    (f.px(p.0), f.py(p.1))
 }
 
 /// A tick spacing of 1, 2 or 5 times a power of ten giving at most eight

@@ -175,7 +175,7 @@ fn arrows_show_out_and_back_motion() {
             .filter(|h| !h.trim().is_empty())
             .map(|h| {
                 let n: Vec<f64> = h
-                    .split(|c: char| c == 'M' || c == 'L' || c == ',' || c == ' ')
+                    .split(['M', 'L', ',', ' '])
                     .filter_map(|t| t.parse().ok())
                     .collect();
                 n[0] - (n[2] + n[4]) / 2.0
