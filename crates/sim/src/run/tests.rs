@@ -579,3 +579,51 @@ fn the_trace_records_navigation_goals_and_beliefs() {
         "a goal only while something drives"
     );
 }
+
+/// The recharge latency is measured, not 0 by construction: Fig. 8d with
+/// no battery guard on `Move-To cube2` (its arrival goes to SELECTOR, which
+/// has one) drives on to the cube after the battery falls at 4 s and starts
+/// Recharge only once it arrives, while the BT of Fig. 7d (its battery
+/// check ticked every step) starts it in the step the battery falls.
+#[test]
+fn recharge_latency_is_the_time_a_policy_takes_to_react() {
+    let dir = std::env::temp_dir().join(format!("btfsm-latency-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/../../policies/paper/");
+    let fsm = std::fs::read_to_string(format!("{paper}fig08d-fsm.toml")).unwrap();
+    let guard = "guards = [{ unless = \"Battery-Level\", args = { min = 20 }, to = \"Recharge\", label = \"battery < 20%\" }]\non = { SUCCESS = \"Pick cube2\",";
+    assert!(fsm.contains(guard));
+    let late = fsm
+        .replace(guard, "on = { SUCCESS = \"SELECTOR\",")
+        .replace("name = \"Fig. 8d FSM recharge\"", "name = \"late\"");
+    std::fs::write(dir.join("late.toml"), late).unwrap();
+    std::fs::copy(format!("{paper}fig07d-bt.toml"), dir.join("bt.toml")).unwrap();
+    let text = r#"goal = [{ if = "Object-At", args = { object = "cube2", at = "delivery" } }]
+[world]
+robot = "start"
+objects = { cube2 = { at = "east-table" } }
+[[policies]]
+file = "bt.toml"
+[[policies]]
+file = "late.toml"
+[[disturbances]]
+at = 4.0
+battery = 15
+"#;
+    let f = btfsm_core::diagnostic::SourceFile::new("s.toml", text);
+    let s = crate::scenario::parse(&f, &dir, &btfsm_format::Limits::default()).unwrap();
+    let runs = run_scenario(&s, false);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(runs[0].recharge_latency_s, [0.0], "the BT reacts at once");
+    let arrived = (runs[1].skills.iter())
+        .find(|k| k.skill == "Move-To")
+        .and_then(|k| k.end)
+        .expect("the first Move-To ends");
+    assert!(arrived > 4.5, "{arrived}");
+    let lat = runs[1].recharge_latency_s[0];
+    assert!(
+        (lat - (arrived - 4.0)).abs() <= s.dt + 1e-9,
+        "{lat} vs arrival {arrived}"
+    );
+    assert!(runs.iter().all(|r| r.goal_met == Some(true)));
+}
