@@ -790,12 +790,11 @@ mod hostile {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    /// `sim --trace` kept every step of every run in memory (a run of
-    /// 200,000 steps: over 80 MiB; 10^6 steps of two policies: 1 GB): it is
-    /// now written as the runs go, in a temporary file renamed when whole.
-    #[test]
-    fn sim_hostile_long_trace_is_streamed_in_bounded_memory() {
-        let dir = scratch("long-trace");
+    /// A scratch folder holding `long.toml`, a scenario of one policy that
+    /// runs its 200,000 steps (a disturbance far past them keeps it
+    /// going), and the path of a trace to write there.
+    fn long_run(name: &str) -> (std::path::PathBuf, std::path::PathBuf, std::path::PathBuf) {
+        let dir = scratch(name);
         let f = dir.join("long.toml");
         std::fs::write(
             &f,
@@ -806,6 +805,15 @@ mod hostile {
         )
         .unwrap();
         let trace = dir.join("trace.json");
+        (dir, f, trace)
+    }
+
+    /// `sim --trace` kept every step of every run in memory (a run of
+    /// 200,000 steps: over 80 MiB; 10^6 steps of two policies: 1 GB): it is
+    /// now written as the runs go, in a temporary file renamed when whole.
+    #[test]
+    fn sim_hostile_long_trace_is_streamed_in_bounded_memory() {
+        let (dir, f, trace) = long_run("long-trace");
         let (code, out, err, took) = btfsm_within(
             80,
             &[
@@ -841,17 +849,7 @@ mod hostile {
     /// exits 2 and leaves no file.
     #[test]
     fn sim_hostile_trace_is_bounded_by_max_file_bytes() {
-        let dir = scratch("capped-trace");
-        let f = dir.join("long.toml");
-        std::fs::write(
-            &f,
-            format!(
-                "max_steps = 200000\n{CUBE}{}[[disturbances]]\nat = 1000000000.0\nbattery = 100.0\n",
-                policies(1)
-            ),
-        )
-        .unwrap();
-        let trace = dir.join("trace.json");
+        let (dir, f, trace) = long_run("capped-trace");
         let (code, _, err, took) = btfsm_within(
             80,
             &[
