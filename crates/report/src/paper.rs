@@ -611,39 +611,17 @@ impl Build<'_> {
         (b, gb): (&Policy, &PolicyGraph),
         (f, gf): (&Policy, &PolicyGraph),
     ) {
-        let pv = |k: &str, side: usize| published(&self.pubd, "Table III", name, k, Some(side));
-        self.rows.push(row(
-            "Table III",
-            name,
-            "CC BT (essential)",
-            pv("CC", 0),
-            int(essential(b)),
-            NOTE_UNKNOWN,
-        ));
-        self.rows.push(row(
-            "Table III",
-            name,
-            "CC BT (cc)",
-            pv("CC", 0),
-            int(cyclomatic(gb)),
-            NOTE_BT_CC,
-        ));
-        self.rows.push(row(
-            "Table III",
-            name,
-            "CC FSM (cc)",
-            pv("CC", 1),
-            int(cyclomatic(gf)),
-            NOTE_UNKNOWN,
-        ));
-        self.rows.push(row(
-            "Table III",
-            name,
-            "CC FSM (essential)",
-            pv("CC", 1),
-            int(essential(f)),
-            NOTE_FSM_ESS,
-        ));
+        let cells = [
+            ("CC BT (essential)", 0, essential(b), NOTE_UNKNOWN),
+            ("CC BT (cc)", 0, cyclomatic(gb), NOTE_BT_CC),
+            ("CC FSM (cc)", 1, cyclomatic(gf), NOTE_UNKNOWN),
+            ("CC FSM (essential)", 1, essential(f), NOTE_FSM_ESS),
+        ];
+        for (what, side, value, note) in cells {
+            let paper = published(&self.pubd, "Table III", name, "CC", Some(side));
+            self.rows
+                .push(row("Table III", name, what, paper, int(value), note));
+        }
     }
 
     /// Table III's GED rows of experiment `name`: structural and named GED
