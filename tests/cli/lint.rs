@@ -19,6 +19,22 @@ fn fixture(code: &str, which: &str) -> String {
 }
 
 /// The codes `btfsm lint --list` prints, with their default level.
+/// `code file line` of each finding of `lint --format json` output (the
+/// file's name only).
+fn code_file_line(out: &str) -> Vec<String> {
+    let v: serde_json::Value = serde_json::from_str(out).unwrap();
+    (v.as_array().unwrap().iter())
+        .map(|f| {
+            format!(
+                "{} {} {}",
+                f["code"].as_str().unwrap(),
+                f["file"].as_str().unwrap().rsplit('/').next().unwrap(),
+                f["line"]
+            )
+        })
+        .collect()
+}
+
 fn codes_and_levels() -> Vec<(String, String)> {
     let (code, out, err) = btfsm(&["lint", "--list"]);
     assert_eq!(code, 0, "{err}");
@@ -152,20 +168,7 @@ fn lint_on_the_bundled_real_files_reports_what_docs_lint_md_lists() {
     let (code, out, err) = btfsm(&["lint", "tests/fixtures/corpus", "--format", "json"]);
     assert_eq!(code, 1, "{err}");
     assert!(err.is_empty(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let found: Vec<String> = v
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| {
-            format!(
-                "{} {} {}",
-                f["code"].as_str().unwrap(),
-                f["file"].as_str().unwrap().rsplit('/').next().unwrap(),
-                f["line"]
-            )
-        })
-        .collect();
+    let found = code_file_line(&out);
     assert_eq!(
         found,
         [
@@ -523,20 +526,7 @@ fn lint_finds_nav2s_model_in_another_folder_and_is_right_on_its_trees() {
     // are not reported; the docking example's `<inverter>` is.
     let (code, out, err) = btfsm(&["lint", "tests/fixtures/lint-real/nav2", "--format", "json"]);
     assert_eq!(code, 1, "{out}{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let found: Vec<String> = v
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| {
-            format!(
-                "{} {} {}",
-                f["code"].as_str().unwrap(),
-                f["file"].as_str().unwrap().rsplit('/').next().unwrap(),
-                f["line"]
-            )
-        })
-        .collect();
+    let found = code_file_line(&out);
     assert_eq!(found, ["unknown-node-type application_example.xml 22"]);
     let (_, text, _) = btfsm(&["lint", "tests/fixtures/lint-real/nav2"]);
     assert!(
