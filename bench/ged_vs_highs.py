@@ -5,7 +5,10 @@ Generates seeded random pairs (tests/differential/ged_highs.py): independent
 random trees of 15-27 nodes (as BehaviorTree TOML) and of 40-50 nodes, and
 FSM-like graphs of 10-28 states (as FSM TOML), and with `--groups shapes`
 pairs of other shapes (`ged_highs.shapes`: trees of six shapes, edited
-copies of trees and FSMs, FSMs of very different sizes, SCXML charts); times
+copies of trees and FSMs, FSMs of very different sizes, SCXML charts), with
+`--groups ft-rewired` fault-tolerant FSMs of 18-25 vertices with arcs moved,
+and with `--groups nav2` Nav2's trees across releases (bench/nav2-releases,
+structural only); times
 `btfsm compare --mode structural|labeled --format json` at its default budget
 (the engine's own `micros`, no process start-up; at least 1 µs) and HiGHS (PyPI `highspy`, one thread) on the binary formulations
 documented in ged_highs.py: F2 (Lerouge et al. 2017, unit costs) and F2 with
@@ -16,7 +19,7 @@ pairs btfsm settled exactly and the median ratio on the pairs both settled
 (HiGHS within --highs-timeout).
 
 Usage: python3 bench/ged_vs_highs.py BTFSM [--seed S] [--highs-timeout S]
-       [--groups trees,big-trees,fsm,fsm-set,shapes] [--fsm-count N] [--fsm-sizes LO,HI]
+       [--groups trees,big-trees,fsm,fsm-set,shapes,ft-rewired,nav2] [--fsm-count N] [--fsm-sizes LO,HI]
        [--formulations f2,strong] [--kinds PREFIXES]
        [--work UNITS] [--json OUT]
 """
@@ -31,7 +34,42 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "differential"))
 
-from ged_highs import random_fsm, random_tree, run_btfsm, shapes, solve, write_pair  # noqa: E402
+from ged_highs import (bt_toml_graph, ft_rewired, random_fsm, random_tree, run_btfsm,  # noqa: E402
+                       shapes, solve, write_pair)
+
+NAV2 = os.path.join(ROOT, "bench", "nav2-releases")
+
+
+def nav2_pairs(btfsm):
+    """Nav2's trees across releases (bench/nav2-releases): each version
+    against the next, and the first against the last, of each lineage;
+    both as btfsm reads them (`convert --to toml` with Nav2's node model:
+    SubTrees expanded) so that HiGHS gets the same graphs."""
+    import subprocess
+    lines = {}
+    for f in sorted(os.listdir(NAV2)):
+        if f.endswith(".xml") and f != "nav2_tree_nodes.xml":
+            line, tag = f[:-4].rsplit("-", 1)
+            lines.setdefault(line, []).append((tag, f))
+
+    def order(tag):
+        return (1, ()) if tag == "main" else (0, tuple(int(x) for x in tag.split(".")))
+
+    def read(f):
+        text = subprocess.run([btfsm, "convert", os.path.join(NAV2, f), "--to", "toml",
+                               "--nodes-model", os.path.join(NAV2, "nav2_tree_nodes.xml"),
+                               "--assume-leaf", "action"], capture_output=True, text=True, check=True).stdout
+        return text, bt_toml_graph(text)
+
+    out = []
+    for line, versions in sorted(lines.items()):
+        versions.sort(key=lambda v: order(v[0]))
+        steps = list(zip(versions, versions[1:]))
+        if len(versions) > 2:
+            steps.append((versions[0], versions[-1]))
+        for (ta, fa), (tb, fb) in steps:
+            out.append((f"nav2-{line}-{ta}-{tb}", read(fa), read(fb)))
+    return out
 
 
 def groups(seed, fsm_count=30, fsm_sizes=(10, 28)):
@@ -51,6 +89,8 @@ def groups(seed, fsm_count=30, fsm_sizes=(10, 28)):
     # Other shapes, from their own generator (ged_highs.shapes): the
     # groups above do not depend on it.
     yield "shapes", shapes(seed)
+    # Fault-tolerant FSMs (the paper's Fig. 8d / 16b shape) with arcs moved.
+    yield "ft-rewired", ft_rewired(seed)
 
 
 def main():
@@ -82,7 +122,10 @@ def main():
     rows = []
     with tempfile.TemporaryDirectory() as d:
         sizes = tuple(int(x) for x in args.fsm_sizes.split(","))
-        for group, plist in groups(args.seed, args.fsm_count, sizes):
+        all_groups = list(groups(args.seed, args.fsm_count, sizes))
+        if "nav2" in wanted:
+            all_groups.append(("nav2", nav2_pairs(args.btfsm)))
+        for group, plist in all_groups:
             if group not in wanted:
                 continue
             for i, pair in enumerate(plist):
@@ -91,6 +134,8 @@ def main():
                     continue
                 fa, fb = write_pair(d, ta, tb)
                 for mode in args.modes.split(","):
+                    if group == "nav2" and mode == "labeled":
+                        continue  # Nav2's own node types: structural only
                     r = run_btfsm(args.btfsm, fa, fb, mode, extra)
                     # The engine's own time in microseconds (`micros`), at
                     # least 1 µs; older builds report whole milliseconds
@@ -144,6 +189,15 @@ def main():
             line += (f"; HiGHS solved {len(either)} in some formulation, btfsm exact on "
                      f"{sum(r['exact'] for r in either)} of those")
             print(line)
+    # Issue 34: every pair at least 10x faster than HiGHS, or named here.
+    slow = []
+    for r in rows:
+        solved = [r[f"ratio_{f}"] for f in forms if r.get(f"highs_{f}") is not None]
+        if solved and r["exact"] and min(solved) < 10.0:
+            slow.append((r, min(solved)))
+    print(f"\npair-modes HiGHS solved and btfsm settled at less than 10x the fastest HiGHS: {len(slow)}")
+    for r, ratio in slow:
+        print(f"  {r['kind']}-{r['pair']} {r['mode']}: {ratio:.1f}x (btfsm {r['btfsm_ms']:.1f} ms)")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)

@@ -394,6 +394,113 @@ def shapes(seed):
     return out
 
 
+def ft_fsm(k):
+    """A fault-tolerant FSM of k action states in the shape of the paper's
+    Fig. 8d / 16b, as a list of (name, label, [(trigger, target)]): each
+    action state goes on to the next on SUCCESS (the last to the outcome
+    SUCCESS), to SELECTOR on FAILURE, to itself on RUNNING, and has a
+    battery guard to Recharge; Recharge returns to SELECTOR; SELECTOR (a
+    decision state) guards to Recharge, to every action state and to the
+    outcome SUCCESS. k + 4 vertices (with the outcomes SUCCESS and
+    FAILURE), 5k + 5 arcs."""
+    acts = [f"a{i}" for i in range(k)]
+    states = []
+    for i, a in enumerate(acts):
+        nxt = acts[i + 1] if i + 1 < k else "SUCCESS"
+        states.append((a, "state", [("SUCCESS", nxt), ("FAILURE", "SELECTOR"), ("RUNNING", a),
+                                    ("guard", "Recharge")]))
+    states.append(("Recharge", "state", [("SUCCESS", "SELECTOR"), ("RUNNING", "Recharge")]))
+    states.append(("SELECTOR", "decision", [("guard", "Recharge")] + [("guard", a) for a in acts]
+                   + [("guard", "SUCCESS"), ("RUNNING", "SELECTOR")]))
+    return states
+
+
+def rewire(rng, states, r):
+    """r arcs of an FSM of `ft_fsm`'s form moved to random targets (states
+    or outcomes)."""
+    states = [(n, lab, list(arcs)) for n, lab, arcs in states]
+    targets = [n for n, _, _ in states] + ["SUCCESS", "FAILURE"]
+    for _ in range(r):
+        _, _, arcs = rng.choice(states)
+        j = rng.randrange(len(arcs))
+        arcs[j] = (arcs[j][0], rng.choice(targets))
+    return states
+
+
+def ft_text(states):
+    """The FSM TOML text of `ft_fsm`'s states and its graph (states in
+    order, then the outcomes SUCCESS and FAILURE)."""
+    names = [n for n, _, _ in states] + ["SUCCESS", "FAILURE"]
+    index = {n: i for i, n in enumerate(names)}
+    lines = ['kind = "fsm"', 'name = "fault-tolerant fsm"', f'initial = "{states[0][0]}"',
+             'outcomes = ["SUCCESS", "FAILURE"]', ""]
+    arcs, labels = [], []
+    for i, (n, lab, trs) in enumerate(states):
+        labels.append(lab)
+        lines.append(f"[states.{n}]")
+        if lab == "decision":
+            lines.append("decision = true")
+        else:
+            lines += ['skill = "Pick"', 'args = { object = "c" }']
+        guards = [t for g, t in trs if g == "guard"]
+        if guards:
+            lines.append("guards = [" + ", ".join(
+                f'{{ unless = "Battery-Level", args = {{ min = 20 }}, to = "{t}" }}' for t in guards) + "]")
+        on = [(g, t) for g, t in trs if g != "guard"]
+        if on:
+            lines.append("on = { " + ", ".join(f'{g} = "{t}"' for g, t in on) + " }")
+        lines.append("")
+        arcs += [(i, index[t]) for g, t in trs]
+    return "\n".join(lines), {"n": len(names), "arcs": arcs, "labels": labels + ["outcome", "outcome"]}
+
+
+def ft_rewired(seed):
+    """Pairs of rewired fault-tolerant FSMs of 18-25 vertices (14-21 action
+    states, up to 110 arcs): an FSM and a copy with 3-12 arcs moved, and
+    two independently rewired FSMs of close sizes."""
+    rng = random.Random(seed)
+    out = []
+    for r in (3, 6, 12):
+        for _ in range(3):
+            base = ft_fsm(rng.randint(14, 21))
+            out.append((f"ft-copy{r}", ft_text(base), ft_text(rewire(rng, base, r))))
+    for _ in range(4):
+        k = rng.randint(14, 21)
+        a = rewire(rng, ft_fsm(k), rng.randint(3, 12))
+        b = rewire(rng, ft_fsm(max(14, min(21, k + rng.randint(-3, 3)))), rng.randint(3, 12))
+        out.append(("ft-pair", ft_text(a), ft_text(b)))
+    return out
+
+
+def bt_toml_graph(text):
+    """The graph of a BT TOML text (the vertices reachable from `root`,
+    parent -> child arcs, each labelled by its kind key), for trees that
+    btfsm converted (`convert --to toml`, SubTrees expanded)."""
+    import tomllib
+    t = tomllib.loads(text)
+    nodes = t["nodes"]
+    leaf_keys = ("action", "condition")
+    order, index, arcs, labels = [], {}, [], []
+    stack = [t["root"]]
+    while stack:
+        n = stack.pop()
+        index[n] = len(order)
+        order.append(n)
+        spec = nodes[n]
+        kind = next(k for k in spec if k not in ("name", "type", "ports", "skill", "args", "description"))
+        labels.append(kind)
+        kids = [] if kind in leaf_keys else spec[kind]
+        kids = [kids] if isinstance(kids, str) else kids
+        stack += list(reversed(kids))
+    for n in order:
+        spec = nodes[n]
+        kind = labels[index[n]]
+        kids = [] if kind in leaf_keys else spec[kind]
+        kids = [kids] if isinstance(kids, str) else kids
+        arcs += [(index[n], index[c]) for c in kids]
+    return {"n": len(order), "arcs": arcs, "labels": labels}
+
+
 def write_pair(d, ta, tb):
     """Writes a pair's two texts into directory d (.scxml or .toml, by
     content) and returns their paths."""
