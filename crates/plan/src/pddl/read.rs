@@ -352,10 +352,13 @@ impl Reader {
                 self.err(span.clone(), format!("a second type `{t}`"), "declare it once");
             }
         }
-        for (t, span, up, up_span) in &typed {
-            if !self.known_type(up, up_span, m) {
-                continue;
+        // A supertype only named after `-` is a type too (below `object`).
+        for (_, _, up, _) in &typed {
+            if up != "object" && !m.types.contains_key(up) {
+                m.types.insert(up.clone(), "object".into());
             }
+        }
+        for (t, span, up, _) in &typed {
             // Acyclic and at most MAX_TYPE_DEPTH deep.
             let mut at = up.as_str();
             let mut depth = 1;
@@ -404,9 +407,8 @@ impl Reader {
     fn params(&mut self, items: &[Sexp], m: &Model) -> Vec<Param> {
         let mut out: Vec<Param> = Vec::new();
         for (name, span, ty, ty_span) in self.typed_list(items, true, m) {
-            if !self.known_type(&ty, &ty_span, m) {
-                continue;
-            }
+            // Kept with an unknown type (reported): its uses are checked.
+            self.known_type(&ty, &ty_span, m);
             if out.iter().any(|p| p.name == name) {
                 self.err(span, format!("a second parameter `?{name}`"), "rename one");
                 continue;
