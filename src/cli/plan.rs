@@ -109,22 +109,19 @@ fn read_task(path: &Path, problem: Option<&Path>, limits: &Limits) -> Option<pla
     }
 }
 
-pub(super) fn execute(a: PlanArgs) -> u8 {
-    let limits = a.limits.limits();
-    let shown = a.domain.display().to_string();
-    let Some(mut domain) = read_task(&a.domain, a.problem.as_deref(), &limits) else {
-        return EXIT_BAD_INPUT;
-    };
+/// The goal and start the options give (`--task`, `--goal`, `--init`),
+/// or the exit code when they are wrong.
+fn set_task(a: &PlanArgs, domain: &mut plan::Domain, shown: &str) -> Result<(), u8> {
     if domain.goal.facts.is_empty() && a.goals.is_empty() {
-        return fail(
+        return Err(fail(
             Diagnostic::error(format!("{shown}: the PDDL domain has no goal"))
                 .hint("give its problem with --problem FILE, or the goal with --goal FACT"),
-        );
+        ));
     }
     if let Some(t) = &a.task
         && let Err(e) = domain.select_task(t)
     {
-        return fail(Diagnostic::error(e.to_string()));
+        return Err(fail(Diagnostic::error(e.to_string())));
     }
     let set = |d: &mut plan::domain::Domain| {
         if !a.goals.is_empty() {
@@ -135,11 +132,23 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
         }
         Ok::<(), Vec<String>>(())
     };
-    if let Err(es) = set(&mut domain) {
+    if let Err(es) = set(domain) {
         for e in es {
             eprint!("{}", Diagnostic::error(e.to_string()));
         }
+        return Err(EXIT_BAD_INPUT);
+    }
+    Ok(())
+}
+
+pub(super) fn execute(a: PlanArgs) -> u8 {
+    let limits = a.limits.limits();
+    let shown = a.domain.display().to_string();
+    let Some(mut domain) = read_task(&a.domain, a.problem.as_deref(), &limits) else {
         return EXIT_BAD_INPUT;
+    };
+    if let Err(code) = set_task(&a, &mut domain, &shown) {
+        return code;
     }
     let opts = Options {
         reorder: !a.no_reorder,

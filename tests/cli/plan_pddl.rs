@@ -30,13 +30,20 @@ fn plansys2_example_domains_load_and_plan() {
         ("multidomain_domain_1", 0, "multidomain1-fsm.toml"),
         ("patrol", 0, "patrol-fsm.toml"),
         ("multidomain_domain_2", 2, "the plan has no step"),
-        ("bt_example", 2, "the tree would have more than 150000 nodes"),
+        (
+            "bt_example",
+            2,
+            "the tree would have more than 150000 nodes",
+        ),
     ];
     let mut planned = 0;
     for (name, code, says) in cases {
         let (got, out, err) = plan(name, &format!("{name}-problem"), &[]);
         assert_eq!(got, *code, "{name}: {err}");
-        assert!(out.contains(says) || err.contains(says), "{name}: {out}{err}");
+        assert!(
+            out.contains(says) || err.contains(says),
+            "{name}: {out}{err}"
+        );
         planned += usize::from(got == 0);
     }
     assert_eq!(planned, 4);
@@ -204,7 +211,9 @@ fn pddl_goals_options_and_refusals() {
     let (code, _, err) = btfsm(&["plan", f.to_str().expect("utf-8"), "--goal", "(q)"]);
     assert_eq!(code, 2);
     assert!(
-        err.contains("`when` in an effect needs `:conditional-effects`, which `btfsm plan` does not support"),
+        err.contains(
+            "`when` in an effect needs `:conditional-effects`, which `btfsm plan` does not support"
+        ),
         "{err}"
     );
     assert!(err.contains("when.pddl:5:13"), "{err}");

@@ -445,13 +445,16 @@ impl<'d> Planner<'d, '_> {
         if self.statics.is_empty() {
             return true;
         }
-        a.pre.iter().filter(|p| self.statics.contains(&p.pred)).all(|p| {
-            let is_param = |t: &String| a.params.iter().any(|q| &q.name == t);
-            if p.args.iter().any(|t| is_param(t) && !bind.contains_key(t)) {
-                return true;
-            }
-            self.init.contains(&p.ground(&|t| bind.get(t).cloned()))
-        })
+        a.pre
+            .iter()
+            .filter(|p| self.statics.contains(&p.pred))
+            .all(|p| {
+                let is_param = |t: &String| a.params.iter().any(|q| &q.name == t);
+                if p.args.iter().any(|t| is_param(t) && !bind.contains_key(t)) {
+                    return true;
+                }
+                self.init.contains(&p.ground(&|t| bind.get(t).cloned()))
+            })
     }
 
     /// Orders the precondition subtrees `kids` (see [`conflicts::order`]).

@@ -264,15 +264,26 @@ fn static_preconditions_false_at_the_start_rule_achievers_out() {
     let calls: Vec<String> = (p.steps.iter().flatten())
         .map(|(a, bind)| {
             let action = &d.actions[*a];
-            let args: Vec<&str> = action.params.iter().map(|q| bind[&q.name].as_str()).collect();
+            let args: Vec<&str> = action
+                .params
+                .iter()
+                .map(|q| bind[&q.name].as_str())
+                .collect();
             format!("{} {}", action.name, args.join(" "))
         })
         .collect();
     let askcharge = calls.iter().filter(|c| c.starts_with("askcharge"));
     assert!(askcharge.clone().count() > 0, "{calls:?}");
-    assert!(askcharge.clone().all(|c| c.ends_with(" chargingroom")), "{calls:?}");
+    assert!(
+        askcharge.clone().all(|c| c.ends_with(" chargingroom")),
+        "{calls:?}"
+    );
     assert!(calls.contains(&"move leia bedroom bathroom".to_string()));
-    assert!(!calls.iter().any(|c| c.starts_with("move leia kitchen bathroom")));
+    assert!(
+        !calls
+            .iter()
+            .any(|c| c.starts_with("move leia kitchen bathroom"))
+    );
     let mut no_init = d.clone();
     no_init.goal.init.clear();
     let capped = Options {

@@ -74,9 +74,11 @@ impl Reader {
             return;
         }
         let d = if self.diags.len() == MAX_ERRORS {
-            Diagnostic::error(format!("more than {MAX_ERRORS} errors; the rest are not shown"))
-                .in_file(&self.file)
-                .hint("fix these first")
+            Diagnostic::error(format!(
+                "more than {MAX_ERRORS} errors; the rest are not shown"
+            ))
+            .in_file(&self.file)
+            .hint("fix these first")
         } else {
             Diagnostic::error(msg).at(&self.file, span).hint(hint)
         };
@@ -101,7 +103,11 @@ impl Reader {
     fn define<'s>(&mut self, top: &'s [Sexp], kind: &str) -> Option<(String, &'s [Sexp])> {
         let want = format!("a PDDL {kind} is `(define ({kind} NAME) ...)`");
         let Some(first) = top.first() else {
-            self.err(0..0, format!("no `(define ({kind} ...))` in the file"), want);
+            self.err(
+                0..0,
+                format!("no `(define ({kind} ...))` in the file"),
+                want,
+            );
             return None;
         };
         if let Some(extra) = top.get(1) {
@@ -349,7 +355,11 @@ impl Reader {
                 continue;
             }
             if m.types.insert(t.clone(), up.clone()).is_some() {
-                self.err(span.clone(), format!("a second type `{t}`"), "declare it once");
+                self.err(
+                    span.clone(),
+                    format!("a second type `{t}`"),
+                    "declare it once",
+                );
             }
         }
         // A supertype only named after `-` is a type too (below `object`).
@@ -386,7 +396,11 @@ impl Reader {
                 continue;
             }
             if m.objects.len() >= MAX_DECLARATIONS {
-                self.err(span, format!("more than {MAX_DECLARATIONS} objects"), "fewer objects");
+                self.err(
+                    span,
+                    format!("more than {MAX_DECLARATIONS} objects"),
+                    "fewer objects",
+                );
                 return;
             }
             match m.objects.get(&name) {
@@ -421,16 +435,32 @@ impl Reader {
     fn predicates(&mut self, items: &[Sexp], m: &mut Model) {
         for p in items {
             let list = p.list().unwrap_or_default();
-            let Some(name) = list.first().and_then(Sexp::atom).filter(|n| fact::is_name(n)) else {
-                self.err(p.span(), "expected `(name ?param - type ...)`", "declare a predicate");
+            let Some(name) = list
+                .first()
+                .and_then(Sexp::atom)
+                .filter(|n| fact::is_name(n))
+            else {
+                self.err(
+                    p.span(),
+                    "expected `(name ?param - type ...)`",
+                    "declare a predicate",
+                );
                 continue;
             };
             if m.predicate(name).is_some() {
-                self.err(p.span(), format!("a second predicate `{name}`"), "declare it once");
+                self.err(
+                    p.span(),
+                    format!("a second predicate `{name}`"),
+                    "declare it once",
+                );
                 continue;
             }
             if m.predicates.len() >= MAX_DECLARATIONS {
-                self.err(p.span(), format!("more than {MAX_DECLARATIONS} predicates"), "split the domain");
+                self.err(
+                    p.span(),
+                    format!("more than {MAX_DECLARATIONS} predicates"),
+                    "split the domain",
+                );
                 return;
             }
             let params = self.params(&list[1..], m);
@@ -460,8 +490,16 @@ impl Reader {
                 "add `:durative-actions` to `(:requirements ...)`",
             );
         }
-        let Some(name) = items.get(1).and_then(Sexp::atom).filter(|n| fact::is_name(n)) else {
-            self.err(s.span(), "an action has no name", "write `(:action NAME :parameters (...) ...)`");
+        let Some(name) = items
+            .get(1)
+            .and_then(Sexp::atom)
+            .filter(|n| fact::is_name(n))
+        else {
+            self.err(
+                s.span(),
+                "an action has no name",
+                "write `(:action NAME :parameters (...) ...)`",
+            );
             return None;
         };
         let keys: &[&str] = if durative {
@@ -493,7 +531,10 @@ impl Reader {
             if m.objects.contains_key(&p.name) {
                 self.err(
                     items[1].span(),
-                    format!("parameter `?{}` of `{name}` has the name of a constant", p.name),
+                    format!(
+                        "parameter `?{}` of `{name}` has the name of a constant",
+                        p.name
+                    ),
                     "rename the parameter",
                 );
             }
@@ -554,7 +595,11 @@ fn strips(
         }
     }
     let mut add: Vec<Pattern> = Vec::new();
-    for p in add_start.iter().filter(|p| !del_end.contains(p)).chain(&add_end) {
+    for p in add_start
+        .iter()
+        .filter(|p| !del_end.contains(p))
+        .chain(&add_end)
+    {
         if !add.contains(p) {
             add.push((*p).clone());
         }
@@ -587,7 +632,11 @@ impl Reader {
                 } else {
                     "a durative action's condition is `(at start c)`, `(at end c)` or `(over all c)`"
                 };
-                self.err(s.span(), what, "wrap it in `(at start ...)` or `(at end ...)`");
+                self.err(
+                    s.span(),
+                    what,
+                    "wrap it in `(at start ...)` or `(at end ...)`",
+                );
                 return None;
             }
         };
@@ -692,7 +741,11 @@ impl Reader {
         }
         let items = s.list().unwrap_or_default();
         let Some(name) = items.first().and_then(Sexp::atom) else {
-            self.err(s.span(), "expected an atom `(predicate term...)`", "write `(pred ?x ...)`");
+            self.err(
+                s.span(),
+                "expected an atom `(predicate term...)`",
+                "write `(pred ?x ...)`",
+            );
             return None;
         };
         let Some(decl) = m.predicate(name) else {
@@ -711,7 +764,11 @@ impl Reader {
         if items.len() - 1 != decl.len() {
             self.err(
                 s.span(),
-                format!("`{name}` takes {} argument(s), found {}", decl.len(), items.len() - 1),
+                format!(
+                    "`{name}` takes {} argument(s), found {}",
+                    decl.len(),
+                    items.len() - 1
+                ),
                 format!("declared as `({name}{})`", typed_params(decl)),
             );
             return None;
@@ -804,9 +861,22 @@ impl Reader {
             ..Task::default()
         };
         let section = |key: &str| sections.iter().find(|s| s.head() == Some(key));
-        let body = |s: &Sexp| s.list().unwrap_or_default().get(1..).unwrap_or_default().to_vec();
+        let body = |s: &Sexp| {
+            s.list()
+                .unwrap_or_default()
+                .get(1..)
+                .unwrap_or_default()
+                .to_vec()
+        };
         for s in sections {
-            let keys = [":domain", ":requirements", ":objects", ":init", ":goal", ":metric"];
+            let keys = [
+                ":domain",
+                ":requirements",
+                ":objects",
+                ":init",
+                ":goal",
+                ":metric",
+            ];
             if !s.head().is_some_and(|h| keys.contains(&h)) {
                 let h = s.head().unwrap_or("(");
                 self.err(
@@ -820,10 +890,18 @@ impl Reader {
             Some([d]) if d.atom() == Some(&m.name) => {}
             Some([d]) => self.err(
                 d.span(),
-                format!("the problem is for domain `{}`, not `{}`", shown(d.atom().unwrap_or("(")), m.name),
+                format!(
+                    "the problem is for domain `{}`, not `{}`",
+                    shown(d.atom().unwrap_or("(")),
+                    m.name
+                ),
                 "give the domain file the problem names",
             ),
-            _ => self.err(0..0, "the problem has no `(:domain NAME)`", "name its domain"),
+            _ => self.err(
+                0..0,
+                "the problem has no `(:domain NAME)`",
+                "name its domain",
+            ),
         }
         if let Some(s) = section(":objects") {
             self.objects(&body(s), m, "object");
@@ -839,14 +917,26 @@ impl Reader {
         let mut goal = Vec::new();
         match section(":goal").map(body).as_deref() {
             Some([g]) => self.condition(g, &ctx, m, Some(When::Start), &mut goal),
-            _ => self.err(0..0, "the problem has no `(:goal ...)`", "write `(:goal (and (pred obj ...)))`"),
+            _ => self.err(
+                0..0,
+                "the problem has no `(:goal ...)`",
+                "write `(:goal (and (pred obj ...)))`",
+            ),
         }
         if goal.len() > MAX_SIBLINGS {
-            self.err(0..0, format!("the goal has more than {MAX_SIBLINGS} facts"), "split the goal");
+            self.err(
+                0..0,
+                format!("the goal has more than {MAX_SIBLINGS} facts"),
+                "split the goal",
+            );
         }
         task.goal = goal.into_iter().map(|(_, p)| p.ground(&|_| None)).collect();
         if task.goal.is_empty() && self.diags.is_empty() {
-            self.err(0..0, "the problem's goal has no facts", "write `(:goal (and (pred obj ...)))`");
+            self.err(
+                0..0,
+                "the problem's goal has no facts",
+                "write `(:goal (and (pred obj ...)))`",
+            );
         }
         task
     }
@@ -855,11 +945,28 @@ impl Reader {
         let mut out = Vec::new();
         for f in items {
             match f.head() {
-                Some("=") => self.refuse(f.span(), "a function value `(= ...)` in `:init`", ":numeric-fluents"),
-                Some("at") if f.list().and_then(|l| l.get(1)).and_then(Sexp::atom).is_some_and(|a| a.parse::<f64>().is_ok()) => {
-                    self.refuse(f.span(), "`(at TIME ...)` in `:init`", ":timed-initial-literals");
+                Some("=") => self.refuse(
+                    f.span(),
+                    "a function value `(= ...)` in `:init`",
+                    ":numeric-fluents",
+                ),
+                Some("at")
+                    if f.list()
+                        .and_then(|l| l.get(1))
+                        .and_then(Sexp::atom)
+                        .is_some_and(|a| a.parse::<f64>().is_ok()) =>
+                {
+                    self.refuse(
+                        f.span(),
+                        "`(at TIME ...)` in `:init`",
+                        ":timed-initial-literals",
+                    );
                 }
-                Some("not") => self.err(f.span(), "`not` in `:init`", "list only the facts that hold: every other is false"),
+                Some("not") => self.err(
+                    f.span(),
+                    "`not` in `:init`",
+                    "list only the facts that hold: every other is false",
+                ),
                 _ => {
                     if let Some(p) = self.atom(f, ctx, m) {
                         out.push(p.ground(&|_| None));
@@ -867,7 +974,11 @@ impl Reader {
                 }
             }
             if out.len() > MAX_DECLARATIONS {
-                self.err(f.span(), format!("more than {MAX_DECLARATIONS} initial facts"), "fewer facts");
+                self.err(
+                    f.span(),
+                    format!("more than {MAX_DECLARATIONS} initial facts"),
+                    "fewer facts",
+                );
                 break;
             }
         }

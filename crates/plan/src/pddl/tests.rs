@@ -15,7 +15,11 @@ fn errors(domain: &str, problem: Option<&str>) -> Vec<String> {
     e.iter()
         .map(|d| {
             let (_, l, c) = d.location().unwrap_or_default();
-            format!("{l}:{c} {} ({})", d.message, d.hint.clone().unwrap_or_default())
+            format!(
+                "{l}:{c} {} ({})",
+                d.message,
+                d.hint.clone().unwrap_or_default()
+            )
         })
         .collect()
 }
@@ -76,7 +80,10 @@ fn types_constants_and_problem_objects_become_typed_objects() {
         d.objects["bolt"].types,
         ["part", "reachable", "location", "object"]
     );
-    assert_eq!(d.objects["bench"].types, ["reachable", "location", "object"]);
+    assert_eq!(
+        d.objects["bench"].types,
+        ["reachable", "location", "object"]
+    );
     assert_eq!(d.objects["tray"].types, ["location", "object"]);
     assert_eq!(d.goal.id, "p");
     assert_eq!(d.goal.facts[0].to_string(), "in(bolt)");
@@ -98,7 +105,9 @@ fn an_undeclared_predicate_names_the_declared_one_it_abbreviates() {
     );
     assert_eq!(
         e,
-        ["4:29 undeclared predicate `piece_is_sterwheel` (did you mean `piece_is_steering_wheel`?)"]
+        [
+            "4:29 undeclared predicate `piece_is_sterwheel` (did you mean `piece_is_steering_wheel`?)"
+        ]
     );
     // A plain misspelling still gets the edit-distance suggestion.
     let e = errors(
@@ -122,17 +131,41 @@ fn unsupported_features_are_refused_where_they_are_used() {
         )
     };
     let cases = [
-        ("(not (p ?x))", "(q ?x)", "3:45 `not` in a condition needs `:negative-preconditions`"),
-        ("(or (p ?x) (q ?x))", "(q ?x)", "3:45 `or` in a condition needs `:disjunctive-preconditions`"),
-        ("(= ?x ?x)", "(q ?x)", "3:45 `=` in a condition needs `:equality`"),
-        ("(p ?x)", "(when (p ?x) (q ?x))", "3:60 `when` in an effect needs `:conditional-effects`"),
-        ("(p ?x)", "(increase (total-cost) 1)", "3:60 `increase` in an effect needs `:numeric-fluents`"),
+        (
+            "(not (p ?x))",
+            "(q ?x)",
+            "3:45 `not` in a condition needs `:negative-preconditions`",
+        ),
+        (
+            "(or (p ?x) (q ?x))",
+            "(q ?x)",
+            "3:45 `or` in a condition needs `:disjunctive-preconditions`",
+        ),
+        (
+            "(= ?x ?x)",
+            "(q ?x)",
+            "3:45 `=` in a condition needs `:equality`",
+        ),
+        (
+            "(p ?x)",
+            "(when (p ?x) (q ?x))",
+            "3:60 `when` in an effect needs `:conditional-effects`",
+        ),
+        (
+            "(p ?x)",
+            "(increase (total-cost) 1)",
+            "3:60 `increase` in an effect needs `:numeric-fluents`",
+        ),
     ];
     for (pre, eff, want) in cases {
         let e = errors(&dom(pre, eff), None);
         assert_eq!(e.len(), 1, "{e:?}");
         assert!(e[0].starts_with(want), "{} vs {want}", e[0]);
-        assert!(e[0].contains("which `btfsm plan` does not support"), "{}", e[0]);
+        assert!(
+            e[0].contains("which `btfsm plan` does not support"),
+            "{}",
+            e[0]
+        );
     }
     // Declaring them is allowed; an unknown requirement is not.
     let e = errors("(define (domain f) (:requirements :strip))", None);
@@ -171,8 +204,14 @@ fn terms_are_checked_against_parameters_objects_and_types() {
     let dom_ok = "(define (domain f) (:requirements :typing) (:types robot room)
       (:predicates (at ?r - robot ?x - room)))";
     let e = errors(dom_ok, Some(prob));
-    assert_eq!(e[0], "1:30 the problem is for domain `g`, not `f` (give the domain file the problem names)");
-    assert!(e[1].starts_with("1:69 `r1` is a `robot`; `at` takes a `room`"), "{e:?}");
+    assert_eq!(
+        e[0],
+        "1:30 the problem is for domain `g`, not `f` (give the domain file the problem names)"
+    );
+    assert!(
+        e[1].starts_with("1:69 `r1` is a `robot`; `at` takes a `room`"),
+        "{e:?}"
+    );
 }
 
 /// |objects|^arity ground actions: capped before the planner starts.
@@ -181,7 +220,8 @@ fn groundings_are_capped() {
     let dom = "(define (domain g) (:predicates (p ?a ?b ?c ?d ?e))
       (:action a :parameters (?a ?b ?c ?d ?e) :precondition () :effect (p ?a ?b ?c ?d ?e)))";
     let objects: String = (0..20).map(|i| format!("o{i} ")).collect();
-    let prob = format!("(define (problem p) (:domain g) (:objects {objects}) (:goal (p o1 o1 o1 o1 o1)))");
+    let prob =
+        format!("(define (problem p) (:domain g) (:objects {objects}) (:goal (p o1 o1 o1 o1 o1)))");
     // 20^5 = 3.2 million > 1 million.
     let e = errors(dom, Some(&prob));
     assert_eq!(e.len(), 1);
@@ -190,7 +230,8 @@ fn groundings_are_capped() {
         "{e:?}"
     );
     let few: String = (0..10).map(|i| format!("o{i} ")).collect();
-    let prob = format!("(define (problem p) (:domain g) (:objects {few}) (:goal (p o1 o1 o1 o1 o1)))");
+    let prob =
+        format!("(define (problem p) (:domain g) (:objects {few}) (:goal (p o1 o1 o1 o1 o1)))");
     assert!(load_str(dom, Some(&prob)).is_ok());
 }
 
@@ -199,7 +240,13 @@ fn pddl_is_told_from_toml_and_atoms_become_fact_text() {
     assert!(looks_like_pddl("x.PDDL", ""));
     assert!(looks_like_pddl("x", "; c\n  ; d\n(define"));
     assert!(!looks_like_pddl("x.toml", "name = \"d\"\n"));
-    assert_eq!(fact_text("(Robot_At leia  kitchen)"), "robot_at(leia, kitchen)");
+    assert_eq!(
+        fact_text("(Robot_At leia  kitchen)"),
+        "robot_at(leia, kitchen)"
+    );
     assert_eq!(fact_text("(done)"), "done");
-    assert_eq!(fact_text("Object-At(cube2, delivery)"), "Object-At(cube2, delivery)");
+    assert_eq!(
+        fact_text("Object-At(cube2, delivery)"),
+        "Object-At(cube2, delivery)"
+    );
 }
