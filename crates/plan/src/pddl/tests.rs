@@ -250,3 +250,69 @@ fn pddl_is_told_from_toml_and_atoms_become_fact_text() {
         "Object-At(cube2, delivery)"
     );
 }
+
+/// Mutated PlanSys2 domains and problems (characters deleted, doubled or
+/// swapped for parentheses, `not`, `?`, `-`; a seeded LCG) load to a
+/// domain or to positioned errors, never a panic; what loads plans or
+/// reports its cap.
+#[test]
+fn mutated_domains_and_problems_never_panic() {
+    let domain = include_str!("../../../../tests/fixtures/domains/pddl/bt_example.pddl");
+    let problem = include_str!("../../../../tests/fixtures/domains/pddl/patrol-problem.pddl");
+    let patrol = include_str!("../../../../tests/fixtures/domains/pddl/patrol.pddl");
+    let mut seed: u64 = 0x5eed_0f_9dd1;
+    let mut next = move |n: usize| {
+        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        ((seed >> 33) as usize) % n.max(1)
+    };
+    let pieces = [
+        "(", ")", "(not ", "?", " - ", "(and ", " x ", ";", "(at end ",
+    ];
+    let opts = crate::Options {
+        max_nodes: 2_000,
+        ..crate::Options::default()
+    };
+    for round in 0..600 {
+        let (d, p) = if round % 2 == 0 {
+            (domain, None)
+        } else {
+            (patrol, Some(problem))
+        };
+        let target = if round % 4 == 1 { p.unwrap_or(d) } else { d };
+        let mut t: Vec<char> = target.chars().collect();
+        for _ in 0..1 + next(4) {
+            let at = next(t.len());
+            match next(3) {
+                0 => {
+                    t.remove(at);
+                }
+                1 => t.insert(at, t[at]),
+                _ => {
+                    let piece = pieces[next(pieces.len())];
+                    for (i, c) in piece.chars().enumerate() {
+                        t.insert(at + i, c);
+                    }
+                }
+            }
+        }
+        let mutated: String = t.into_iter().collect();
+        let (d, p) = if round % 4 == 1 {
+            (d.to_string(), Some(mutated))
+        } else {
+            (mutated, p.map(str::to_string))
+        };
+        match load_str(&d, p.as_deref()) {
+            Ok(dom) if !dom.goal.facts.is_empty() => {
+                let _ = crate::plan_bt(&dom, &opts);
+            }
+            Ok(_) => {}
+            Err(diags) => {
+                assert!(!diags.is_empty());
+                for x in &diags {
+                    assert!(x.file.is_some(), "{}", x.message);
+                    assert!(!x.message.is_empty() && x.hint.is_some(), "{}", x.message);
+                }
+            }
+        }
+    }
+}
