@@ -260,7 +260,7 @@ fn mutated_domains_and_problems_never_panic() {
     let domain = include_str!("../../../../tests/fixtures/domains/pddl/bt_example.pddl");
     let problem = include_str!("../../../../tests/fixtures/domains/pddl/patrol-problem.pddl");
     let patrol = include_str!("../../../../tests/fixtures/domains/pddl/patrol.pddl");
-    let mut seed: u64 = 0x5eed_0f_9dd1;
+    let mut seed: u64 = 0x005e_ed0f_9dd1;
     let mut next = move |n: usize| {
         seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
         ((seed >> 33) as usize) % n.max(1)
