@@ -29,8 +29,13 @@ pub(crate) enum PlanTarget {
 
 #[derive(Debug, Args)]
 pub(crate) struct PlanArgs {
-    /// Action domain (TOML; docs/guide/plan.md), e.g. policies/domains/moma.toml
+    /// Action domain (TOML, or PDDL: a `.pddl` file; docs/guide/plan.md),
+    /// e.g. policies/domains/moma.toml
     pub domain: PathBuf,
+    /// PDDL problem of a PDDL domain: its objects, `:init` (the facts at
+    /// the start) and `:goal` (the goal)
+    #[arg(long, value_name = "FILE")]
+    pub problem: Option<PathBuf>,
     /// A task of the domain (`[tasks.NAME]`) instead of its `[goal]`
     #[arg(long, value_name = "NAME")]
     pub task: Option<String>,
@@ -67,16 +72,35 @@ pub(crate) struct PlanArgs {
 
 /// Reads and validates a domain file, printing its errors.
 pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> {
+    read_task(path, None, limits)
+}
+
+/// Reads a domain file (TOML or PDDL) and, for a PDDL domain, its problem
+/// file, printing their errors.
+fn read_task(path: &Path, problem: Option<&Path>, limits: &Limits) -> Option<plan::Domain> {
     let stderr = std::io::stderr();
-    let shown = path.display().to_string();
-    let file = match btfsm_format::source::read(path, &shown, limits, true) {
-        Ok(f) => f,
-        Err(d) => {
+    let read = |p: &Path| {
+        btfsm_format::source::read(p, &p.display().to_string(), limits, true).map_err(|d| {
             print_diagnostics(&mut stderr.lock(), &d);
-            return None;
-        }
+        })
     };
-    match plan::load(&file) {
+    let file = read(path).ok()?;
+    let loaded = if plan::pddl::looks_like_pddl(&file.path, &file.text) {
+        let problem = match problem {
+            Some(p) => Some(read(p).ok()?),
+            None => None,
+        };
+        plan::pddl::load(&file, problem.as_ref())
+    } else if problem.is_some() {
+        Err(vec![
+            Diagnostic::error("--problem is for a PDDL domain; this domain is TOML")
+                .in_file(&file)
+                .hint("a TOML domain holds its goal (`[goal]`, `--goal`, `--task`)"),
+        ])
+    } else {
+        plan::load(&file)
+    };
+    match loaded {
         Ok(d) => Some(d),
         Err(d) => {
             print_diagnostics(&mut stderr.lock(), &d);
@@ -85,16 +109,19 @@ pub(super) fn read_domain(path: &Path, limits: &Limits) -> Option<plan::Domain> 
     }
 }
 
-pub(super) fn execute(a: PlanArgs) -> u8 {
-    let limits = a.limits.limits();
-    let shown = a.domain.display().to_string();
-    let Some(mut domain) = read_domain(&a.domain, &limits) else {
-        return EXIT_BAD_INPUT;
-    };
+/// The goal and start the options give (`--task`, `--goal`, `--init`),
+/// or the exit code when they are wrong.
+fn set_task(a: &PlanArgs, domain: &mut plan::Domain, shown: &str) -> Result<(), u8> {
+    if domain.goal.facts.is_empty() && a.goals.is_empty() {
+        return Err(fail(
+            Diagnostic::error(format!("{shown}: the PDDL domain has no goal"))
+                .hint("give its problem with --problem FILE, or the goal with --goal FACT"),
+        ));
+    }
     if let Some(t) = &a.task
         && let Err(e) = domain.select_task(t)
     {
-        return fail(Diagnostic::error(e.to_string()));
+        return Err(fail(Diagnostic::error(e.to_string())));
     }
     let set = |d: &mut plan::domain::Domain| {
         if !a.goals.is_empty() {
@@ -105,11 +132,23 @@ pub(super) fn execute(a: PlanArgs) -> u8 {
         }
         Ok::<(), Vec<String>>(())
     };
-    if let Err(es) = set(&mut domain) {
+    if let Err(es) = set(domain) {
         for e in es {
             eprint!("{}", Diagnostic::error(e.to_string()));
         }
+        return Err(EXIT_BAD_INPUT);
+    }
+    Ok(())
+}
+
+pub(super) fn execute(a: PlanArgs) -> u8 {
+    let limits = a.limits.limits();
+    let shown = a.domain.display().to_string();
+    let Some(mut domain) = read_task(&a.domain, a.problem.as_deref(), &limits) else {
         return EXIT_BAD_INPUT;
+    };
+    if let Err(code) = set_task(&a, &mut domain, &shown) {
+        return code;
     }
     let opts = Options {
         reorder: !a.no_reorder,

@@ -27,6 +27,7 @@ mod lint;
 mod log;
 mod paper;
 mod plan;
+mod plan_pddl;
 mod provenance;
 mod review;
 mod sim;

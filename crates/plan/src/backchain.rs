@@ -107,6 +107,8 @@ pub fn plan_bt(d: &Domain, opts: &Options) -> Result<Planned, PlanError> {
         conflicts: Vec::new(),
         ensured: Vec::new(),
         steps: Vec::new(),
+        statics: statics(d),
+        init: d.goal.init.iter().cloned().collect(),
     };
     let root = if let [only] = d.goal.facts.as_slice() {
         p.ensure(only, &mut Vec::new(), 0, Some(d.goal.id.clone()))?
@@ -174,6 +176,27 @@ struct Planner<'d, 'o> {
     ensured: Vec<Option<Fact>>,
     /// Per node: the ground actions below it (for the conflict check).
     steps: Vec<Vec<(usize, BTreeMap<String, String>)>>,
+    /// The static predicates (no action adds or deletes one of their
+    /// facts) when the goal's `init` is known; empty otherwise.
+    statics: BTreeSet<String>,
+    init: BTreeSet<Fact>,
+}
+
+/// With the facts at the start known (`init`, every other false), the
+/// predicates no action adds or deletes: their facts never change, so an
+/// action needing one `init` does not list can never run.
+fn statics(d: &Domain) -> BTreeSet<String> {
+    if d.goal.init.is_empty() {
+        return BTreeSet::new();
+    }
+    let changed: BTreeSet<&str> = (d.actions.iter())
+        .flat_map(|a| a.add.iter().chain(&a.del))
+        .map(|p| p.pred.as_str())
+        .collect();
+    (d.predicates.iter())
+        .filter(|p| !changed.contains(p.name.as_str()))
+        .map(|p| p.name.clone())
+        .collect()
 }
 
 impl<'d> Planner<'d, '_> {
@@ -367,10 +390,11 @@ impl<'d> Planner<'d, '_> {
                         ok = false;
                     }
                 }
-                if !ok {
+                if !ok || !self.possible(a, &bind) {
                     continue;
                 }
-                // Type check and ground the parameters left.
+                // Type check and ground the parameters left (a binding
+                // whose static preconditions fail is dropped at once).
                 let mut partial = vec![bind];
                 for p in &a.params {
                     let mut next = Vec::new();
@@ -382,7 +406,7 @@ impl<'d> Planner<'d, '_> {
                                     .objects
                                     .get(obj)
                                     .is_some_and(|o| o.types.contains(&p.ty));
-                                if typed {
+                                if typed && self.possible(a, &b) {
                                     next.push(b);
                                 }
                             }
@@ -390,6 +414,9 @@ impl<'d> Planner<'d, '_> {
                                 for obj in self.d.objects_of(&p.ty) {
                                     let mut b2 = b.clone();
                                     b2.insert(p.name.clone(), obj.to_string());
+                                    if !self.possible(a, &b2) {
+                                        continue;
+                                    }
                                     next.push(b2);
                                     if next.len() > self.opts.max_achievers {
                                         break;
@@ -409,6 +436,25 @@ impl<'d> Planner<'d, '_> {
             }
         }
         out
+    }
+
+    /// Can `a` under the (partial) binding `bind` run as far as the static
+    /// facts tell: each precondition on a static predicate whose terms are
+    /// all bound is in `init`.
+    fn possible(&self, a: &Action, bind: &BTreeMap<String, String>) -> bool {
+        if self.statics.is_empty() {
+            return true;
+        }
+        a.pre
+            .iter()
+            .filter(|p| self.statics.contains(&p.pred))
+            .all(|p| {
+                let is_param = |t: &String| a.params.iter().any(|q| &q.name == t);
+                if p.args.iter().any(|t| is_param(t) && !bind.contains_key(t)) {
+                    return true;
+                }
+                self.init.contains(&p.ground(&|t| bind.get(t).cloned()))
+            })
     }
 
     /// Orders the precondition subtrees `kids` (see [`conflicts::order`]).

@@ -171,10 +171,11 @@ impl Domain {
     }
 
     /// A ground fact of the domain from its text (`Object-At(cube2,
-    /// delivery)`), checked as a goal fact is (predicate, arity, objects of
+    /// delivery)`, or a PDDL atom `(robot_at leia kitchen)`), checked as a goal fact is (predicate, arity, objects of
     /// the parameters' types); the error: what is wrong and a hint.
     pub fn ground_fact(&self, text: &str) -> Result<Fact, (String, String)> {
         let file = SourceFile::new("fact", String::new());
+        let text = &super::pddl::fact_text(text);
         let (found, diags) = super::validate::goal_fact(&file, text, self);
         match (found.into_iter().next(), diags.into_iter().next()) {
             (Some(p), None) => Ok(p.ground(&|_| None)),

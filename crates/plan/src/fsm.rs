@@ -165,6 +165,7 @@ fn start_state(ks: &[Vec<Fact>], init: &[Fact]) -> usize {
     if init.is_empty() {
         return 0;
     }
+    let init: std::collections::BTreeSet<&Fact> = init.iter().collect();
     let holds = |k: &Vec<Fact>| k.iter().all(|f| init.contains(f));
     if holds(&ks[n]) {
         return n;

@@ -9,6 +9,7 @@ pub mod conflicts;
 pub mod domain;
 pub mod fact;
 pub mod fsm;
+pub mod pddl;
 mod validate;
 
 pub use backchain::{Options, PlanError, Planned, plan_bt};

@@ -250,3 +250,48 @@ fn init_in_the_domain_sets_the_start() {
     let m = fsm::plan_fsm(&d, &p).unwrap();
     assert_eq!(m.states[m.top.initial_state().unwrap()].name, "Unlock door");
 }
+
+/// With the start known, an achiever needing a static fact (of a
+/// predicate no action changes) that `init` does not list is never
+/// tried: PlanSys2's `askcharge` only to the room with a charging point,
+/// `move` only along the room graph. Without `init` every grounding is
+/// tried and the tree outgrows the node cap.
+#[test]
+fn static_preconditions_false_at_the_start_rule_achievers_out() {
+    let text = include_str!("../../../tests/fixtures/domains/simple-durative.toml");
+    let d = domain(text);
+    let p = plan_bt(&d, &Options::default()).unwrap();
+    let calls: Vec<String> = (p.steps.iter().flatten())
+        .map(|(a, bind)| {
+            let action = &d.actions[*a];
+            let args: Vec<&str> = action
+                .params
+                .iter()
+                .map(|q| bind[&q.name].as_str())
+                .collect();
+            format!("{} {}", action.name, args.join(" "))
+        })
+        .collect();
+    let askcharge = calls.iter().filter(|c| c.starts_with("askcharge"));
+    assert!(askcharge.clone().count() > 0, "{calls:?}");
+    assert!(
+        askcharge.clone().all(|c| c.ends_with(" chargingroom")),
+        "{calls:?}"
+    );
+    assert!(calls.contains(&"move leia bedroom bathroom".to_string()));
+    assert!(
+        !calls
+            .iter()
+            .any(|c| c.starts_with("move leia kitchen bathroom"))
+    );
+    let mut no_init = d.clone();
+    no_init.goal.init.clear();
+    let capped = Options {
+        max_nodes: 10 * p.bt.nodes.len(),
+        ..Options::default()
+    };
+    assert_eq!(
+        plan_bt(&no_init, &capped).unwrap_err(),
+        PlanError::TooLarge(10 * p.bt.nodes.len())
+    );
+}

@@ -652,7 +652,7 @@ impl Validator {
     }
 }
 
-fn default_id(name: &str, params: &[Param]) -> String {
+pub(crate) fn default_id(name: &str, params: &[Param]) -> String {
     let mut id = name.to_lowercase();
     for p in params {
         id.push_str(&format!("-{{{}:short}}", p.name));
