@@ -35,12 +35,45 @@ pub enum FsmError {
     NoStep,
 }
 
-/// The plan's steps in nominal execution order: the BT ticked from a world
-/// where nothing holds, each step's effects applied as it completes, so a
+/// The plan's steps in nominal execution order: the BT walked from a world
+/// where nothing holds ([`walked_steps`]), so that every step stays in the
+/// chain for the SELECTOR to resume at. With initial facts (`init`,
+/// `--init`, a PDDL problem's `:init`) that chain must also run from them
+/// (each step's preconditions holding when it comes, or its effects
+/// holding already, and the goal at the end); when it does not — a domain
+/// where a fact has many achievers, such as a robot in one of many rooms —
+/// the chain is what the BT does when ticked from them ([`ticked_steps`]).
+pub fn steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
+    let walked = walked_steps(d, p);
+    if d.goal.init.is_empty() || runs_from_init(d, &walked) {
+        return walked;
+    }
+    let ticked = ticked_steps(d, p);
+    if ticked.is_empty() { walked } else { ticked }
+}
+
+/// Whether `chain` runs from the initial facts to the goal (see [`steps`]).
+fn runs_from_init(d: &Domain, chain: &[Step<'_>]) -> bool {
+    let mut facts: std::collections::BTreeSet<Fact> = d.goal.init.iter().cloned().collect();
+    for s in chain {
+        if s.pre().iter().all(|f| facts.contains(f)) {
+            for f in s.deletes() {
+                facts.remove(&f);
+            }
+            facts.extend(s.adds());
+        } else if !s.adds().iter().all(|f| facts.contains(f)) {
+            return false;
+        }
+    }
+    d.goal.facts.iter().all(|f| facts.contains(f))
+}
+
+/// The BT walked from a world where nothing holds, each step's effects
+/// applied as it completes, so a
 /// Fallback whose condition an earlier step made true (and no step undid
 /// since) runs no achiever — a door unlocked once is not unlocked again
 /// for the next part, a robot at the bench does not drive there again.
-pub fn steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
+fn walked_steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
     let bt = &p.bt;
     let mut out = Vec::new();
     let mut holds: Vec<Option<Fact>> = Vec::new();
@@ -72,6 +105,66 @@ pub fn steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
         }
     }
     out
+}
+
+/// Most steps [`ticked_steps`] runs, and ticks of the root.
+const MAX_TICKED_STEPS: usize = 10_000;
+const MAX_TICKS: usize = 1_000;
+
+/// What the BT does from the initial facts, ticked as BehaviorTree.CPP
+/// ticks it with actions that complete at once: a condition succeeds when
+/// its fact holds, an action when its preconditions hold (its effects then
+/// apply: deletes, then adds), a Sequence runs its children until one does
+/// not succeed, a Fallback until one does. The root is ticked again until
+/// it succeeds or a tick runs no action (at most [`MAX_TICKS`] ticks and
+/// [`MAX_TICKED_STEPS`] steps); the actions run, in order, are the chain.
+fn ticked_steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
+    let mut facts: std::collections::BTreeSet<Fact> = d.goal.init.iter().cloned().collect();
+    let mut out = Vec::new();
+    for _ in 0..MAX_TICKS {
+        let before = out.len();
+        let ok = tick(d, p, p.bt.root, &mut facts, &mut out);
+        if ok || out.len() == before || out.len() >= MAX_TICKED_STEPS {
+            break;
+        }
+    }
+    out
+}
+
+/// One tick of node `n` (see [`ticked_steps`]); whether it succeeded.
+fn tick<'d>(
+    d: &'d Domain,
+    p: &Planned,
+    n: usize,
+    facts: &mut std::collections::BTreeSet<Fact>,
+    out: &mut Vec<Step<'d>>,
+) -> bool {
+    let node = &p.bt.nodes[n];
+    match node.kind {
+        BtNodeKind::Condition => p.ensured[n].as_ref().is_some_and(|f| facts.contains(f)),
+        BtNodeKind::Action => {
+            let Some((a, bind)) = &p.steps[n] else {
+                return false;
+            };
+            let step = Step {
+                action: &d.actions[*a],
+                bind: bind.clone(),
+            };
+            if out.len() >= MAX_TICKED_STEPS || !step.pre().iter().all(|f| facts.contains(f)) {
+                return false;
+            }
+            for f in step.deletes() {
+                facts.remove(&f);
+            }
+            facts.extend(step.adds());
+            out.push(step);
+            true
+        }
+        BtNodeKind::Fallback | BtNodeKind::FallbackMemory => {
+            (node.children.iter()).any(|&c| tick(d, p, c, facts, out))
+        }
+        _ => (node.children.iter()).all(|&c| tick(d, p, c, facts, out)),
+    }
 }
 
 /// The facts that hold after `step` completes where `holds` held.
