@@ -19,6 +19,7 @@ mod conventions;
 mod dot;
 mod fault_tolerant;
 mod field_formats;
+mod flexbe;
 mod formats;
 mod gate;
 mod ged_budget;
