@@ -29,6 +29,7 @@ mod log;
 mod paper;
 mod plan;
 mod provenance;
+mod py_trees_dot;
 mod review;
 mod sim;
 mod sim_sensitivity;
