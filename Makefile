@@ -74,6 +74,9 @@ test: prerequisites
 # mismatches in accept_btcpp_known.txt, which must not go stale); then the
 # trees of every project folder of tests/fixtures/btcpp-projects/, whose
 # SubTrees are spread over files given together (projects_btcpp.py); every
+# FlexBE behavior fixture btfsm loads, built by Python running its
+# `create()` with stand-ins for flexbe_core and agreeing with btfsm's TOML
+# export state by state (flexbe_exec.py); every
 # SARIF log of `lint` against the official schema (sarif_check.py); which
 # problems BehaviorTree.CPP meets at creation and which at the first tick, as
 # `lint` reports them (btcpp_when.py); the
@@ -107,6 +110,9 @@ differential: $(VENV)/.installed
 	$(VENV)/bin/python tests/differential/projects_btcpp.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/projects_btcpp.txt 2>&1 \
 	  || { cat $(TARGET_DIR)/projects_btcpp.txt; exit 1; }
 	@tail -1 $(TARGET_DIR)/projects_btcpp.txt
+	$(VENV)/bin/python tests/differential/flexbe_exec.py --btfsm $(TARGET_DIR)/debug/btfsm > $(TARGET_DIR)/flexbe_exec.txt 2>&1 \
+	  || { cat $(TARGET_DIR)/flexbe_exec.txt; exit 1; }
+	@tail -1 $(TARGET_DIR)/flexbe_exec.txt
 	$(VENV)/bin/python tests/differential/sarif_check.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/junit_check.py --btfsm $(TARGET_DIR)/debug/btfsm
 	$(VENV)/bin/python tests/differential/btcpp_when.py --btfsm $(TARGET_DIR)/debug/btfsm

@@ -5,7 +5,7 @@
 # in fuzz/artifacts/TARGET/ (keep each as a regression test:
 # tests/fixtures/fuzz-regressions/, see docs/robustness.md).
 # Usage: fuzz/run.sh [TARGET...]   (default: every target in fuzz/Cargo.toml:
-# toml_policy, compare, btcpp_xml, scxml, yasmin, scenario, project, domain)
+# toml_policy, compare, btcpp_xml, scxml, yasmin, flexbe, py_trees_dot, scenario, project, domain)
 set -eu
 cd "$(dirname "$0")"
 SECONDS_EACH=${FUZZ_SECONDS:-600}
@@ -39,6 +39,14 @@ for t in $TARGETS; do
     yasmin)
       for f in $(find ../tests/fixtures/corpus/yasmin -name '*.xml' 2>/dev/null); do
         cp "$f" "corpus/$t/seed-$(echo "$f" | tr '/.' '__')"
+      done ;;
+    flexbe)
+      for f in $(find ../tests/fixtures/flexbe -name '*_sm.py' 2>/dev/null); do
+        cp "$f" "corpus/$t/seed-$(echo "$f" | tr '/.' '__')"
+      done ;;
+    py_trees_dot)
+      for f in ../tests/fixtures/py_trees_dot/*.dot; do
+        cp "$f" "corpus/$t/seed-$(basename "$f")"
       done ;;
     scenario)
       for f in ../policies/scenarios/*.toml ../tests/fixtures/sim-invalid/*.toml; do

@@ -16,7 +16,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
 pub(crate) struct AnalyzeArgs {
-    /// Policy files (TOML, BehaviorTree.CPP XML, SCXML, yasmin XML), `-`
+    /// Policy files (TOML, BehaviorTree.CPP XML, SCXML, yasmin XML, FlexBE
+    /// `*_sm.py`, py_trees DOT renders), `-`
     /// for stdin, or directories (every policy file below, sorted)
     #[arg(required = true)]
     pub(super) files: Vec<PathBuf>,

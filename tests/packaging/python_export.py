@@ -67,6 +67,7 @@ def main():
         check(where.stdout.strip().startswith(venv), "`import btfsm` is the wheel's module", where.stdout + where.stderr)
         paper(py, btfsm, env, tmp)
         mappings(py, btfsm, env, tmp)
+        renders(py, btfsm, env, tmp)
     print(f"python_export: {len(FAILS)} failure(s)")
     return 1 if FAILS else 0
 
@@ -289,6 +290,68 @@ def mappings(py, btfsm, env, tmp):
     r, _ = export("smach", "smach_nested:iterator")
     check(r.returncode == 2 and "`loop`" in r.stderr and "Iterator" in r.stderr,
           "smach: an Iterator is refused naming the state", r.stderr)
+
+
+def renders(py, btfsm, env, tmp):
+    """py_trees DOT renders read as BTs (docs/guide/py-trees-dot.md): the
+    real py_trees draws each tree (`py_trees.display.dot_tree`), btfsm reads
+    the render, and it is the tree `python -m btfsm export py_trees` writes
+    of the same tree: named GED 0 where every name is unique and every
+    leaf's kind is in its name (Fig. 1), structural GED 0 for the tree of
+    every composite, Parallel policy and decorator (py_trees renders a
+    repeated name `a` as `a*`, the export as `a (2)`; a decorator's class
+    and a leaf's class are not in a render)."""
+    env = dict(env, PYTHONPATH=env["PYTHONPATH"] + ":" + os.path.join(tmp, "mods"))
+    draw = "import importlib, sys, py_trees; m, f = sys.argv[1].split(':'); " \
+        "open(sys.argv[2], 'w').write(py_trees.display.dot_tree(getattr(importlib.import_module(m), f)()).to_string())"
+    for factory, mode in (("examples.py_trees_fig01:make", "named"), ("pt_all:make", "structural")):
+        base = os.path.join(tmp, "render_" + factory.replace(":", "_").replace(".", "_"))
+        r = run([py, "-c", draw, factory, base + ".dot"], env, cwd=REPO)
+        check(r.returncode == 0, f"py_trees renders {factory}", r.stderr[-1500:])
+        e = run([py, "-m", "btfsm", "export", "py_trees", factory, "-o", base + ".toml"], env, cwd=REPO)
+        check(e.returncode == 0, f"export {factory} (to compare with its render)", e.stderr[-1500:])
+        if r.returncode != 0 or e.returncode != 0:
+            continue
+        c = run([btfsm, "compare", base + ".dot", base + ".toml", "--mode", mode, "--format", "json"], env)
+        got = json.loads(c.stdout).get(mode, {}) if c.returncode in (0, 1) and c.stdout else {}
+        check(got.get("ged") == 0 and got.get("exact") is True,
+              f"{factory}: py_trees' render vs the export, {mode} GED {got.get('ged')}", c.stderr[-1500:])
+        # GED does not count a node's type: compare the types too, node by
+        # node in pre-order, from the render's TOML and the export, both
+        # read with Python's tomllib.
+        t = run([btfsm, "convert", base + ".dot", "--to", "toml", "-o", base + ".dot.toml"], env)
+        check(t.returncode == 0, f"{factory}: the render converts to TOML", t.stderr[-1500:])
+        if t.returncode == 0:
+            got, want = node_types(base + ".dot.toml"), node_types(base + ".toml")
+            # Not in a render: a decorator's class (every one is `decorator`),
+            # and the class that makes `docked` (IsDocked) and `has key`
+            # (CheckBlackboardVariableExists) conditions.
+            want = [("decorator", None) if k in DECORATOR_KINDS else
+                    ("action", None) if (k, n) in (("condition", "docked"), ("condition", "has key")) else (k, sc)
+                    for (k, sc, n) in want]
+            got = [(k, sc) for (k, sc, _) in got]
+            check(got == want, f"{factory}: render and export have the same node types and Parallel successes in pre-order",
+                  f"{got} != {want}")
+
+
+DECORATOR_KINDS = ("inverter", "force_success", "force_failure", "repeat", "retry", "timeout", "decorator")
+NODE_KINDS = ("sequence", "fallback", "sequence_memory", "fallback_memory", "parallel", "action", "condition") + DECORATOR_KINDS
+
+
+def node_types(path):
+    """(type, Parallel success, name) of each node of a TOML BT, in pre-order."""
+    import tomllib
+    with open(path, "rb") as f:
+        doc = tomllib.load(f)
+    nodes, out, stack = doc["nodes"], [], [doc["root"]]
+    while stack:
+        nid = stack.pop()
+        n = nodes[nid]
+        kind = next(k for k in NODE_KINDS if k in n)
+        kids = n[kind] if isinstance(n[kind], list) else [n[kind]] if kind in DECORATOR_KINDS else []
+        out.append((kind, n.get("success"), n.get(kind) if kind in ("action", "condition") else nid))
+        stack.extend(reversed(kids))
+    return out
 
 
 def check_hostile(py, btfsm, env, out):

@@ -5,10 +5,13 @@
 //! followed, and the walk is bounded in entries and depth.
 //!
 //! A file below a directory is a candidate by its extension (`.toml`,
-//! `.xml`, `.scxml`, Groot2's `.btproj`) and is kept when its content is a
-//! policy: a TOML file with a top-level `kind` key, an XML file with a
+//! `.xml`, `.scxml`, Groot2's `.btproj`, `.py`, `.dot`, `.gv`) and is kept when its content
+//! is a policy: a TOML file with a top-level `kind` key, an XML file with a
 //! `<BehaviorTree>`, an `<scxml>` or a yasmin `<StateMachine>` document
-//! element. Other files (a `Cargo.toml`, a ROS `package.xml`, a Nav2 nodes
+//! element, a Python file that is a FlexBE behavior
+//! ([`super::flexbe::looks_like_flexbe`]: a class deriving `Behavior` that
+//! builds an `OperatableStateMachine`), a `.dot`/`.gv` file that is a
+//! py_trees render (`digraph pastafarianism`). Other files (a `Cargo.toml`, a ROS `package.xml`, a Nav2 nodes
 //! model) are counted as skipped, not reported as errors; a Groot2 project
 //! file found so is no policy either, but it is among the BehaviorTree.CPP
 //! files given together (`btcpp_xml::Companions`), whose node models the
@@ -91,7 +94,8 @@ fn walk(dir: &Path, visited: &mut usize, out: &mut Vec<Input>) -> Result<(), Dia
                 stack.push((path, depth + 1));
             } else if ft.is_file()
                 && path.extension().and_then(|x| x.to_str()).is_some_and(|x| {
-                    ["toml", "xml", "scxml", "btproj"].contains(&x.to_ascii_lowercase().as_str())
+                    ["toml", "xml", "scxml", "btproj", "py", "dot", "gv"]
+                        .contains(&x.to_ascii_lowercase().as_str())
                 })
             {
                 found.push(path);
@@ -124,6 +128,8 @@ pub fn read(
         FileFormat::Toml if crate::discover::looks_like_domain(text) => Some(super::Input::Domain),
         FileFormat::Toml if !has_top_level_kind(text) => None,
         FileFormat::BtcppXml if !text.contains("<BehaviorTree") => None,
+        FileFormat::Flexbe if !super::flexbe::looks_like_flexbe(path, text) => None,
+        FileFormat::PyTreesDot if !super::py_trees_dot::looks_like_py_trees_dot(text) => None,
         f => Some(super::Input::Policy(f)),
     };
     Ok((file, holds))

@@ -4,6 +4,8 @@
 pub mod btcpp_xml;
 pub mod btcpp_xml_write;
 pub mod discover;
+pub mod flexbe;
+pub mod py_trees_dot;
 pub mod ros_pkg;
 pub mod scxml;
 pub mod scxml_write;
@@ -247,14 +249,23 @@ pub enum FileFormat {
     Scxml,
     /// yasmin (ROS 2) state machine XML.
     Yasmin,
+    /// A FlexBE behavior's generated Python (`*_sm.py`; [`flexbe`]).
+    Flexbe,
+    /// A py_trees DOT render (`.dot`, `.gv`; [`py_trees_dot`]).
+    PyTreesDot,
 }
 
+/// The format of a file: by its extension (`.toml`, `.scxml`, `.py` for a
+/// FlexBE behavior, `.dot`/`.gv` for a py_trees render), else by its
 /// first bytes (`<scxml`, `<StateMachine` for yasmin, `<root`, ...); TOML otherwise.
-/// first bytes (`<scxml`, `<root`, ...); TOML otherwise.
 pub fn detect(path: &Path, text: &str) -> FileFormat {
     match path.extension().and_then(|e| e.to_str()) {
         Some(e) if e.eq_ignore_ascii_case("toml") => return FileFormat::Toml,
         Some(e) if e.eq_ignore_ascii_case("scxml") => return FileFormat::Scxml,
+        Some(e) if e.eq_ignore_ascii_case("py") => return FileFormat::Flexbe,
+        Some(e) if e.eq_ignore_ascii_case("dot") || e.eq_ignore_ascii_case("gv") => {
+            return FileFormat::PyTreesDot;
+        }
         _ => {}
     }
     let head = head(text);
@@ -365,6 +376,8 @@ pub fn load_read(
         FileFormat::BtcppXml => btcpp_xml::load_read(file, path, limits),
         FileFormat::Scxml => scxml::load_read(file, limits),
         FileFormat::Yasmin => yasmin::load_read(file, path, limits),
+        FileFormat::Flexbe => flexbe::load_read(file, limits),
+        FileFormat::PyTreesDot => py_trees_dot::load_read(file, limits),
     }?;
     // Every format: node count and nesting depth (the TOML reader has
     // already said where).

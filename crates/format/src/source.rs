@@ -241,7 +241,7 @@ impl Named {
             Named::Xml("root") => "a BehaviorTree.CPP XML file (`.xml`, document element `<root>`)",
             Named::Xml(_) => "a yasmin XML file (`.xml`, document element `<StateMachine>`)",
             Named::AnyPolicy => {
-                "a policy file (a TOML policy that sets `kind`, or BehaviorTree.CPP, yasmin or SCXML XML)"
+                "a policy file (a TOML policy that sets `kind`, BehaviorTree.CPP, yasmin or SCXML XML, a FlexBE behavior `.py` or a py_trees DOT render)"
             }
         }
     }
@@ -262,6 +262,9 @@ pub fn check_named(path: &Path, text: &str, expect: Named) -> Result<(), Refusal
         Named::Xml(root) => ext == "xml" && element() == Some(root),
         Named::AnyPolicy => {
             toml()
+                || (ext == "py" && crate::flexbe::looks_like_flexbe(path, text))
+                || (["dot", "gv"].contains(&ext.as_str())
+                    && crate::py_trees_dot::looks_like_py_trees_dot(text))
                 || (["xml", "scxml", "btproj"].contains(&ext.as_str())
                     && element().is_some_and(|e| {
                         ["root", "BehaviorTree", "StateMachine", "scxml"].contains(&e)

@@ -200,6 +200,53 @@ proptest::proptest! {
     }
 }
 
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, ..Default::default() })]
+
+    /// Cut and spliced FlexBE behaviors never panic: they load (and go
+    /// through graph, metrics, DOT, write-back) or give errors.
+    #[test]
+    fn mangled_flexbe_behaviors_never_panic(seed in 0..3usize, a in 0..9000usize, b in 0..9000usize, ins in "[(){}\\[\\]:,'= a-zA-Z_\n\t]{0,12}") {
+        let seeds = [
+            include_str!("../../../tests/fixtures/flexbe/vigir/flexbe_test_behavior_sm.py"),
+            include_str!("../../../tests/fixtures/flexbe/turtlesim/example_3_sm.py"),
+            include_str!("../../../tests/fixtures/flexbe/engine/complex_behavior_test_sm.py"),
+        ];
+        let t = seeds[seed];
+        let (mut a, mut b) = (a.min(t.len()), b.min(t.len()));
+        if a > b {
+            std::mem::swap(&mut a, &mut b);
+        }
+        while !t.is_char_boundary(a) { a -= 1; }
+        while !t.is_char_boundary(b) { b -= 1; }
+        let text = format!("{}{ins}{}", &t[..a], &t[b..]);
+        crate::flexbe(text.as_bytes());
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, ..Default::default() })]
+
+    /// Cut and spliced py_trees renders never panic: they load (and go
+    /// through graph, metrics, DOT, write-back) or give errors.
+    #[test]
+    fn mangled_py_trees_renders_never_panic(seed in 0..2usize, a in 0..4000usize, b in 0..4000usize, ins in "[\"{}\\[\\];,=> a-zA-Z_\n-]{0,12}") {
+        let seeds = [
+            include_str!("../../../tests/fixtures/py_trees_dot/every_node_type.dot"),
+            include_str!("../../../tests/fixtures/py_trees_dot/blackboard.dot"),
+        ];
+        let t = seeds[seed];
+        let (mut a, mut b) = (a.min(t.len()), b.min(t.len()));
+        if a > b {
+            std::mem::swap(&mut a, &mut b);
+        }
+        while !t.is_char_boundary(a) { a -= 1; }
+        while !t.is_char_boundary(b) { b -= 1; }
+        let text = format!("{}{ins}{}", &t[..a], &t[b..]);
+        crate::py_trees_dot(text.as_bytes());
+    }
+}
+
 #[test]
 fn mutated_domains_never_panic() {
     // Seeded byte and line mutations of the paper's domain through the fuzz

@@ -105,6 +105,32 @@ pub fn yasmin(data: &[u8]) {
     accepted(btfsm_format::yasmin::parse_str("fuzz.xml", text, &limits()));
 }
 
+/// Fuzz target `flexbe`: any bytes through the FlexBE behavior reader
+/// (Python parsed, never run) and downstream.
+pub fn flexbe(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    accepted(btfsm_format::flexbe::parse_str(
+        "fuzz_sm.py",
+        text,
+        &limits(),
+    ));
+}
+
+/// Fuzz target `py_trees_dot`: any bytes through the py_trees DOT render
+/// reader and downstream.
+pub fn py_trees_dot(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    accepted(btfsm_format::py_trees_dot::parse_str(
+        "fuzz.dot",
+        text,
+        &limits(),
+    ));
+}
+
 /// Fuzz target `scenario`: any bytes as a simulator scenario (policies
 /// resolve against `policies/scenarios/`); an accepted one is run for at most
 /// 2000 steps per policy.
@@ -445,6 +471,8 @@ mod tests {
                 Some("btcpp_xml") => btcpp_xml(&data),
                 Some("scxml") => scxml(&data),
                 Some("yasmin") => yasmin(&data),
+                Some("flexbe") => flexbe(&data),
+                Some("py_trees_dot") => py_trees_dot(&data),
                 Some("scenario") => scenario(&data),
                 Some("project") => project(&data),
                 Some("domain") => domain(&data),
