@@ -62,8 +62,8 @@ pub(crate) struct CompareArgs {
     #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
     pub(super) tree_max_work: u64,
     /// Memory budget of --mode tree, in MiB of tables held at once (the
-    /// exact computation needs about 4·n1·n2 bytes: 400 MB for two
-    /// 10,000-node trees): past it the result is an interval with
+    /// exact computation needs about 4·n1·n2 bytes and some rows: 400-650
+    /// MB for two unrelated 10,000-node trees): past it the result is an interval with
     /// `stopped_by: memory`, whatever --tree-max-work says
     #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_BYTES >> 20, value_name = "MIB")]
     pub(super) tree_max_memory: u64,

@@ -65,9 +65,10 @@ pub(super) fn cell_bytes(n1: usize, n2: usize) -> u64 {
     }
 }
 
-/// Bytes the dense computation holds at most: the subtree distances, and
-/// the larger of the forward pass's kept rows with their layout
-/// (`sweep.rs`) and the whole trees' forest table (the mapping's walk).
+/// Bytes the dense computation holds at most: the subtree distances, the
+/// forward pass's kept rows with their layout (`sweep.rs`) and the whole
+/// trees' forest table (the mapping's walk). The rows are freed before the
+/// walk, but counted with it: an allocator may keep their memory.
 pub(super) fn memory_bytes(f: &OrderedTree, g: &OrderedTree) -> u64 {
     let (n1, n2) = (f.len() as u64, g.len() as u64);
     let cell = cell_bytes(f.len(), g.len());
@@ -77,7 +78,7 @@ pub(super) fn memory_bytes(f: &OrderedTree, g: &OrderedTree) -> u64 {
         return u64::MAX;
     }
     let rows = (super::sweep::rows_kept(f) as u64 + 1) * w * cell + 32 * w;
-    cell * n1 * n2 + rows.max(cell * (n1 + 1) * (n2 + 1))
+    cell * n1 * n2 + rows + cell * (n1 + 1) * (n2 + 1)
 }
 
 /// Cells the forward computation fills: the product of the keyroot weights.

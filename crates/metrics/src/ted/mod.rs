@@ -109,9 +109,10 @@ pub struct TedOptions {
 /// times what two unrelated 10,000-node random trees need unbanded
 /// (docs/performance.md).
 pub const DEFAULT_MAX_WORK: u64 = 10_000_000_000;
-/// Default [`TedOptions::max_bytes`]: 512 MiB, enough for the unbanded
-/// tables of two 11,000-node trees (2 bytes a cell, about 2·n1·n2 cells).
-pub const DEFAULT_MAX_BYTES: u64 = 1 << 29;
+/// Default [`TedOptions::max_bytes`]: 1 GiB, enough for the unbanded
+/// tables of two unrelated 10,000-node random trees (2 bytes a cell, about
+/// 2·n1·n2 cells plus the kept rows: 400–650 MB).
+pub const DEFAULT_MAX_BYTES: u64 = 1 << 30;
 
 impl Default for TedOptions {
     fn default() -> Self {

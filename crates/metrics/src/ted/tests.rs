@@ -217,7 +217,7 @@ fn past_the_work_budget_the_result_is_an_interval_with_a_script_of_its_upper_bou
 }
 
 /// Memory: two unrelated 10,000-node trees hold at most
-/// `DEFAULT_MAX_BYTES` (512 MiB) at once; under a small work budget the
+/// `DEFAULT_MAX_BYTES` (1 GiB) at once; under a small work budget the
 /// unbanded run, counted in advance, does not start, and the result says
 /// that the work budget ended it.
 #[test]
