@@ -238,11 +238,13 @@ bench-ged: $(VENV)/.installed
 	$(CARGO) build --quiet --locked --release
 	$(VENV)/bin/python bench/ged_vs_highs.py $(BIN)
 
-# btfsm's tree edit distance vs the `apted` package on the same pairs, in one
-# run (docs/performance.md); uses .venv (make differential creates it).
+# btfsm's tree edit distance vs the `apted` package on the same pairs, then
+# vs the compiled `edist` on unrelated 1k/5k/10k-node trees, in one run
+# (docs/performance.md); uses .venv (make differential creates it).
 bench-ted: $(VENV)/.installed
 	$(CARGO) build --release --locked
 	$(VENV)/bin/python bench/ted_vs_apted.py $(BIN)
+	$(VENV)/bin/python bench/ted_vs_edist.py $(BIN)
 
 # Each fuzz target for FUZZ_SECONDS (default 600) with cargo-fuzz on nightly
 # (docs/robustness.md); FUZZ_TARGETS="toml_policy" runs only some.

@@ -54,11 +54,19 @@ pub(crate) struct CompareArgs {
     /// certified interval with `exact: false` and `stopped_by: work`
     #[arg(long, default_value_t = btfsm_metrics::ged::DEFAULT_WORK, value_name = "UNITS")]
     pub(super) work: u64,
-    /// Work budget of --mode tree, in table cells (the default takes 1-3 s;
-    /// memory is capped at 2^25 cells, 128 MiB): past it the result is an
-    /// interval with `exact: false`, the same on any machine
+    /// Work budget of --mode tree, in table cells (about 3 ns each; the
+    /// default, 10^10, computes two unrelated 10,000-node trees exactly in
+    /// seconds): past it the result is an interval with `exact: false` and
+    /// `stopped_by: work`, the same on any machine. Counted before the
+    /// exact computation starts, so a pair beyond it does not spend it
     #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_WORK, value_name = "CELLS")]
     pub(super) tree_max_work: u64,
+    /// Memory budget of --mode tree, in MiB of tables held at once (the
+    /// exact computation needs about 4·n1·n2 bytes and some rows: 400-650
+    /// MB for two unrelated 10,000-node trees): past it the result is an interval with
+    /// `stopped_by: memory`, whatever --tree-max-work says
+    #[arg(long, default_value_t = btfsm_metrics::ted::DEFAULT_MAX_BYTES >> 20, value_name = "MIB")]
+    pub(super) tree_max_memory: u64,
     /// Output format
     #[arg(long, value_parser = super::format::parser(Comparison::FORMATS, super::format::COMPARISON_HELP), default_value = "table")]
     pub(super) format: Format,
@@ -119,7 +127,7 @@ pub(super) fn run(args: CompareArgs) -> u8 {
     }
     let topts = TedOptions {
         max_work: args.tree_max_work,
-        ..TedOptions::default()
+        max_bytes: args.tree_max_memory.saturating_mul(1 << 20),
     };
     let pair = Pair::with_tree_options(
         Side {

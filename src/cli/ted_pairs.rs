@@ -1,7 +1,8 @@
 //! `btfsm ted-pairs FILE` (hidden): the ordered tree edit distance of each
 //! pair of trees in bracket notation (`metrics::ted::tree_text`), one pair
 //! per line separated by a tab, printed as one JSON object per line
-//! (`ted`, `exact`, `lower_bound`, `script_cost`, `moves`, `work`, and
+//! (`ted`, `exact`, `lower_bound`, `script_cost`, `moves`, `work`,
+//! `stopped_by`, `peak_bytes`, and
 //! `micros`, the distance's time, for the benchmark). It lets
 //! tests/differential/ted.py check thousands of pairs against the `apted`
 //! and `zss` packages, and bench/ted_vs_apted.py time them, in one process.
@@ -79,11 +80,13 @@ pub(super) fn execute(a: TedPairsArgs) -> u8 {
             .filter(|e| matches!(e, TreeEdit::Move { .. }))
             .count();
         out.push_str(&format!(
-            "{{\"ted\": {}, \"exact\": {}, \"lower_bound\": {}, \"script_cost\": {cost}, \"moves\": {moves}, \"work\": {}, \"micros\": {micros}}}\n",
+            "{{\"ted\": {}, \"exact\": {}, \"lower_bound\": {}, \"script_cost\": {cost}, \"moves\": {moves}, \"work\": {}, \"stopped_by\": {}, \"peak_bytes\": {}, \"micros\": {micros}}}\n",
             r.upper,
             r.exact(),
             r.lower,
-            r.work
+            r.work,
+            r.stopped_by.map_or("null".to_string(), |s| format!("\"{}\"", s.as_str())),
+            r.peak_bytes
         ));
     }
     emit_text(None, out)

@@ -133,7 +133,8 @@ fn tree_mode_on_an_fsm_is_exit_2_with_a_hint() {
 }
 
 /// Past `--tree-max-work` the distance is a certified interval with a
-/// script costing its upper bound, the same on every run.
+/// script costing its upper bound, the same on every run, and
+/// `stopped_by: work`; exact, `stopped_by` is null.
 #[test]
 fn tree_max_work_gives_an_interval() {
     let args = [
@@ -157,7 +158,51 @@ fn tree_max_work_gives_an_interval() {
     );
     assert!(lo <= exact && exact <= hi, "{lo} {exact} {hi}");
     assert_eq!(script_cost(t), hi);
-    assert_eq!(json(&args)["tree"]["upper_bound"], t["upper_bound"]);
+    assert_eq!(t["stopped_by"], "work", "{t}");
+    let again = json(&args);
+    assert_eq!(again["tree"]["upper_bound"], t["upper_bound"]);
+    assert_eq!(again["tree"]["work"], t["work"]);
+    let whole = json(&args[..7]);
+    assert!(whole["tree"]["stopped_by"].is_null(), "{}", whole["tree"]);
+    assert_eq!(whole["tree"]["exact"], true);
+}
+
+/// Past `--tree-max-memory` (MiB) the distance is an interval with
+/// `stopped_by: memory`, however large `--tree-max-work` is.
+#[test]
+fn tree_max_memory_gives_an_interval_said_to_be_memory() {
+    let args = [
+        "compare",
+        FIG1,
+        "policies/paper/fig07c-bt.toml",
+        "--mode",
+        "tree",
+        "--format",
+        "json",
+        "--tree-max-memory",
+        "0",
+        "--tree-max-work",
+        "1000000000000",
+    ];
+    let v = json(&args);
+    let t = &v["tree"];
+    let exact = json(&args[..7])["tree"]["ted"].as_u64().expect("ted");
+    let (lo, hi) = (
+        t["lower_bound"].as_u64().expect("lo"),
+        t["upper_bound"].as_u64().expect("hi"),
+    );
+    assert!(lo <= exact && exact < hi, "{lo} {exact} {hi}");
+    assert_eq!(t["exact"], false, "{t}");
+    assert_eq!(t["stopped_by"], "memory", "{t}");
+    assert_eq!(script_cost(t), hi);
+    let text: Vec<&str> = args
+        .iter()
+        .copied()
+        .filter(|a| !["--format", "json"].contains(a))
+        .collect();
+    let (code, out, _) = btfsm(&text);
+    assert_eq!(code, 0);
+    assert!(out.contains("raise --tree-max-memory"), "{out}");
 }
 
 /// Markdown: the distance under the GED table and its script in a `diff`

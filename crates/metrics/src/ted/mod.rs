@@ -18,31 +18,38 @@
 //! bound, with `u` grown by half (or set to the best mapping's cost once
 //! close to it) until the band's result is at most `u`, which proves it
 //! exact. Similar trees cost about O(n·k·u²) cells (`k` the keyroots on a
-//! root-leaf path; measured: docs/performance.md) and O(n·u) memory. Of the
-//! trees' two orientations (as drawn and mirrored, same distance) the one
-//! with fewer cells is used.
+//! root-leaf path; measured: docs/performance.md) and O(n·u) memory.
+//! Once a band would cost as much as the whole tables — counted before it
+//! runs: an upper bound of its cells against the product of the keyroot
+//! weights — Zhang & Shasha's algorithm runs unbanded (`dense.rs`: 16-bit
+//! cells, contiguous rows), which is exact whatever the distance: two
+//! unrelated 10,000-node random trees take seconds (docs/performance.md).
+//! Of the trees' two orientations (as drawn and mirrored, same distance:
+//! leftmost or rightmost paths, as in Pawlik & Augsten's RTED, PVLDB 2011,
+//! but chosen once per pair) the one with fewer cells is used.
 //!
-//! Not built: Pawlik & Augsten's optimal path strategies (RTED, PVLDB 2011;
-//! APTED, TODS 2015, Inf. Syst. 2016). Counted with their cost formula on
-//! the 10,000-node benchmark trees (deep: 172 levels), the optimal strategy
-//! needs 1.6·10¹¹ subproblems for two unrelated trees and 5.4·10¹¹ for a
-//! tree and its edited copy (Zhang–Shasha: 2.6·10¹¹ and 8.4·10¹¹), and its
-//! n·m subtree-distance table alone (10⁸ entries) exceeds the memory bound:
-//! far past the work budget either way, so unrelated large trees end with
-//! the interval of the bounds above.
+//! Work and memory are bounded by counts, not time ([`TedOptions`]): table
+//! cells computed, and bytes of tables held, each checked before a table is
+//! allocated or a band or the unbanded run starts. Past either, the result
+//! is an interval `[lower, upper]` with the script of a mapping costing
+//! `upper`, the same on any machine, and [`TedResult::stopped_by`] says
+//! which budget ended it.
 //!
-//! Work and memory are bounded by counts, not time ([`TedOptions`]): past
-//! either, the result is an interval `[lower, upper]` with the script of a
-//! mapping costing `upper`, the same on any machine.
+//! Not built: Pawlik & Augsten's per-subtree-pair optimal path strategies
+//! (APTED, TODS 2015, Inf. Syst. 2016), which would need fewer subproblems
+//! on deep trees (docs/performance.md counts them) at the price of a
+//! strategy table as large as the distance table.
 
 mod band;
 mod bounds;
 pub mod bt;
+mod dense;
 mod greedy;
 mod mapping;
 mod refine;
 mod script;
 mod sed;
+mod sweep;
 #[cfg(test)]
 mod tests;
 mod tree;
@@ -87,23 +94,51 @@ impl LabelledTree {
 /// the machine's load.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TedOptions {
-    /// Most table cells computed, over all bands tried (checked after each
-    /// forest table).
+    /// Most table cells computed, over the bounds, all bands tried and the
+    /// unbanded run (checked after each band's forest table, and before
+    /// the unbanded run, whose cells are counted in advance). Recovering
+    /// the mapping afterwards adds at most as many cells as its tables
+    /// took.
     pub max_work: u64,
-    /// Most table cells held at once (4 bytes each).
-    pub max_cells: u64,
+    /// Most bytes of tables held at once (checked before each is
+    /// allocated).
+    pub max_bytes: u64,
 }
 
-/// Default [`TedOptions::max_work`]: 3·10⁸ cells, about 1–3 s.
-pub const DEFAULT_MAX_WORK: u64 = 300_000_000;
-/// Default [`TedOptions::max_cells`]: 2²⁵ cells, 128 MiB.
-pub const DEFAULT_MAX_CELLS: u64 = 1 << 25;
+/// Default [`TedOptions::max_work`]: 10¹⁰ cells (about 3 ns each), three
+/// times what two unrelated 10,000-node random trees need unbanded
+/// (docs/performance.md).
+pub const DEFAULT_MAX_WORK: u64 = 10_000_000_000;
+/// Default [`TedOptions::max_bytes`]: 1 GiB, enough for the unbanded
+/// tables of two unrelated 10,000-node random trees (2 bytes a cell, about
+/// 2·n1·n2 cells plus the kept rows: 400–650 MB).
+pub const DEFAULT_MAX_BYTES: u64 = 1 << 30;
 
 impl Default for TedOptions {
     fn default() -> Self {
         TedOptions {
             max_work: DEFAULT_MAX_WORK,
-            max_cells: DEFAULT_MAX_CELLS,
+            max_bytes: DEFAULT_MAX_BYTES,
+        }
+    }
+}
+
+/// Which budget ended an inexact computation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TedStop {
+    /// [`TedOptions::max_work`]: the next table would pass it.
+    Work,
+    /// [`TedOptions::max_bytes`]: the next tables would not fit (raising
+    /// the work budget alone does not help).
+    Memory,
+}
+
+impl TedStop {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TedStop::Work => "work",
+            TedStop::Memory => "memory",
         }
     }
 }
@@ -117,11 +152,15 @@ pub struct TedResult {
     pub mapping: Vec<(usize, usize)>,
     /// Table cells computed (the work budget's unit).
     pub work: u64,
-    /// Width `u` of the last band that ran to completion (0 when none).
+    /// Width `u` of the last band that ran to completion (0 when none;
+    /// `n1 + n2` after the unbanded run).
     pub band: usize,
-    /// Most table cells held at once (4 bytes each), never above
-    /// [`TedOptions::max_cells`].
-    pub peak_cells: u64,
+    /// Most bytes of tables held at once, never above
+    /// [`TedOptions::max_bytes`].
+    pub peak_bytes: u64,
+    /// When not exact: the budget that ended the computation (`None` when
+    /// exact).
+    pub stopped_by: Option<TedStop>,
 }
 
 impl TedResult {
@@ -142,7 +181,8 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
             mapping: Vec::new(),
             work: 0,
             band: 0,
-            peak_cells: 0,
+            peak_bytes: 0,
+            stopped_by: None,
         };
     }
     let mut pr = Progress {
@@ -150,12 +190,13 @@ pub fn ted(a: &LabelledTree, b: &LabelledTree, opts: &TedOptions) -> TedResult {
         best: first_mapping(a, b, &f, &g),
         work: 0,
         peak: 0,
+        stopped: None,
     };
     // The label sequences' bounds (`bounds.rs`): a lower bound that often
     // meets the upper one on a tree and its edited copy, and a mapping that
     // is often better than the greedy one; skipped when they do not fit
     // the budgets.
-    if bounds::work(n1, n2) <= opts.max_work && bounds::cells(n1, n2) <= opts.max_cells {
+    if bounds::work(n1, n2) <= opts.max_work && 4 * bounds::cells(n1, n2) <= opts.max_bytes {
         pr.sequence_bounds(&f, &g);
         if pr.lower >= pr.best.0 {
             return pr.finish(0);
@@ -218,8 +259,10 @@ struct Progress {
     best: (u64, Vec<(usize, usize)>),
     /// Table cells computed.
     work: u64,
-    /// Most table cells held at once.
+    /// Most bytes of tables held at once.
     peak: u64,
+    /// The budget that refused the last step, if one did.
+    stopped: Option<TedStop>,
 }
 
 impl Progress {
@@ -227,7 +270,7 @@ impl Progress {
     fn sequence_bounds(&mut self, f: &OrderedTree, g: &OrderedTree) {
         let sb = bounds::sequence_bounds(f, g);
         self.work += sb.work;
-        self.peak = self.peak.max(sb.peak);
+        self.peak = self.peak.max(4 * sb.peak);
         self.lower = self.lower.max(sb.lower);
         if sb.upper < self.best.0 {
             self.best = (sb.upper, to_arena(f, g, sb.mapping));
@@ -238,13 +281,35 @@ impl Progress {
     /// of the last band that ran to completion.
     fn finish(self, band: usize) -> TedResult {
         let (upper, mapping) = self.best;
+        let lower = self.lower.min(upper);
         TedResult {
-            lower: self.lower.min(upper),
+            lower,
             upper,
             mapping,
             work: self.work,
             band,
-            peak_cells: self.peak,
+            peak_bytes: self.peak,
+            stopped_by: if lower < upper { self.stopped } else { None },
+        }
+    }
+
+    /// The exact distance `d` with a mapping of that cost (postorder pairs).
+    fn exact(
+        self,
+        f: &OrderedTree,
+        g: &OrderedTree,
+        d: u64,
+        m: Vec<(usize, usize)>,
+        band: usize,
+    ) -> TedResult {
+        TedResult {
+            lower: d,
+            upper: d,
+            mapping: to_arena(f, g, m),
+            work: self.work,
+            band,
+            peak_bytes: self.peak,
+            stopped_by: None,
         }
     }
 }
@@ -277,8 +342,46 @@ fn band_width(
     u.min(full)
 }
 
+/// Zhang & Shasha's whole tables (`dense.rs`), when their cells (known in
+/// advance) fit the work left and their bytes the memory budget: the exact
+/// distance; otherwise the interval so far, with the budget that refused.
+fn unbanded(
+    f: &OrderedTree,
+    g: &OrderedTree,
+    opts: &TedOptions,
+    mut pr: Progress,
+    band: usize,
+) -> TedResult {
+    if dense::memory_bytes(f, g) > opts.max_bytes {
+        pr.stopped = Some(TedStop::Memory);
+        return pr.finish(band);
+    }
+    if dense::work(f, g) > u128::from(opts.max_work.saturating_sub(pr.work)) {
+        pr.stopped = Some(TedStop::Work);
+        return pr.finish(band);
+    }
+    pr.peak = pr.peak.max(dense::memory_bytes(f, g));
+    let (d, m, work) = if dense::cell_bytes(f.len(), g.len()) == 2 {
+        run_dense::<u16>(f, g)
+    } else {
+        run_dense::<u32>(f, g)
+    };
+    pr.work += work;
+    pr.exact(f, g, d, m, f.len() + g.len())
+}
+
+/// The distance, an optimal mapping and the cells computed, unbanded.
+fn run_dense<T: dense::Cell>(f: &OrderedTree, g: &OrderedTree) -> (u64, Vec<(usize, usize)>, u64) {
+    let mut d = dense::Dense::<T>::new(f, g);
+    d.run();
+    let dist = d.distance() as u64;
+    let m = d.mapping();
+    (dist, m, d.work)
+}
+
 /// Zhang & Shasha in ever wider bands, from the lower bound, until a band's
-/// result is at most its width (exact) or a budget is spent (an interval).
+/// result is at most its width (exact), or unbanded once a band would cost
+/// as much, or until a budget is spent (an interval).
 fn band_search(f: &OrderedTree, g: &OrderedTree, opts: &TedOptions, mut pr: Progress) -> TedResult {
     let (n1, n2) = (f.len(), g.len());
     // No mapping costs more than n1 + n2: a band this wide prunes nothing.
@@ -289,36 +392,32 @@ fn band_search(f: &OrderedTree, g: &OrderedTree, opts: &TedOptions, mut pr: Prog
         .abs_diff(n2)
         .max(2)
         .max(usize::try_from(pr.lower).unwrap_or(usize::MAX));
-    let full_cells = u128::from(f.keyroot_weight()) * u128::from(g.keyroot_weight());
+    let full_cells = dense::work(f, g);
     // The width and work of the last band run.
     let mut last: Option<(usize, u64)> = None;
     loop {
         u = band_width(u, pr.best.0, last, full_cells, full);
-        if Banded::memory_cells(f, g, u) > opts.max_cells {
-            break;
+        let bytes = 4 * Banded::memory_cells(f, g, u);
+        if u == full || Banded::cells_at_most(f, g, u) >= full_cells || bytes > opts.max_bytes {
+            return unbanded(f, g, opts, pr, done_band);
         }
         let mut band = Banded::new(f, g, u);
         let ran = band.run(opts.max_work.saturating_sub(pr.work));
         pr.work += band.work;
-        pr.peak = pr.peak.max(band.peak);
+        pr.peak = pr.peak.max(4 * band.peak);
         last = Some((u.max(1), band.work.max(1)));
         if ran.is_err() {
+            pr.stopped = Some(TedStop::Work);
             break;
         }
         done_band = u;
         let r = u64::from(band.distance());
-        if r <= u as u64 || u == full {
+        if r <= u as u64 {
             band.work = 0;
             let m = mapping::mapping(&mut band);
             pr.work += band.work;
-            return TedResult {
-                lower: r,
-                upper: r,
-                mapping: to_arena(f, g, m),
-                work: pr.work,
-                band: u,
-                peak_cells: pr.peak.max(band.peak),
-            };
+            pr.peak = pr.peak.max(4 * band.peak);
+            return pr.exact(f, g, r, m, u);
         }
         // The distance is above u; r, if finite, is a mapping's cost.
         pr.lower = pr.lower.max(u as u64 + 1);
@@ -326,7 +425,7 @@ fn band_search(f: &OrderedTree, g: &OrderedTree, opts: &TedOptions, mut pr: Prog
             band.work = 0;
             let m = mapping::mapping(&mut band);
             pr.work += band.work;
-            pr.peak = pr.peak.max(band.peak);
+            pr.peak = pr.peak.max(4 * band.peak);
             pr.best = (r, to_arena(f, g, m));
         }
         // Grow by half: the work grows as about u³, so overshooting the

@@ -216,10 +216,12 @@ fn past_the_work_budget_the_result_is_an_interval_with_a_script_of_its_upper_bou
     }
 }
 
-/// Memory: two unrelated 10,000-node trees under the default options hold
-/// at most `DEFAULT_MAX_CELLS` cells (128 MiB) at once, whatever the band.
+/// Memory: two unrelated 10,000-node trees hold at most
+/// `DEFAULT_MAX_BYTES` (1 GiB) at once; under a small work budget the
+/// unbanded run, counted in advance, does not start, and the result says
+/// that the work budget ended it.
 #[test]
-fn memory_stays_within_max_cells_on_two_10k_node_trees() {
+fn memory_stays_within_max_bytes_on_two_10k_node_trees() {
     let mut rng = Rng(10);
     let a = random_tree(&mut rng, 10_000, 4);
     let b = random_tree(&mut rng, 10_000, 4);
@@ -229,10 +231,11 @@ fn memory_stays_within_max_cells_on_two_10k_node_trees() {
     };
     let r = ted(&a, &b, &opts);
     assert!(
-        r.peak_cells > 0 && r.peak_cells <= DEFAULT_MAX_CELLS,
+        r.peak_bytes > 0 && r.peak_bytes <= DEFAULT_MAX_BYTES,
         "{}",
-        r.peak_cells
+        r.peak_bytes
     );
+    assert_eq!(r.stopped_by, Some(TedStop::Work));
     assert!(r.lower <= r.upper && r.upper <= 19_999);
     assert!(r.work <= opts.max_work + 20_000 * 20_000);
 }
@@ -243,11 +246,12 @@ fn past_the_memory_budget_the_result_is_an_interval() {
     let a = random_tree(&mut rng, 300, 2);
     let b = random_tree(&mut rng, 300, 2);
     let opts = TedOptions {
-        max_cells: 5_000,
+        max_bytes: 20_000,
         ..TedOptions::default()
     };
     let r = ted(&a, &b, &opts);
-    assert!(r.peak_cells <= 5_000, "{}", r.peak_cells);
+    assert!(r.peak_bytes <= 20_000, "{}", r.peak_bytes);
+    assert_eq!(r.stopped_by, Some(TedStop::Memory));
     let exact = ted(&a, &b, &TedOptions::default());
     assert!(!r.exact());
     assert!(r.lower <= exact.upper && exact.upper <= r.upper);
@@ -380,7 +384,8 @@ fn sequence_bounds_bracket_the_distance_with_a_valid_mapping() {
             mapping,
             work: sb.work,
             band: 0,
-            peak_cells: sb.peak,
+            peak_bytes: 4 * sb.peak,
+            stopped_by: None,
         };
         check_mapping(&a, &b, &r);
         // And the whole computation agrees with Zhang–Shasha.
@@ -433,11 +438,11 @@ fn bounds_past_the_budgets_are_skipped() {
     let r = ted(&a, &b, &small);
     assert!(r.work <= small.max_work + 500 * 500 * 4);
     let tight = TedOptions {
-        max_cells: bounds::cells(500, 500) - 1,
+        max_bytes: 4 * bounds::cells(500, 500) - 1,
         ..TedOptions::default()
     };
     let r = ted(&a, &b, &tight);
-    assert!(r.peak_cells <= tight.max_cells);
+    assert!(r.peak_bytes <= tight.max_bytes);
     check_mapping(&a, &b, &r);
 }
 
@@ -466,4 +471,39 @@ fn preferring_same_class_keeps_a_valid_optimal_mapping() {
         moved += before - after;
     }
     assert!(moved > 0, "the random pairs never exercised a move");
+}
+
+/// The unbanded computation (`dense.rs`, `sweep.rs`) equals the forest
+/// recursion of the definition on random small trees, in both cell widths
+/// and both orientations, with a mapping that costs the distance.
+#[test]
+fn unbanded_zhang_shasha_equals_the_definition() {
+    let mut rng = Rng(41);
+    for _ in 0..300 {
+        let alphabet = 2 + rng.below(4) as u64;
+        let (n1, n2) = (1 + rng.below(14), 1 + rng.below(14));
+        let a = random_tree(&mut rng, n1, alphabet);
+        let b = random_tree(&mut rng, n2, alphabet);
+        let want = reference(&a, &b) as u64;
+        for mirrored in [false, true] {
+            let f = OrderedTree::build(&a.children, &a.labels, a.root, mirrored);
+            let g = OrderedTree::build(&b.children, &b.labels, b.root, mirrored);
+            let (d16, m16, w16) = run_dense::<u16>(&f, &g);
+            let (d32, m32, _) = run_dense::<u32>(&f, &g);
+            assert_eq!((d16, d32), (want, want), "{a:?} {b:?}");
+            assert_eq!(m16, m32);
+            // The forward pass is counted in advance; the walk adds at most as much.
+            let forward = dense::work(&f, &g) as u64;
+            assert!(forward <= w16 && w16 <= 2 * forward, "{w16} {forward}");
+            let r = Progress {
+                lower: 0,
+                best: (want, Vec::new()),
+                work: 0,
+                peak: 0,
+                stopped: None,
+            }
+            .exact(&f, &g, want, m16, 0);
+            check_mapping(&a, &b, &r);
+        }
+    }
 }

@@ -71,6 +71,37 @@ impl<'a> Banded<'a> {
         Stair::cells((0, n1 - 1), (0, n2 - 1), band) + Stair::cells((0, n1), (0, n2), band)
     }
 
+    /// An upper bound of the cells [`Banded::run`] computes at width `u`,
+    /// counted in O(n1 + n2) without running it: the table of keyroots
+    /// `k1`, `k2` (run only when their leftmost leaves are at most `u`
+    /// apart) has at most `|T(k1)| + 1` rows of at most
+    /// `min(|T(k2)| + 1, u + 1)` cells (its diagonals, [`diagonals`]).
+    pub(super) fn cells_at_most(f: &OrderedTree, g: &OrderedTree, u: usize) -> u128 {
+        let n2 = g.len();
+        // Row width of the keyroot of g starting at each leaf, summed.
+        let mut prefix = vec![0u128; n2 + 1];
+        for q in 0..n2 {
+            let w = if g.lml[q] == q {
+                let k = g.keyroot_of[q];
+                (k + 2 - q).min(u + 1) as u128
+            } else {
+                0
+            };
+            prefix[q + 1] = prefix[q] + w;
+        }
+        f.keyroots
+            .iter()
+            .map(|&k1| {
+                let l1 = f.lml[k1];
+                let (from, to) = (
+                    l1.saturating_sub(u).min(n2),
+                    l1.saturating_add(u + 1).min(n2),
+                );
+                (k1 + 2 - l1) as u128 * (prefix[to] - prefix[from])
+            })
+            .sum()
+    }
+
     pub(super) fn new(f: &'a OrderedTree, g: &'a OrderedTree, u: usize) -> Self {
         let mut td = Stair::default();
         if !f.is_empty() && !g.is_empty() {

@@ -8,7 +8,7 @@
 
 use btfsm_core::sanitize::shown;
 use btfsm_metrics::ted::bt::{BtPair, label_pair};
-use btfsm_metrics::ted::{self, TedOptions, TedResult, TreeEdit};
+use btfsm_metrics::ted::{self, TedOptions, TedResult, TedStop, TreeEdit};
 use btfsm_model::Bt;
 use std::time::Instant;
 
@@ -70,6 +70,10 @@ pub struct TreeReport {
     pub upper_bound: u64,
     /// Table cells computed (the deterministic work budget's unit).
     pub work: u64,
+    /// When not exact: the budget that ended the computation, `work`
+    /// (`--tree-max-work`) or `memory` (`--tree-max-memory`); `null` when
+    /// exact. The same on any machine.
+    pub stopped_by: Option<TedStop>,
     pub millis: u64,
     pub label: &'static str,
     pub edit_script: TreeScript,
@@ -155,6 +159,7 @@ impl TreeMapping {
             lower_bound: r.lower,
             upper_bound: r.upper,
             work: r.work,
+            stopped_by: if r.exact() { None } else { r.stopped_by },
             millis: self.millis,
             label: LABEL,
             edit_script: s,
@@ -172,8 +177,12 @@ pub fn summary(t: &TreeReport) -> String {
     let how = if t.exact {
         "exact".to_string()
     } else {
+        let why = match t.stopped_by {
+            Some(TedStop::Memory) => "the memory budget would be passed (raise --tree-max-memory)",
+            _ => "the work budget ran out (raise --tree-max-work)",
+        };
         format!(
-            "not exact: in [{}, {}], the work budget ran out (raise --tree-max-work)",
+            "not exact: in [{}, {}], {why}",
             t.lower_bound, t.upper_bound
         )
     };
