@@ -36,13 +36,13 @@ pub enum FsmError {
 }
 
 /// The plan's steps in nominal execution order: the BT walked from a world
-/// where nothing holds ([`walked_steps`]), so that every step stays in the
+/// where nothing holds (`walked_steps`), so that every step stays in the
 /// chain for the SELECTOR to resume at. With initial facts (`init`,
 /// `--init`, a PDDL problem's `:init`) that chain must also run from them
 /// (each step's preconditions holding when it comes, or its effects
 /// holding already, and the goal at the end); when it does not — a domain
 /// where a fact has many achievers, such as a robot in one of many rooms —
-/// the chain is what the BT does when ticked from them ([`ticked_steps`]).
+/// the chain is what the BT does when ticked from them (`ticked_steps`).
 pub fn steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
     let walked = walked_steps(d, p);
     if d.goal.init.is_empty() || runs_from_init(d, &walked) {
