@@ -157,6 +157,22 @@ proptest! {
 /// mutation test starts from it too).
 const PARALLEL: &str = include_str!("../../../tests/fixtures/valid/parallel-mutation-seed.scxml");
 
+/// `t` with the bytes between `a` and `b` (either order, moved back to
+/// character boundaries) replaced by `ins`: a cut and splice of a seed.
+fn splice(t: &str, a: usize, b: usize, ins: &str) -> String {
+    let (mut a, mut b) = (a.min(t.len()), b.min(t.len()));
+    if a > b {
+        std::mem::swap(&mut a, &mut b);
+    }
+    while !t.is_char_boundary(a) {
+        a -= 1;
+    }
+    while !t.is_char_boundary(b) {
+        b -= 1;
+    }
+    format!("{}{ins}{}", &t[..a], &t[b..])
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig { cases: 300, ..Default::default() })]
 
@@ -188,14 +204,7 @@ proptest::proptest! {
             include_str!("../../../tests/fixtures/corpus/yasmin/yasmin_factory/test/test_nested_sm.xml"),
             include_str!("../../../tests/fixtures/corpus/yasmin/yasmin_demos/state_machines/demo_orthogonal.xml"),
         ];
-        let t = seeds[seed];
-        let (mut a, mut b) = (a.min(t.len()), b.min(t.len()));
-        if a > b {
-            std::mem::swap(&mut a, &mut b);
-        }
-        while !t.is_char_boundary(a) { a -= 1; }
-        while !t.is_char_boundary(b) { b -= 1; }
-        let text = format!("{}{ins}{}", &t[..a], &t[b..]);
+        let text = splice(seeds[seed], a, b, &ins);
         crate::yasmin(text.as_bytes());
     }
 }
@@ -212,14 +221,7 @@ proptest::proptest! {
             include_str!("../../../tests/fixtures/flexbe/turtlesim/example_3_sm.py"),
             include_str!("../../../tests/fixtures/flexbe/engine/complex_behavior_test_sm.py"),
         ];
-        let t = seeds[seed];
-        let (mut a, mut b) = (a.min(t.len()), b.min(t.len()));
-        if a > b {
-            std::mem::swap(&mut a, &mut b);
-        }
-        while !t.is_char_boundary(a) { a -= 1; }
-        while !t.is_char_boundary(b) { b -= 1; }
-        let text = format!("{}{ins}{}", &t[..a], &t[b..]);
+        let text = splice(seeds[seed], a, b, &ins);
         crate::flexbe(text.as_bytes());
     }
 }
@@ -235,14 +237,7 @@ proptest::proptest! {
             include_str!("../../../tests/fixtures/py_trees_dot/every_node_type.dot"),
             include_str!("../../../tests/fixtures/py_trees_dot/blackboard.dot"),
         ];
-        let t = seeds[seed];
-        let (mut a, mut b) = (a.min(t.len()), b.min(t.len()));
-        if a > b {
-            std::mem::swap(&mut a, &mut b);
-        }
-        while !t.is_char_boundary(a) { a -= 1; }
-        while !t.is_char_boundary(b) { b -= 1; }
-        let text = format!("{}{ins}{}", &t[..a], &t[b..]);
+        let text = splice(seeds[seed], a, b, &ins);
         crate::py_trees_dot(text.as_bytes());
     }
 }
