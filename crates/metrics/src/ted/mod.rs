@@ -398,7 +398,12 @@ fn band_search(f: &OrderedTree, g: &OrderedTree, opts: &TedOptions, mut pr: Prog
     loop {
         u = band_width(u, pr.best.0, last, full_cells, full);
         let bytes = 4 * Banded::memory_cells(f, g, u);
-        if u == full || Banded::cells_at_most(f, g, u) >= full_cells || bytes > opts.max_bytes {
+        let most = Banded::cells_at_most(f, g, u);
+        // A band that may not fit the work left is not started (it would
+        // spend the budget and end as an interval anyway): the unbanded run
+        // knows its cost and stops at once when that does not fit either.
+        let left = u128::from(opts.max_work.saturating_sub(pr.work));
+        if u == full || most >= full_cells || most > left || bytes > opts.max_bytes {
             return unbanded(f, g, opts, pr, done_band);
         }
         let mut band = Banded::new(f, g, u);
