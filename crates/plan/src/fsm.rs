@@ -52,15 +52,20 @@ pub fn steps<'d>(d: &'d Domain, p: &Planned) -> Vec<Step<'d>> {
     if ticked.is_empty() { walked } else { ticked }
 }
 
+/// The facts after `step` completes: its deletes removed, then its adds.
+fn complete(step: &Step<'_>, facts: &mut std::collections::BTreeSet<Fact>) {
+    for f in step.deletes() {
+        facts.remove(&f);
+    }
+    facts.extend(step.adds());
+}
+
 /// Whether `chain` runs from the initial facts to the goal (see [`steps`]).
 fn runs_from_init(d: &Domain, chain: &[Step<'_>]) -> bool {
     let mut facts: std::collections::BTreeSet<Fact> = d.goal.init.iter().cloned().collect();
     for s in chain {
         if s.pre().iter().all(|f| facts.contains(f)) {
-            for f in s.deletes() {
-                facts.remove(&f);
-            }
-            facts.extend(s.adds());
+            complete(s, &mut facts);
         } else if !s.adds().iter().all(|f| facts.contains(f)) {
             return false;
         }
@@ -153,10 +158,7 @@ fn tick<'d>(
             if out.len() >= MAX_TICKED_STEPS || !step.pre().iter().all(|f| facts.contains(f)) {
                 return false;
             }
-            for f in step.deletes() {
-                facts.remove(&f);
-            }
-            facts.extend(step.adds());
+            complete(&step, facts);
             out.push(step);
             true
         }

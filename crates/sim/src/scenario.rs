@@ -20,6 +20,7 @@ mod disturbance;
 pub mod expect;
 pub mod mc;
 mod policies;
+pub(crate) use policies::numbered;
 mod world;
 
 type Val<'i> = Spanned<DeValue<'i>>;

@@ -233,14 +233,7 @@ impl Reader {
             );
             return;
         }
-        let mut k = *count;
-        let renamed = loop {
-            let candidate = format!("{name}#{k}");
-            if !seen.contains_key(&candidate) {
-                break candidate;
-            }
-            k += 1;
-        };
+        let renamed = numbered(&name, |n| seen.contains_key(n));
         seen.insert(renamed.clone(), 1);
         self.diags.push(
             Diagnostic::warning(format!(
@@ -484,6 +477,15 @@ impl Reader {
             );
         }
     }
+}
+
+/// `NAME#2` (`#3`, ...): the first such name not `taken`, for a policy
+/// named as an earlier one (planar and symbolic scenarios alike).
+pub(crate) fn numbered(name: &str, taken: impl Fn(&str) -> bool) -> String {
+    (2..)
+        .map(|k| format!("{name}#{k}"))
+        .find(|n| !taken(n))
+        .expect("some number is free")
 }
 
 /// The numbers of a scenario's runs.

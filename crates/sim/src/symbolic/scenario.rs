@@ -534,7 +534,7 @@ fn distinct_name(
         );
         return None;
     }
-    (2..).map(|k| format!("{name}#{k}")).find(|n| !taken(n))
+    Some(crate::scenario::numbered(name, taken))
 }
 
 /// Why a policy cannot run in the domain's world (a leaf or guard bound to
